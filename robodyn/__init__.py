@@ -1,0 +1,59 @@
+"""robodyn: rigid-body robot dynamics from any URDF, through Pinocchio, verified.
+
+Load a robot with :func:`load` and ask for its equations of motion
+``tau = M(q) a + C(q, v) v + G(q)``::
+
+    import robodyn
+    robot = robodyn.load("rp_arm")          # or "panda", a URDF path, URDF text
+    tau = robot.inverse_dynamics(q, v, a)
+    M = robot.mass_matrix(q)
+
+Names that need Pinocchio are imported on first use, so that the independent reference
+(:mod:`robodyn.reference`) can run in a process without Pinocchio.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from robodyn.exceptions import FrameError, InputError, RobodynError, SingularMassMatrixError, UnknownRobotError, URDFError
+from robodyn.models import RPArmParameters, rp_arm_urdf
+from robodyn.sources import robot_names
+
+__version__ = "0.1.0"
+
+# Public name -> module that defines it (imported lazily: these modules import Pinocchio).
+_LAZY = {
+    "load": "robodyn.loading",
+    "Robot": "robodyn.robot",
+    "JointInfo": "robodyn.robot",
+}
+
+__all__ = [
+    "FrameError",
+    "InputError",
+    "JointInfo",
+    "RPArmParameters",
+    "RobodynError",
+    "Robot",
+    "SingularMassMatrixError",
+    "URDFError",
+    "UnknownRobotError",
+    "__version__",
+    "load",
+    "robot_names",
+    "rp_arm_urdf",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'robodyn' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,0 +1,140 @@
+"""``robodyn.load``: the one door from a URDF (path, text, zoo or generated name) to a Robot.
+
+The URDF is validated first (:mod:`robodyn.validation`); Pinocchio then builds the model
+from a normalised copy of it:
+
+- continuous joints become revolute joints with unbounded limits, so that ``q`` holds
+  their angle (one number a degree of freedom) instead of Pinocchio's (cos, sin) pair;
+- joint axes are written with unit length (both Pinocchio and the reference read the same
+  axis);
+- ``<mimic>`` is honoured (Pinocchio's ``mimic=True``); a mimic tag on a fixed joint,
+  which cannot move, is dropped (the validator warns about it).
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from robodyn.exceptions import URDFError
+from robodyn.robot import MimicExpansion, Robot
+from robodyn.sources import resolve_source
+from robodyn.validation import URDFSpec, parse_urdf
+
+#: Limit written for continuous joints in the copy Pinocchio reads, in [rad].
+_UNBOUNDED = "1e10"
+
+
+def pinocchio_xml(spec: URDFSpec) -> str:
+    """The URDF text Pinocchio builds the model from (see the module docstring)."""
+    root = copy.deepcopy(spec.xml)
+    for node in root.findall("joint"):
+        joint = spec.joints[node.get("name")]
+        if joint.type == "fixed":
+            for mimic in node.findall("mimic"):
+                node.remove(mimic)
+            continue
+        axis = node.find("axis")
+        if axis is None:
+            axis = ET.SubElement(node, "axis")
+        axis.set("xyz", " ".join(repr(float(value)) for value in joint.axis))
+        if joint.type == "continuous":
+            node.set("type", "revolute")
+            limit = node.find("limit")
+            if limit is None:
+                limit = ET.SubElement(node, "limit", effort="0", velocity="0")
+            limit.set("lower", "-" + _UNBOUNDED)
+            limit.set("upper", _UNBOUNDED)
+    return ET.tostring(root, encoding="unicode")
+
+
+def load(
+    source: str | os.PathLike,
+    *,
+    floating_base: bool | None = None,
+    gravity: Sequence[float] | None = None,
+    check_inertia: bool = True,
+) -> Robot:
+    """Load a robot.
+
+    Args:
+        source: A URDF file path, URDF XML text, a zoo robot name (``"panda"``,
+            ``"ur5"``, ...) or a generated robot's name (``"rp_arm"``); ``robodyn list``
+            prints the names.
+        floating_base: Give the root link a free-flyer joint. ``None``: true for zoo
+            robots that walk, swim or fly, false otherwise.
+        gravity: Gravity acceleration in the world frame, in [m/s²]; default
+            ``(0, 0, -9.81)``.
+        check_inertia: Refuse physically impossible inertias on moving links (set false
+            to load published models that have them).
+
+    Returns:
+        The robot.
+
+    Raises:
+        UnknownRobotError: If the name is not a file or known robot.
+        URDFError: If the URDF cannot be read or describes an impossible robot.
+        InputError: If ``gravity`` is not 3 finite numbers.
+    """
+    from robodyn.inputs import as_state
+
+    resolved = resolve_source(source)
+    floating = resolved.floating_base if floating_base is None else bool(floating_base)
+    spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia)
+    xml = pinocchio_xml(spec)
+    try:
+        if floating:
+            model = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint", mimic=True)
+        else:
+            model = pin.buildModelFromXML(xml, mimic=True)
+    except (RuntimeError, ValueError) as error:
+        raise URDFError(resolved.label, f"Pinocchio refused the model ({str(error).strip()})") from None
+    mimic = _mimic_expansion(model, spec, xml, floating) if model.nq != _model_without_mimic_nq(spec, floating) else None
+    if gravity is not None:
+        model.gravity.linear = as_state(gravity, "gravity", 3)
+        if mimic is not None:
+            mimic.model.gravity.linear = model.gravity.linear
+    if model.nv == 0:
+        raise URDFError(resolved.label, "the robot has no moving joint")
+    name = spec.name if resolved.name == "robot" else resolved.name
+    return Robot(
+        model,
+        name=name,
+        urdf=resolved.text,
+        spec=spec,
+        floating_base=floating,
+        source_path=resolved.path,
+        package_dirs=resolved.package_dirs,
+        mimic=mimic,
+    )
+
+
+def _model_without_mimic_nq(spec: URDFSpec, floating: bool) -> int:
+    return (7 if floating else 0) + sum(joint.type != "fixed" for joint in spec.joints.values())
+
+
+def _mimic_expansion(model: pin.Model, spec: URDFSpec, xml: str, floating: bool) -> MimicExpansion:
+    """Build the expanded model (every joint free) and the linear map to it."""
+    full = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint") if floating else pin.buildModelFromXML(xml)
+    selection = np.zeros((full.nv, model.nv))
+    offset = np.zeros(full.nq)
+    for joint_id in range(1, full.njoints):
+        name = full.names[joint_id]
+        full_joint = full.joints[joint_id]
+        urdf_joint = spec.joints.get(name)
+        source, multiplier = name, 1.0
+        if urdf_joint is not None and urdf_joint.mimic is not None:
+            source, multiplier = urdf_joint.mimic.joint, urdf_joint.mimic.multiplier
+            offset[full_joint.idx_q] = urdf_joint.mimic.offset
+        source_joint = model.joints[model.getJointId(source)]
+        for k in range(full_joint.nv):
+            selection[full_joint.idx_v + k, source_joint.idx_v + k] = multiplier
+    return MimicExpansion(full, selection, offset)
+
+
+__all__ = ["load", "pinocchio_xml"]

@@ -1,0 +1,15 @@
+"""Robots robodyn generates itself, by name.
+
+``GENERATED`` maps each generated robot's name to a function returning its URDF text with
+default parameters; :func:`robodyn.load` accepts these names.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from robodyn.models.rp_arm import RPArmParameters, rp_arm_urdf
+
+GENERATED: dict[str, Callable[[], str]] = {"rp_arm": rp_arm_urdf}
+
+__all__ = ["GENERATED", "RPArmParameters", "rp_arm_urdf"]

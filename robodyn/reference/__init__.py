@@ -1,0 +1,1 @@
+"""The independent Lagrangian reference: robot dynamics from a URDF without Pinocchio."""

@@ -1,0 +1,165 @@
+"""Human- and machine-readable reports of a robot: its description and its dynamics terms.
+
+Used by the CLI (``robodyn info``, ``robodyn equations``); every number printed carries its
+unit or says what it is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robodyn.robot import Robot
+
+
+@dataclass(frozen=True)
+class DynamicsTerms:
+    """The terms of ``tau = M(q) a + C(q, v) v + G(q)`` at one state (SI units)."""
+
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    M: np.ndarray
+    C: np.ndarray
+    G: np.ndarray
+
+
+def equations_at(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> DynamicsTerms:
+    """Evaluate ``tau``, ``M``, ``C`` and ``G`` at one state (1-D arrays)."""
+    return DynamicsTerms(
+        np.asarray(q, float), np.asarray(v, float), np.asarray(a, float),
+        robot.inverse_dynamics(q, v, a), robot.mass_matrix(q), robot.coriolis_matrix(q, v), robot.gravity(q),
+    )  # fmt: skip
+
+
+def _dof_types(robot: Robot) -> list[str]:
+    """Joint type of each velocity coordinate (a floating base gives 3 linear, 3 angular)."""
+    types = []
+    for joint in robot.joints:
+        types += ["prismatic"] * 3 + ["revolute"] * 3 if joint.type == "floating" else [joint.type]
+    return types
+
+
+def _is_linear(joint_type: str) -> bool:
+    return joint_type == "prismatic"
+
+
+def dof_units(robot: Robot) -> dict[str, list[str]]:
+    """Units of each entry of ``q``, ``v``, ``a`` and ``tau``, by velocity coordinate."""
+    linear = [_is_linear(t) for t in _dof_types(robot)]
+    return {
+        "v": ["m/s" if lin else "rad/s" for lin in linear],
+        "a": ["m/s^2" if lin else "rad/s^2" for lin in linear],
+        "tau": ["N" if lin else "N m" for lin in linear],
+    }
+
+
+def info_dict(robot: Robot) -> dict:
+    """A JSON-ready description of a robot: joints, limits, masses."""
+
+    def finite(value: float) -> float | None:
+        return float(value) if np.isfinite(value) else None
+
+    return {
+        "name": robot.name,
+        "nq": robot.nq,
+        "nv": robot.nv,
+        "floating_base": robot.floating_base,
+        "gravity_m_s2": robot.gravity_vector.tolist(),
+        "joints": [
+            {
+                "name": j.name,
+                "type": j.type,
+                "lower": finite(j.lower),
+                "upper": finite(j.upper),
+                "effort": finite(j.effort),
+                "velocity": finite(j.velocity),
+            }
+            for j in robot.joints
+        ],
+        "link_masses_kg": robot.link_masses,
+        "total_mass_kg": robot.total_mass,
+    }
+
+
+def info_text(robot: Robot) -> str:
+    """A readable description of a robot: joints with types and limits, link masses."""
+    lines = [
+        f"robot {robot.name}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
+        f"{'floating' if robot.floating_base else 'fixed'} base, gravity {_vector(robot.gravity_vector, 4)} m/s²",
+        "",
+        f"{'joint':30s} {'type':11s} {'lower':>10s} {'upper':>10s} {'effort':>10s} {'velocity':>10s}",
+    ]
+    for joint in robot.joints:
+        position_unit, effort_unit, speed_unit = ("m", "N", "m/s") if joint.type == "prismatic" else ("rad", "N m", "rad/s")
+        if joint.type == "floating":
+            lines.append(f"{joint.name:30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
+            continue
+        lines.append(
+            f"{joint.name:30s} {joint.type:11s} {_limit(joint.lower, position_unit):>10s} {_limit(joint.upper, position_unit):>10s} "
+            f"{_limit(joint.effort, effort_unit):>10s} {_limit(joint.velocity, speed_unit):>10s}"
+        )
+    lines += ["", f"{'link':30s} {'mass':>12s}"]
+    lines += [f"{name:30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
+    lines.append(f"{'total':30s} {robot.total_mass:>9.4g} kg")
+    return "\n".join(lines)
+
+
+def _limit(value: float, unit: str) -> str:
+    return "-" if not np.isfinite(value) else f"{value:.4g} {unit}"
+
+
+def _vector(values: np.ndarray, precision: int) -> str:
+    return "[" + ", ".join(f"{value:.{precision}g}" for value in values) + "]"
+
+
+def _matrix(matrix: np.ndarray, precision: int) -> list[str]:
+    width = precision + 7
+    return ["  [" + " ".join(f"{value:{width}.{precision}g}" for value in row) + " ]" for row in matrix]
+
+
+def equations_dict(robot: Robot, terms: DynamicsTerms) -> dict:
+    """A JSON-ready record of the dynamics terms (keys ``tau``, ``M``, ``C``, ``G``, ...)."""
+    return {
+        "robot": robot.name,
+        "joint_names": robot.joint_names,
+        "equation": "tau = M(q) a + C(q, v) v + G(q)",
+        "units": {**dof_units(robot), "M": "SI (kg m^2, kg m or kg by joint pair)", "C": "SI (M per second)"},
+        "q": terms.q.tolist(),
+        "v": terms.v.tolist(),
+        "a": terms.a.tolist(),
+        "tau": terms.tau.tolist(),
+        "M": terms.M.tolist(),
+        "C": terms.C.tolist(),
+        "G": terms.G.tolist(),
+    }
+
+
+def equations_text(robot: Robot, terms: DynamicsTerms, *, precision: int = 6) -> str:
+    """The dynamics terms as readable text, one block a term, with units."""
+    units = dof_units(robot)
+    lines = [f"{robot.name}: tau = M(q) a + C(q, v) v + G(q)", ""]
+    header = f"{'joint':26s} {'q':>14s} {'v':>16s} {'a':>18s} {'tau':>16s} {'G':>16s}"
+    lines.append(header)
+    q_index = robot.nq - robot.nv  # a floating base has one more q than v entries
+    for index, name in enumerate(robot.joint_names if not robot.floating_base else _dof_labels(robot)):
+        q_value = terms.q[index + q_index] if index >= (6 if robot.floating_base else 0) else None
+        q_unit = "m" if units["v"][index] == "m/s" else "rad"
+        q_text = f"{q_value:.{precision}g} {q_unit}" if q_value is not None else "(base)"
+        lines.append(
+            f"{name:26s} {q_text:>14s} {terms.v[index]:>{10}.{precision}g} {units['v'][index]:5s} "
+            f"{terms.a[index]:>{10}.{precision}g} {units['a'][index]:7s} {terms.tau[index]:>{11}.{precision}g} {units['tau'][index]:4s} "
+            f"{terms.G[index]:>{11}.{precision}g} {units['tau'][index]:4s}"
+        )
+    lines += ["", "M(q), mass matrix (SI: kg m² between revolute joints, kg between prismatic, kg m mixed):"]
+    lines += _matrix(terms.M, precision)
+    lines += ["", "C(q, v), Coriolis matrix (SI: the units of M per second; C v is in the units of tau):"]
+    lines += _matrix(terms.C, precision)
+    return "\n".join(lines)
+
+
+def _dof_labels(robot: Robot) -> list[str]:
+    base = [f"base {axis}" for axis in ("vx", "vy", "vz", "wx", "wy", "wz")]
+    return base + robot.joint_names[1:]

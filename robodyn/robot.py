@@ -1,0 +1,454 @@
+"""The :class:`Robot`: a loaded model and its dynamics, computed by Pinocchio.
+
+Conventions, stated once:
+    - ``q`` has ``nq`` entries and ``v``, ``a``, ``tau`` have ``nv``, in the order of
+      :attr:`Robot.joint_names`. For a fixed-base robot ``nq == nv``: a continuous joint's
+      entry is its angle in [rad], not Pinocchio's (cos, sin) pair. A floating base adds
+      the base pose first (position in [m], unit quaternion x, y, z, w; ``nq = nv + 1``)
+      and the base twist in the base frame (linear in [m/s], angular in [rad/s]).
+    - Joint positions are in [rad] (revolute, continuous) or [m] (prismatic), torques
+      in [N m] or forces in [N].
+    - Every method takes one state as 1-D arrays, or a trajectory as 2-D arrays with one
+      state a row, and returns one result or a stack of results with a leading axis of
+      length N accordingly.
+    - The equations of motion are ``tau = M(q) a + C(q, v) v + G(q)``; ``C`` is
+      Pinocchio's Coriolis matrix, which satisfies ``dM/dt = C + C^T``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from robodyn.exceptions import FrameError, SingularMassMatrixError
+from robodyn.inputs import as_state, as_states
+from robodyn.validation import URDFSpec
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """One degree of freedom of a robot.
+
+    Attributes:
+        name: Joint name in the URDF.
+        type: ``"revolute"``, ``"continuous"``, ``"prismatic"`` or ``"floating"``.
+        lower, upper: Position limits in [rad] or [m] (±inf when unlimited).
+        effort: Effort limit in [N m] or [N] (inf when not given).
+        velocity: Velocity limit in [rad/s] or [m/s] (inf when not given).
+    """
+
+    name: str
+    type: str
+    lower: float
+    upper: float
+    effort: float
+    velocity: float
+
+
+@dataclass
+class MimicExpansion:
+    """The map from a robot with mimic joints to the same robot with every joint free.
+
+    ``q_full = selection @ q + offset`` and ``v_full = selection @ v`` (the mimic relation
+    ``q_mimic = multiplier * q_source + offset`` is linear), so ``M = Sᵀ M_full S`` and
+    ``C = Sᵀ C_full S``.
+
+    Attributes:
+        model: The Pinocchio model with mimic joints as independent joints.
+        selection: Shape (nv_full, nv).
+        offset: Shape (nq_full,).
+    """
+
+    model: pin.Model
+    selection: np.ndarray
+    offset: np.ndarray
+
+    def __post_init__(self) -> None:
+        self.data = self.model.createData()
+
+    def q(self, q: np.ndarray) -> np.ndarray:
+        """Configuration of the expanded model."""
+        return self.selection @ q + self.offset
+
+
+class Robot:
+    """A rigid-body robot and its dynamics (RNEA, CRBA, ABA through Pinocchio).
+
+    Build one with :func:`robodyn.load`. The Pinocchio model is available as
+    :attr:`model` for anything robodyn does not wrap.
+
+    Attributes:
+        name: Robot name.
+        urdf: The URDF text it was built from (generated robots included).
+        model: The Pinocchio model.
+        spec: The validated URDF (links, joints, inertials).
+        floating_base: Whether the root is a free-flyer joint.
+        source_path: The URDF file, if it came from one.
+        package_dirs: Folders under which ``package://`` mesh paths resolve.
+        mimic: For robots with mimic joints, the model with every joint independent and the
+            map to it (Pinocchio supports mimic joints in RNEA and CRBA but not everywhere).
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        *,
+        name: str,
+        urdf: str,
+        spec: URDFSpec,
+        floating_base: bool = False,
+        source_path: Path | None = None,
+        package_dirs: tuple[Path, ...] = (),
+        mimic: MimicExpansion | None = None,
+    ):
+        self.model = model
+        self.data = model.createData()
+        self.name = name
+        self.urdf = urdf
+        self.spec = spec
+        self.floating_base = floating_base
+        self.source_path = source_path
+        self.package_dirs = package_dirs
+        self.nq: int = model.nq
+        self.nv: int = model.nv
+        self.joints: list[JointInfo] = self._joint_infos()
+        self.joint_names: list[str] = [joint.name for joint in self.joints]
+        self._frame_ids = {frame.name: index for index, frame in enumerate(model.frames)}
+        self._pool: pin.ModelPool | None = None
+        self.mimic = mimic
+
+    def __repr__(self) -> str:
+        return f"<Robot {self.name!r}: nq={self.nq}, nv={self.nv}, joints={self.joint_names}>"
+
+    def _joint_infos(self) -> list[JointInfo]:
+        infos = []
+        for joint_id in range(1, self.model.njoints):
+            joint = self.model.joints[joint_id]
+            if joint.nv == 0:  # mimic joints follow another joint
+                continue
+            name = self.model.names[joint_id]
+            if name in self.spec.joints:
+                urdf_joint = self.spec.joints[name]
+                infos.append(
+                    JointInfo(name, urdf_joint.type, urdf_joint.lower, urdf_joint.upper, urdf_joint.effort, urdf_joint.velocity)
+                )
+            else:
+                infos.append(JointInfo(name, "floating", -np.inf, np.inf, np.inf, np.inf))
+        return infos
+
+    # ----------------------------------------------------------------------------------
+    # Properties of the model
+    # ----------------------------------------------------------------------------------
+    @property
+    def gravity_vector(self) -> np.ndarray:
+        """Gravity acceleration in the world frame, shape (3,), in [m/s²]."""
+        return self.model.gravity.linear.copy()
+
+    @property
+    def frame_names(self) -> list[str]:
+        """Names of every frame: links, joints and fixed frames of the URDF."""
+        return list(self._frame_ids)
+
+    @cached_property
+    def link_masses(self) -> dict[str, float]:
+        """Mass of every URDF link that has one, in [kg]."""
+        return {name: inertial.mass for name, inertial in self.spec.links.items() if inertial is not None}
+
+    @cached_property
+    def massless_joints(self) -> list[str]:
+        """Joints whose whole subtree has no mass: they make ``M(q)`` singular."""
+        subtree_mass = [self.model.inertias[i].mass for i in range(self.model.njoints)]
+        for joint_id in range(self.model.njoints - 1, 0, -1):
+            subtree_mass[self.model.parents[joint_id]] += subtree_mass[joint_id]
+        return [self.model.names[i] for i in range(1, self.model.njoints) if subtree_mass[i] <= 0 and self.model.joints[i].nv > 0]
+
+    @property
+    def total_mass(self) -> float:
+        """Total mass of the robot in [kg]."""
+        return float(sum(self.link_masses.values()))
+
+    @property
+    def lower_limits(self) -> np.ndarray:
+        """Lower position limits per degree of freedom, shape (nv,), in [rad] or [m].
+
+        The six base coordinates of a floating base are unlimited (-inf).
+        """
+        return np.array([joint.lower for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m]."""
+        return np.array([joint.upper for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
+
+    def neutral_configuration(self) -> np.ndarray:
+        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
+        return pin.neutral(self.model)
+
+    def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
+        """Configurations drawn uniformly within the joint limits.
+
+        Unlimited joints draw from [-π, π]; a floating base draws its position from
+        [-1, 1] m and a uniform random orientation.
+
+        Args:
+            rng: Random generator (for reproducible draws).
+            count: Number of configurations; ``None`` for a single one.
+
+        Returns:
+            Shape (nq,) or (count, nq).
+        """
+        rows = 1 if count is None else count
+        lower = np.where(np.isfinite(self.lower_limits), self.lower_limits, -np.pi)
+        upper = np.where(np.isfinite(self.upper_limits), self.upper_limits, np.pi)
+        if self.floating_base:
+            lower, upper = lower[6:], upper[6:]
+        joints = rng.uniform(lower, upper, size=(rows, lower.size))
+        if self.floating_base:
+            quaternion = rng.normal(size=(rows, 4))
+            quaternion /= np.linalg.norm(quaternion, axis=1, keepdims=True)
+            joints = np.hstack([rng.uniform(-1, 1, size=(rows, 3)), quaternion, joints])
+        return joints[0] if count is None else joints
+
+    # ----------------------------------------------------------------------------------
+    # Dynamics
+    # ----------------------------------------------------------------------------------
+    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+            a: Acceleration, shape (nv,) or (N, nv).
+
+        Returns:
+            Torques in [N m] / [N], shape (nv,) or (N, nv).
+        """
+        (q, v, a), batch = as_states({"q": (q, self.nq), "v": (v, self.nv), "a": (a, self.nv)})
+        if batch:
+            return self._in_parallel(pin.rneaInParallel, q, v, a)
+        return pin.rnea(self.model, self.data, q, v, a).copy()
+
+    def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+            tau: Torques in [N m] / [N], shape (nv,) or (N, nv).
+
+        Returns:
+            Accelerations, shape (nv,) or (N, nv).
+        """
+        (q, v, tau), batch = as_states({"q": (q, self.nq), "v": (v, self.nv), "tau": (tau, self.nv)})
+        if self.mimic is not None:  # Pinocchio's ABA does not support mimic joints
+            if batch:
+                result = (
+                    np.stack([self._solve_dynamics(*row) for row in zip(q, v, tau, strict=True)])
+                    if len(q)
+                    else np.zeros((0, self.nv))
+                )
+            else:
+                result = self._solve_dynamics(q, v, tau)
+        elif batch:
+            result = self._in_parallel(pin.abaInParallel, q, v, tau)
+        else:
+            result = pin.aba(self.model, self.data, q, v, tau).copy()
+        if not np.isfinite(result).all():  # finite inputs: only a singular M gives this
+            raise SingularMassMatrixError(self.name, self.massless_joints)
+        return result
+
+    def _solve_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """``M⁻¹ (tau − C v − G)`` by a Cholesky solve (for models ABA cannot take)."""
+        mass = self._mass_matrix(q)
+        rhs = tau - pin.nonLinearEffects(self.model, self.data, q, v)
+        try:
+            return np.linalg.solve(mass, rhs)
+        except np.linalg.LinAlgError:
+            raise SingularMassMatrixError(self.name, self.massless_joints) from None
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """Joint-space inertia matrix ``M(q)`` (CRBA), symmetric.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+
+        Returns:
+            Shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
+        """
+        return self._per_state(self._mass_matrix, as_state(q, "q", self.nq))
+
+    def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        upper = pin.crba(self.model, self.data, q)
+        return np.triu(upper) + np.triu(upper, 1).T
+
+    def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Coriolis and centrifugal matrix ``C(q, v)``, with ``dM/dt = C + Cᵀ``.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+
+        Returns:
+            Shape (nv, nv) or (N, nv, nv).
+        """
+        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        if batch:
+            return (
+                np.stack([self._coriolis(qi, vi) for qi, vi in zip(q, v, strict=True)])
+                if len(q)
+                else np.zeros((0, self.nv, self.nv))
+            )
+        return self._coriolis(q, v)
+
+    def _coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        if self.mimic is not None:  # computeCoriolisMatrix mishandles mimic joints
+            expansion = self.mimic
+            full = pin.computeCoriolisMatrix(expansion.model, expansion.data, expansion.q(q), expansion.selection @ v)
+            return expansion.selection.T @ full @ expansion.selection
+        return pin.computeCoriolisMatrix(self.model, self.data, q, v).copy()
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        """Generalised gravity ``G(q)``: the torques that hold the robot still.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+
+        Returns:
+            Shape (nv,) or (N, nv), in [N m] / [N].
+        """
+        q = as_state(q, "q", self.nq)
+        if q.ndim == 2:
+            zeros = np.zeros((q.shape[0], self.nv))
+            return self._in_parallel(pin.rneaInParallel, q, zeros, zeros)
+        return pin.computeGeneralizedGravity(self.model, self.data, q).copy()
+
+    def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``C(q, v) v + G(q)``: the torques at zero acceleration.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+
+        Returns:
+            Shape (nv,) or (N, nv), in [N m] / [N].
+        """
+        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        if batch:
+            return self._in_parallel(pin.rneaInParallel, q, v, np.zeros_like(v))
+        return pin.nonLinearEffects(self.model, self.data, q, v).copy()
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
+        """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch."""
+        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        # From the mass matrix rather than computeKineticEnergy, which refuses mimic joints.
+        if batch:
+            return np.array([0.5 * vi @ self._mass_matrix(qi) @ vi for qi, vi in zip(q, v, strict=True)])
+        return float(0.5 * v @ self._mass_matrix(q) @ v)
+
+    def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
+        """Gravitational potential energy ``−Σ m_i gᵀ p_i`` in [J]: a float, or shape (N,).
+
+        Zero when every centre of mass is at height zero (for the default gravity).
+        """
+        q = as_state(q, "q", self.nq)
+        # computePotentialEnergy refuses mimic joints: use the expanded model for those.
+        model, data, expand = (
+            (self.model, self.data, None) if self.mimic is None else (self.mimic.model, self.mimic.data, self.mimic.q)
+        )
+        if q.ndim == 2:
+            return np.array([pin.computePotentialEnergy(model, data, qi if expand is None else expand(qi)) for qi in q])
+        return float(pin.computePotentialEnergy(model, data, q if expand is None else expand(q)))
+
+    # ----------------------------------------------------------------------------------
+    # Kinematics
+    # ----------------------------------------------------------------------------------
+    def frame_id(self, frame: str) -> int:
+        """Pinocchio index of a frame (link, joint or fixed frame) by name.
+
+        Raises:
+            FrameError: If the robot has no such frame.
+        """
+        try:
+            return self._frame_ids[frame]
+        except KeyError:
+            raise FrameError(frame, self.name) from None
+
+    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Position of a frame's origin in the world frame.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            frame: Link or joint name, e.g. ``"end_effector"``.
+
+        Returns:
+            Shape (3,) or (N, 3), in [m].
+        """
+        frame_id = self.frame_id(frame)
+        q = as_state(q, "q", self.nq)
+        return self._per_state(lambda qi: self._placement(qi, frame_id).translation.copy(), q)
+
+    def frame_rotation(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Orientation of a frame in the world frame: shape (3, 3) or (N, 3, 3)."""
+        frame_id = self.frame_id(frame)
+        q = as_state(q, "q", self.nq)
+        return self._per_state(lambda qi: self._placement(qi, frame_id).rotation.copy(), q)
+
+    def _placement(self, q: np.ndarray, frame_id: int) -> pin.SE3:
+        pin.framesForwardKinematics(self.model, self.data, q)
+        return self.data.oMf[frame_id]
+
+    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Jacobian of a frame: its velocity is ``J v`` (linear first, then angular).
+
+        Both parts are expressed in world-aligned axes at the frame's origin (Pinocchio's
+        ``LOCAL_WORLD_ALIGNED``): rows 0-2 give the origin's velocity in [m/s], rows 3-5
+        the angular velocity in [rad/s].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            frame: Link or joint name.
+
+        Returns:
+            Shape (6, nv) or (N, 6, nv).
+        """
+        frame_id = self.frame_id(frame)
+        q = as_state(q, "q", self.nq)
+        return self._per_state(
+            lambda qi: pin.computeFrameJacobian(self.model, self.data, qi, frame_id, pin.LOCAL_WORLD_ALIGNED).copy(), q
+        )
+
+    # ----------------------------------------------------------------------------------
+    # Helpers
+    # ----------------------------------------------------------------------------------
+    @cached_property
+    def _threads(self) -> int:
+        return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
+
+    def _model_pool(self) -> pin.ModelPool:
+        if self._pool is None:
+            self._pool = pin.ModelPool(self.model, self._threads)
+        return self._pool
+
+    def _in_parallel(self, algorithm, q: np.ndarray, v: np.ndarray, third: np.ndarray) -> np.ndarray:
+        """Run ``rneaInParallel`` or ``abaInParallel`` on stacks of states, shape (N, nv)."""
+        if q.shape[0] == 0:
+            return np.zeros((0, self.nv))
+        # Pinocchio wants one state a column: the transpose of a C-ordered stack, no copy.
+        columns = [np.ascontiguousarray(array).T for array in (q, v, third)]
+        result = algorithm(self._threads, self._model_pool(), *columns)
+        return np.asarray(result).reshape(self.nv, q.shape[0]).T.copy()
+
+    @staticmethod
+    def _per_state(function, q: np.ndarray) -> np.ndarray:
+        """Apply a one-state function to a 1-D state or to each row of a 2-D stack."""
+        if q.ndim == 1:
+            return function(q)
+        results = [function(row) for row in q]
+        if results:
+            return np.stack(results)
+        return np.zeros((0, *np.shape(function(np.zeros(q.shape[1])))))

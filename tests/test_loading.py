@@ -1,0 +1,103 @@
+"""robodyn.load: every kind of source, and clear errors for bad ones."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn import UnknownRobotError, URDFError
+from tests.conftest import ROOT
+
+RP_PATH = ROOT / "urdf" / "rp_arm.urdf"
+
+
+def test_every_source_kind_gives_the_same_robot():
+    robots = [robodyn.load("rp_arm"), robodyn.load(str(RP_PATH)), robodyn.load(RP_PATH), robodyn.load(RP_PATH.read_text())]
+    q = [0.4, 0.1]
+    for robot in robots:
+        assert robot.joint_names == ["joint1", "joint2"]
+        np.testing.assert_allclose(robot.mass_matrix(q), robots[0].mass_matrix(q))
+
+
+def test_generated_robot_keeps_its_urdf_text():
+    assert robodyn.load("rp_arm").urdf == robodyn.rp_arm_urdf()
+
+
+def test_zoo_robot_resolves_package_paths():
+    robot = robodyn.load("panda")
+    assert robot.nq == robot.nv == 8  # seven arm joints and one finger; the other finger mimics it
+    assert robot.package_dirs and all(Path(d).is_dir() for d in robot.package_dirs)
+    mesh = robot.spec.xml.find(".//mesh").get("filename")
+    assert mesh.startswith("package://")
+    relative = mesh.removeprefix("package://")
+    assert any((Path(d) / relative).is_file() for d in robot.package_dirs)
+
+
+def test_continuous_joints_take_one_angle_each():
+    robot = robodyn.load("double_pendulum_continuous")
+    assert [joint.type for joint in robot.joints] == ["continuous", "continuous"]
+    assert robot.nq == robot.nv == 2
+    # An angle and the same angle plus a full turn are the same configuration.
+    q = np.array([0.3, -1.1])
+    np.testing.assert_allclose(robot.mass_matrix(q), robot.mass_matrix(q + 2 * np.pi), atol=1e-12)
+
+
+def test_mimic_joint_follows_its_source():
+    robot = robodyn.load("panda")
+    assert "panda_finger_joint2" not in robot.joint_names
+    q = robot.neutral_configuration()
+    q[-1] = 0.03
+    left = robot.frame_position(q, "panda_leftfinger")
+    right = robot.frame_position(q, "panda_rightfinger")
+    assert np.linalg.norm(left - right) == pytest.approx(0.06, abs=1e-9)
+
+
+def test_joints_are_ordered_by_name_not_by_position_in_the_file():
+    text = RP_PATH.read_text()
+    joint2 = text[text.index('  <joint name="joint2"') : text.index("  </joint>", text.index('<joint name="joint2"')) + 11]
+    reordered = text.replace(joint2, "").replace("</robot>", joint2 + "</robot>")
+    robot = robodyn.load(reordered)
+    assert robot.joint_names == ["joint1", "joint2"]
+    np.testing.assert_allclose(robot.gravity([0.2, 0.1]), robodyn.load("rp_arm").gravity([0.2, 0.1]))
+
+
+def test_floating_base_from_the_zoo():
+    robot = robodyn.load("solo12")
+    assert robot.floating_base and robot.nq == robot.nv + 1 == 19
+    assert robodyn.load("solo12", floating_base=False).nq == 12
+
+
+def test_gravity_option():
+    robot = robodyn.load("rp_arm", gravity=[0, 0, -1.62])
+    assert robot.gravity([0.0, 0.0])[0] == pytest.approx(robodyn.load("rp_arm").gravity([0.0, 0.0])[0] * 1.62 / 9.81)
+
+
+def test_unknown_name_suggests_close_names():
+    with pytest.raises(UnknownRobotError, match="did you mean panda"):
+        robodyn.load("pandaa")
+
+
+def test_missing_file_is_a_urdf_error(tmp_path):
+    with pytest.raises(URDFError, match="no such file"):
+        robodyn.load(tmp_path / "missing.urdf")
+
+
+def test_malformed_xml_is_a_urdf_error():
+    with pytest.raises(URDFError, match="not well-formed XML"):
+        robodyn.load("<robot name='x'><link name='a'></robot>")
+
+
+def test_negative_mass_names_the_link():
+    text = robodyn.rp_arm_urdf().replace('<mass value="1.0"/>', '<mass value="-1.0"/>')
+    with pytest.raises(URDFError, match=re.escape('link "link2": mass -1.0 kg must not be negative')):
+        robodyn.load(text)
+
+
+def test_robot_names_list_generated_and_zoo():
+    names = robodyn.robot_names()
+    assert names[0] == "rp_arm"
+    assert {"panda", "ur5", "double_pendulum", "solo12"} <= set(names)
