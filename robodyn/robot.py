@@ -17,6 +17,7 @@ Conventions, stated once:
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from functools import cached_property
@@ -25,9 +26,15 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from robodyn.exceptions import FrameError, SingularMassMatrixError
-from robodyn.inputs import as_state, as_states
+from robodyn.exceptions import FrameError, InputError, RobodynError, SingularMassMatrixError
+from robodyn.inputs import as_states
 from robodyn.validation import URDFSpec
+
+
+#: Largest accepted deviation of a floating base's quaternion norm from 1.
+QUATERNION_TOLERANCE = 1e-6
+#: What Pinocchio raises for arguments it refuses (wrong size, type, unsupported joint).
+_PINOCCHIO_ERRORS = (TypeError, ValueError, RuntimeError)
 
 
 @dataclass(frozen=True)
@@ -216,7 +223,30 @@ class Robot:
 
     # ----------------------------------------------------------------------------------
     # Dynamics
+    #
+    # Each method first tries Pinocchio directly on 1-D float64 arrays: Pinocchio refuses
+    # wrong sizes and shapes (caught below), and a NaN or infinity anywhere in the inputs
+    # makes the result non-finite, which one dot product detects. Anything else goes
+    # through the full boundary check, which names the offending argument.
     # ----------------------------------------------------------------------------------
+    def _accept(self, result: np.ndarray, q: np.ndarray) -> bool:
+        """Whether a fast-path result can be returned as it is (a NaN or inf makes the
+        sum of squares non-finite; a huge finite result is re-checked exactly)."""
+        flat = result if result.ndim == 1 else result.ravel()
+        if not math.isfinite(flat.dot(flat)):
+            return False
+        return not self.floating_base or abs(q[3:7].dot(q[3:7]) - 1.0) < QUATERNION_TOLERANCE
+
+    def _checked(self, **named: np.ndarray) -> tuple[list[np.ndarray], bool]:
+        """Full boundary check of state arguments (sizes by name: q has nq, others nv)."""
+        arrays, batch = as_states({name: (value, self.nq if name == "q" else self.nv) for name, value in named.items()})
+        if self.floating_base:
+            norms = np.linalg.norm(arrays[0][..., 3:7], axis=-1)
+            if np.any(np.abs(norms - 1.0) >= QUATERNION_TOLERANCE):
+                worst = float(np.atleast_1d(norms)[np.argmax(np.abs(np.atleast_1d(norms) - 1.0))])
+                raise InputError("q[3:7]", "a unit quaternion (x, y, z, w) for the floating base", f"norm {worst:.9g}")
+        return arrays, batch
+
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA).
 
@@ -228,10 +258,16 @@ class Robot:
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
-        (q, v, a), batch = as_states({"q": (q, self.nq), "v": (v, self.nv), "a": (a, self.nv)})
+        try:
+            tau = pin.rnea(self.model, self.data, q, v, a)
+            if self._accept(tau, q):
+                return tau
+        except _PINOCCHIO_ERRORS:
+            pass
+        (q, v, a), batch = self._checked(q=q, v=v, a=a)
         if batch:
             return self._in_parallel(pin.rneaInParallel, q, v, a)
-        return pin.rnea(self.model, self.data, q, v, a).copy()
+        return self._finite(pin.rnea(self.model, self.data, q, v, a), "tau")
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).
@@ -243,27 +279,33 @@ class Robot:
 
         Returns:
             Accelerations, shape (nv,) or (N, nv).
+
+        Raises:
+            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
-        (q, v, tau), batch = as_states({"q": (q, self.nq), "v": (v, self.nv), "tau": (tau, self.nv)})
+        if self.mimic is None:
+            try:
+                a = pin.aba(self.model, self.data, q, v, tau)
+                if self._accept(a, q):
+                    return a
+            except _PINOCCHIO_ERRORS:
+                pass
+        (q, v, tau), batch = self._checked(q=q, v=v, tau=tau)
         if self.mimic is not None:  # Pinocchio's ABA does not support mimic joints
             if batch:
-                result = (
-                    np.stack([self._solve_dynamics(*row) for row in zip(q, v, tau, strict=True)])
-                    if len(q)
-                    else np.zeros((0, self.nv))
-                )
+                result = np.stack([self._solve_dynamics(*row) for row in zip(q, v, tau, strict=True)]) if len(q) else np.zeros((0, self.nv))
             else:
                 result = self._solve_dynamics(q, v, tau)
         elif batch:
             result = self._in_parallel(pin.abaInParallel, q, v, tau)
         else:
-            result = pin.aba(self.model, self.data, q, v, tau).copy()
+            result = pin.aba(self.model, self.data, q, v, tau)
         if not np.isfinite(result).all():  # finite inputs: only a singular M gives this
             raise SingularMassMatrixError(self.name, self.massless_joints)
         return result
 
     def _solve_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """``M⁻¹ (tau − C v − G)`` by a Cholesky solve (for models ABA cannot take)."""
+        """``M⁻¹ (tau − C v − G)`` by a linear solve (for models ABA cannot take)."""
         mass = self._mass_matrix(q)
         rhs = tau - pin.nonLinearEffects(self.model, self.data, q, v)
         try:
@@ -280,11 +322,21 @@ class Robot:
         Returns:
             Shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
         """
-        return self._per_state(self._mass_matrix, as_state(q, "q", self.nq))
+        try:
+            mass = self._mass_matrix(q)
+            # CRBA works in local frames: a NaN in q need not reach M, so check q too.
+            if self._accept(mass, q) and math.isfinite(q.dot(q)):
+                return mass
+        except _PINOCCHIO_ERRORS:
+            pass
+        (q,), _ = self._checked(q=q)
+        return self._finite(self._per_state(self._mass_matrix, q), "M")
 
     def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        upper = pin.crba(self.model, self.data, q)
-        return np.triu(upper) + np.triu(upper, 1).T
+        mass = pin.crba(self.model, self.data, q)  # upper triangle only
+        lower = np.tril_indices(self.nv, -1)
+        mass[lower] = mass.T[lower]
+        return mass
 
     def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Coriolis and centrifugal matrix ``C(q, v)``, with ``dM/dt = C + Cᵀ``.
@@ -296,21 +348,26 @@ class Robot:
         Returns:
             Shape (nv, nv) or (N, nv, nv).
         """
-        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        if self.mimic is None:
+            try:
+                coriolis = pin.computeCoriolisMatrix(self.model, self.data, q, v)
+                if self._accept(coriolis, q):
+                    return coriolis
+            except _PINOCCHIO_ERRORS:
+                pass
+        (q, v), batch = self._checked(q=q, v=v)
         if batch:
-            return (
-                np.stack([self._coriolis(qi, vi) for qi, vi in zip(q, v, strict=True)])
-                if len(q)
-                else np.zeros((0, self.nv, self.nv))
-            )
-        return self._coriolis(q, v)
+            if not len(q):
+                return np.zeros((0, self.nv, self.nv))
+            return self._finite(np.stack([self._coriolis(qi, vi) for qi, vi in zip(q, v, strict=True)]), "C")
+        return self._finite(self._coriolis(q, v), "C")
 
     def _coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self.mimic is not None:  # computeCoriolisMatrix mishandles mimic joints
             expansion = self.mimic
             full = pin.computeCoriolisMatrix(expansion.model, expansion.data, expansion.q(q), expansion.selection @ v)
             return expansion.selection.T @ full @ expansion.selection
-        return pin.computeCoriolisMatrix(self.model, self.data, q, v).copy()
+        return pin.computeCoriolisMatrix(self.model, self.data, q, v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
         """Generalised gravity ``G(q)``: the torques that hold the robot still.
@@ -321,11 +378,17 @@ class Robot:
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        q = as_state(q, "q", self.nq)
-        if q.ndim == 2:
+        try:
+            torques = pin.computeGeneralizedGravity(self.model, self.data, q)
+            if self._accept(torques, q):
+                return torques
+        except _PINOCCHIO_ERRORS:
+            pass
+        (q,), batch = self._checked(q=q)
+        if batch:
             zeros = np.zeros((q.shape[0], self.nv))
             return self._in_parallel(pin.rneaInParallel, q, zeros, zeros)
-        return pin.computeGeneralizedGravity(self.model, self.data, q).copy()
+        return self._finite(pin.computeGeneralizedGravity(self.model, self.data, q), "G")
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``C(q, v) v + G(q)``: the torques at zero acceleration.
@@ -337,14 +400,20 @@ class Robot:
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        try:
+            torques = pin.nonLinearEffects(self.model, self.data, q, v)
+            if self._accept(torques, q):
+                return torques
+        except _PINOCCHIO_ERRORS:
+            pass
+        (q, v), batch = self._checked(q=q, v=v)
         if batch:
             return self._in_parallel(pin.rneaInParallel, q, v, np.zeros_like(v))
-        return pin.nonLinearEffects(self.model, self.data, q, v).copy()
+        return self._finite(pin.nonLinearEffects(self.model, self.data, q, v), "C v + G")
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
         """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch."""
-        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        (q, v), batch = self._checked(q=q, v=v)
         # From the mass matrix rather than computeKineticEnergy, which refuses mimic joints.
         if batch:
             return np.array([0.5 * vi @ self._mass_matrix(qi) @ vi for qi, vi in zip(q, v, strict=True)])
@@ -355,7 +424,7 @@ class Robot:
 
         Zero when every centre of mass is at height zero (for the default gravity).
         """
-        q = as_state(q, "q", self.nq)
+        (q,), _ = self._checked(q=q)
         # computePotentialEnergy refuses mimic joints: use the expanded model for those.
         model, data, expand = (
             (self.model, self.data, None) if self.mimic is None else (self.mimic.model, self.mimic.data, self.mimic.q)
@@ -389,13 +458,13 @@ class Robot:
             Shape (3,) or (N, 3), in [m].
         """
         frame_id = self.frame_id(frame)
-        q = as_state(q, "q", self.nq)
+        (q,), _ = self._checked(q=q)
         return self._per_state(lambda qi: self._placement(qi, frame_id).translation.copy(), q)
 
     def frame_rotation(self, q: np.ndarray, frame: str) -> np.ndarray:
         """Orientation of a frame in the world frame: shape (3, 3) or (N, 3, 3)."""
         frame_id = self.frame_id(frame)
-        q = as_state(q, "q", self.nq)
+        (q,), _ = self._checked(q=q)
         return self._per_state(lambda qi: self._placement(qi, frame_id).rotation.copy(), q)
 
     def _placement(self, q: np.ndarray, frame_id: int) -> pin.SE3:
@@ -417,7 +486,7 @@ class Robot:
             Shape (6, nv) or (N, 6, nv).
         """
         frame_id = self.frame_id(frame)
-        q = as_state(q, "q", self.nq)
+        (q,), _ = self._checked(q=q)
         return self._per_state(
             lambda qi: pin.computeFrameJacobian(self.model, self.data, qi, frame_id, pin.LOCAL_WORLD_ALIGNED).copy(), q
         )
@@ -441,7 +510,13 @@ class Robot:
         # Pinocchio wants one state a column: the transpose of a C-ordered stack, no copy.
         columns = [np.ascontiguousarray(array).T for array in (q, v, third)]
         result = algorithm(self._threads, self._model_pool(), *columns)
-        return np.asarray(result).reshape(self.nv, q.shape[0]).T.copy()
+        return self._finite(np.asarray(result).reshape(self.nv, q.shape[0]).T.copy(), algorithm.__name__)
+
+    def _finite(self, result: np.ndarray, what: str) -> np.ndarray:
+        """Refuse a non-finite result of finite inputs (an overflow), never return it."""
+        if not np.isfinite(result).all():
+            raise RobodynError(f"robot {self.name!r}: {what} overflowed to a non-finite value for finite inputs.")
+        return result
 
     @staticmethod
     def _per_state(function, q: np.ndarray) -> np.ndarray:
