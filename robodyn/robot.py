@@ -30,7 +30,6 @@ from robodyn.exceptions import FrameError, InputError, RobodynError, SingularMas
 from robodyn.inputs import as_states
 from robodyn.validation import URDFSpec
 
-
 #: Largest accepted deviation of a floating base's quaternion norm from 1.
 QUATERNION_TOLERANCE = 1e-6
 #: What Pinocchio raises for arguments it refuses (wrong size, type, unsupported joint).
@@ -293,7 +292,11 @@ class Robot:
         (q, v, tau), batch = self._checked(q=q, v=v, tau=tau)
         if self.mimic is not None:  # Pinocchio's ABA does not support mimic joints
             if batch:
-                result = np.stack([self._solve_dynamics(*row) for row in zip(q, v, tau, strict=True)]) if len(q) else np.zeros((0, self.nv))
+                result = (
+                    np.stack([self._solve_dynamics(*row) for row in zip(q, v, tau, strict=True)])
+                    if len(q)
+                    else np.zeros((0, self.nv))
+                )
             else:
                 result = self._solve_dynamics(q, v, tau)
         elif batch:
