@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import traceback
 from collections.abc import Sequence
@@ -109,6 +110,23 @@ def _command_equations(arguments: argparse.Namespace) -> int:
     return 0
 
 
+def _command_check(arguments: argparse.Namespace) -> int:
+    from robodyn.check import check_robot, report_dict, report_text
+
+    if arguments.floating_base:
+        raise RobodynError("robodyn check compares fixed-base models only (the reference has no floating base yet).")
+    robot = robodyn.load(arguments.model, floating_base=False, gravity=arguments.gravity, check_inertia=arguments.check_inertia)
+    report = check_robot(
+        robot,
+        samples=arguments.samples,
+        seed=arguments.seed,
+        tolerance=arguments.tolerance,
+        check_inertia=arguments.check_inertia,
+    )
+    print(json.dumps(report_dict(report), indent=2) if arguments.json else report_text(report))
+    return 0 if report.passed else 1
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``robodyn`` command."""
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics from any URDF, verified.")
@@ -133,6 +151,14 @@ def build_parser() -> argparse.ArgumentParser:
     equations.add_argument("--json", action="store_true", help="print JSON (keys tau, M, C, G, joint_names, ...)")
     equations.add_argument("--precision", type=int, default=6, help="significant digits in text output")
     equations.set_defaults(run=_command_equations)
+
+    check = commands.add_parser("check", help="compare Pinocchio with the independent Lagrangian reference")
+    _add_model_arguments(check)
+    check.add_argument("--samples", type=int, default=100, help="random states within the joint limits (default 100)")
+    check.add_argument("--seed", type=int, default=0, help="seed of the random states (default 0)")
+    check.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error accepted (default 1e-9)")
+    check.add_argument("--json", action="store_true", help="print JSON")
+    check.set_defaults(run=_command_check)
     return parser
 
 
@@ -160,6 +186,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("robodyn: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into a reader that stopped (e.g. head)
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115
+        return 0
 
 
 if __name__ == "__main__":

@@ -1,1 +1,55 @@
-"""The independent Lagrangian reference: robot dynamics from a URDF without Pinocchio."""
+"""The independent Lagrangian reference: robot dynamics from a URDF without Pinocchio.
+
+A second implementation of the equations of motion, written from the lecture's method
+(kinetic and potential energy of every link, ``tau = d/dt ∂L/∂q̇ − ∂L/∂q``) and used to
+verify Pinocchio's numbers. It reads the URDF itself (robodyn's strict validator, then
+yourdfpy), computes its own kinematics, and shares nothing with Pinocchio: nothing in this
+package imports it, and a test runs it in a process where Pinocchio cannot be imported.
+
+- :func:`load` gives a :class:`~robodyn.reference.numeric.ReferenceRobot` (numpy, any size,
+  stacks of states) with the same method names as :class:`robodyn.Robot`.
+- :mod:`robodyn.reference.rp_closed_form` is the RP arm's closed form, written by hand.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+
+import numpy as np
+
+from robodyn.inputs import as_state
+from robodyn.reference.numeric import ReferenceRobot
+from robodyn.reference.tree import KinematicTree, build_tree
+from robodyn.sources import resolve_source
+from robodyn.validation import parse_urdf
+
+STANDARD_GRAVITY = (0.0, 0.0, -9.81)
+
+
+def load(
+    source: str | os.PathLike,
+    *,
+    gravity: Sequence[float] | None = None,
+    check_inertia: bool = True,
+) -> ReferenceRobot:
+    """Load the reference model of a robot (fixed base).
+
+    Args:
+        source: As for :func:`robodyn.load`: a URDF path, URDF text, a zoo name or a
+            generated robot's name.
+        gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
+        check_inertia: As for :func:`robodyn.load`.
+
+    Raises:
+        UnknownRobotError, URDFError: As :func:`robodyn.load`.
+    """
+    resolved = resolve_source(source)
+    spec = parse_urdf(resolved.text, resolved.label, check_inertia=check_inertia)
+    tree = build_tree(spec, resolved.text)
+    name = spec.name if resolved.name == "robot" else resolved.name
+    gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)
+    return ReferenceRobot(tree, name=name, urdf=resolved.text, spec=spec, gravity=gravity_vector)
+
+
+__all__ = ["KinematicTree", "ReferenceRobot", "build_tree", "load"]

@@ -1,0 +1,262 @@
+"""The reference in numbers: the Lagrangian of a kinematic tree, evaluated with numpy.
+
+For every body ``b`` (centre of mass ``p_b(q)``, rotation ``R_b(q)``, mass ``m_b``,
+inertia ``I_b`` about its centre of mass in its own frame) and joint ``i`` (world axis
+``z_i``, world origin ``o_i``), the geometric Jacobians are
+
+    J_v[b, i] = z_i × (p_b − o_i)   (revolute)    or  z_i  (prismatic)
+    J_ω[b, i] = z_i                 (revolute)    or  0
+
+for ``i`` an ancestor of ``b`` (or ``b`` itself), zero otherwise. From the energies
+``T = Σ ½ m_b |J_v v|² + ½ (J_ω v)ᵀ R_b I_b R_bᵀ (J_ω v)`` and ``U = −Σ m_b gᵀ p_b``:
+
+    M = Σ_b m_b J_vᵀ J_v + J_ωᵀ R_b I_b R_bᵀ J_ω,     G = ∂U/∂q = −Σ_b m_b J_vᵀ g,
+    C_ij = Σ_k Γ_ijk v_k,   Γ_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i),
+    τ = M a + C v + G.
+
+``∂M/∂q_k`` is analytic (exact to rounding): moving joint ``k`` rotates everything
+beyond it about ``z_k``, so ``∂J[b, i]/∂q_k = z_k × J[b, i]`` when ``k`` is ``i`` or an
+ancestor of it and revolute; ``∂J_v[b, i]/∂q_k = z_i × J_v[b, k]`` when ``i`` is a
+revolute strict ancestor of ``k``; ``∂(R I Rᵀ)/∂q_k = [z_k]× RIRᵀ − RIRᵀ [z_k]×``.
+
+Every method works on a stack of states at once (one state a row). Mimic joints are
+handled in the coordinates of every body, ``theta = S q + offset``: ``M = Sᵀ M_θ S``,
+``C = Sᵀ C_θ S``, ``G = Sᵀ G_θ``. No Pinocchio here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robodyn.inputs import as_states
+from robodyn.reference.tree import KinematicTree
+from robodyn.validation import URDFSpec
+
+#: Largest number of states processed at once.
+CHUNK = 256
+#: Bound on the entries of the largest intermediate array (the derivative of the body
+#: Jacobians: bodies × joints² × 3 a state), which sets the chunk for large robots.
+MAX_CHUNK_ENTRIES = 4_000_000
+
+
+def _skew(vectors: np.ndarray) -> np.ndarray:
+    """Cross-product matrices of vectors, shape (..., 3) -> (..., 3, 3)."""
+    x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
+    zero = np.zeros_like(x)
+    return np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)], -2)
+
+
+class ReferenceRobot:
+    """The independent Lagrangian model of a robot (same method names as ``Robot``).
+
+    Build one with :func:`robodyn.reference.load`.
+
+    Attributes:
+        name: Robot name.
+        urdf: The URDF text it was built from.
+        spec: The validated URDF.
+        tree: The kinematic tree (bodies in topological order).
+        joint_names: Joints in the order of ``q`` (the URDF's depth-first order, which may
+            differ from Pinocchio's: compare by name).
+        nq, nv: Number of coordinates (equal: fixed base only).
+        gravity_vector: Gravity in the world frame, in [m/s²].
+    """
+
+    def __init__(self, tree: KinematicTree, *, name: str, urdf: str, spec: URDFSpec, gravity: np.ndarray):
+        self.tree = tree
+        self.name = name
+        self.urdf = urdf
+        self.spec = spec
+        self.joint_names = list(tree.joint_names)
+        self.nq = self.nv = len(self.joint_names)
+        self.gravity_vector = np.asarray(gravity, float)
+        bodies = tree.bodies
+        self._origins = np.array([body.origin for body in bodies]).reshape(-1, 4, 4)
+        self._axes = np.array([body.axis for body in bodies]).reshape(-1, 3)
+        self._revolute = np.array([body.revolute for body in bodies], dtype=bool)
+        self._masses = np.array([body.mass for body in bodies])
+        self._coms = np.array([body.com for body in bodies]).reshape(-1, 3)
+        self._inertias = np.array([body.inertia for body in bodies]).reshape(-1, 3, 3)
+        self._axis_skews = _skew(self._axes)
+        ancestors = tree.ancestors
+        # dJ[b, i]/dθ_k = z_k × J[b, i] where k is i or an ancestor of i, and revolute.
+        self._mask_rotating = ancestors & self._revolute[None, :]
+        # dJ_v[b, i]/dθ_k = z_i × J_v[b, k] where i is a revolute strict ancestor of k.
+        self._mask_lever = ancestors.T & ~np.eye(len(bodies), dtype=bool) & self._revolute[:, None]
+        self._selection = tree.selection
+        self._offset = tree.offset
+
+    def __repr__(self) -> str:
+        return f"<ReferenceRobot {self.name!r}: n={self.nv}, joints={self.joint_names}>"
+
+    # ----------------------------------------------------------------------------------
+    # Kinematics of every body, for a stack of body coordinates theta (N, n_bodies)
+    # ----------------------------------------------------------------------------------
+    def _kinematics(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
+        """World rotations R (N, B, 3, 3) and origins (N, B, 3) of the body frames, joint
+        axes z and origins o (N, B, 3)."""
+        count, bodies = theta.shape
+        rotations = np.empty((count, bodies, 3, 3))
+        positions = np.empty((count, bodies, 3))
+        axes = np.empty((count, bodies, 3))
+        joint_origins = np.empty((count, bodies, 3))
+        identity = np.eye(3)
+        for index, body in enumerate(self.tree.bodies):
+            if body.parent < 0:
+                parent_rotation, parent_position = identity[None], np.zeros((1, 3))
+            else:
+                parent_rotation, parent_position = rotations[:, body.parent], positions[:, body.parent]
+            joint_rotation = parent_rotation @ self._origins[index, :3, :3]
+            joint_origins[:, index] = parent_position + parent_rotation @ self._origins[index, :3, 3]
+            axes[:, index] = joint_rotation @ self._axes[index]
+            angle = theta[:, index]
+            if body.revolute:
+                skew = self._axis_skews[index]
+                rodrigues = identity + np.sin(angle)[:, None, None] * skew + (1 - np.cos(angle))[:, None, None] * (skew @ skew)
+                rotations[:, index] = joint_rotation @ rodrigues
+                positions[:, index] = joint_origins[:, index]
+            else:
+                rotations[:, index] = joint_rotation
+                positions[:, index] = joint_origins[:, index] + axes[:, index] * angle[:, None]
+        return rotations, positions, axes, joint_origins
+
+    def _jacobians(
+        self, points: np.ndarray, axes: np.ndarray, joint_origins: np.ndarray, rows: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Linear and angular Jacobians of points carried by bodies: (N, P, B, 3) each.
+
+        Args:
+            points: World points, (N, P, 3).
+            axes, joint_origins: From :meth:`_kinematics`.
+            rows: Boolean (P, B): which joints move each point.
+        """
+        lever = points[:, :, None, :] - joint_origins[:, None, :, :]
+        joint_axes = np.broadcast_to(axes[:, None, :, :], lever.shape)
+        revolute = self._revolute[None, None, :, None]
+        moves = rows[None, :, :, None]
+        linear = np.where(revolute, np.cross(joint_axes, lever), joint_axes) * moves
+        angular = np.where(revolute, joint_axes, 0.0) * moves
+        return linear, angular
+
+    # ----------------------------------------------------------------------------------
+    # The Lagrangian terms in body coordinates
+    # ----------------------------------------------------------------------------------
+    def _terms(self, q: np.ndarray, derivative: bool) -> dict[str, np.ndarray]:
+        theta = q @ self._selection.T + self._offset
+        rotations, positions, axes, joint_origins = self._kinematics(theta)
+        coms = positions + np.einsum("nbij,bj->nbi", rotations, self._coms)
+        linear, angular = self._jacobians(coms, axes, joint_origins, self.tree.ancestors)
+        world_inertia = rotations @ self._inertias[None] @ np.swapaxes(rotations, -1, -2)
+        weighted = self._masses[None, :, None, None] * linear
+        mass = np.einsum("nbia,nbja->nij", weighted, linear, optimize=True) + np.einsum(
+            "nbia,nbac,nbjc->nij", angular, world_inertia, angular, optimize=True
+        )
+        terms = {
+            "M": mass,
+            "G": -np.einsum("nbia,a->ni", weighted, self.gravity_vector),
+            "U": -np.einsum("b,nba,a->n", self._masses, coms, self.gravity_vector),
+        }
+        if derivative:
+            terms["dM"] = self._mass_derivative(linear, angular, weighted, world_inertia, axes)
+        return terms
+
+    def _mass_derivative(self, linear, angular, weighted, world_inertia, axes) -> np.ndarray:
+        """``dM[n, i, j, k] = ∂M_ij/∂θ_k`` (see the module docstring)."""
+        z_k = axes[:, None, None, :, :]  # (N, 1, 1, K, 3)
+        rotating = self._mask_rotating[None, None, :, :, None]
+        lever = self._mask_lever[None, None, :, :, None]
+        d_linear = rotating * np.cross(z_k, linear[:, :, :, None, :]) + lever * np.cross(
+            axes[:, None, :, None, :], linear[:, :, None, :, :]
+        )
+        d_angular = rotating * np.cross(z_k, angular[:, :, :, None, :])
+        spin = _skew(axes)  # (N, K, 3, 3)
+        moving = (self.tree.ancestors & self._revolute[None, :])[None, :, :, None, None]  # (1, B, K, 1, 1)
+        d_inertia = moving * (spin[:, None] @ world_inertia[:, :, None] - world_inertia[:, :, None] @ spin[:, None])
+        inertia_angular = world_inertia @ np.swapaxes(angular, -1, -2)  # (N, B, 3, n)
+        translational = np.einsum("nbika,nbja->nijk", d_linear, weighted, optimize=True)
+        rotational = np.einsum("nbika,nbaj->nijk", d_angular, inertia_angular, optimize=True)
+        spin_term = np.einsum("nbia,nbkac,nbjc->nijk", angular, d_inertia, angular, optimize=True)
+        return translational + np.swapaxes(translational, 1, 2) + rotational + np.swapaxes(rotational, 1, 2) + spin_term
+
+    def _evaluate(self, q: np.ndarray, v: np.ndarray | None, a: np.ndarray | None) -> dict[str, np.ndarray]:
+        """All terms in the independent coordinates, for stacks q, v, a (chunked)."""
+        results: dict[str, list[np.ndarray]] = {}
+        selection = self._selection
+        bodies = len(self.tree.bodies)
+        size = max(1, min(CHUNK, MAX_CHUNK_ENTRIES // (3 * bodies**3 + 1)))
+        for start in range(0, max(len(q), 1), size):
+            chunk = slice(start, start + size)
+            terms = self._terms(q[chunk], derivative=v is not None)
+            out = {
+                "M": selection.T @ terms["M"] @ selection,
+                "G": terms["G"] @ selection,
+                "U": terms["U"],
+            }
+            if v is not None:
+                theta_dot = v[chunk] @ selection.T
+                dM = terms["dM"]
+                # Γ_ijk = ½ (∂M_ij/∂θ_k + ∂M_ik/∂θ_j − ∂M_jk/∂θ_i)
+                christoffel = 0.5 * (dM + np.einsum("nikj->nijk", dM) - np.einsum("njki->nijk", dM))
+                coriolis_theta = np.einsum("nijk,nk->nij", christoffel, theta_dot)
+                out["C"] = selection.T @ coriolis_theta @ selection
+                out["Mdot"] = selection.T @ np.einsum("nijk,nk->nij", dM, theta_dot) @ selection
+                out["Cv"] = np.einsum("nij,nj->ni", out["C"], v[chunk])
+                if a is not None:
+                    out["tau"] = np.einsum("nij,nj->ni", out["M"], a[chunk]) + out["Cv"] + out["G"]
+            for key, value in out.items():
+                results.setdefault(key, []).append(value)
+        return {key: np.concatenate(values)[: len(q)] for key, values in results.items()}
+
+    def _call(self, key: str, **named: np.ndarray) -> np.ndarray:
+        arrays, batch = as_states({name: (value, self.nv) for name, value in named.items()})
+        stacked = [array if batch else array[None] for array in arrays]
+        q, v, a = [*stacked, None, None][:3]
+        result = self._evaluate(q, v, a)[key]
+        return result if batch else result[0]
+
+    # ----------------------------------------------------------------------------------
+    # Public API, mirroring robodyn.Robot
+    # ----------------------------------------------------------------------------------
+    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """``tau = M a + C v + G``, shape (n,) or (N, n)."""
+        return self._call("tau", q=q, v=v, a=a)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """``M(q)``, shape (n, n) or (N, n, n)."""
+        return self._call("M", q=q)
+
+    def mass_matrix_derivative(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``dM/dt = Σ_k ∂M/∂q_k v_k`` (analytic), shape (n, n) or (N, n, n)."""
+        return self._call("Mdot", q=q, v=v)
+
+    def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``C(q, v)`` from the Christoffel symbols of ``M``, shape (n, n) or (N, n, n)."""
+        return self._call("C", q=q, v=v)
+
+    def coriolis_forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``C(q, v) v``, shape (n,) or (N, n)."""
+        return self._call("Cv", q=q, v=v)
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        """``G(q) = ∂U/∂q``, shape (n,) or (N, n)."""
+        return self._call("G", q=q)
+
+    def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``C(q, v) v + G(q)``, shape (n,) or (N, n)."""
+        return self._call("Cv", q=q, v=v) + self.gravity(q)
+
+    def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """``a = M⁻¹ (tau − C v − G)``, shape (n,) or (N, n)."""
+        (q, v, tau), _ = as_states({"q": (q, self.nv), "v": (v, self.nv), "tau": (tau, self.nv)})
+        return np.linalg.solve(self.mass_matrix(q), (tau - self.nonlinear_effects(q, v))[..., None])[..., 0]
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
+        """``T = ½ vᵀ M v`` in [J]: a float or shape (N,)."""
+        (q, v), batch = as_states({"q": (q, self.nv), "v": (v, self.nv)})
+        energy = 0.5 * np.einsum("...i,...ij,...j->...", v, self.mass_matrix(q), v)
+        return energy if batch else float(energy)
+
+    def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
+        """``U = −Σ m_b gᵀ p_b`` in [J]: a float or shape (N,)."""
+        energy = self._call("U", q=q)
+        return energy if np.ndim(energy) else float(energy)

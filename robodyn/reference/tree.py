@@ -1,0 +1,190 @@
+"""The kinematic tree the reference works on, read from the URDF with yourdfpy.
+
+The URDF first passes robodyn's strict validator (:mod:`robodyn.validation`); yourdfpy then
+reads it and this module turns it into a list of rigid :class:`Body` objects, one for each
+moving joint:
+
+- links welded to a body by fixed joints are merged into it (masses added, centres of
+  mass averaged, inertias moved with the parallel-axis theorem), and the fixed joints
+  between two moving joints are folded into the constant transform ``origin``;
+- the bodies are in topological order (a parent before its children), so forward
+  kinematics is one pass;
+- joint axes are normalised (as the validator requires of both implementations);
+- a ``<mimic>`` joint stays a body of its own; :attr:`KinematicTree.selection` maps the
+  independent coordinates ``q`` onto the coordinate of every body
+  (``theta = selection @ q + offset``).
+
+Nothing here imports Pinocchio.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+
+import numpy as np
+import yourdfpy
+
+from robodyn.validation import URDFSpec
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body carried by one moving joint.
+
+    Attributes:
+        joint: Name of the joint that moves it.
+        parent: Index of the parent body, or -1 when the parent is the fixed root.
+        origin: 4×4 transform from the parent body's frame to the joint frame (constant).
+        axis: Unit joint axis in the joint frame.
+        revolute: True for revolute/continuous joints, false for prismatic ones.
+        mass: Total mass in [kg] of the links welded together.
+        com: Centre of mass in the body frame, in [m].
+        inertia: 3×3 inertia about the centre of mass, body-frame axes, in [kg m²].
+    """
+
+    joint: str
+    parent: int
+    origin: np.ndarray
+    axis: np.ndarray
+    revolute: bool
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+
+
+@dataclass(frozen=True)
+class KinematicTree:
+    """The robot as moving bodies, in topological order.
+
+    Attributes:
+        name: Robot name.
+        bodies: One body per moving joint (mimic joints included).
+        joint_names: The independent joints, in the order of ``q`` (bodies' order, mimic
+            joints left out).
+        selection: Shape (n_bodies, n_joints): ``theta = selection @ q + offset``.
+        offset: Shape (n_bodies,).
+        ancestors: Boolean (n_bodies, n_bodies): ``ancestors[b, i]`` when body ``i`` is
+            body ``b`` or one of its ancestors.
+    """
+
+    name: str
+    bodies: list[Body]
+    joint_names: list[str]
+    selection: np.ndarray
+    offset: np.ndarray
+    ancestors: np.ndarray
+
+
+def _rpy_matrix(rpy: np.ndarray) -> np.ndarray:
+    roll, pitch, yaw = rpy
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def _homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
+    transform = np.eye(4)
+    transform[:3, :3] = rotation
+    transform[:3, 3] = translation
+    return transform
+
+
+def _link_mass_properties(link: yourdfpy.Link) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass, centre of mass and inertia about the centre of mass, in the link frame."""
+    inertial = link.inertial
+    if inertial is None or inertial.mass is None or inertial.mass == 0:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    origin = inertial.origin if inertial.origin is not None else np.eye(4)
+    rotation = origin[:3, :3]
+    inertia = np.zeros((3, 3)) if inertial.inertia is None else np.asarray(inertial.inertia, float)
+    return float(inertial.mass), origin[:3, 3].copy(), rotation @ inertia @ rotation.T
+
+
+def _combine(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, np.ndarray, np.ndarray]:
+    """Merge rigidly attached masses (each: mass, centre, inertia about its centre)."""
+    mass = sum(part[0] for part in parts)
+    if mass == 0:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    com = sum(part[0] * part[1] for part in parts) / mass
+    inertia = np.zeros((3, 3))
+    for part_mass, part_com, part_inertia in parts:
+        d = part_com - com
+        inertia += part_inertia + part_mass * (d @ d * np.eye(3) - np.outer(d, d))
+    return mass, com, inertia
+
+
+def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> KinematicTree:
+    """Build the reference's kinematic tree from a validated URDF.
+
+    Args:
+        spec: The validated URDF (from :func:`robodyn.validation.parse_urdf`).
+        text: The same URDF text, read again here by yourdfpy.
+        floating_base: Not supported by the reference yet.
+
+    Raises:
+        NotImplementedError: For a floating base.
+    """
+    if floating_base:
+        raise NotImplementedError("the reference does not model floating bases yet")
+    urdf = yourdfpy.URDF.load(io.BytesIO(text.encode("utf-8")), build_scene_graph=False, load_meshes=False)
+    links = {link.name: link for link in urdf.robot.links}
+    children: dict[str, list[yourdfpy.Joint]] = {}
+    for joint in urdf.robot.joints:
+        children.setdefault(joint.parent, []).append(joint)
+
+    bodies: list[Body] = []
+    # Depth-first from the root; each entry: (link, transform from the current body's
+    # frame to this link's frame, index of the current body).
+    stack = [(spec.root, np.eye(4), -1)]
+    welded: dict[int, list[tuple[float, np.ndarray, np.ndarray]]] = {}
+    while stack:
+        link_name, to_link, body_index = stack.pop()
+        mass, com, inertia = _link_mass_properties(links[link_name])
+        rotation = to_link[:3, :3]
+        welded.setdefault(body_index, []).append((mass, rotation @ com + to_link[:3, 3], rotation @ inertia @ rotation.T))
+        for joint in reversed(children.get(link_name, [])):
+            origin = joint.origin if joint.origin is not None else np.eye(4)
+            if joint.type == "fixed":
+                stack.append((joint.child, to_link @ origin, body_index))
+                continue
+            axis = np.asarray(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), float)
+            bodies.append(
+                Body(
+                    joint.name,
+                    body_index,
+                    to_link @ origin,
+                    axis / np.linalg.norm(axis),
+                    joint.type != "prismatic",
+                    0.0,
+                    np.zeros(3),
+                    np.zeros((3, 3)),
+                )
+            )
+            stack.append((joint.child, np.eye(4), len(bodies) - 1))
+    bodies = [
+        Body(b.joint, b.parent, b.origin, b.axis, b.revolute, *_combine(welded.get(index, []))) for index, b in enumerate(bodies)
+    ]
+
+    independent = [body.joint for body in bodies if spec.joints[body.joint].mimic is None]
+    column_of = {name: column for column, name in enumerate(independent)}
+    selection = np.zeros((len(bodies), len(independent)))
+    offset = np.zeros(len(bodies))
+    for index, body in enumerate(bodies):
+        mimic = spec.joints[body.joint].mimic
+        if mimic is None:
+            selection[index, column_of[body.joint]] = 1.0
+        else:
+            selection[index, column_of[mimic.joint]] = mimic.multiplier
+            offset[index] = mimic.offset
+    ancestors = np.zeros((len(bodies), len(bodies)), dtype=bool)
+    for index, body in enumerate(bodies):
+        ancestors[index, index] = True
+        if body.parent >= 0:
+            ancestors[index] |= ancestors[body.parent]
+    return KinematicTree(spec.name, bodies, independent, selection, offset, ancestors)
