@@ -127,6 +127,57 @@ def _command_check(arguments: argparse.Namespace) -> int:
     return 0 if report.passed else 1
 
 
+def _default_frame(robot: robodyn.Robot) -> str:
+    links = robot.spec.links
+    return "end_effector" if "end_effector" in links else list(links)[-1]
+
+
+def _command_simulate(arguments: argparse.Namespace) -> int:
+    from robodyn.experiment import run_simulation
+
+    robot = _load(arguments)
+    summary = run_simulation(
+        robot,
+        controller=arguments.controller,
+        target=arguments.target,
+        frame=arguments.frame or _default_frame(robot),
+        q0=arguments.q0,
+        duration=arguments.duration,
+        dt=arguments.dt,
+        integrator=arguments.integrator,
+        out=arguments.out,
+        plot=arguments.plot,
+    )
+    print(json.dumps(summary, indent=2) if arguments.json else "\n".join(f"{key}: {value}" for key, value in summary.items()))
+    return 0
+
+
+def _command_whatif(arguments: argparse.Namespace) -> int:
+    from robodyn.plots import plot_whatif
+    from robodyn.report import dof_units
+    from robodyn.whatif import sweep, table_dict, table_text
+
+    materials = tuple(arguments.materials.split(",")) if arguments.materials else None
+    forces = ((0.0, 0.0, 0.0),) + ((tuple(arguments.force),) if arguments.force else ())
+    if arguments.force and len(arguments.force) != 3:
+        raise InputError("--force", "3 values FX,FY,FZ in [N]", f"{len(arguments.force)} values")
+    rows = sweep(
+        arguments.model, materials=materials, payloads=tuple(arguments.payloads), forces=forces, duration=arguments.duration
+    )
+    robot = robodyn.load(arguments.model)
+    units = dof_units(robot)["tau"]
+    if arguments.plot:
+        plot_whatif(rows, robot.joint_names, units, arguments.plot)
+    if arguments.json:
+        print(json.dumps(table_dict(rows, robot.joint_names, units), indent=2))
+    else:
+        print(f"{robot.name}: one rest-to-rest motion of {arguments.duration:g} s; torques of each joint\n")
+        print(table_text(rows, robot.joint_names, units))
+        if arguments.plot:
+            print(f"\nplot: {arguments.plot}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``robodyn`` command."""
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics from any URDF, verified.")
@@ -159,6 +210,32 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error accepted (default 1e-9)")
     check.add_argument("--json", action="store_true", help="print JSON")
     check.set_defaults(run=_command_check)
+
+    simulate = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
+    _add_model_arguments(simulate)
+    simulate.add_argument("--controller", choices=["passive", "pd", "computed-torque", "task-space"], default="passive")
+    simulate.add_argument(
+        "--target", type=_vector, help="task-space: frame position X,Z or X,Y,Z in [m]; pd / computed-torque: joint target"
+    )
+    simulate.add_argument("--frame", help="controlled frame for task-space (default end_effector or the last link)")
+    simulate.add_argument("--q0", type=_vector, help="initial configuration (default neutral)")
+    simulate.add_argument("--duration", type=float, default=3.0, help="simulated time in [s] (default 3)")
+    simulate.add_argument("--dt", type=float, default=1e-3, help="step in [s] (default 0.001)")
+    simulate.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], default="rk4")
+    simulate.add_argument("--out", help="trajectory file (.csv or .npz)")
+    simulate.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
+    simulate.add_argument("--json", action="store_true", help="print the summary as JSON")
+    simulate.set_defaults(run=_command_simulate)
+
+    whatif = commands.add_parser("whatif", help="peak and RMS torques of one motion across materials, payloads, forces")
+    whatif.add_argument("model", nargs="?", default="rp_arm", help="robot (default rp_arm; materials apply to rp_arm only)")
+    whatif.add_argument("--materials", help="comma-separated: abs (plastic), aluminium, steel or densities in kg/m³")
+    whatif.add_argument("--payloads", type=_vector, default=[0.0, 0.5, 2.0], help="payload masses in [kg] at the end effector")
+    whatif.add_argument("--force", type=_vector, help="also an external force FX,FY,FZ in [N] on the end effector")
+    whatif.add_argument("--duration", type=float, default=1.5, help="motion time in [s]")
+    whatif.add_argument("--plot", help="PNG bar chart of the table")
+    whatif.add_argument("--json", action="store_true", help="print JSON")
+    whatif.set_defaults(run=_command_whatif)
     return parser
 
 

@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from robodyn.exceptions import URDFError
 from robodyn.robot import MimicExpansion, Robot
-from robodyn.sources import resolve_source
+from robodyn.sources import URDFSource, resolve_source
 from robodyn.validation import URDFSpec, parse_urdf
 
 #: Limit written for continuous joints in the copy Pinocchio reads, in [rad].
@@ -81,9 +81,22 @@ def load(
         URDFError: If the URDF cannot be read or describes an impossible robot.
         InputError: If ``gravity`` is not 3 finite numbers.
     """
+    return build_robot(resolve_source(source), floating_base=floating_base, gravity=gravity, check_inertia=check_inertia)
+
+
+def build_robot(
+    resolved: URDFSource,
+    *,
+    floating_base: bool | None = None,
+    gravity: Sequence[float] | None = None,
+    check_inertia: bool = True,
+) -> Robot:
+    """Build a robot from a resolved URDF source (what :func:`load` does after resolving).
+
+    Arguments as for :func:`load`; used by tools that write URDF text (payloads).
+    """
     from robodyn.inputs import as_state
 
-    resolved = resolve_source(source)
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia)
     xml = pinocchio_xml(spec)
@@ -137,4 +150,4 @@ def _mimic_expansion(model: pin.Model, spec: URDFSpec, xml: str, floating: bool)
     return MimicExpansion(full, selection, offset)
 
 
-__all__ = ["load", "pinocchio_xml"]
+__all__ = ["build_robot", "load", "pinocchio_xml"]

@@ -307,6 +307,17 @@ class Robot:
             raise SingularMassMatrixError(self.name, self.massless_joints)
         return result
 
+    def forward_dynamics_unchecked(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """:meth:`forward_dynamics` of one state without the boundary checks.
+
+        For inner loops (simulation) whose inputs were checked once: float64 1-D arrays of
+        the right sizes. A singular mass matrix gives non-finite values here.
+        """
+        if self.mimic is not None:
+            mass = self._mass_matrix(q)
+            return np.linalg.solve(mass, tau - pin.nonLinearEffects(self.model, self.data, q, v))
+        return pin.aba(self.model, self.data, q, v, tau)
+
     def _solve_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """``M⁻¹ (tau − C v − G)`` by a linear solve (for models ABA cannot take)."""
         mass = self._mass_matrix(q)
@@ -493,6 +504,55 @@ class Robot:
         return self._per_state(
             lambda qi: pin.computeFrameJacobian(self.model, self.data, qi, frame_id, pin.LOCAL_WORLD_ALIGNED).copy(), q
         )
+
+    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str) -> np.ndarray:
+        """``J̇(q, v) v``: the acceleration of a frame's origin at zero joint acceleration.
+
+        The classical (not spatial) acceleration of the origin, in world axes, in [m/s²];
+        the frame's acceleration is ``J a + J̇ v`` with ``J`` from :meth:`frame_jacobian`.
+
+        Args:
+            q: Configuration, shape (nq,).
+            v: Velocity, shape (nv,).
+            frame: Link or joint name.
+
+        Returns:
+            Shape (3,).
+        """
+        frame_id = self.frame_id(frame)
+        (q, v), _ = self._checked(q=q, v=v)
+        pin.forwardKinematics(self.model, self.data, q, v, np.zeros(self.nv))
+        return pin.getFrameClassicalAcceleration(self.model, self.data, frame_id, pin.LOCAL_WORLD_ALIGNED).linear.copy()
+
+    def wrench_torques(self, q: np.ndarray, frame: str, wrench: np.ndarray) -> np.ndarray:
+        """Joint torques ``J(q)ᵀ w`` that an external wrench on a frame exerts on the joints.
+
+        Args:
+            q: Configuration, shape (nq,).
+            frame: Link or joint name; the wrench acts at its origin.
+            wrench: Force in [N] then torque in [N m], world axes, shape (6,) (or a force
+                alone, shape (3,)).
+
+        Returns:
+            Shape (nv,): add to the motor torques in forward dynamics, subtract from the
+            inverse dynamics' torques.
+        """
+        wrench = np.asarray(wrench, dtype=float)
+        if wrench.shape == (3,):
+            wrench = np.concatenate([wrench, np.zeros(3)])
+        if wrench.shape != (6,) or not np.isfinite(wrench).all():
+            raise InputError("wrench", "6 finite values (force in [N], torque in [N m])", f"shape {wrench.shape}")
+        return self.frame_jacobian(q, frame).T @ wrench
+
+    def integrate(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        """The configuration reached from ``q`` along the velocity ``dq`` in unit time.
+
+        ``q + dq`` for joints; the floating base's pose moves on SE(3) (Pinocchio's
+        ``integrate``), keeping its quaternion unit.
+        """
+        if self.floating_base:
+            return pin.integrate(self.model, q, dq)
+        return q + dq
 
     # ----------------------------------------------------------------------------------
     # Helpers

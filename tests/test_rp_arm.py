@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.models import RPArmParameters, rp_arm_urdf
+from robodyn.models import GENERATED, RPArmParameters, rp_arm_urdf
 from robodyn.reference import rp_closed_form as closed
 from tests.conftest import ROOT
 
@@ -20,8 +20,9 @@ def relative_error(actual: np.ndarray, expected: np.ndarray) -> float:
     return float(np.max(np.abs(actual - expected)) / max(1.0, float(np.max(np.abs(expected)))))
 
 
-def test_committed_urdf_equals_generator_output():
-    assert (ROOT / "urdf" / "rp_arm.urdf").read_text(encoding="utf-8") == rp_arm_urdf()
+@pytest.mark.parametrize("name", sorted(GENERATED))
+def test_committed_urdf_equals_generator_output(name):
+    assert (ROOT / "urdf" / f"{name}.urdf").read_text(encoding="utf-8") == GENERATED[name]()
 
 
 @pytest.mark.parametrize("parameters", PARAMETERS, ids=["default", "custom"])

@@ -53,6 +53,32 @@ class RPArmParameters:
     effort_limits: tuple[float, float] = (100.0, 100.0)
     velocity_limits: tuple[float, float] = (3.0, 1.0)
 
+    @classmethod
+    def from_material(
+        cls, material: str | float, *, l1: float = 0.5, l2: float = 0.4, width: float = 0.05, **limits
+    ) -> RPArmParameters:
+        """An arm of solid square-section links of one material.
+
+        Args:
+            material: ``"abs"`` (plastic), ``"aluminium"``, ``"steel"`` or a density in [kg/m³].
+            l1, l2: Link lengths in [m].
+            width: Side of the square cross-section in [m].
+            **limits: Other fields (joint limits).
+
+        Returns:
+            Parameters with masses ``density × length × width²`` and box inertias.
+        """
+        from robodyn.materials import box_mass
+
+        return cls(
+            l1=l1,
+            l2=l2,
+            width=width,
+            m1=box_mass(material, (l1, width, width)),
+            m2=box_mass(material, (l2, width, width)),
+            **limits,
+        )
+
     @property
     def inertia1(self) -> float:
         """``Iz1`` in [kg m²], defaulted from the box."""

@@ -1,0 +1,134 @@
+"""Dynamics-based controllers: the lecture's loop and the ones a textbook pairs with it.
+
+Each controller is a callable ``controller(t, q, v) -> tau`` for :func:`robodyn.simulate`
+and holds its **own** model of the robot, which may differ from the simulated plant
+(a wrong payload, another material): that is how model mismatch is studied.
+
+- :class:`PDGravity` — ``tau = Kp (q_d − q) − Kd v + G(q)``: settles at a joint target.
+- :class:`ComputedTorque` — feedback linearisation along a joint trajectory,
+  ``tau = M(q) (a_d + Kd (v_d − v) + Kp (q_d − q)) + C(q, v) v + G(q)``: with a perfect
+  model the error obeys ``ë + Kd ė + Kp e = 0``.
+- :class:`TaskSpace` — the lecture's slide 37: drives a frame's origin to a target
+  position. The task error goes through a PD law to a desired task acceleration, which is
+  mapped to joint accelerations (damped least squares of the frame Jacobian) and then to
+  torques through the model, ``tau = M a* + C v + G``.
+
+Gains are scalars or per-joint arrays, in SI units (``Kp`` in [1/s²], ``Kd`` in [1/s] for
+the computed-torque and task-space laws; [N m/rad] and [N m s/rad] for PD).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from robodyn.robot import Robot
+
+#: A joint reference: time in [s] -> (q_d, v_d, a_d).
+JointReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+@dataclass
+class PDGravity:
+    """PD control with gravity compensation, to a fixed joint target.
+
+    Attributes:
+        model: The controller's model of the robot.
+        target: Joint target, shape (nq,).
+        kp: Stiffness, in [N m/rad] or [N/m] (scalar or shape (nv,)).
+        kd: Damping, in [N m s/rad] or [N s/m].
+    """
+
+    model: Robot
+    target: np.ndarray
+    kp: float | np.ndarray = 100.0
+    kd: float | np.ndarray = 20.0
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self.kp * (self.target - q) - self.kd * v + self.model.gravity(q)
+
+
+@dataclass
+class ComputedTorque:
+    """Joint-space computed torque (feedback linearisation) along a reference.
+
+    Attributes:
+        model: The controller's model of the robot.
+        reference: ``reference(t) -> (q_d, v_d, a_d)``.
+        kp: Position gain in [1/s²] (scalar or shape (nv,)).
+        kd: Velocity gain in [1/s].
+    """
+
+    model: Robot
+    reference: JointReference
+    kp: float | np.ndarray = 400.0
+    kd: float | np.ndarray = 40.0
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        q_d, v_d, a_d = self.reference(t)
+        command = a_d + self.kd * (v_d - v) + self.kp * (q_d - q)
+        return self.model.inverse_dynamics(q, v, command)
+
+
+@dataclass
+class TaskSpace:
+    """Drive a frame's origin to a target position through the robot's dynamics.
+
+    Attributes:
+        model: The controller's model of the robot.
+        frame: The controlled frame (e.g. ``"end_effector"``).
+        target: Desired position of its origin, world frame, in [m], shape (3,).
+        kp: Task stiffness in [1/s²].
+        kd: Task damping in [1/s].
+        damping: Damped-least-squares regularisation of the Jacobian inverse (handles
+            directions the frame cannot move in, e.g. out of the RP arm's plane).
+        joint_damping: Damping in [1/s] of the joint motion the task leaves free (the
+            null space), so that redundant arms come to rest.
+    """
+
+    model: Robot
+    frame: str
+    target: np.ndarray
+    kp: float = 100.0
+    kd: float = 20.0
+    damping: float = 1e-6
+    joint_damping: float = 5.0
+
+    def task_error(self, q: np.ndarray) -> np.ndarray:
+        """Target minus the frame's position, shape (3,), in [m]."""
+        return np.asarray(self.target, float) - self.model.frame_position(q, self.frame)
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        jacobian = self.model.frame_jacobian(q, self.frame)[:3]
+        velocity = jacobian @ v
+        desired = self.kp * self.task_error(q) - self.kd * velocity - self.model.frame_bias_acceleration(q, v, self.frame)
+        gram = jacobian @ jacobian.T + self.damping * np.eye(3)
+        pseudo_inverse = jacobian.T @ np.linalg.solve(gram, np.eye(3))
+        null_space = np.eye(self.model.nv) - pseudo_inverse @ jacobian
+        command = pseudo_inverse @ desired - null_space @ (self.joint_damping * v)
+        return self.model.inverse_dynamics(q, v, command)
+
+
+def quintic_reference(q_start: np.ndarray, q_end: np.ndarray, duration: float) -> JointReference:
+    """A rest-to-rest joint motion with zero velocity and acceleration at both ends.
+
+    Args:
+        q_start, q_end: Start and end configurations, shape (n,).
+        duration: Motion time in [s]; after it the reference holds ``q_end``.
+
+    Returns:
+        ``reference(t) -> (q_d, v_d, a_d)``.
+    """
+    q_start, q_end = np.asarray(q_start, float), np.asarray(q_end, float)
+    delta = q_end - q_start
+
+    def reference(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s = min(max(t / duration, 0.0), 1.0)
+        position = 10 * s**3 - 15 * s**4 + 6 * s**5
+        speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / duration if 0 < t < duration else 0.0
+        acceleration = (60 * s - 180 * s**2 + 120 * s**3) / duration**2 if 0 < t < duration else 0.0
+        return q_start + position * delta, speed * delta, acceleration * delta
+
+    return reference

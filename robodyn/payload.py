@@ -1,0 +1,75 @@
+"""Loads carried by a robot: attach a mass to a link and get a new robot.
+
+The payload is written into the robot's URDF (a link welded to the carrying link), so the
+new robot is an ordinary robot: Pinocchio and the reference both see it, ``robot.urdf``
+shows it, and viewers draw it.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+
+import numpy as np
+
+from robodyn.exceptions import FrameError, InputError
+from robodyn.loading import build_robot
+from robodyn.robot import Robot
+from robodyn.sources import URDFSource
+
+
+def attach_payload(
+    robot: Robot,
+    link: str,
+    mass: float,
+    *,
+    com: Sequence[float] = (0.0, 0.0, 0.0),
+    inertia: np.ndarray | None = None,
+    name: str = "payload",
+) -> Robot:
+    """A copy of ``robot`` carrying a payload rigidly attached to ``link``.
+
+    Args:
+        robot: The robot.
+        link: The URDF link that carries it (e.g. ``"end_effector"``).
+        mass: Payload mass in [kg] (> 0).
+        com: Payload centre of mass in the link's frame, in [m].
+        inertia: 3×3 inertia about its centre of mass in [kg m²]; default a solid sphere
+            of 3 cm radius.
+        name: Name of the payload link (unique in the robot).
+
+    Raises:
+        FrameError: If the robot has no such link.
+        InputError: For a non-positive mass or a bad inertia.
+    """
+    if link not in robot.spec.links:
+        raise FrameError(link, robot.name)
+    if not (np.isfinite(mass) and mass > 0):
+        raise InputError("mass", "a positive number of kg", repr(mass))
+    com = np.asarray(com, dtype=float)
+    inertia = np.eye(3) * (0.4 * mass * 0.03**2) if inertia is None else np.asarray(inertia, dtype=float)
+    if com.shape != (3,) or inertia.shape != (3, 3) or not (np.isfinite(com).all() and np.isfinite(inertia).all()):
+        raise InputError("com and inertia", "3 finite values and a finite 3×3 matrix", f"shapes {com.shape} and {inertia.shape}")
+    root = ET.fromstring(ET.tostring(robot.spec.xml))
+    payload_link = ET.SubElement(root, "link", name=name)
+    inertial = ET.SubElement(payload_link, "inertial")
+    ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
+    ET.SubElement(inertial, "mass", value=repr(float(mass)))
+    ET.SubElement(
+        inertial,
+        "inertia",
+        ixx=repr(float(inertia[0, 0])), ixy=repr(float(inertia[0, 1])), ixz=repr(float(inertia[0, 2])),
+        iyy=repr(float(inertia[1, 1])), iyz=repr(float(inertia[1, 2])), izz=repr(float(inertia[2, 2])),
+    )  # fmt: skip
+    visual = ET.SubElement(payload_link, "visual")
+    ET.SubElement(visual, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
+    ET.SubElement(ET.SubElement(visual, "geometry"), "sphere", radius="0.03")
+    joint = ET.SubElement(root, "joint", name=f"{name}_joint", type="fixed")
+    ET.SubElement(joint, "parent", link=link)
+    ET.SubElement(joint, "child", link=name)
+    ET.SubElement(joint, "origin", xyz="0 0 0", rpy="0 0 0")
+    text = ET.tostring(root, encoding="unicode")
+    source = URDFSource(
+        text, f"{robot.name}+{name}", f"{robot.name}+{name}", robot.source_path, robot.floating_base, robot.package_dirs
+    )
+    return build_robot(source, floating_base=robot.floating_base, gravity=robot.gravity_vector)

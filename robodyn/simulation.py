@@ -1,0 +1,287 @@
+"""Simulation: integrate the forward dynamics (ABA) of a robot in time.
+
+:func:`simulate` advances ``(q, v)`` with a fixed step ``dt``, either by the classical
+fourth-order Runge–Kutta method (``"rk4"``) or by semi-implicit (symplectic) Euler
+(``"semi-implicit-euler"``: ``v ← v + dt a(q, v)``, then ``q ← q ⊕ dt v``). Positions move
+on the configuration manifold (``Robot.integrate``: plain addition for joints, SE(3) for a
+floating base).
+
+The controller is a continuous-time law evaluated wherever the integrator evaluates the
+dynamics (every Runge–Kutta stage); with ``hold=True`` it is sampled once per step and its
+torque held during the step (zero-order hold, as on a digital controller). External
+wrenches are evaluated at every stage. The
+result is a :class:`Trajectory` (one row a sample) that saves to and loads from CSV and NPZ.
+
+A state that stops being finite ends the run with a :class:`SimulationError` saying when
+and which joint.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robodyn.exceptions import InputError, RobodynError
+from robodyn.files import atomic_write_bytes, atomic_write_text
+from robodyn.robot import Robot
+
+#: A controller maps time in [s], q and v to joint torques, shape (nv,).
+Controller = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+INTEGRATORS = ("rk4", "semi-implicit-euler")
+
+
+class SimulationError(RobodynError):
+    """The simulated state stopped being finite.
+
+    Attributes:
+        time: Simulation time of the last finite state, in [s].
+        step: Index of the step that diverged.
+        joint: Name of the first joint whose position or velocity is not finite.
+    """
+
+    def __init__(self, time: float, step: int, joint: str):
+        self.time = time
+        self.step = step
+        self.joint = joint
+        super().__init__(
+            f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
+        )
+
+
+@dataclass(frozen=True)
+class ExternalWrench:
+    """A wrench applied by the environment at a frame's origin (world axes).
+
+    Attributes:
+        frame: Link or joint name.
+        wrench: Force in [N] and torque in [N m] (shape (6,), or a force, shape (3,)), or a
+            function of time in [s] returning one.
+    """
+
+    frame: str
+    wrench: np.ndarray | Sequence[float] | Callable[[float], np.ndarray]
+
+    def value(self, time: float) -> np.ndarray:
+        """The wrench at a time, shape (6,) or (3,)."""
+        return np.asarray(self.wrench(time) if callable(self.wrench) else self.wrench, dtype=float)
+
+
+def external_torques(robot: Robot, q: np.ndarray, time: float, external: Sequence[ExternalWrench]) -> np.ndarray:
+    """Sum of ``J(q)ᵀ w`` over external wrenches at a time, shape (nv,)."""
+    total = np.zeros(robot.nv)
+    for item in external:
+        total += robot.wrench_torques(q, item.frame, item.value(time))
+    return total
+
+
+@dataclass
+class Trajectory:
+    """A sampled motion, one row a sample.
+
+    Attributes:
+        t: Times in [s], shape (N,).
+        q: Configurations, shape (N, nq).
+        v: Velocities, shape (N, nv).
+        a: Accelerations, shape (N, nv) (at the start of each step; last row repeats).
+        tau: Applied joint torques, shape (N, nv).
+        joint_names: Names of the velocity coordinates' joints (``Robot.joint_names``).
+        robot: Name of the robot.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    joint_names: list[str] = field(default_factory=list)
+    robot: str = ""
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def save(self, path: str | Path) -> Path:
+        """Write to ``.npz`` or ``.csv`` (by extension), atomically.
+
+        The CSV has a header ``t,q[name],...,v[name],...,a[...],tau[...]`` and a first
+        comment line naming the robot.
+        """
+        path = Path(path)
+        if path.suffix == ".npz":
+            import io
+
+            buffer = io.BytesIO()
+            np.savez(
+                buffer,
+                t=self.t,
+                q=self.q,
+                v=self.v,
+                a=self.a,
+                tau=self.tau,
+                joint_names=np.array(self.joint_names),
+                robot=np.array(self.robot),
+            )
+            atomic_write_bytes(path, buffer.getvalue())
+        elif path.suffix == ".csv":
+            atomic_write_text(path, self._csv())
+        else:
+            raise InputError("path", "a .csv or .npz file name", repr(str(path)))
+        return path
+
+    def _csv(self) -> str:
+        q_names = [f"q{i}" for i in range(self.q.shape[1])]
+        if self.q.shape[1] == len(self.joint_names):
+            q_names = [f"q[{name}]" for name in self.joint_names]
+        header = ["t", *q_names] + [f"{kind}[{name}]" for kind in ("v", "a", "tau") for name in self.joint_names]
+        table = np.column_stack([self.t, self.q, self.v, self.a, self.tau])
+        lines = [f"# robodyn trajectory of {self.robot}; SI units (s, rad or m, rad/s or m/s, N m or N)", ",".join(header)]
+        lines += [",".join(repr(float(x)) for x in row) for row in table]
+        return "\n".join(lines) + "\n"
+
+    @classmethod
+    def load(cls, path: str | Path) -> Trajectory:
+        """Read a trajectory written by :meth:`save`.
+
+        Raises:
+            RobodynError: If the file is missing or not a robodyn trajectory.
+        """
+        path = Path(path)
+        try:
+            if path.suffix == ".npz":
+                with np.load(path, allow_pickle=False) as data:
+                    return cls(
+                        data["t"],
+                        data["q"],
+                        data["v"],
+                        data["a"],
+                        data["tau"],
+                        [str(n) for n in data["joint_names"]],
+                        str(data["robot"]),
+                    )
+            if path.suffix == ".csv":
+                return cls._from_csv(path)
+        except (OSError, KeyError, ValueError, IndexError) as error:
+            raise RobodynError(f"{path}: not a readable robodyn trajectory ({error}).") from None
+        raise InputError("path", "a .csv or .npz file name", repr(str(path)))
+
+    @classmethod
+    def _from_csv(cls, path: Path) -> Trajectory:
+        lines = path.read_text(encoding="utf-8").splitlines()
+        commented = bool(lines) and lines[0].startswith("#")
+        robot = lines[0].removeprefix("# robodyn trajectory of ").split(";")[0] if commented else ""
+        header = lines[int(commented)].split(",")
+        table = np.loadtxt(path, delimiter=",", skiprows=int(commented) + 1, ndmin=2)
+        names = [h[2:-1] for h in header if h.startswith("v[")]
+        nv = len(names)
+        nq = len(header) - 1 - 3 * nv
+        q_end = 1 + nq
+        return cls(
+            table[:, 0],
+            table[:, 1:q_end],
+            table[:, q_end : q_end + nv],
+            table[:, q_end + nv : q_end + 2 * nv],
+            table[:, q_end + 2 * nv :],
+            names,
+            robot,
+        )
+
+
+def simulate(
+    robot: Robot,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    duration: float,
+    dt: float,
+    *,
+    controller: Controller | None = None,
+    integrator: str = "rk4",
+    external: Sequence[ExternalWrench] = (),
+    hold: bool = False,
+) -> Trajectory:
+    """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
+
+    Args:
+        robot: The plant.
+        q0: Initial configuration, shape (nq,).
+        v0: Initial velocity, shape (nv,).
+        duration: Simulated time in [s].
+        dt: Step in [s].
+        controller: ``controller(t, q, v) -> tau``; ``None`` for zero torque (passive).
+        integrator: ``"rk4"`` or ``"semi-implicit-euler"``.
+        external: Wrenches the environment applies (constant or functions of time).
+        hold: Sample the controller once per step and hold its torque (zero-order hold)
+            instead of evaluating it at every integration stage.
+
+    Returns:
+        The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0``.
+
+    Raises:
+        InputError: For bad initial states, step or integrator.
+        SimulationError: If the state stops being finite.
+    """
+    if integrator not in INTEGRATORS:
+        raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
+    if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
+        raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
+    (q, v), _ = robot._checked(q=q0, v=v0)
+    if q.ndim != 1:
+        raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
+    steps = round(duration / dt)
+    times = np.arange(steps + 1) * dt
+    qs, vs = np.empty((steps + 1, robot.nq)), np.empty((steps + 1, robot.nv))
+    accelerations, torques = np.zeros((steps + 1, robot.nv)), np.zeros((steps + 1, robot.nv))
+    zero = np.zeros(robot.nv)
+    forward = _accelerator(robot, external)
+    if controller is None:
+        accelerate = lambda t, q, v, tau: forward(t, q, v, zero)  # noqa: E731
+    elif hold:
+        accelerate = forward
+    else:
+        accelerate = lambda t, q, v, tau: forward(t, q, v, np.asarray(controller(t, q, v), dtype=float))  # noqa: E731
+    integrate = robot.integrate
+    q, v = q.copy(), v.copy()
+    for step in range(steps):
+        t = times[step]
+        qs[step], vs[step] = q, v
+        tau = zero if controller is None else np.asarray(controller(t, q, v), dtype=float)
+        torques[step] = tau
+        a = forward(t, q, v, tau)
+        accelerations[step] = a
+        if integrator == "rk4":
+            half = 0.5 * dt
+            v2 = v + half * a
+            a2 = accelerate(t + half, integrate(q, half * v), v2, tau)
+            v3 = v + half * a2
+            a3 = accelerate(t + half, integrate(q, half * v2), v3, tau)
+            v4 = v + dt * a3
+            a4 = accelerate(t + dt, integrate(q, dt * v3), v4, tau)
+            q = integrate(q, (dt / 6) * (v + 2 * v2 + 2 * v3 + v4))
+            v = v + (dt / 6) * (a + 2 * a2 + 2 * a3 + a4)
+        else:
+            v = v + dt * a
+            q = integrate(q, dt * v)
+        if not (math.isfinite(v.dot(v)) and math.isfinite(q.dot(q))):
+            bad = np.flatnonzero(~np.isfinite(v))
+            joint = robot.joint_names[min(int(bad[0]) if bad.size else 0, len(robot.joint_names) - 1)]
+            raise SimulationError(float(t), step, joint)
+    qs[steps], vs[steps] = q, v
+    torques[steps] = torques[steps - 1] if steps else 0.0
+    accelerations[steps] = accelerations[steps - 1] if steps else 0.0
+    return Trajectory(times, qs, vs, accelerations, torques, list(robot.joint_names), robot.name)
+
+
+def _accelerator(
+    robot: Robot, external: Sequence[ExternalWrench]
+) -> Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+    """``a(t, q, v, tau)``: forward dynamics with the external wrenches' torques added.
+
+    Calls Pinocchio without the boundary checks (the state was checked once, and the loop
+    checks finiteness each step).
+    """
+    forward = robot.forward_dynamics_unchecked
+    if not external:
+        return lambda t, q, v, tau: forward(q, v, tau)
+    return lambda t, q, v, tau: forward(q, v, tau + external_torques(robot, q, t, external))

@@ -1,0 +1,160 @@
+"""The lecture's "what if" questions, answered with numbers.
+
+What changes if the links are plastic, aluminium or steel? If the robot carries a load at
+its end effector? If an external force acts on it? :func:`sweep` drives one motion (a
+rest-to-rest quintic between two configurations) through the inverse dynamics of each
+variant of the arm and reports the peak and RMS torque of every joint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robodyn.control import quintic_reference
+from robodyn.loading import load
+from robodyn.models import RPArmParameters, rp_arm_urdf
+from robodyn.payload import attach_payload
+from robodyn.robot import Robot
+
+DEFAULT_MATERIALS = ("abs", "aluminium", "steel")
+DEFAULT_PAYLOADS = (0.0, 0.5, 2.0)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One row of the what-if table.
+
+    Attributes:
+        material: Link material (or ``"as loaded"`` for robots that are not generated).
+        payload: Payload mass at the end effector in [kg].
+        force: External force at the end effector in [N], world axes, shape (3,).
+        robot_mass: Total mass of the arm with its payload in [kg].
+        peak: Peak absolute torque per joint in [N m] / [N], shape (nv,).
+        rms: RMS torque per joint over the motion, shape (nv,).
+    """
+
+    material: str
+    payload: float
+    force: np.ndarray
+    robot_mass: float
+    peak: np.ndarray
+    rms: np.ndarray
+
+
+def motion_torques(
+    robot: Robot,
+    q_start: np.ndarray,
+    q_end: np.ndarray,
+    duration: float,
+    *,
+    samples: int = 401,
+    frame: str | None = None,
+    force: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Torques along a rest-to-rest quintic motion: times (N,) and torques (N, nv).
+
+    An external ``force`` (in [N], world axes) acting on ``frame`` is subtracted through
+    ``J(q)ᵀ f``: the motors need that much less torque when it helps, more when it resists.
+    """
+    reference = quintic_reference(q_start, q_end, duration)
+    times = np.linspace(0.0, duration, samples)
+    q, v, a = (np.array(column) for column in zip(*(reference(t) for t in times), strict=True))
+    torques = robot.inverse_dynamics(q, v, a)
+    if force is not None and np.any(force):
+        torques = torques - np.array([robot.wrench_torques(qi, frame, force) for qi in q])
+    return times, torques
+
+
+def sweep(
+    model: str = "rp_arm",
+    *,
+    materials: tuple[str, ...] | None = None,
+    payloads: tuple[float, ...] = DEFAULT_PAYLOADS,
+    forces: tuple[tuple[float, float, float], ...] = ((0.0, 0.0, 0.0),),
+    q_start: np.ndarray | None = None,
+    q_end: np.ndarray | None = None,
+    duration: float = 1.5,
+    frame: str | None = None,
+) -> list[Variant]:
+    """Peak and RMS joint torques of one motion, for each material × payload × force.
+
+    Args:
+        model: ``"rp_arm"`` (materials apply) or any robot :func:`robodyn.load` takes
+            (then ``materials`` must be ``None``).
+        materials: Link materials for the RP arm; default plastic, aluminium, steel.
+        payloads: Payload masses at the end effector, in [kg].
+        forces: External forces at the end effector, in [N], world axes.
+        q_start, q_end: The motion; default: the RP arm from hanging 45° down and retracted
+            to 45° up and extended; other robots from neutral to 0.5 rad on every joint.
+        duration: Motion time in [s].
+        frame: The end-effector link; default ``end_effector`` or the last link.
+    """
+    generated = model == "rp_arm"
+    if generated:
+        variants = [(name, load(rp_arm_urdf(RPArmParameters.from_material(name)))) for name in (materials or DEFAULT_MATERIALS)]
+    else:
+        if materials:
+            from robodyn.exceptions import InputError
+
+            raise InputError("materials", "given only for the generated rp_arm", f"{len(materials)} materials for {model!r}")
+        variants = [("as loaded", load(model))]
+    base_robot = variants[0][1]
+    frame = frame or ("end_effector" if "end_effector" in base_robot.spec.links else list(base_robot.spec.links)[-1])
+    if q_start is None:
+        q_start = np.array([-np.pi / 4, 0.0]) if generated else base_robot.neutral_configuration()
+    if q_end is None:
+        q_end = np.array([np.pi / 4, 0.25]) if generated else base_robot.neutral_configuration() + 0.5
+    rows = []
+    for material, robot in variants:
+        for payload in payloads:
+            loaded = attach_payload(robot, frame, payload) if payload > 0 else robot
+            for force in forces:
+                force = np.asarray(force, dtype=float)
+                _, torques = motion_torques(loaded, q_start, q_end, duration, frame=frame, force=force)
+                rows.append(
+                    Variant(
+                        material,
+                        float(payload),
+                        force,
+                        loaded.total_mass,
+                        np.abs(torques).max(axis=0),
+                        np.sqrt((torques**2).mean(axis=0)),
+                    )
+                )
+    return rows
+
+
+def table_text(rows: list[Variant], joint_names: list[str], units: list[str]) -> str:
+    """The sweep as a readable table."""
+    header = f"{'material':10s} {'payload':>8s} {'force [N]':>16s} {'mass':>8s}"
+    for name, unit in zip(joint_names, units, strict=True):
+        header += f" {'peak ' + name + ' [' + unit + ']':>22s} {'rms ' + name:>14s}"
+    lines = [header]
+    for row in rows:
+        force = ",".join(f"{f:g}" for f in row.force)
+        line = f"{row.material:10s} {row.payload:>6.2f}kg {force:>16s} {row.robot_mass:>6.2f}kg"
+        for peak, rms in zip(row.peak, row.rms, strict=True):
+            line += f" {peak:>22.3f} {rms:>14.3f}"
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def table_dict(rows: list[Variant], joint_names: list[str], units: list[str]) -> dict:
+    """The sweep, JSON-ready."""
+    return {
+        "joint_names": joint_names,
+        "torque_units": units,
+        "rows": [
+            {
+                "material": r.material,
+                "payload_kg": r.payload,
+                "force_N": r.force.tolist(),
+                "robot_mass_kg": r.robot_mass,
+                "peak_torque": r.peak.tolist(),
+                "rms_torque": r.rms.tolist(),
+            }
+            for r in rows
+        ],
+    }
