@@ -20,7 +20,7 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 def test_list_names_generated_and_zoo_robots(capsys):
     status, out, _ = run(capsys, "list")
     assert status == 0
-    assert out.splitlines()[0].startswith("rp_arm")
+    assert {line.split()[0] for line in out.splitlines()[:2]} == {"pendulum", "rp_arm"}
     assert "panda" in out and "floating base" in out
 
 
