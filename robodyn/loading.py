@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from robodyn.exceptions import URDFError
 from robodyn.robot import MimicExpansion, Robot
-from robodyn.sources import URDFSource, resolve_source
+from robodyn.sources import URDFSource, locked_source, resolve_source
 from robodyn.validation import URDFSpec, parse_urdf
 
 #: Limit written for continuous joints in the copy Pinocchio reads, in [rad].
@@ -59,6 +59,7 @@ def load(
     floating_base: bool | None = None,
     gravity: Sequence[float] | None = None,
     check_inertia: bool = True,
+    lock: dict[str, float] | None = None,
 ) -> Robot:
     """Load a robot.
 
@@ -72,6 +73,8 @@ def load(
             ``(0, 0, -9.81)``.
         check_inertia: Refuse physically impossible inertias on moving links (set false
             to load published models that have them).
+        lock: Joints to freeze, by name, at positions in [rad] / [m] (e.g. a gripper's
+            fingers): they become fixed joints, and joints mimicking them follow.
 
     Returns:
         The robot.
@@ -81,7 +84,10 @@ def load(
         URDFError: If the URDF cannot be read or describes an impossible robot.
         InputError: If ``gravity`` is not 3 finite numbers.
     """
-    return build_robot(resolve_source(source), floating_base=floating_base, gravity=gravity, check_inertia=check_inertia)
+    resolved = resolve_source(source)
+    if lock:
+        resolved = locked_source(resolved, lock, floating_base=floating_base, check_inertia=check_inertia)
+    return build_robot(resolved, floating_base=floating_base, gravity=gravity, check_inertia=check_inertia)
 
 
 def build_robot(

@@ -16,6 +16,7 @@ from robodyn.exceptions import FrameError, InputError
 from robodyn.loading import build_robot
 from robodyn.robot import Robot
 from robodyn.sources import URDFSource
+from robodyn.urdf_edit import weld_link
 
 
 def attach_payload(
@@ -50,8 +51,7 @@ def attach_payload(
     inertia = np.eye(3) * (0.4 * mass * 0.03**2) if inertia is None else np.asarray(inertia, dtype=float)
     if com.shape != (3,) or inertia.shape != (3, 3) or not (np.isfinite(com).all() and np.isfinite(inertia).all()):
         raise InputError("com and inertia", "3 finite values and a finite 3×3 matrix", f"shapes {com.shape} and {inertia.shape}")
-    root = ET.fromstring(ET.tostring(robot.spec.xml))
-    payload_link = ET.SubElement(root, "link", name=name)
+    payload_link = ET.Element("link", name=name)
     inertial = ET.SubElement(payload_link, "inertial")
     ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
     ET.SubElement(inertial, "mass", value=repr(float(mass)))
@@ -64,11 +64,7 @@ def attach_payload(
     visual = ET.SubElement(payload_link, "visual")
     ET.SubElement(visual, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
     ET.SubElement(ET.SubElement(visual, "geometry"), "sphere", radius="0.03")
-    joint = ET.SubElement(root, "joint", name=f"{name}_joint", type="fixed")
-    ET.SubElement(joint, "parent", link=link)
-    ET.SubElement(joint, "child", link=name)
-    ET.SubElement(joint, "origin", xyz="0 0 0", rpy="0 0 0")
-    text = ET.tostring(root, encoding="unicode")
+    text = weld_link(robot.spec, link, payload_link)
     source = URDFSource(
         text, f"{robot.name}+{name}", f"{robot.name}+{name}", robot.source_path, robot.floating_base, robot.package_dirs
     )

@@ -34,6 +34,7 @@ from robodyn.validation import URDFSpec
 QUATERNION_TOLERANCE = 1e-6
 #: What Pinocchio raises for arguments it refuses (wrong size, type, unsupported joint).
 _PINOCCHIO_ERRORS = (TypeError, ValueError, RuntimeError)
+_isfinite = math.isfinite
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,7 @@ class Robot:
         self.urdf = urdf
         self.spec = spec
         self.floating_base = floating_base
+        self._fixed_base = not floating_base
         self.source_path = source_path
         self.package_dirs = package_dirs
         self.nq: int = model.nq
@@ -127,6 +129,7 @@ class Robot:
         self._frame_ids = {frame.name: index for index, frame in enumerate(model.frames)}
         self._pool: pin.ModelPool | None = None
         self.mimic = mimic
+        self._lower_triangle = np.tri(self.nv, self.nv, -1, dtype=bool)
 
     def __repr__(self) -> str:
         return f"<Robot {self.name!r}: nq={self.nq}, nv={self.nv}, joints={self.joint_names}>"
@@ -229,12 +232,15 @@ class Robot:
     # through the full boundary check, which names the offending argument.
     # ----------------------------------------------------------------------------------
     def _accept(self, result: np.ndarray, q: np.ndarray) -> bool:
-        """Whether a fast-path result can be returned as it is (a NaN or inf makes the
-        sum of squares non-finite; a huge finite result is re-checked exactly)."""
-        flat = result if result.ndim == 1 else result.ravel()
-        if not math.isfinite(flat.dot(flat)):
-            return False
-        return not self.floating_base or abs(q[3:7].dot(q[3:7]) - 1.0) < QUATERNION_TOLERANCE
+        """Whether a fast-path matrix result can be returned as it is (a NaN or inf makes
+        the sum of squares non-finite; a huge finite result is re-checked exactly)."""
+        flat = result.ravel()
+        return _isfinite(flat.dot(flat)) and (self._fixed_base or self._unit_quaternion(q))
+
+    @staticmethod
+    def _unit_quaternion(q: np.ndarray) -> bool:
+        quaternion = q[3:7]
+        return abs(quaternion.dot(quaternion) - 1.0) < QUATERNION_TOLERANCE
 
     def _checked(self, **named: np.ndarray) -> tuple[list[np.ndarray], bool]:
         """Full boundary check of state arguments (sizes by name: q has nq, others nv)."""
@@ -259,10 +265,11 @@ class Robot:
         """
         try:
             tau = pin.rnea(self.model, self.data, q, v, a)
-            if self._accept(tau, q):
-                return tau
         except _PINOCCHIO_ERRORS:
             pass
+        else:
+            if _isfinite(tau.dot(tau)) and (self._fixed_base or self._unit_quaternion(q)):
+                return tau
         (q, v, a), batch = self._checked(q=q, v=v, a=a)
         if batch:
             return self._in_parallel(pin.rneaInParallel, q, v, a)
@@ -285,10 +292,11 @@ class Robot:
         if self.mimic is None:
             try:
                 a = pin.aba(self.model, self.data, q, v, tau)
-                if self._accept(a, q):
-                    return a
             except _PINOCCHIO_ERRORS:
                 pass
+            else:
+                if _isfinite(a.dot(a)) and (self._fixed_base or self._unit_quaternion(q)):
+                    return a
         (q, v, tau), batch = self._checked(q=q, v=v, tau=tau)
         if self.mimic is not None:  # Pinocchio's ABA does not support mimic joints
             if batch:
@@ -339,7 +347,7 @@ class Robot:
         try:
             mass = self._mass_matrix(q)
             # CRBA works in local frames: a NaN in q need not reach M, so check q too.
-            if self._accept(mass, q) and math.isfinite(q.dot(q)):
+            if self._accept(mass, q) and _isfinite(q.dot(q)):
                 return mass
         except _PINOCCHIO_ERRORS:
             pass
@@ -348,8 +356,7 @@ class Robot:
 
     def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
         mass = pin.crba(self.model, self.data, q)  # upper triangle only
-        lower = np.tril_indices(self.nv, -1)
-        mass[lower] = mass.T[lower]
+        np.copyto(mass, mass.T, where=self._lower_triangle)
         return mass
 
     def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -362,13 +369,13 @@ class Robot:
         Returns:
             Shape (nv, nv) or (N, nv, nv).
         """
-        if self.mimic is None:
-            try:
-                coriolis = pin.computeCoriolisMatrix(self.model, self.data, q, v)
-                if self._accept(coriolis, q):
-                    return coriolis
-            except _PINOCCHIO_ERRORS:
-                pass
+        try:
+            coriolis = self._coriolis(q, v)
+        except _PINOCCHIO_ERRORS:
+            pass
+        else:
+            if self._accept(coriolis, q):
+                return coriolis
         (q, v), batch = self._checked(q=q, v=v)
         if batch:
             if not len(q):
@@ -379,8 +386,9 @@ class Robot:
     def _coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self.mimic is not None:  # computeCoriolisMatrix mishandles mimic joints
             expansion = self.mimic
-            full = pin.computeCoriolisMatrix(expansion.model, expansion.data, expansion.q(q), expansion.selection @ v)
-            return expansion.selection.T @ full @ expansion.selection
+            with np.errstate(invalid="ignore"):  # inf inputs: the checks after report them
+                full = pin.computeCoriolisMatrix(expansion.model, expansion.data, expansion.q(q), expansion.selection @ v)
+                return expansion.selection.T @ full @ expansion.selection
         return pin.computeCoriolisMatrix(self.model, self.data, q, v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
@@ -394,10 +402,11 @@ class Robot:
         """
         try:
             torques = pin.computeGeneralizedGravity(self.model, self.data, q)
-            if self._accept(torques, q):
-                return torques
         except _PINOCCHIO_ERRORS:
             pass
+        else:
+            if _isfinite(torques.dot(torques)) and (self._fixed_base or self._unit_quaternion(q)):
+                return torques
         (q,), batch = self._checked(q=q)
         if batch:
             zeros = np.zeros((q.shape[0], self.nv))
@@ -416,10 +425,11 @@ class Robot:
         """
         try:
             torques = pin.nonLinearEffects(self.model, self.data, q, v)
-            if self._accept(torques, q):
-                return torques
         except _PINOCCHIO_ERRORS:
             pass
+        else:
+            if _isfinite(torques.dot(torques)) and (self._fixed_base or self._unit_quaternion(q)):
+                return torques
         (q, v), batch = self._checked(q=q, v=v)
         if batch:
             return self._in_parallel(pin.rneaInParallel, q, v, np.zeros_like(v))

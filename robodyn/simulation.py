@@ -231,46 +231,81 @@ def simulate(
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     steps = round(duration / dt)
     times = np.arange(steps + 1) * dt
-    qs, vs = np.empty((steps + 1, robot.nq)), np.empty((steps + 1, robot.nv))
-    accelerations, torques = np.zeros((steps + 1, robot.nv)), np.zeros((steps + 1, robot.nv))
+    qs, vs, accelerations, torques = [], [], [], []
     zero = np.zeros(robot.nv)
     forward = _accelerator(robot, external)
-    if controller is None:
-        accelerate = lambda t, q, v, tau: forward(t, q, v, zero)  # noqa: E731
-    elif hold:
+    if controller is None or hold:  # the step's torque (zero when passive) holds
         accelerate = forward
     else:
         accelerate = lambda t, q, v, tau: forward(t, q, v, np.asarray(controller(t, q, v), dtype=float))  # noqa: E731
-    integrate = robot.integrate
+    # Fixed base: q moves by plain addition (no call); floating base: on SE(3).
+    integrate = robot.integrate if robot.floating_base else None
     q, v = q.copy(), v.copy()
+    half, sixth = 0.5 * dt, dt / 6.0
+    rk4 = integrator == "rk4"
     for step in range(steps):
-        t = times[step]
-        qs[step], vs[step] = q, v
-        tau = zero if controller is None else np.asarray(controller(t, q, v), dtype=float)
-        torques[step] = tau
-        a = forward(t, q, v, tau)
-        accelerations[step] = a
-        if integrator == "rk4":
-            half = 0.5 * dt
-            v2 = v + half * a
-            a2 = accelerate(t + half, integrate(q, half * v), v2, tau)
-            v3 = v + half * a2
-            a3 = accelerate(t + half, integrate(q, half * v2), v3, tau)
-            v4 = v + dt * a3
-            a4 = accelerate(t + dt, integrate(q, dt * v3), v4, tau)
-            q = integrate(q, (dt / 6) * (v + 2 * v2 + 2 * v3 + v4))
-            v = v + (dt / 6) * (a + 2 * a2 + 2 * a3 + a4)
-        else:
-            v = v + dt * a
-            q = integrate(q, dt * v)
-        if not (math.isfinite(v.dot(v)) and math.isfinite(q.dot(q))):
-            bad = np.flatnonzero(~np.isfinite(v))
+        t = step * dt
+        try:
+            qs.append(q)
+            vs.append(v)
+            tau = zero if controller is None else np.asarray(controller(t, q, v), dtype=float)
+            torques.append(tau)
+            a = forward(t, q, v, tau)
+            accelerations.append(a)
+            if rk4:
+                v2 = v + half * a
+                if integrate is None:
+                    a2 = accelerate(t + half, q + half * v, v2, tau)
+                    v3 = v + half * a2
+                    a3 = accelerate(t + half, q + half * v2, v3, tau)
+                    v4 = v + dt * a3
+                    a4 = accelerate(t + dt, q + dt * v3, v4, tau)
+                    q = q + sixth * (v + v4 + 2.0 * (v2 + v3))
+                else:
+                    a2 = accelerate(t + half, integrate(q, half * v), v2, tau)
+                    v3 = v + half * a2
+                    a3 = accelerate(t + half, integrate(q, half * v2), v3, tau)
+                    v4 = v + dt * a3
+                    a4 = accelerate(t + dt, integrate(q, dt * v3), v4, tau)
+                    q = integrate(q, sixth * (v + v4 + 2.0 * (v2 + v3)))
+                v = v + sixth * (a + a4 + 2.0 * (a2 + a3))
+            else:
+                v = v + dt * a
+                q = q + dt * v if integrate is None else integrate(q, dt * v)
+        except InputError:  # a non-finite state reached a controller's checked call
+            _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
+            raise
+        if step % _CHECK_EVERY == 0 or step == steps - 1:
+            _check_finite(robot, qs, vs, q, v, dt)
+    qs.append(q)
+    vs.append(v)
+    torques.append(torques[-1] if steps else zero)
+    accelerations.append(accelerations[-1] if steps else forward(0.0, q, v, zero))
+    return Trajectory(
+        times, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques), list(robot.joint_names), robot.name
+    )
+
+
+#: Steps between two finiteness checks of the state (a divergence is located exactly).
+_CHECK_EVERY = 64
+
+
+def _check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: np.ndarray, v: np.ndarray, dt: float) -> None:
+    """Raise :class:`SimulationError` at the first non-finite state since the last check."""
+    if math.isfinite(v.dot(v)) and math.isfinite(q.dot(q)):
+        return
+    states = [*zip(qs[-_CHECK_EVERY:], vs[-_CHECK_EVERY:], strict=True), (q, v)]
+    first = len(qs) - len(states) + 1
+    for offset, (q_i, v_i) in enumerate(states):
+        if not (np.isfinite(q_i).all() and np.isfinite(v_i).all()):
+            bad = (
+                np.flatnonzero(~np.isfinite(v_i))
+                if not np.isfinite(v_i).all()
+                else np.flatnonzero(~np.isfinite(q_i[robot.nq - robot.nv :]))
+            )
             joint = robot.joint_names[min(int(bad[0]) if bad.size else 0, len(robot.joint_names) - 1)]
-            raise SimulationError(float(t), step, joint)
-    qs[steps], vs[steps] = q, v
-    torques[steps] = torques[steps - 1] if steps else 0.0
-    accelerations[steps] = accelerations[steps - 1] if steps else 0.0
-    return Trajectory(times, qs, vs, accelerations, torques, list(robot.joint_names), robot.name)
+            step = first + offset - 1
+            raise SimulationError(step * dt, step, joint)
 
 
 def _accelerator(
@@ -283,5 +318,10 @@ def _accelerator(
     """
     forward = robot.forward_dynamics_unchecked
     if not external:
+        if robot.mimic is None:  # straight to Pinocchio's ABA
+            import pinocchio as pin
+
+            aba, model, data = pin.aba, robot.model, robot.data
+            return lambda t, q, v, tau: aba(model, data, q, v, tau)
         return lambda t, q, v, tau: forward(q, v, tau)
     return lambda t, q, v, tau: forward(q, v, tau + external_torques(robot, q, t, external))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import difflib
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from robodyn import zoo
@@ -82,3 +82,16 @@ def resolve_source(source: str | os.PathLike) -> URDFSource:
     if path.is_file() or os.sep in text or text.endswith((".urdf", ".xml")):
         return _read_file(path)
     raise UnknownRobotError(text, difflib.get_close_matches(text, list(GENERATED) + list(zoo.ZOO), n=3))
+
+
+def locked_source(
+    resolved: URDFSource, lock: dict[str, float], *, floating_base: bool | None = None, check_inertia: bool = True
+) -> URDFSource:
+    """The same source with joints frozen at positions (see :func:`robodyn.urdf_edit.lock_joints`)."""
+    from robodyn.urdf_edit import lock_joints
+    from robodyn.validation import parse_urdf
+
+    floating = resolved.floating_base if floating_base is None else floating_base
+    spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia)
+    text = lock_joints(spec, lock, resolved.label)
+    return replace(resolved, text=text, label=f"{resolved.label} (locked {', '.join(lock)})")

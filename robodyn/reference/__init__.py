@@ -21,7 +21,7 @@ import numpy as np
 from robodyn.inputs import as_state
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.tree import KinematicTree, build_tree
-from robodyn.sources import resolve_source
+from robodyn.sources import locked_source, resolve_source
 from robodyn.validation import parse_urdf
 
 STANDARD_GRAVITY = (0.0, 0.0, -9.81)
@@ -32,6 +32,7 @@ def load(
     *,
     gravity: Sequence[float] | None = None,
     check_inertia: bool = True,
+    lock: dict[str, float] | None = None,
 ) -> ReferenceRobot:
     """Load the reference model of a robot (fixed base).
 
@@ -39,12 +40,14 @@ def load(
         source: As for :func:`robodyn.load`: a URDF path, URDF text, a zoo name or a
             generated robot's name.
         gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
-        check_inertia: As for :func:`robodyn.load`.
+        check_inertia, lock: As for :func:`robodyn.load`.
 
     Raises:
         UnknownRobotError, URDFError: As :func:`robodyn.load`.
     """
     resolved = resolve_source(source)
+    if lock:
+        resolved = locked_source(resolved, lock, floating_base=False, check_inertia=check_inertia)
     spec = parse_urdf(resolved.text, resolved.label, check_inertia=check_inertia)
     tree = build_tree(spec, resolved.text)
     name = spec.name if resolved.name == "robot" else resolved.name

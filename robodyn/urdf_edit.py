@@ -1,0 +1,101 @@
+"""Edits of a validated URDF that give a new robot: locking joints, welding on a link.
+
+Both return URDF text, so the edited robot is an ordinary robot that Pinocchio and the
+independent reference read alike. Nothing here imports Pinocchio.
+
+- :func:`lock_joints` turns moving joints into fixed ones at given positions (e.g. a
+  gripper's fingers), folding the joint's motion into its origin; joints that mimic a
+  locked joint are locked at the matching position.
+- :func:`weld_link` adds a link (a payload, a tool) rigidly attached to an existing one.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from robodyn.exceptions import InputError
+from robodyn.validation import URDFSpec
+
+
+def _rpy_matrix(rpy: np.ndarray) -> np.ndarray:
+    roll, pitch, yaw = rpy
+    rx = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
+    ry = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]])
+    rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def _matrix_rpy(rotation: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw of a rotation matrix (URDF's fixed-axis X-Y-Z convention)."""
+    pitch = math.atan2(-rotation[2, 0], math.hypot(rotation[0, 0], rotation[1, 0]))
+    if abs(math.cos(pitch)) < 1e-12:  # gimbal lock: put everything in yaw
+        return np.array([0.0, pitch, math.atan2(-rotation[0, 1], rotation[1, 1])])
+    return np.array([math.atan2(rotation[2, 1], rotation[2, 2]), pitch, math.atan2(rotation[1, 0], rotation[0, 0])])
+
+
+def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    x, y, z = axis
+    skew = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return np.eye(3) + math.sin(angle) * skew + (1 - math.cos(angle)) * skew @ skew
+
+
+def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<string>") -> str:
+    """URDF text with the named joints fixed at the given positions.
+
+    Args:
+        spec: The validated URDF.
+        positions: Joint name -> position in [rad] or [m].
+        source: For messages.
+
+    Raises:
+        InputError: For an unknown or fixed joint, a non-finite position, or a position
+            outside the joint's limits.
+    """
+    values = dict(positions)
+    for name, value in values.items():
+        joint = spec.joints.get(name)
+        if joint is None or joint.type == "fixed":
+            raise InputError("lock", f"moving joints of {source}", f"{name!r}")
+        if not math.isfinite(value) or not (joint.lower - 1e-12 <= value <= joint.upper + 1e-12):
+            raise InputError("lock", f"a position of {name!r} within [{joint.lower}, {joint.upper}]", repr(value))
+    for joint in spec.joints.values():  # mimic joints follow their locked source
+        if joint.mimic is not None and joint.mimic.joint in values and joint.name not in values:
+            values[joint.name] = joint.mimic.multiplier * values[joint.mimic.joint] + joint.mimic.offset
+    root = copy.deepcopy(spec.xml)
+    for node in root.findall("joint"):
+        name = node.get("name")
+        if name not in values:
+            continue
+        joint = spec.joints[name]
+        rotation = _rpy_matrix(joint.origin_rpy)
+        translation = joint.origin_xyz.copy()
+        if joint.type == "prismatic":
+            translation = translation + rotation @ joint.axis * values[name]
+        else:
+            rotation = rotation @ _axis_rotation(joint.axis, values[name])
+        for child in list(node):
+            if child.tag in ("origin", "axis", "limit", "mimic", "dynamics", "safety_controller", "calibration"):
+                node.remove(child)
+        node.set("type", "fixed")
+        ET.SubElement(
+            node,
+            "origin",
+            xyz=" ".join(repr(float(x)) for x in translation),
+            rpy=" ".join(repr(float(x)) for x in _matrix_rpy(rotation)),
+        )
+    return ET.tostring(root, encoding="unicode")
+
+
+def weld_link(spec: URDFSpec, parent: str, link: ET.Element, xyz: str = "0 0 0", rpy: str = "0 0 0") -> str:
+    """URDF text with ``link`` (a ``<link>`` element) welded to ``parent`` by a fixed joint."""
+    root = copy.deepcopy(spec.xml)
+    root.append(link)
+    joint = ET.SubElement(root, "joint", name=f"{link.get('name')}_joint", type="fixed")
+    ET.SubElement(joint, "parent", link=parent)
+    ET.SubElement(joint, "child", link=link.get("name"))
+    ET.SubElement(joint, "origin", xyz=xyz, rpy=rpy)
+    return ET.tostring(root, encoding="unicode")
