@@ -178,6 +178,31 @@ def _command_whatif(arguments: argparse.Namespace) -> int:
     return 0
 
 
+def _command_lint(arguments: argparse.Namespace) -> int:
+    from robodyn.validation import lint_source
+
+    problems = lint_source(arguments.model, floating_base=arguments.floating_base)
+    errors = sum(problem.severity == "error" for problem in problems)
+    if arguments.json:
+        print(
+            json.dumps(
+                {
+                    "errors": errors,
+                    "warnings": len(problems) - errors,
+                    "problems": [{"severity": p.severity, "element": p.element, "rule": p.rule} for p in problems],
+                },
+                indent=2,
+            )
+        )
+    else:
+        for problem in problems:
+            print(f"{problem.severity}: {problem}")
+        print(
+            f"{arguments.model if len(arguments.model) < 80 else '<URDF text>'}: {errors} errors, {len(problems) - errors} warnings"
+        )
+    return 1 if errors else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``robodyn`` command."""
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics from any URDF, verified.")
@@ -210,6 +235,14 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error accepted (default 1e-9)")
     check.add_argument("--json", action="store_true", help="print JSON")
     check.set_defaults(run=_command_check)
+
+    lint = commands.add_parser("lint", help="every problem of a URDF at once (exit 1 if any error)")
+    lint.add_argument("model", help="URDF path, robot name or URDF text")
+    lint.add_argument(
+        "--floating-base", dest="floating_base", action="store_true", default=None, help="check as a floating-base robot"
+    )
+    lint.add_argument("--json", action="store_true", help="print JSON")
+    lint.set_defaults(run=_command_lint)
 
     simulate = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
     _add_model_arguments(simulate)

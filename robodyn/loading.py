@@ -13,8 +13,11 @@ from a normalised copy of it:
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import os
+import sys
+import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 
@@ -104,15 +107,19 @@ def build_robot(
     from robodyn.inputs import as_state
 
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
-    spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia)
+    spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia, **resolved.mesh_context)
     xml = pinocchio_xml(spec)
-    try:
-        if floating:
-            model = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint", mimic=True)
-        else:
-            model = pin.buildModelFromXML(xml, mimic=True)
-    except (RuntimeError, ValueError) as error:
-        raise URDFError(resolved.label, f"Pinocchio refused the model ({str(error).strip()})") from None
+    with _captured_stderr() as captured:
+        try:
+            if floating:
+                model = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint", mimic=True)
+            else:
+                model = pin.buildModelFromXML(xml, mimic=True)
+        except (RuntimeError, ValueError) as error:
+            model, refusal = None, str(error).strip()
+    if model is None:
+        reason = " ".join(line.strip() for line in captured.text().splitlines() if line.strip())
+        raise URDFError(resolved.label, f"Pinocchio refused the model ({refusal}{'; ' + reason if reason else ''})")
     mimic = _mimic_expansion(model, spec, xml, floating) if model.nq != _model_without_mimic_nq(spec, floating) else None
     if gravity is not None:
         model.gravity.linear = as_state(gravity, "gravity", 3)
@@ -131,6 +138,37 @@ def build_robot(
         package_dirs=resolved.package_dirs,
         mimic=mimic,
     )
+
+
+class _Captured:
+    """What was written to stderr, read when the capture ends."""
+
+    def __init__(self) -> None:
+        self.content = ""
+
+    def text(self) -> str:
+        return self.content
+
+
+@contextlib.contextmanager
+def _captured_stderr():
+    """Capture what C++ code writes to the process's stderr (file descriptor 2).
+
+    Pinocchio's URDF parser prints its reason for refusing a model there, where Python
+    cannot catch it; robodyn puts it into the error message instead.
+    """
+    with tempfile.TemporaryFile() as stream:
+        sys.stderr.flush()
+        saved = os.dup(2)
+        captured = _Captured()
+        try:
+            os.dup2(stream.fileno(), 2)
+            yield captured
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            stream.seek(0)
+            captured.content = stream.read(4000).decode("utf-8", "replace")
 
 
 def _model_without_mimic_nq(spec: URDFSpec, floating: bool) -> int:

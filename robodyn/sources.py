@@ -38,6 +38,11 @@ class URDFSource:
     floating_base: bool = False
     package_dirs: tuple[Path, ...] = field(default_factory=tuple)
 
+    @property
+    def mesh_context(self) -> dict:
+        """Keyword arguments locating mesh files (for :func:`robodyn.validation.parse_urdf`)."""
+        return {"base_dir": self.path.parent if self.path is not None else None, "package_dirs": self.package_dirs}
+
 
 def robot_names() -> list[str]:
     """Names :func:`robodyn.load` accepts: generated robots first, then the zoo."""
@@ -51,7 +56,7 @@ def _read_file(path: Path) -> URDFSource:
         raise URDFError(str(path), "no such file") from None
     except (OSError, UnicodeDecodeError) as error:
         raise URDFError(str(path), f"cannot be read ({error.__class__.__name__}: {error})") from None
-    return URDFSource(text, path.stem, str(path), path.resolve(), False, (path.resolve().parent,))
+    return URDFSource(text, path.stem, str(path), path.resolve(), False, ())
 
 
 def resolve_source(source: str | os.PathLike) -> URDFSource:

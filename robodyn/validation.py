@@ -18,19 +18,26 @@ This module does not import Pinocchio.
 from __future__ import annotations
 
 import math
+import os
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from robodyn.exceptions import URDFError
+from robodyn.meshes import mesh_problems
 
 #: Joint types robodyn knows. ``floating`` and ``planar`` are refused with a clear reason.
 MOVING_JOINT_TYPES = ("revolute", "continuous", "prismatic")
 KNOWN_JOINT_TYPES = (*MOVING_JOINT_TYPES, "fixed", "floating", "planar")
 #: Deepest kinematic chain accepted (Pinocchio's parser crashes around 4000).
 MAX_DEPTH = 1000
+#: Largest magnitude accepted for a length, angle, mass, inertia or limit (SI units):
+#: beyond it the dynamics overflow long before they mean anything.
+MAX_MAGNITUDE = 1e12
 #: Relative tolerance on the triangle inequality of principal moments of inertia.
 TRIANGLE_TOLERANCE = 1e-6
 
@@ -168,9 +175,14 @@ class _Reader:
         if not np.all(np.isfinite(values)):
             self.error(where, f"{attribute}={text!r} must be finite")
             return np.array([float(token) for token in default.split()])
+        if np.abs(values).max(initial=0.0) > MAX_MAGNITUDE:
+            self.error(where, f"{attribute}={text!r} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
+            return np.array([float(token) for token in default.split()])
         return values
 
-    def number(self, where: str, node: ET.Element | None, attribute: str, default: float | None) -> float | None:
+    def number(
+        self, where: str, node: ET.Element | None, attribute: str, default: float | None, *, bounded: bool = True
+    ) -> float | None:
         if node is None or node.get(attribute) is None:
             return default
         text = node.get(attribute)
@@ -181,6 +193,9 @@ class _Reader:
             return default
         if math.isnan(value):
             self.error(where, f"{attribute}={text!r} is not a number")
+            return default
+        if bounded and math.isfinite(value) and abs(value) > MAX_MAGNITUDE:
+            self.error(where, f"{attribute}={text!r} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
             return default
         return value
 
@@ -252,8 +267,8 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
     axis = axis / norm if norm >= 1e-12 else axis
     limit = node.find("limit")
     lower, upper = -math.inf, math.inf
-    effort = reader.number(where, limit, "effort", math.inf)
-    velocity = reader.number(where, limit, "velocity", math.inf)
+    effort = reader.number(where, limit, "effort", math.inf, bounded=False)
+    velocity = reader.number(where, limit, "velocity", math.inf, bounded=False)
     if joint_type in ("revolute", "prismatic"):
         if limit is None:
             reader.error(where, f"a {joint_type} joint needs a <limit> element")
@@ -404,7 +419,13 @@ def _check_moving_masses(reader: _Reader, spec_links: dict, joints: dict[str, Jo
 
 
 def lint_urdf(
-    text: str, source: str = "<string>", *, floating_base: bool = False, check_inertia: bool = True
+    text: str,
+    source: str = "<string>",
+    *,
+    floating_base: bool = False,
+    check_inertia: bool = True,
+    base_dir: Path | None = None,
+    package_dirs: Sequence[Path] = (),
 ) -> tuple[URDFSpec | None, list[Problem]]:
     """Check URDF text and return its spec (``None`` if it has errors) and every problem.
 
@@ -414,6 +435,8 @@ def lint_urdf(
         floating_base: Whether the root link moves freely (then every link moves).
         check_inertia: If false, physically impossible inertias of moving links are
             warnings instead of errors (some published URDFs have them).
+        base_dir: Folder of the URDF file, for relative mesh paths.
+        package_dirs: Folders under which ``package://`` mesh paths resolve.
 
     Returns:
         The validated spec, or ``None`` when any error was found, and the list of problems
@@ -448,6 +471,8 @@ def lint_urdf(
         reader.error(None, "the robot has no links")
     tree_root = _check_tree(reader, links, joints) if links else None
     _check_mimics(reader, joints)
+    for element, rule, severity in mesh_problems(root, base_dir=base_dir, package_dirs=package_dirs):
+        (reader.error if severity == "error" else reader.warn)(element, rule)
     if tree_root is not None:
         _check_inertias(reader, links, _moving_links(tree_root, joints, floating_base), check_inertia)
         _check_moving_masses(reader, links, joints)
@@ -456,13 +481,23 @@ def lint_urdf(
     return spec, reader.problems
 
 
-def parse_urdf(text: str, source: str = "<string>", *, floating_base: bool = False, check_inertia: bool = True) -> URDFSpec:
+def parse_urdf(
+    text: str,
+    source: str = "<string>",
+    *,
+    floating_base: bool = False,
+    check_inertia: bool = True,
+    base_dir: Path | None = None,
+    package_dirs: Sequence[Path] = (),
+) -> URDFSpec:
     """Validate URDF text and return its spec (arguments as for :func:`lint_urdf`).
 
     Raises:
         URDFError: Naming the source, the element and the rule of the first error found.
     """
-    spec, problems = lint_urdf(text, source, floating_base=floating_base, check_inertia=check_inertia)
+    spec, problems = lint_urdf(
+        text, source, floating_base=floating_base, check_inertia=check_inertia, base_dir=base_dir, package_dirs=package_dirs
+    )
     if spec is None:
         first = next(problem for problem in problems if problem.severity == "error")
         rule = first.rule
@@ -470,3 +505,22 @@ def parse_urdf(text: str, source: str = "<string>", *, floating_base: bool = Fal
             rule += " (check_inertia=False or --no-check-inertia loads it anyway)"
         raise URDFError(source, rule, first.element)
     return spec
+
+
+def lint_source(source: str | os.PathLike, *, floating_base: bool | None = None) -> list[Problem]:
+    """Every problem of a URDF (a path, text or robot name), errors and warnings.
+
+    A document that is not even well-formed XML gives one error problem.
+
+    Raises:
+        UnknownRobotError, URDFError: If the source cannot be found or read.
+    """
+    from robodyn.sources import resolve_source
+
+    resolved = resolve_source(source)
+    floating = resolved.floating_base if floating_base is None else floating_base
+    try:
+        _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, **resolved.mesh_context)
+    except URDFError as error:
+        return [Problem(error.element, error.rule)]
+    return problems

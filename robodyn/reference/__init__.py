@@ -48,7 +48,7 @@ def load(
     resolved = resolve_source(source)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=False, check_inertia=check_inertia)
-    spec = parse_urdf(resolved.text, resolved.label, check_inertia=check_inertia)
+    spec = parse_urdf(resolved.text, resolved.label, check_inertia=check_inertia, **resolved.mesh_context)
     tree = build_tree(spec, resolved.text)
     name = spec.name if resolved.name == "robot" else resolved.name
     gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)

@@ -1,0 +1,87 @@
+"""Mesh paths of a URDF: where they point, and that they stay inside the model's folders.
+
+A URDF's ``<mesh filename=...>`` may be ``package://NAME/...`` (resolved under the package
+folders, e.g. example-robot-data's share folder), ``file://...``, absolute, or relative
+to the URDF file's folder. :func:`resolve_mesh` finds the file and refuses any path that
+leaves those folders (``../``, absolute paths elsewhere): a URDF must not make robodyn
+read arbitrary files. A mesh that is simply missing is a warning; the model still loads
+(only drawings need meshes). This module does not import Pinocchio.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from pathlib import Path
+from urllib.parse import unquote, urlparse
+
+
+class MeshPathError(ValueError):
+    """A mesh path that leaves the model's folders (raised by :func:`resolve_mesh`)."""
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    try:
+        path.resolve().relative_to(folder.resolve())
+    except ValueError:
+        return False
+    return True
+
+
+def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> Path | None:
+    """The file a mesh path names, or ``None`` if it cannot be found.
+
+    Args:
+        filename: The ``filename`` attribute of a ``<mesh>``.
+        base_dir: Folder of the URDF file (``None`` for URDF text).
+        package_dirs: Folders holding the packages ``package://`` names.
+
+    Raises:
+        MeshPathError: If the path leaves the URDF's folder or the package folders.
+    """
+    roots = [Path(d) for d in package_dirs] + ([Path(base_dir)] if base_dir is not None else [])
+    if filename.startswith("package://"):
+        relative = filename[len("package://") :].lstrip("/")
+        package = relative.split("/", 1)[0]
+        for folder in package_dirs:
+            candidate = Path(folder) / relative
+            if not _inside(candidate, Path(folder) / package):
+                raise MeshPathError(f"mesh {filename!r} leaves its package {package!r}")
+            if candidate.is_file():
+                return candidate
+        return None
+    if filename.startswith("file://"):
+        candidate = Path(unquote(urlparse(filename).path))
+    elif os.path.isabs(filename):
+        candidate = Path(filename)
+    elif base_dir is None:
+        return None
+    else:
+        candidate = Path(base_dir) / filename
+        if not _inside(candidate, Path(base_dir)):
+            raise MeshPathError(f"mesh {filename!r} leaves the URDF's folder")
+    if not any(_inside(candidate, root) for root in roots):
+        raise MeshPathError(f"mesh {filename!r} is outside the URDF's folder and package folders")
+    return candidate if candidate.is_file() else None
+
+
+def mesh_problems(root: ET.Element, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:
+    """Problems of every ``<mesh>``: ``(element, rule, severity)`` tuples."""
+    problems = []
+    for link in root.findall("link"):
+        for kind in ("visual", "collision"):
+            for mesh in link.findall(f"{kind}/geometry/mesh"):
+                filename = mesh.get("filename") or ""
+                where = f'link "{link.get("name")}"'
+                if not filename:
+                    problems.append((where, f"a {kind} <mesh> has no filename", "error"))
+                    continue
+                try:
+                    found = resolve_mesh(filename, base_dir=base_dir, package_dirs=package_dirs)
+                except MeshPathError as error:
+                    problems.append((where, str(error), "error"))
+                    continue
+                if found is None:
+                    problems.append((where, f"{kind} mesh {filename!r} not found (the model loads without it)", "warning"))
+    return problems
