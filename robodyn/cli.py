@@ -10,6 +10,7 @@ import argparse
 import json
 import os
 import sys
+import time
 import traceback
 from collections.abc import Sequence
 
@@ -97,7 +98,72 @@ def _state(robot: robodyn.Robot, values: list[float] | None, name: str, size: in
     return np.array(values)
 
 
+def _lock_values(text: str | None) -> dict[str, float] | None:
+    """Parse ``--lock name=value,name2=value2`` (a bare name locks at 0)."""
+    if not text:
+        return None
+    locked = {}
+    for item in text.split(","):
+        name, _, value = item.partition("=")
+        try:
+            locked[name.strip()] = float(value) if value else 0.0
+        except ValueError:
+            raise InputError("--lock", "name=value pairs with numbers", repr(item)) from None
+    return locked
+
+
+class _Progress:
+    """A progress bar on stderr, shown once a derivation takes more than ``DELAY`` seconds."""
+
+    DELAY = 0.5
+
+    def __init__(self, label: str) -> None:
+        self._label, self._start, self._shown = label, time.monotonic(), False
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        if time.monotonic() - self._start < self.DELAY and not self._shown:
+            return
+        self._shown = True
+        filled = int(20 * done / max(total, 1))
+        sys.stderr.write(f"\r{self._label}: {stage:22s} [{'#' * filled}{'.' * (20 - filled)}] {done}/{total}")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        if self._shown:
+            sys.stderr.write("\n")
+
+
+def _command_symbolic(arguments: argparse.Namespace) -> int:
+    from robodyn.equations import derive_equations, lecture_text, render
+
+    if arguments.lecture:
+        print(lecture_text(), end="")
+        return 0
+    progress = _Progress(f"deriving {arguments.model}")
+    try:
+        equations = derive_equations(
+            arguments.model,
+            form=arguments.form,
+            keep_params=arguments.keep_params,
+            lock=_lock_values(arguments.lock),
+            progress=progress,
+        )
+    finally:
+        progress.close()
+    output = render(equations, arguments.format)
+    if arguments.out:
+        from robodyn.files import atomic_write_text
+
+        atomic_write_text(arguments.out, output)
+        print(f"wrote {arguments.out} ({equations.form} form, {equations.operation_count()} operations)", file=sys.stderr)
+    else:
+        print(output, end="")
+    return 0
+
+
 def _command_equations(arguments: argparse.Namespace) -> int:
+    if arguments.symbolic or arguments.lecture:
+        return _command_symbolic(arguments)
     robot = _load(arguments)
     q = _state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
     v = _state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
@@ -226,6 +292,22 @@ def build_parser() -> argparse.ArgumentParser:
     equations.add_argument("--a", type=_vector, help="acceleration in [rad/s²] / [m/s²] (default: zeros)")
     equations.add_argument("--json", action="store_true", help="print JSON (keys tau, M, C, G, joint_names, ...)")
     equations.add_argument("--precision", type=int, default=6, help="significant digits in text output")
+    equations.add_argument(
+        "--symbolic", action="store_true", help="closed-form equations from the reference's symbolic Lagrangian"
+    )
+    equations.add_argument("--format", choices=["text", "latex", "json", "python", "c"], default="text", help="with --symbolic")
+    equations.add_argument("--out", help="with --symbolic: write to this file instead of stdout")
+    equations.add_argument(
+        "--form",
+        choices=["auto", "closed", "compact"],
+        default="auto",
+        help="closed (simplified) or compact (intermediate variables)",
+    )
+    equations.add_argument("--keep-params", action="store_true", help="keep masses, lengths, inertias and g as symbols")
+    equations.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
+    equations.add_argument(
+        "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
+    )
     equations.set_defaults(run=_command_equations)
 
     check = commands.add_parser("check", help="compare Pinocchio with the independent Lagrangian reference")

@@ -19,7 +19,7 @@ Meant for small chains (up to three or four joints fully simplified). No Pinocch
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import sympy as sp
@@ -43,6 +43,7 @@ class SymbolicDynamics:
         M: Mass matrix (n × n).
         C: Coriolis matrix from the Christoffel symbols of ``M`` (n × n).
         G: Gravity vector (n × 1).
+        parameters: Symbols kept for physical parameters, with their values.
     """
 
     q: list[sp.Symbol]
@@ -53,6 +54,7 @@ class SymbolicDynamics:
     M: sp.Matrix
     C: sp.Matrix
     G: sp.Matrix
+    parameters: dict = field(default_factory=dict)
 
     @property
     def tau(self) -> sp.Matrix:
@@ -124,23 +126,46 @@ def joint_symbols(names: list[str]) -> tuple[list[sp.Symbol], list[sp.Symbol], l
     )
 
 
-def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8) -> SymbolicDynamics:
+def _parameter(values: np.ndarray, names: list[str], keep: dict | None) -> sp.Matrix:
+    """Exact constants, or (when ``keep`` is a dict) symbols for the non-zero ones."""
+    flat = np.ravel(values)
+    entries = []
+    for value, name in zip(flat, names, strict=True):
+        if keep is None or value == 0:
+            entries.append(_exact(float(value), 0.0))
+        else:
+            symbol = sp.Symbol(name, real=True)
+            keep[symbol] = float(value)
+            entries.append(symbol)
+    return sp.Matrix(np.shape(values)[0], 1 if np.ndim(values) == 1 else np.shape(values)[1], entries)
+
+
+def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8, keep_params: bool = False) -> SymbolicDynamics:
     """Closed-form dynamics of a reference robot, by the Lagrangian of its bodies.
 
     Args:
         robot: From :func:`robodyn.reference.load`.
         simplify: Trigonometric simplification (small chains only).
         snap: Tolerance for making URDF constants exact (0 to keep every float as is).
+        keep_params: Keep masses (``m_<link>``), centres of mass (``c_<link>_x``...),
+            inertias (``I_<link>_xx``...), joint offsets (``d_<joint>_x``...) and gravity
+            ``g`` as symbols; their values are in ``SymbolicDynamics.parameters``.
 
     Returns:
         The equations, in the order of ``robot.joint_names``.
     """
     tree = robot.tree
+    keep: dict | None = {} if keep_params else None
     q, qd, qdd = joint_symbols(robot.joint_names)
     selection = _exact_array(tree.selection, 0.0)
     theta = selection * sp.Matrix(q) + _exact_array(tree.offset[:, None], 0.0)
     theta_dot = selection * sp.Matrix(qd)
     gravity = _exact_array(robot.gravity_vector[:, None], 0.0)
+    if keep is not None:
+        magnitude = float(np.linalg.norm(robot.gravity_vector))
+        g = sp.Symbol("g", positive=True)
+        keep[g] = magnitude
+        gravity = _exact_array(robot.gravity_vector[:, None] / magnitude, snap) * g if magnitude > 0 else gravity
     rotations: list[sp.Matrix] = []
     positions: list[sp.Matrix] = []
     axes: list[sp.Matrix] = []
@@ -151,7 +176,8 @@ def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8) 
         parent_rotation = sp.eye(3) if body.parent < 0 else rotations[body.parent]
         parent_position = sp.zeros(3, 1) if body.parent < 0 else positions[body.parent]
         joint_rotation = parent_rotation * _exact_array(body.origin[:3, :3], snap)
-        origin = parent_position + parent_rotation * _exact_array(body.origin[:3, 3:], 0.0)
+        offset = _parameter(body.origin[:3, 3], [f"d_{body.joint}_{a}" for a in "xyz"], keep)
+        origin = parent_position + parent_rotation * offset
         axis = _exact_array(body.axis[:, None], snap)
         world_axis = joint_rotation * axis
         angle = theta[index]
@@ -168,14 +194,17 @@ def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8) 
         origins.append(origin)
         if body.mass == 0:
             continue
-        com = position + rotation * _exact_array(body.com[:, None], 0.0)
+        com = position + rotation * _parameter(body.com, [f"c_{body.link}_{a}" for a in "xyz"], keep)
         velocity = com.jacobian(q) * sp.Matrix(qd)
         omega = sp.zeros(3, 1)
         for ancestor in range(index + 1):
             if tree.ancestors[index, ancestor] and tree.bodies[ancestor].revolute:
                 omega += axes[ancestor] * theta_dot[ancestor]
-        inertia = rotation * _exact_array(body.inertia, 0.0) * rotation.T
-        mass = _exact(body.mass, 0.0)
+        names = [f"I_{body.link}_{a}{b}" for a in "xyz" for b in "xyz"]
+        names = [name if name[-2] <= name[-1] else name[:-2] + name[-1] + name[-2] for name in names]  # I_yx -> I_xy
+        inertia = rotation * _parameter(body.inertia, names, keep).reshape(3, 3) * rotation.T
+        mass = _parameter(np.array([body.mass]), [f"m_{body.link}"], keep)[0]
         T += mass * (velocity.T * velocity)[0] / 2 + (omega.T * inertia * omega)[0] / 2
         U += -mass * (gravity.T * com)[0]
-    return lagrangian_dynamics(T, U, q, qd, qdd, simplify=simplify)
+    dynamics = lagrangian_dynamics(T, U, q, qd, qdd, simplify=simplify)
+    return replace(dynamics, parameters=keep or {})

@@ -34,6 +34,7 @@ class Body:
 
     Attributes:
         joint: Name of the joint that moves it.
+        link: Name of the joint's child link (the body's frame).
         parent: Index of the parent body, or -1 when the parent is the fixed root.
         origin: 4×4 transform from the parent body's frame to the joint frame (constant).
         axis: Unit joint axis in the joint frame.
@@ -44,6 +45,7 @@ class Body:
     """
 
     joint: str
+    link: str
     parent: int
     origin: np.ndarray
     axis: np.ndarray
@@ -157,6 +159,7 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
             bodies.append(
                 Body(
                     joint.name,
+                    joint.child,
                     body_index,
                     to_link @ origin,
                     axis / np.linalg.norm(axis),
@@ -168,7 +171,8 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
             )
             stack.append((joint.child, np.eye(4), len(bodies) - 1))
     bodies = [
-        Body(b.joint, b.parent, b.origin, b.axis, b.revolute, *_combine(welded.get(index, []))) for index, b in enumerate(bodies)
+        Body(b.joint, b.link, b.parent, b.origin, b.axis, b.revolute, *_combine(welded.get(index, [])))
+        for index, b in enumerate(bodies)
     ]
 
     independent = [body.joint for body in bodies if spec.joints[body.joint].mimic is None]
