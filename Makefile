@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint bench clean
+.PHONY: demo test test-fast lint bench clean chromium
 
 $(STAMP): pyproject.toml requirements.lock
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -14,11 +14,23 @@ $(STAMP): pyproject.toml requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	touch $(STAMP)
 
-demo: $(STAMP)
+# Headless Chromium renders recordings (stills, and the browser test). Debian's package,
+# installed when missing and we may (root with apt); otherwise those steps say so.
+chromium:
+	@command -v chromium >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
+		(apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) || \
+		echo "note: no chromium (install Debian's 'chromium' for stills and the browser test)"; }
+
+# The main job on the built-in robot: the RP arm's equations, then the lecture's control
+# story (drive the end effector to a target) as trajectory, plot, animation and still.
+demo: $(STAMP) chromium
 	$(BIN)/robodyn equations rp_arm --q 0.5,0.1 --v 1.0,0.2 --a 0.5,-0.3
+	$(BIN)/robodyn simulate rp_arm --controller task-space --q0 0,0.1 --target 0.7,0.7 --duration 3 \
+		--out out/rp_arm.csv --plot out/rp_arm.png --record out/rp_arm.html \
+		$$(command -v chromium >/dev/null 2>&1 && echo --png out/rp_arm_poster.png)
 
 # Everything CI runs: lint, the fast tier, then the slow tier.
-test: $(STAMP)
+test: $(STAMP) chromium
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/python -m pytest -m "not slow"
 	$(BIN)/python -m pytest -m slow

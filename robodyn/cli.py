@@ -213,8 +213,42 @@ def _command_simulate(arguments: argparse.Namespace) -> int:
         integrator=arguments.integrator,
         out=arguments.out,
         plot=arguments.plot,
+        record=arguments.record,
+        png=arguments.png,
     )
     print(json.dumps(summary, indent=2) if arguments.json else "\n".join(f"{key}: {value}" for key, value in summary.items()))
+    return 0
+
+
+def _command_record(arguments: argparse.Namespace) -> int:
+    from robodyn.simulation import Trajectory
+    from robodyn.viewer import record
+
+    robot = _load(arguments)
+    trajectory = Trajectory.load(arguments.trajectory)
+    started = time.perf_counter()
+    path = record(robot, trajectory, arguments.out, fps=arguments.fps, png=arguments.png)
+    print(
+        f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB, {len(trajectory)} samples at {arguments.fps:g} fps, {time.perf_counter() - started:.2f} s)"
+    )
+    if arguments.png:
+        print(f"wrote {arguments.png}")
+    return 0
+
+
+def _command_view(arguments: argparse.Namespace) -> int:
+    from robodyn.simulation import Trajectory
+    from robodyn.viewer import LiveViewer, wait
+
+    robot = _load(arguments)
+    trajectory = Trajectory.load(arguments.trajectory) if arguments.trajectory else None
+    try:
+        with LiveViewer() as viewer:
+            viewer.show(robot, trajectory)
+            print(f"meshcat viewer: {viewer.url}  (Ctrl-C to stop)", flush=True)
+            wait(arguments.seconds)
+    except KeyboardInterrupt:
+        pass
     return 0
 
 
@@ -339,8 +373,24 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], default="rk4")
     simulate.add_argument("--out", help="trajectory file (.csv or .npz)")
     simulate.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
+    simulate.add_argument("--record", help="HTML animation (meshcat, self-contained, plays on open)")
+    simulate.add_argument("--png", help="with --record: a still of the first frame (needs Chromium)")
     simulate.add_argument("--json", action="store_true", help="print the summary as JSON")
     simulate.set_defaults(run=_command_simulate)
+
+    record = commands.add_parser("record", help="write a trajectory as a self-contained HTML animation")
+    _add_model_arguments(record)
+    record.add_argument("--trajectory", required=True, help="trajectory file (.csv or .npz) from robodyn simulate")
+    record.add_argument("--out", required=True, help="HTML file to write")
+    record.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    record.add_argument("--png", help="also a still of the first frame (needs Chromium)")
+    record.set_defaults(run=_command_record)
+
+    view = commands.add_parser("view", help="show a robot (and a trajectory) in a live meshcat viewer on 127.0.0.1")
+    _add_model_arguments(view)
+    view.add_argument("--trajectory", help="trajectory file to play")
+    view.add_argument("--seconds", type=float, help="stop after this many seconds (default: until Ctrl-C)")
+    view.set_defaults(run=_command_view)
 
     whatif = commands.add_parser("whatif", help="peak and RMS torques of one motion across materials, payloads, forces")
     whatif.add_argument("model", nargs="?", default="rp_arm", help="robot (default rp_arm; materials apply to rp_arm only)")

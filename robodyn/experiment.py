@@ -51,6 +51,8 @@ def run_simulation(
     integrator: str = "rk4",
     out: str | None = None,
     plot: str | None = None,
+    record: str | None = None,
+    png: str | None = None,
 ) -> dict:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -65,6 +67,8 @@ def run_simulation(
         duration, dt, integrator: As for :func:`robodyn.simulate`.
         out: Trajectory file (.csv or .npz) to write.
         plot: PNG file to write.
+        record: HTML animation to write (meshcat, self-contained).
+        png: Still of the animation's first frame (with ``record``; needs Chromium).
 
     Returns:
         A JSON-ready summary with units in the keys.
@@ -121,4 +125,10 @@ def run_simulation(
         from robodyn.plots import plot_simulation
 
         summary["plot"] = str(plot_simulation(robot, trajectory, plot, frame=frame if task is not None else None, target=task))
+    if record:
+        from robodyn.viewer import record as record_html
+
+        summary["recording"] = str(record_html(robot, trajectory, record, png=png))
+        if png:
+            summary["poster"] = str(png)
     return summary

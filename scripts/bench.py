@@ -170,18 +170,62 @@ def bench_reference(quick: bool) -> list[dict]:
 
 
 def bench_symbolic(quick: bool) -> list[dict]:
-    from robodyn.reference.symbolic import derive
+    from robodyn.equations import derive_equations
 
     rows = []
-    for name in ("rp_arm", "double_pendulum"):
-        model = reference.load(name)
+    for name, lock in (("rp_arm", None), ("double_pendulum", None), ("ur5", None), ("panda", PANDA_ARM["lock"])):
         start = time.perf_counter()
-        equations = derive(model)
+        equations = derive_equations(name, lock=lock)
         elapsed = time.perf_counter() - start
-        import sympy
+        label = name + (" (7 arm joints)" if lock else "")
+        rows.append(
+            {
+                "robot": label,
+                "form": equations.form,
+                "derive_s": elapsed,
+                "operations_M_Cv_G": equations.operation_count(),
+                "assignments": len(equations.assignments),
+            }
+        )
+    return rows
 
-        ops = sum(sympy.count_ops(e) for e in (*equations.M, *(equations.C * sympy.Matrix(equations.qd)), *equations.G))
-        rows.append({"robot": name, "form": "fully simplified", "derive_s": elapsed, "operations_M_Cv_G": int(ops)})
+
+def bench_codegen(quick: bool) -> list[dict]:
+    import importlib.util
+    import tempfile
+
+    from robodyn.equations import derive_equations, render
+
+    rows = []
+    for name, lock in (("ur5", None), ("panda", PANDA_ARM["lock"])):
+        robot = robodyn.load(name, lock=lock)
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / f"{name}_dynamics.py"
+            path.write_text(render(derive_equations(name, lock=lock), "python"))
+            spec = importlib.util.spec_from_file_location(path.stem, path)
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+        rng = np.random.default_rng(3)
+        q, v, a = robot.random_configuration(rng), rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+        model, data = robot.model, robot.model.createData()
+        generated_s, raw_s, ratio = paired(
+            lambda: module.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a), repeats=7
+        )
+        count = 2_000 if quick else 20_000
+        qs = robot.random_configuration(rng, count)
+        vs, as_ = rng.normal(size=(2, count, robot.nv))
+        batch_generated = median_once(lambda: module.inverse_dynamics(qs, vs, as_))
+        batch_robodyn = median_once(lambda: robot.inverse_dynamics(qs, vs, as_))
+        rows.append(
+            {
+                "robot": name + (" (7 arm joints)" if lock else ""),
+                "generated_python_us": generated_s * 1e6,
+                "pin_rnea_us": raw_s * 1e6,
+                "single_ratio": ratio,
+                "generated_numpy_batch_states_per_s": count / batch_generated,
+                "robodyn_batch_states_per_s": count / batch_robodyn,
+            }
+        )
     return rows
 
 
@@ -232,12 +276,40 @@ def bench_simulation(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_recording(quick: bool) -> list[dict]:
+    import tempfile
+
+    from robodyn.viewer import record
+
+    duration = 2.0 if quick else 10.0
+    robot = robodyn.load("panda")
+    trajectory = simulate(
+        robot, robot.neutral_configuration(), np.zeros(robot.nv), duration, 1e-3, integrator="semi-implicit-euler"
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "panda.html"
+        elapsed = median_once(lambda: record(robot, trajectory, path, fps=30))
+        size = path.stat().st_size
+    return [
+        {
+            "robot": "panda (as loaded)",
+            "duration_s": duration,
+            "fps": 30,
+            "frames": int(duration * 30) + 1,
+            "record_s": elapsed,
+            "html_MB": size / 1e6,
+        }
+    ]
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
     "reference": bench_reference,
     "symbolic": bench_symbolic,
+    "codegen": bench_codegen,
     "simulation": bench_simulation,
+    "recording": bench_recording,
 }
 
 
