@@ -142,7 +142,7 @@ def _resample(trajectory: Trajectory, fps: float) -> tuple[np.ndarray, np.ndarra
 
 def animation_command(robot: Robot, trajectory: Trajectory, fps: float = 30.0) -> tuple[dict, np.ndarray]:
     """The meshcat animation of every link over a trajectory, and all link positions seen."""
-    times, configurations = _resample(trajectory, fps)
+    _times, configurations = _resample(trajectory, fps)
     if robot.floating_base:
         configurations[:, 3:7] /= np.linalg.norm(configurations[:, 3:7], axis=1, keepdims=True)
     clips: dict[str, AnimationClip] = {}

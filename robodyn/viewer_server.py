@@ -7,6 +7,7 @@ runs this instead, so the viewer is reachable from this machine only. Prints
 
 from __future__ import annotations
 
+import contextlib
 import sys
 
 from meshcat.servers.zmqserver import ZMQWebSocketBridge
@@ -27,10 +28,8 @@ def main() -> None:
     zmq_url, port = sys.argv[1], int(sys.argv[2])
     bridge = LocalBridge(zmq_url=zmq_url, host="127.0.0.1", port=port)
     print(f"web_url={bridge.web_url}", flush=True)
-    try:
+    with contextlib.suppress(KeyboardInterrupt):
         bridge.run()
-    except KeyboardInterrupt:
-        pass
 
 
 if __name__ == "__main__":

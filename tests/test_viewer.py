@@ -84,7 +84,7 @@ def test_failed_recording_leaves_the_old_file(tmp_path, swinging):
 
 
 def test_record_command(tmp_path, swinging, capsys):
-    robot, trajectory = swinging
+    _robot, trajectory = swinging
     trajectory.save(tmp_path / "swing.npz")
     assert main(["record", "pendulum", "--trajectory", str(tmp_path / "swing.npz"), "--out", str(tmp_path / "swing.html")]) == 0
     assert "wrote" in capsys.readouterr().out and (tmp_path / "swing.html").stat().st_size > 100_000
