@@ -21,7 +21,8 @@ from robodyn.exceptions import InputError
 from robodyn.validation import URDFSpec
 
 
-def _rpy_matrix(rpy: np.ndarray) -> np.ndarray:
+def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
+    """Rotation matrix of URDF roll-pitch-yaw angles in [rad] (fixed axes X, Y, Z)."""
     roll, pitch, yaw = rpy
     rx = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
     ry = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]])
@@ -71,7 +72,7 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
         if name not in values:
             continue
         joint = spec.joints[name]
-        rotation = _rpy_matrix(joint.origin_rpy)
+        rotation = rpy_matrix(joint.origin_rpy)
         translation = joint.origin_xyz.copy()
         if joint.type == "prismatic":
             translation = translation + rotation @ joint.axis * values[name]

@@ -36,7 +36,7 @@ from robodyn.files import atomic_write_text
 from robodyn.meshes import MeshPathError, resolve_mesh
 from robodyn.robot import Robot
 from robodyn.simulation import Trajectory
-from robodyn.urdf_edit import _rpy_matrix
+from robodyn.urdf_edit import rpy_matrix
 
 ROOT_PATH = ("robodyn",)
 DEFAULT_COLOR = 0xB0B8C0
@@ -48,7 +48,7 @@ def _path(*entries: str) -> MeshcatPath:
 
 def _transform(xyz: np.ndarray, rpy: np.ndarray, scale: np.ndarray | None = None) -> np.ndarray:
     matrix = np.eye(4)
-    matrix[:3, :3] = _rpy_matrix(rpy) @ np.diag(scale if scale is not None else np.ones(3))
+    matrix[:3, :3] = rpy_matrix(rpy) @ np.diag(scale if scale is not None else np.ones(3))
     matrix[:3, 3] = xyz
     return matrix
 
@@ -80,7 +80,7 @@ def _geometry(visual: ET.Element, robot: Robot) -> tuple[mg.Geometry | None, np.
     if shape.tag == "sphere":
         return mg.Sphere(float(shape.get("radius", "0.05"))), extra
     if shape.tag == "cylinder":  # three.js cylinders run along y, URDF ones along z
-        extra[:3, :3] = _rpy_matrix(np.array([np.pi / 2, 0.0, 0.0]))
+        extra[:3, :3] = rpy_matrix(np.array([np.pi / 2, 0.0, 0.0]))
         return mg.Cylinder(float(shape.get("length", "0.1")), float(shape.get("radius", "0.05"))), extra
     if shape.tag == "mesh":
         base_dir = robot.source_path.parent if robot.source_path is not None else None

@@ -78,25 +78,6 @@ class KinematicTree:
     ancestors: np.ndarray
 
 
-def _rpy_matrix(rpy: np.ndarray) -> np.ndarray:
-    roll, pitch, yaw = rpy
-    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def _homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
-    transform = np.eye(4)
-    transform[:3, :3] = rotation
-    transform[:3, 3] = translation
-    return transform
-
-
 def _link_mass_properties(link: yourdfpy.Link) -> tuple[float, np.ndarray, np.ndarray]:
     """Mass, centre of mass and inertia about the centre of mass, in the link frame."""
     inertial = link.inertial
