@@ -84,7 +84,7 @@ class CheckReport:
     @property
     def worst_relative_error(self) -> float:
         """Largest relative error of the reference-vs-Pinocchio comparisons."""
-        return max(self.comparisons[name].max_rel for name in QUANTITIES)
+        return max(self.comparisons[name].max_rel for name in QUANTITIES if name in self.comparisons)
 
 
 def _largest(values: np.ndarray) -> float:
@@ -116,7 +116,9 @@ def check_robot(
     """Compare Pinocchio with the reference at random states within the joint limits.
 
     Args:
-        source: Anything :func:`robodyn.load` takes, or a loaded fixed-base ``Robot``.
+        source: Anything :func:`robodyn.load` takes, or a loaded ``Robot``. With a floating
+            base ``tau``, ``M``, ``C v`` and ``G`` are compared (the reference's ``C`` is in
+            its own coordinates there).
         samples: Number of random states.
         seed: Seed of the random generator.
         tolerance: Largest accepted relative error.
@@ -125,30 +127,37 @@ def check_robot(
     Returns:
         The report; ``report.passed`` tells whether every error is within tolerance.
     """
-    robot = source if isinstance(source, Robot) else load(source, floating_base=False, check_inertia=check_inertia)
-    model = reference.load(robot.urdf, gravity=robot.gravity_vector, check_inertia=check_inertia)
+    robot = source if isinstance(source, Robot) else load(source, check_inertia=check_inertia)
+    model = reference.load(
+        robot.urdf, gravity=robot.gravity_vector, check_inertia=check_inertia, floating_base=robot.floating_base
+    )
     if sorted(model.joint_names) != sorted(robot.joint_names):
         raise AssertionError(f"joint sets differ: {robot.joint_names} vs {model.joint_names}")
-    order = [model.joint_names.index(name) for name in robot.joint_names]
+    # Index of each of robot's coordinates in the reference's (joints matched by name; a
+    # floating base's 7 position and 6 velocity coordinates come first in both).
+    base_q, base_v = (7, 6) if robot.floating_base else (0, 0)
+    joints = robot.joint_names[1:] if robot.floating_base else robot.joint_names
+    reference_joints = model.joint_names[1:] if robot.floating_base else model.joint_names
+    v_order = list(range(base_v)) + [base_v + reference_joints.index(name) for name in joints]
+    q_order = list(range(base_q)) + [base_q + reference_joints.index(name) for name in joints]
     rng = np.random.default_rng(seed)
     q = robot.random_configuration(rng, samples)
     v = rng.normal(size=(samples, robot.nv))
     a = rng.normal(size=(samples, robot.nv))
 
-    def to_reference(x: np.ndarray) -> np.ndarray:
+    def to_reference(x: np.ndarray, order: list[int]) -> np.ndarray:
         out = np.empty_like(x)
         out[:, order] = x
         return out
 
     def from_reference(x: np.ndarray) -> np.ndarray:
-        return x[:, order] if x.ndim == 2 else x[:, order][:, :, order]
+        return x[:, v_order] if x.ndim == 2 else x[:, v_order][:, :, v_order]
 
-    q_ref, v_ref, a_ref = to_reference(q), to_reference(v), to_reference(a)
+    q_ref, v_ref, a_ref = to_reference(q, q_order), to_reference(v, v_order), to_reference(a, v_order)
     reference_values = {
         "tau": from_reference(model.inverse_dynamics(q_ref, v_ref, a_ref)),
         "M": from_reference(model.mass_matrix(q_ref)),
         "Cv": from_reference(model.coriolis_forces(q_ref, v_ref)),
-        "C": from_reference(model.coriolis_matrix(q_ref, v_ref)),
         "G": from_reference(model.gravity(q_ref)),
     }
     coriolis = robot.coriolis_matrix(q, v)
@@ -164,9 +173,13 @@ def check_robot(
     # relative to its natural size: M times speeds, or the torques of the same states.
     mass_scale, speed, torque_scale = _largest(reference_values["M"]), _largest(v), _largest(reference_values["tau"])
     floors = {"tau": 0.0, "M": 0.0, "Cv": mass_scale * speed**2, "C": mass_scale * speed, "G": torque_scale}
-    for name in QUANTITIES:
+    for name in reference_values:
         report.comparisons[name] = _compare(pinocchio_values[name], reference_values[name], tolerance, floors[name])
+    if robot.floating_base:  # C (and Ṁ − 2C) are in other coordinates there: τ, M, C v, G suffice
+        return report
 
+    reference_values["C"] = from_reference(model.coriolis_matrix(q_ref, v_ref))
+    report.comparisons["C"] = _compare(coriolis, reference_values["C"], tolerance, floors["C"])
     step = 1e-6
     m_dot = (robot.mass_matrix(q + step * v) - robot.mass_matrix(q - step * v)) / (2 * step)
     # Relative to the size of Ṁ, or of M times the speeds when Ṁ happens to be tiny

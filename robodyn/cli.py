@@ -179,9 +179,7 @@ def _command_equations(arguments: argparse.Namespace) -> int:
 def _command_check(arguments: argparse.Namespace) -> int:
     from robodyn.check import check_robot, report_dict, report_text
 
-    if arguments.floating_base:
-        raise RobodynError("robodyn check compares fixed-base models only (the reference has no floating base yet).")
-    robot = robodyn.load(arguments.model, floating_base=False, gravity=arguments.gravity, check_inertia=arguments.check_inertia)
+    robot = _load(arguments)
     report = check_robot(
         robot,
         samples=arguments.samples,

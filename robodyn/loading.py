@@ -179,6 +179,7 @@ def _mimic_expansion(model: pin.Model, spec: URDFSpec, xml: str, floating: bool)
     """Build the expanded model (every joint free) and the linear map to it."""
     full = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint") if floating else pin.buildModelFromXML(xml)
     selection = np.zeros((full.nv, model.nv))
+    q_selection = np.zeros((full.nq, model.nq))
     offset = np.zeros(full.nq)
     for joint_id in range(1, full.njoints):
         name = full.names[joint_id]
@@ -191,7 +192,9 @@ def _mimic_expansion(model: pin.Model, spec: URDFSpec, xml: str, floating: bool)
         source_joint = model.joints[model.getJointId(source)]
         for k in range(full_joint.nv):
             selection[full_joint.idx_v + k, source_joint.idx_v + k] = multiplier
-    return MimicExpansion(full, selection, offset)
+        for k in range(full_joint.nq):  # a free flyer: 7 position coordinates, copied
+            q_selection[full_joint.idx_q + k, source_joint.idx_q + k] = multiplier
+    return MimicExpansion(full, selection, offset, q_selection)
 
 
 __all__ = ["build_robot", "load", "pinocchio_xml"]

@@ -61,7 +61,7 @@ class JointInfo:
 class MimicExpansion:
     """The map from a robot with mimic joints to the same robot with every joint free.
 
-    ``q_full = selection @ q + offset`` and ``v_full = selection @ v`` (the mimic relation
+    ``q_full = q_selection @ q + offset`` and ``v_full = selection @ v`` (the mimic relation
     ``q_mimic = multiplier * q_source + offset`` is linear), so ``M = Sᵀ M_full S`` and
     ``C = Sᵀ C_full S``.
 
@@ -69,18 +69,20 @@ class MimicExpansion:
         model: The Pinocchio model with mimic joints as independent joints.
         selection: Shape (nv_full, nv).
         offset: Shape (nq_full,).
+        q_selection: Shape (nq_full, nq) (differs from ``selection`` with a floating base).
     """
 
     model: pin.Model
     selection: np.ndarray
     offset: np.ndarray
+    q_selection: np.ndarray
 
     def __post_init__(self) -> None:
         self.data = self.model.createData()
 
     def q(self, q: np.ndarray) -> np.ndarray:
         """Configuration of the expanded model."""
-        return self.selection @ q + self.offset
+        return self.q_selection @ q + self.offset
 
 
 class Robot:
@@ -197,6 +199,28 @@ class Robot:
     def neutral_configuration(self) -> np.ndarray:
         """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
         return pin.neutral(self.model)
+
+    def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
+        """A floating-base configuration from the base pose and the joint positions.
+
+        Args:
+            position: Base origin in the world frame, in [m], shape (3,).
+            rpy: Base orientation as roll, pitch, yaw in [rad] (rotations about the fixed
+                x, y, z axes, as in URDF), shape (3,).
+            joints: Joint positions, shape (nv - 6,); default zeros.
+
+        Returns:
+            ``q`` of shape (nq,): position, quaternion (x, y, z, w), joints.
+
+        Raises:
+            InputError: For a fixed-base robot or wrong sizes.
+        """
+        if not self.floating_base:
+            raise InputError("robot", "a floating-base robot (load it with floating_base=True)", f"fixed-base {self.name!r}")
+        position, rpy = as_states({"position": (position, 3), "rpy": (rpy, 3)})[0]
+        joints = np.zeros(self.nv - 6) if joints is None else as_states({"joints": (joints, self.nv - 6)})[0][0]
+        quaternion = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs()
+        return np.concatenate([position, quaternion, joints])
 
     def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
         """Configurations drawn uniformly within the joint limits.

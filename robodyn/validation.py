@@ -386,7 +386,13 @@ def _moving_links(root: str, joints: dict[str, JointSpec], floating_base: bool) 
 def _check_inertias(reader: _Reader, links: dict[str, Inertial | None], moving: set[str], strict: bool) -> None:
     """Physical consistency of each link's inertia: an error on links that move."""
     for name, inertial in links.items():
-        if inertial is None or inertial.mass == 0:
+        if inertial is None:
+            continue
+        if inertial.mass == 0:
+            if np.abs(inertial.inertia).max() > 0:
+                reader.warn(
+                    f'link "{name}"', "has rotational inertia but no mass (no rigid body does); both dynamics keep the inertia"
+                )
             continue
         report = reader.error if strict and name in moving else reader.warn
         where = f'link "{name}"'

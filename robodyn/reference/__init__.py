@@ -33,23 +33,29 @@ def load(
     gravity: Sequence[float] | None = None,
     check_inertia: bool = True,
     lock: dict[str, float] | None = None,
+    floating_base: bool = False,
 ) -> ReferenceRobot:
-    """Load the reference model of a robot (fixed base).
+    """Load the reference model of a robot.
 
     Args:
         source: As for :func:`robodyn.load`: a URDF path, URDF text, a zoo name or a
             generated robot's name.
         gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
         check_inertia, lock: As for :func:`robodyn.load`.
+        floating_base: Give the root six degrees of freedom (Pinocchio's free-flyer
+            convention for ``q`` and ``v``); unlike :func:`robodyn.load` the default is
+            a fixed base whatever the source.
 
     Raises:
         UnknownRobotError, URDFError: As :func:`robodyn.load`.
     """
     resolved = resolve_source(source)
     if lock:
-        resolved = locked_source(resolved, lock, floating_base=False, check_inertia=check_inertia)
-    spec = parse_urdf(resolved.text, resolved.label, check_inertia=check_inertia, **resolved.mesh_context)
-    tree = build_tree(spec, resolved.text)
+        resolved = locked_source(resolved, lock, floating_base=floating_base, check_inertia=check_inertia)
+    spec = parse_urdf(
+        resolved.text, resolved.label, floating_base=floating_base, check_inertia=check_inertia, **resolved.mesh_context
+    )
+    tree = build_tree(spec, resolved.text, floating_base=floating_base)
     name = spec.name if resolved.name == "robot" else resolved.name
     gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)
     return ReferenceRobot(tree, name=name, urdf=resolved.text, spec=spec, gravity=gravity_vector)

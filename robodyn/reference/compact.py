@@ -174,7 +174,7 @@ def derive_compact(
         body = bodies[b]
         if progress:
             progress("Lagrangian", count - b, count)
-        if body.mass != 0:
+        if body.mass != 0 or body.inertia.any():
             mass = _exact(body.mass, 0.0)
             c = com[b]
             offset = (c.T * c)[0] * sp.eye(3) - c * c.T

@@ -46,6 +46,34 @@ def _skew(vectors: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)], -2)
 
 
+def _quaternion_matrix(quaternion: np.ndarray) -> np.ndarray:
+    """Rotation matrices of unit quaternions (x, y, z, w), shape (N, 4) -> (N, 3, 3)."""
+    x, y, z, w = (quaternion / np.linalg.norm(quaternion, axis=1, keepdims=True)).T
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
+
+
+def _base_bias(v: np.ndarray) -> np.ndarray:
+    """``θ̈ − a`` for a floating base: the virtual coordinates' accelerations minus
+    Pinocchio's (body-frame) ones, at the virtual joints' zero.
+
+    With the base pose ``(p0 + R0 ξ_lin, R0 Rx(ξ4) Ry(ξ5) Rz(ξ6))`` the body-frame velocity
+    ``(v_lin, ω)`` equals ``ξ̇`` at ``ξ = 0``, and differentiating once more gives
+    ``a_lin = ξ̈_lin − ω × v_lin`` and ``a_ang = ξ̈_ang + (ω_y ω_z, −ω_x ω_z, ω_x ω_y)``.
+    """
+    linear, angular = v[:, :3], v[:, 3:6]
+    bias = np.zeros_like(v)
+    bias[:, :3] = np.cross(angular, linear)
+    bias[:, 3:6] = -np.stack([angular[:, 1] * angular[:, 2], -angular[:, 0] * angular[:, 2], angular[:, 0] * angular[:, 1]], -1)
+    return bias
+
+
 class ReferenceRobot:
     """The independent Lagrangian model of a robot (same method names as ``Robot``).
 
@@ -58,7 +86,11 @@ class ReferenceRobot:
         tree: The kinematic tree (bodies in topological order).
         joint_names: Joints in the order of ``q`` (the URDF's depth-first order, which may
             differ from Pinocchio's: compare by name).
-        nq, nv: Number of coordinates (equal: fixed base only).
+        nq, nv: Number of coordinates. A floating base adds Pinocchio's base pose to ``q``
+            (position, quaternion x, y, z, w: ``nq = nv + 1``) and its body-frame velocity
+            (linear, angular) to ``v``; the reference models it by six virtual joints
+            evaluated at zero, hanging from that pose, and maps its accelerations
+            (:func:`_base_bias`) so that ``tau``, ``M``, ``C v`` and ``G`` are Pinocchio's.
         gravity_vector: Gravity in the world frame, in [m/s²].
     """
 
@@ -67,8 +99,10 @@ class ReferenceRobot:
         self.name = name
         self.urdf = urdf
         self.spec = spec
-        self.joint_names = list(tree.joint_names)
-        self.nq = self.nv = len(self.joint_names)
+        self.floating_base = tree.floating_base
+        self.joint_names = ["root_joint", *tree.joint_names[6:]] if self.floating_base else list(tree.joint_names)
+        self.nv = len(tree.joint_names)
+        self.nq = self.nv + 1 if self.floating_base else self.nv
         self.gravity_vector = np.asarray(gravity, float)
         bodies = tree.bodies
         self._origins = np.array([body.origin for body in bodies]).reshape(-1, 4, 4)
@@ -92,9 +126,10 @@ class ReferenceRobot:
     # ----------------------------------------------------------------------------------
     # Kinematics of every body, for a stack of body coordinates theta (N, n_bodies)
     # ----------------------------------------------------------------------------------
-    def _kinematics(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
+    def _kinematics(self, theta: np.ndarray, base: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, ...]:
         """World rotations R (N, B, 3, 3) and origins (N, B, 3) of the body frames, joint
-        axes z and origins o (N, B, 3)."""
+        axes z and origins o (N, B, 3). ``base``: per-state rotation (N, 3, 3) and position
+        (N, 3) of the frame the root bodies hang from (a floating base's pose)."""
         count, bodies = theta.shape
         rotations = np.empty((count, bodies, 3, 3))
         positions = np.empty((count, bodies, 3))
@@ -103,7 +138,7 @@ class ReferenceRobot:
         identity = np.eye(3)
         for index, body in enumerate(self.tree.bodies):
             if body.parent < 0:
-                parent_rotation, parent_position = identity[None], np.zeros((1, 3))
+                parent_rotation, parent_position = (identity[None], np.zeros((1, 3))) if base is None else base
             else:
                 parent_rotation, parent_position = rotations[:, body.parent], positions[:, body.parent]
             joint_rotation = parent_rotation @ self._origins[index, :3, :3]
@@ -142,8 +177,12 @@ class ReferenceRobot:
     # The Lagrangian terms in body coordinates
     # ----------------------------------------------------------------------------------
     def _terms(self, q: np.ndarray, derivative: bool) -> dict[str, np.ndarray]:
+        base = None
+        if self.floating_base:  # the virtual joints sit at zero, hanging from the base pose
+            base = (_quaternion_matrix(q[:, 3:7]), q[:, :3])
+            q = np.hstack([np.zeros((len(q), 6)), q[:, 7:]])
         theta = q @ self._selection.T + self._offset
-        rotations, positions, axes, joint_origins = self._kinematics(theta)
+        rotations, positions, axes, joint_origins = self._kinematics(theta, base)
         coms = positions + np.einsum("nbij,bj->nbi", rotations, self._coms)
         linear, angular = self._jacobians(coms, axes, joint_origins, self.tree.ancestors)
         world_inertia = rotations @ self._inertias[None] @ np.swapaxes(rotations, -1, -2)
@@ -201,6 +240,8 @@ class ReferenceRobot:
                 out["C"] = selection.T @ coriolis_theta @ selection
                 out["Mdot"] = selection.T @ np.einsum("nijk,nk->nij", dM, theta_dot) @ selection
                 out["Cv"] = np.einsum("nij,nj->ni", out["C"], v[chunk])
+                if self.floating_base:
+                    out["Cv"] = out["Cv"] + np.einsum("nij,nj->ni", out["M"], _base_bias(v[chunk]))
                 if a is not None:
                     out["tau"] = np.einsum("nij,nj->ni", out["M"], a[chunk]) + out["Cv"] + out["G"]
             for key, value in out.items():
@@ -208,7 +249,11 @@ class ReferenceRobot:
         return {key: np.concatenate(values)[: len(q)] for key, values in results.items()}
 
     def _call(self, key: str, **named: np.ndarray) -> np.ndarray:
-        arrays, batch = as_states({name: (value, self.nv) for name, value in named.items()})
+        if self.floating_base and key in ("C", "Mdot"):
+            raise NotImplementedError(
+                "with a floating base the reference compares tau, M, C v and G (its C is in other coordinates)"
+            )
+        arrays, batch = as_states({name: (value, self.nq if name == "q" else self.nv) for name, value in named.items()})
         stacked = [array if batch else array[None] for array in arrays]
         q, v, a = [*stacked, None, None][:3]
         result = self._evaluate(q, v, a)[key]

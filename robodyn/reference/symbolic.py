@@ -192,7 +192,7 @@ def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8, 
         positions.append(position)
         axes.append(world_axis)
         origins.append(origin)
-        if body.mass == 0:
+        if body.mass == 0 and not body.inertia.any():
             continue
         com = position + rotation * _parameter(body.com, [f"c_{body.link}_{a}" for a in "xyz"], keep)
         velocity = com.jacobian(q) * sp.Matrix(qd)

@@ -27,6 +27,10 @@ import yourdfpy
 
 from robodyn.validation import URDFSpec
 
+#: The six virtual joints of a floating base: translations then rotations about the base
+#: frame's x, y, z axes (the root link is carried by the last).
+VIRTUAL_JOINTS = ("root_tx", "root_ty", "root_tz", "root_rx", "root_ry", "root_rz")
+
 
 @dataclass(frozen=True)
 class Body:
@@ -68,6 +72,7 @@ class KinematicTree:
         offset: Shape (n_bodies,).
         ancestors: Boolean (n_bodies, n_bodies): ``ancestors[b, i]`` when body ``i`` is
             body ``b`` or one of its ancestors.
+        floating_base: Whether the first six bodies are the virtual joints of a free root.
     """
 
     name: str
@@ -76,25 +81,28 @@ class KinematicTree:
     selection: np.ndarray
     offset: np.ndarray
     ancestors: np.ndarray
+    floating_base: bool = False
 
 
 def _link_mass_properties(link: yourdfpy.Link) -> tuple[float, np.ndarray, np.ndarray]:
-    """Mass, centre of mass and inertia about the centre of mass, in the link frame."""
+    """Mass, centre of mass and inertia about the centre of mass, in the link frame.
+
+    A link without ``<inertial>`` has none; a massless link keeps the rotational inertia
+    its URDF gives (as Pinocchio does).
+    """
     inertial = link.inertial
-    if inertial is None or inertial.mass is None or inertial.mass == 0:
+    if inertial is None:
         return 0.0, np.zeros(3), np.zeros((3, 3))
     origin = inertial.origin if inertial.origin is not None else np.eye(4)
     rotation = origin[:3, :3]
     inertia = np.zeros((3, 3)) if inertial.inertia is None else np.asarray(inertial.inertia, float)
-    return float(inertial.mass), origin[:3, 3].copy(), rotation @ inertia @ rotation.T
+    return float(inertial.mass or 0.0), origin[:3, 3].copy(), rotation @ inertia @ rotation.T
 
 
 def _combine(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, np.ndarray, np.ndarray]:
     """Merge rigidly attached masses (each: mass, centre, inertia about its centre)."""
     mass = sum(part[0] for part in parts)
-    if mass == 0:
-        return 0.0, np.zeros(3), np.zeros((3, 3))
-    com = sum(part[0] * part[1] for part in parts) / mass
+    com = sum(part[0] * part[1] for part in parts) / mass if mass > 0 else np.zeros(3)
     inertia = np.zeros((3, 3))
     for part_mass, part_com, part_inertia in parts:
         d = part_com - com
@@ -108,13 +116,10 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
     Args:
         spec: The validated URDF (from :func:`robodyn.validation.parse_urdf`).
         text: The same URDF text, read again here by yourdfpy.
-        floating_base: Not supported by the reference yet.
-
-    Raises:
-        NotImplementedError: For a floating base.
+        floating_base: Give the root link six degrees of freedom: three prismatic then
+            three revolute "virtual" joints along the x, y, z axes of the base's own frame
+            (see :mod:`robodyn.reference.numeric` for how they map to Pinocchio's state).
     """
-    if floating_base:
-        raise NotImplementedError("the reference does not model floating bases yet")
     urdf = yourdfpy.URDF.load(io.BytesIO(text.encode("utf-8")), build_scene_graph=False, load_meshes=False)
     links = {link.name: link for link in urdf.robot.links}
     children: dict[str, list[yourdfpy.Joint]] = {}
@@ -122,9 +127,24 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
         children.setdefault(joint.parent, []).append(joint)
 
     bodies: list[Body] = []
+    if floating_base:
+        for index, (name, revolute) in enumerate(zip(VIRTUAL_JOINTS, (False,) * 3 + (True,) * 3, strict=True)):
+            bodies.append(
+                Body(
+                    name,
+                    spec.root if index == 5 else name,
+                    index - 1,
+                    np.eye(4),
+                    np.eye(3)[index % 3],
+                    revolute,
+                    0.0,
+                    np.zeros(3),
+                    np.zeros((3, 3)),
+                )
+            )
     # Depth-first from the root; each entry: (link, transform from the current body's
     # frame to this link's frame, index of the current body).
-    stack = [(spec.root, np.eye(4), -1)]
+    stack = [(spec.root, np.eye(4), len(bodies) - 1)]
     welded: dict[int, list[tuple[float, np.ndarray, np.ndarray]]] = {}
     while stack:
         link_name, to_link, body_index = stack.pop()
@@ -156,12 +176,15 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
         for index, b in enumerate(bodies)
     ]
 
-    independent = [body.joint for body in bodies if spec.joints[body.joint].mimic is None]
+    def mimic_of(body: Body):
+        return None if body.joint in VIRTUAL_JOINTS else spec.joints[body.joint].mimic
+
+    independent = [body.joint for body in bodies if mimic_of(body) is None]
     column_of = {name: column for column, name in enumerate(independent)}
     selection = np.zeros((len(bodies), len(independent)))
     offset = np.zeros(len(bodies))
     for index, body in enumerate(bodies):
-        mimic = spec.joints[body.joint].mimic
+        mimic = mimic_of(body)
         if mimic is None:
             selection[index, column_of[body.joint]] = 1.0
         else:
@@ -172,4 +195,4 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
         ancestors[index, index] = True
         if body.parent >= 0:
             ancestors[index] |= ancestors[body.parent]
-    return KinematicTree(spec.name, bodies, independent, selection, offset, ancestors)
+    return KinematicTree(spec.name, bodies, independent, selection, offset, ancestors, floating_base)
