@@ -191,11 +191,6 @@ def _command_check(arguments: argparse.Namespace) -> int:
     return 0 if report.passed else 1
 
 
-def _default_frame(robot: robodyn.Robot) -> str:
-    links = robot.spec.links
-    return "end_effector" if "end_effector" in links else list(links)[-1]
-
-
 def _command_simulate(arguments: argparse.Namespace) -> int:
     from robodyn.experiment import run_simulation
 
@@ -204,7 +199,7 @@ def _command_simulate(arguments: argparse.Namespace) -> int:
         robot,
         controller=arguments.controller,
         target=arguments.target,
-        frame=arguments.frame or _default_frame(robot),
+        frame=arguments.frame or robot.end_effector,
         q0=arguments.q0,
         duration=arguments.duration,
         dt=arguments.dt,

@@ -165,6 +165,12 @@ class Robot:
         """Names of every frame: links, joints and fixed frames of the URDF."""
         return list(self._frame_ids)
 
+    @property
+    def end_effector(self) -> str:
+        """The frame tasks refer to by default: ``end_effector`` if the URDF has that link,
+        else the URDF's last link."""
+        return "end_effector" if "end_effector" in self.spec.links else list(self.spec.links)[-1]
+
     @cached_property
     def link_masses(self) -> dict[str, float]:
         """Mass of every URDF link that has one, in [kg]."""

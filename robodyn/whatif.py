@@ -101,7 +101,7 @@ def sweep(
             raise InputError("materials", "given only for the generated rp_arm", f"{len(materials)} materials for {model!r}")
         variants = [("as loaded", load(model))]
     base_robot = variants[0][1]
-    frame = frame or ("end_effector" if "end_effector" in base_robot.spec.links else list(base_robot.spec.links)[-1])
+    frame = frame or base_robot.end_effector
     if q_start is None:
         q_start = np.array([-np.pi / 4, 0.0]) if generated else base_robot.neutral_configuration()
     if q_end is None:
