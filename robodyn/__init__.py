@@ -28,22 +28,38 @@ _LAZY = {
     "load": "robodyn.loading",
     "Robot": "robodyn.robot",
     "JointInfo": "robodyn.robot",
+    "simulate": "robodyn.simulation",
+    "Trajectory": "robodyn.simulation",
+    "ExternalWrench": "robodyn.simulation",
+    "SimulationError": "robodyn.simulation",
+    "attach_payload": "robodyn.payload",
+    "record": "robodyn.viewer",
+    "check_robot": "robodyn.check",
+    "derive_equations": "robodyn.equations",
 }
 
 __all__ = [
+    "ExternalWrench",
     "FrameError",
     "InputError",
     "JointInfo",
     "RPArmParameters",
     "RobodynError",
     "Robot",
+    "SimulationError",
     "SingularMassMatrixError",
+    "Trajectory",
     "URDFError",
     "UnknownRobotError",
     "__version__",
+    "attach_payload",
+    "check_robot",
+    "derive_equations",
     "load",
+    "record",
     "robot_names",
     "rp_arm_urdf",
+    "simulate",
 ]
 
 
