@@ -1,28 +1,22 @@
 """Compact closed-form dynamics for real arms: the Lagrangian in intermediate variables.
 
 Fully expanded closed forms explode beyond three or four joints (ur5's ``M(q)`` alone
-grows past a million operations). This module derives the same Lagrangian equations
-as a short program of named assignments, the way SYMORO prints customised models:
+grows past a million operations). This module derives the same equations as a short
+program of named assignments, the way SYMORO prints customised models:
 
-- per-joint exact transforms: rotation entries within ``snap`` of 0, ±1, ±½, ±√2/2,
-  ±√3/2 are exact, and an axis along ±x, ±y, ±z gives a rotation with only ``c``, ``s``;
-- every body's rotation ``R_b``, joint axis ``z_b``, joint origin ``o_b``, centre of mass
-  ``p_b``, angular velocity ``ω_b`` and velocity-product accelerations are one variable
-  each, built recursively from the parent's (a variable is made only for a non-trivial
-  expression; zeros and ones stay exact);
-- the Lagrangian per body gives (``J`` the body's Jacobians, ``J̇ q̇`` its
-  velocity-product accelerations)
-
-      M = Σ_b m_b J_vᵀ J_v + J_ωᵀ I_b J_ω
-      C q̇ = Σ_b J_vᵀ m_b (J̇_v q̇) + J_ωᵀ (I_b (J̇_ω q̇) + ω_b × I_b ω_b)
-      G = −Σ_b J_vᵀ m_b g
-
-  (``d/dt ∂T/∂q̇ − ∂T/∂q`` of ``T = Σ ½ m_b |J_v q̇|² + ½ ω_bᵀ I_b ω_b``, summed body by
-  body), with ``I_b`` the world-frame inertia about the centre of mass. The sums over
-  bodies are grouped by subtree (a joint's Jacobian column is the same for every body
-  beyond it), so each joint needs only its subtree's composite mass, first moment and
-  inertia about the world origin, and its rate of change of momentum;
-- ``sympy.cse`` then shares what is still repeated.
+- every quantity lives in its own body's frame, so link masses, centres of mass and
+  inertias are constants (sparse for most URDFs) and only the parent-to-body rotations
+  depend on ``q``; rotation and axis entries within ``snap`` of 0, ±1, ±½, ±√2/2, ±√3/2
+  are exact, so a joint about ±x, ±y, ±z costs only its ``cos`` and ``sin``;
+- ``C q̇ + G``: the Lagrangian ``d/dt ∂T/∂q̇ − ∂T/∂q + ∂U/∂q`` summed body by body is the
+  rate of change of each subtree's momentum projected on the joint axis: a forward pass
+  of angular velocities and velocity-product accelerations, a backward pass of forces and
+  moments (the Newton–Euler form of the same equations), once with the speeds for
+  ``C q̇`` and once with gravity alone for ``G``;
+- ``M``: column ``i`` is the composite body beyond joint ``i`` moving along its axis,
+  carried up to each ancestor ``j`` and projected on joint ``j``'s axis;
+- a variable is made only for a non-trivial expression, and ``sympy.cse`` then shares
+  what is still repeated.
 
 No Pinocchio here.
 """
@@ -107,123 +101,6 @@ def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
     return sp.eye(3) + s * skew + (1 - c) * skew * skew
 
 
-def derive_compact(
-    robot: ReferenceRobot, *, snap: float = 1e-8, cse: bool = True, progress: Callable[[str, int, int], None] | None = None
-) -> CompactDynamics:
-    """Derive the compact (intermediate-variable) equations of a reference robot.
-
-    Args:
-        robot: From :func:`robodyn.reference.load` (mimic joints are not supported here).
-        snap: Tolerance for exact rotation and axis entries.
-        cse: Share repeated subexpressions with ``sympy.cse`` at the end.
-        progress: Called as ``progress(stage, done, total)``.
-    """
-    tree = robot.tree
-    if not np.array_equal(tree.selection, np.eye(len(tree.bodies))):
-        raise NotImplementedError("compact equations do not support mimic joints; lock them (--lock)")
-    q, qd, qdd = joint_symbols(robot.joint_names)
-    program = _Program()
-    gravity = _constant(robot.gravity_vector[:, None])
-    bodies = tree.bodies
-    count = len(bodies)
-    R, z, o, p, com, w, dw, acc_p, acc_com, inertia = ([None] * count for _ in range(10))
-    zero = sp.zeros(3, 1)
-    for b, body in enumerate(bodies):
-        if progress:
-            progress("kinematics", b, count)
-        parent = body.parent
-        R_par = sp.eye(3) if parent < 0 else R[parent]
-        p_par = zero if parent < 0 else p[parent]
-        w_par = zero if parent < 0 else w[parent]
-        dw_par = zero if parent < 0 else dw[parent]
-        a_par = zero if parent < 0 else acc_p[parent]
-        R_joint = program.matrix(R_par * _exact_matrix(body.origin[:3, :3], snap), f"R{b + 1}_")
-        o[b] = program.vector(p_par + R_par * _constant(body.origin[:3, 3:]), f"o{b + 1}_")
-        axis = _exact_matrix(body.axis[:, None], snap)
-        z[b] = program.vector(R_joint * axis, f"z{b + 1}_")
-        if body.revolute:
-            c = program.let(sp.cos(q[b]), f"c{b + 1}_")
-            s = program.let(sp.sin(q[b]), f"s{b + 1}_")
-            R[b] = program.matrix(R_joint * _rotation(axis, c, s), f"R{b + 1}_")
-            p[b] = o[b]
-            w[b] = program.vector(w_par + z[b] * qd[b], f"w{b + 1}_")
-            dw[b] = program.vector(dw_par + w_par.cross(z[b] * qd[b]), f"dw{b + 1}_")
-        else:
-            R[b] = R_joint
-            p[b] = program.vector(o[b] + z[b] * q[b], f"p{b + 1}_")
-            w[b], dw[b] = w_par, dw_par
-        # Velocity-product acceleration of the body frame's origin, then of the centre of mass.
-        r = p[b] - p_par
-        bias = a_par + dw_par.cross(r) + w_par.cross(w_par.cross(r))
-        if not body.revolute:
-            bias += 2 * w_par.cross(z[b] * qd[b])
-        acc_p[b] = program.vector(bias, f"ap{b + 1}_")
-        com[b] = program.vector(p[b] + R[b] * _constant(body.com[:, None]), f"pc{b + 1}_")
-        rc = com[b] - p[b]
-        acc_com[b] = program.vector(acc_p[b] + dw[b].cross(rc) + w[b].cross(w[b].cross(rc)), f"ac{b + 1}_")
-        inertia[b] = program.matrix(R[b] * _constant(body.inertia) * R[b].T, f"I{b + 1}_")
-
-    # Composite bodies, about the world origin: mass, first moment, rotational inertia,
-    # and the rate of change of momentum (force, moment about the origin) of each subtree.
-    composite_mass = [sp.Integer(0)] * count
-    first_moment = [zero] * count
-    composite_inertia = [sp.zeros(3, 3)] * count
-    force = [zero] * count
-    moment = [zero] * count
-    for b in reversed(range(count)):
-        body = bodies[b]
-        if progress:
-            progress("Lagrangian", count - b, count)
-        if body.mass != 0 or body.inertia.any():
-            mass = _exact(body.mass, 0.0)
-            c = com[b]
-            offset = (c.T * c)[0] * sp.eye(3) - c * c.T
-            composite_mass[b] = composite_mass[b] + mass
-            first_moment[b] = first_moment[b] + program.vector(mass * c, f"h{b + 1}_")
-            composite_inertia[b] = composite_inertia[b] + program.matrix(inertia[b] + mass * offset, f"IO{b + 1}_")
-            f_b = program.vector(mass * acc_com[b], f"f{b + 1}_")
-            n_b = inertia[b] * dw[b] + w[b].cross(inertia[b] * w[b])
-            force[b] = force[b] + f_b
-            moment[b] = moment[b] + program.vector(n_b + c.cross(f_b), f"n{b + 1}_")
-        first_moment[b] = program.vector(first_moment[b], f"hc{b + 1}_")
-        composite_inertia[b] = program.matrix(composite_inertia[b], f"IC{b + 1}_")
-        force[b] = program.vector(force[b], f"fc{b + 1}_")
-        moment[b] = program.vector(moment[b], f"nc{b + 1}_")
-        if body.parent >= 0:
-            parent = body.parent
-            composite_mass[parent] = composite_mass[parent] + composite_mass[b]
-            first_moment[parent] = first_moment[parent] + first_moment[b]
-            composite_inertia[parent] = composite_inertia[parent] + composite_inertia[b]
-            force[parent] = force[parent] + force[b]
-            moment[parent] = moment[parent] + moment[b]
-
-    # Joint axes as spatial motions at the world origin: (angular, linear) velocity.
-    axes_angular = [z[i] if bodies[i].revolute else zero for i in range(count)]
-    axes_linear = [program.vector(o[i].cross(z[i]), f"v{i + 1}_") if bodies[i].revolute else z[i] for i in range(count)]
-    M = sp.zeros(count, count)
-    Cv = sp.zeros(count, 1)
-    G = sp.zeros(count, 1)
-    for i in range(count):
-        omega, velocity = axes_angular[i], axes_linear[i]
-        # M's column i: the spatial force of composite body i moving along joint i's axis.
-        n_i = program.vector(composite_inertia[i] * omega + first_moment[i].cross(velocity), f"Mn{i + 1}_")
-        f_i = program.vector(composite_mass[i] * velocity - first_moment[i].cross(omega), f"Mf{i + 1}_")
-        for j in range(count):
-            if tree.ancestors[i, j]:
-                M[i, j] = M[j, i] = (axes_angular[j].T * n_i)[0] + (axes_linear[j].T * f_i)[0]
-        Cv[i] = (omega.T * moment[i])[0] + (velocity.T * force[i])[0]
-        weight_moment = first_moment[i].cross(gravity)
-        G[i] = -((omega.T * weight_moment)[0] + (velocity.T * (composite_mass[i] * gravity))[0])
-    equations = CompactDynamics(
-        q, qd, qdd, program.assignments, M.applyfunc(sp.expand), Cv.applyfunc(sp.expand), G.applyfunc(sp.expand)
-    )
-    if cse:
-        if progress:
-            progress("common subexpressions", 0, 1)
-        equations = _shared(equations)
-    return equations
-
-
 def _shared(equations: CompactDynamics) -> CompactDynamics:
     """Share repeated subexpressions (``sympy.cse``) and keep only what the outputs need,
     in dependency order."""
@@ -263,3 +140,145 @@ def _in_order(definitions: dict[sp.Symbol, sp.Expr], outputs: list[sp.Expr]) -> 
                 if dependency in definitions and state.get(dependency) != 2:
                     stack.append((dependency, False))
     return ordered
+
+
+def derive_compact(
+    robot: ReferenceRobot, *, snap: float = 1e-8, cse: bool = True, progress: Callable[[str, int, int], None] | None = None
+) -> CompactDynamics:
+    """Derive the compact (intermediate-variable) equations of a reference robot.
+
+    Args:
+        robot: From :func:`robodyn.reference.load` (mimic joints are not supported here).
+        snap: Tolerance for exact rotation and axis entries.
+        cse: Share repeated subexpressions with ``sympy.cse`` at the end.
+        progress: Called as ``progress(stage, done, total)``.
+    """
+    tree = robot.tree
+    if not np.array_equal(tree.selection, np.eye(len(tree.bodies))):
+        raise NotImplementedError("compact equations do not support mimic joints; lock them (--lock)")
+    q, qd, qdd = joint_symbols(robot.joint_names)
+    program = _Program()
+    bodies = tree.bodies
+    count = len(bodies)
+    zero = sp.zeros(3, 1)
+    R = [None] * count  # parent frame <- body frame
+    t = [None] * count  # body origin in the parent frame
+    axis = [None] * count  # joint axis in the body frame
+    w, dw, acc = ([zero] * count for _ in range(3))  # angular velocity, its bias rate, origin's bias acceleration
+    gacc = [zero] * count  # the acceleration gravity amounts to, in the body frame
+    gravity = _constant(-robot.gravity_vector[:, None])  # the base "accelerates upwards"
+    for b, body in enumerate(bodies):
+        if progress:
+            progress("kinematics", b, count)
+        parent = body.parent
+        axis[b] = _exact_matrix(body.axis[:, None], snap)
+        rotation = _exact_matrix(body.origin[:3, :3], snap)
+        translation = _constant(body.origin[:3, 3:])
+        if body.revolute:
+            c = program.let(sp.cos(q[b]), f"c{b + 1}_")
+            s = program.let(sp.sin(q[b]), f"s{b + 1}_")
+            R[b] = program.matrix(rotation * _rotation(axis[b], c, s), f"R{b + 1}_")
+            t[b] = translation
+        else:
+            R[b] = rotation
+            t[b] = program.vector(translation + rotation * axis[b] * q[b], f"t{b + 1}_")
+        Rt = R[b].T
+        w_par = zero if parent < 0 else w[parent]
+        dw_par = zero if parent < 0 else dw[parent]
+        a_par = zero if parent < 0 else acc[parent]
+        g_par = gravity if parent < 0 else gacc[parent]
+        w_in = program.vector(Rt * w_par, f"wi{b + 1}_")
+        gacc[b] = program.vector(Rt * g_par, f"g{b + 1}_")
+        origin_acc = a_par + dw_par.cross(t[b]) + w_par.cross(w_par.cross(t[b]))
+        acc_b = Rt * origin_acc
+        if body.revolute:
+            w[b] = program.vector(w_in + axis[b] * qd[b], f"w{b + 1}_")
+            dw[b] = program.vector(Rt * dw_par + w_in.cross(axis[b] * qd[b]), f"dw{b + 1}_")
+        else:
+            w[b] = w_in
+            dw[b] = program.vector(Rt * dw_par, f"dw{b + 1}_")
+            acc_b = acc_b + 2 * w_in.cross(axis[b] * qd[b])
+        acc[b] = program.vector(acc_b, f"a{b + 1}_")
+
+    # Backward: forces and moments (about each body's origin) of the subtrees, for C q̇ and
+    # for G; composite inertias (about each body's origin) for M.
+    force, moment = [zero] * count, [zero] * count
+    gforce, gmoment = [zero] * count, [zero] * count
+    c_mass = [sp.Integer(0)] * count
+    c_first = [zero] * count
+    c_inertia = [sp.zeros(3, 3)] * count
+    for b in reversed(range(count)):
+        body = bodies[b]
+        if progress:
+            progress("Lagrangian", count - b, count)
+        if body.mass != 0 or body.inertia.any():
+            mass = _exact(body.mass, 0.0)
+            com = _constant(body.com[:, None])
+            inertia = _constant(body.inertia)
+            com_acc = acc[b] + dw[b].cross(com) + w[b].cross(w[b].cross(com))
+            f = program.vector(mass * com_acc, f"f{b + 1}_")
+            n = inertia * dw[b] + w[b].cross(inertia * w[b]) + com.cross(f)
+            force[b] = force[b] + f
+            moment[b] = moment[b] + n
+            fg = mass * gacc[b]
+            gforce[b] = gforce[b] + fg
+            gmoment[b] = gmoment[b] + com.cross(fg)
+            first = mass * com
+            c_mass[b] = c_mass[b] + mass
+            c_first[b] = c_first[b] + first
+            c_inertia[b] = c_inertia[b] + inertia + mass * ((com.T * com)[0] * sp.eye(3) - com * com.T)
+        force[b], moment[b] = program.vector(force[b], f"F{b + 1}_"), program.vector(moment[b], f"N{b + 1}_")
+        gforce[b], gmoment[b] = program.vector(gforce[b], f"FG{b + 1}_"), program.vector(gmoment[b], f"NG{b + 1}_")
+        c_first[b] = program.vector(c_first[b], f"h{b + 1}_")
+        c_inertia[b] = program.matrix(c_inertia[b], f"I{b + 1}_")
+        parent = body.parent
+        if parent >= 0:
+            Rf, Rg = R[b] * force[b], R[b] * gforce[b]
+            force[parent] = force[parent] + Rf
+            moment[parent] = moment[parent] + R[b] * moment[b] + t[b].cross(Rf)
+            gforce[parent] = gforce[parent] + Rg
+            gmoment[parent] = gmoment[parent] + R[b] * gmoment[b] + t[b].cross(Rg)
+            # The child's composite, moved to the parent's origin.
+            h = R[b] * c_first[b]
+            moved = R[b] * c_inertia[b] * R[b].T
+            shift = c_mass[b] * ((t[b].T * t[b])[0] * sp.eye(3) - t[b] * t[b].T)
+            cross = 2 * (t[b].T * h)[0] * sp.eye(3) - t[b] * h.T - h * t[b].T
+            c_mass[parent] = c_mass[parent] + c_mass[b]
+            c_first[parent] = c_first[parent] + h + c_mass[b] * t[b]
+            c_inertia[parent] = c_inertia[parent] + moved + shift + cross
+
+    def project(b: int, n: sp.Matrix, f: sp.Matrix) -> sp.Expr:
+        return (axis[b].T * n)[0] if bodies[b].revolute else (axis[b].T * f)[0]
+
+    M = sp.zeros(count, count)
+    Cv = sp.zeros(count, 1)
+    G = sp.zeros(count, 1)
+    for i in range(count):
+        Cv[i] = project(i, moment[i], force[i])
+        G[i] = project(i, gmoment[i], gforce[i])
+        # Column i of M: the composite body i moving along joint i's axis, carried up.
+        if bodies[i].revolute:
+            n, f = c_inertia[i] * axis[i], axis[i].cross(c_first[i])
+        else:
+            n, f = c_first[i].cross(axis[i]), c_mass[i] * axis[i]
+        n, f = program.vector(n, f"Mn{i + 1}_"), program.vector(f, f"Mf{i + 1}_")
+        j = i
+        while j >= 0:
+            M[i, j] = M[j, i] = project(j, n, f)
+            parent = bodies[j].parent
+            if parent < 0:
+                break
+            f_up = R[j] * f
+            n, f = (
+                program.vector(R[j] * n + t[j].cross(f_up), f"Mn{i + 1}_{parent + 1}_"),
+                program.vector(f_up, f"Mf{i + 1}_{parent + 1}_"),
+            )
+            j = parent
+    equations = CompactDynamics(
+        q, qd, qdd, program.assignments, M.applyfunc(sp.expand), Cv.applyfunc(sp.expand), G.applyfunc(sp.expand)
+    )
+    if cse:
+        if progress:
+            progress("common subexpressions", 0, 1)
+        equations = _shared(equations)
+    return equations
