@@ -92,6 +92,7 @@ def derive_equations(
     form: str = "auto",
     keep_params: bool = False,
     lock: dict[str, float] | None = None,
+    floating_base: bool | None = None,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> Equations:
     """Derive the equations of motion of a robot symbolically.
@@ -101,8 +102,17 @@ def derive_equations(
         form: ``"closed"``, ``"compact"`` or ``"auto"`` (closed up to three joints).
         keep_params: Keep physical parameters as symbols (closed form only).
         lock: Joints to freeze, by name, at positions (e.g. a gripper's fingers).
+        floating_base: As for :func:`robodyn.load`; symbolic equations model fixed bases,
+            so a robot that would load floating must be asked for with ``False``.
         progress: Called as ``progress(stage, done, total)`` during long derivations.
+
+    Raises:
+        InputError: For a floating base, a bad form, or kept parameters in compact form.
     """
+    from robodyn.sources import resolve_source
+
+    if floating_base or (floating_base is None and resolve_source(source).floating_base):
+        raise InputError("floating_base", "False: symbolic equations model fixed bases (--fixed-base)", f"a floating {source}")
     model = reference.load(source, lock=lock)
     if form == "auto":
         form = "closed" if model.nv <= CLOSED_FORM_JOINTS or keep_params else "compact"

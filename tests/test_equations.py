@@ -170,3 +170,10 @@ def test_compact_form_of_random_trees_agrees_with_pinocchio(urdf):
     for target, source in zip(to_module, (q, v, a), strict=True):
         target[:, order] = source
     assert relative(namespace["inverse_dynamics"](*to_module)[:, order], robot.inverse_dynamics(q, v, a)) < 1e-9
+
+
+def test_floating_robots_need_an_explicit_fixed_base(capsys):
+    assert main(["equations", "solo12", "--symbolic"]) == 2
+    assert "symbolic equations model fixed bases (--fixed-base)" in capsys.readouterr().err
+    assert main(["equations", "solo12", "--symbolic", "--fixed-base", "--format", "json"]) == 0
+    assert len(json.loads(capsys.readouterr().out)["joint_names"]) == 12
