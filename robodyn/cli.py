@@ -146,6 +146,7 @@ def _command_symbolic(arguments: argparse.Namespace) -> int:
             form=arguments.form,
             keep_params=arguments.keep_params,
             lock=_lock_values(arguments.lock),
+            floating_base=arguments.floating_base,
             progress=progress,
         )
     finally:
