@@ -17,7 +17,15 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from robodyn.exceptions import FrameError, InputError, RobodynError, SingularMassMatrixError, UnknownRobotError, URDFError
+from robodyn.exceptions import (
+    FrameError,
+    InputError,
+    RobodynError,
+    SimulationError,
+    SingularMassMatrixError,
+    UnknownRobotError,
+    URDFError,
+)
 from robodyn.models import RPArmParameters, rp_arm_urdf
 from robodyn.sources import robot_names
 
@@ -31,7 +39,6 @@ _LAZY = {
     "simulate": "robodyn.simulation",
     "Trajectory": "robodyn.simulation",
     "ExternalWrench": "robodyn.simulation",
-    "SimulationError": "robodyn.simulation",
     "attach_payload": "robodyn.payload",
     "record": "robodyn.viewer",
     "check_robot": "robodyn.check",

@@ -95,3 +95,21 @@ class SingularMassMatrixError(RobodynError, ArithmeticError):
             else "the accelerations are not finite"
         )
         super().__init__(f"robot {robot!r}: the mass matrix is singular, so forward dynamics is undefined ({reason}).")
+
+
+class SimulationError(RobodynError):
+    """The simulated state stopped being finite.
+
+    Attributes:
+        time: Simulation time of the last finite state, in [s].
+        step: Index of the step that diverged.
+        joint: Name of the first joint whose position or velocity is not finite.
+    """
+
+    def __init__(self, time: float, step: int, joint: str):
+        self.time = time
+        self.step = step
+        self.joint = joint
+        super().__init__(
+            f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
+        )

@@ -28,31 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-from robodyn.exceptions import InputError, RobodynError
+from robodyn.exceptions import InputError, RobodynError, SimulationError
 from robodyn.files import atomic_write_bytes, atomic_write_text
 from robodyn.robot import Robot
 
 #: A controller maps time in [s], q and v to joint torques, shape (nv,).
 Controller = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 INTEGRATORS = ("rk4", "semi-implicit-euler")
-
-
-class SimulationError(RobodynError):
-    """The simulated state stopped being finite.
-
-    Attributes:
-        time: Simulation time of the last finite state, in [s].
-        step: Index of the step that diverged.
-        joint: Name of the first joint whose position or velocity is not finite.
-    """
-
-    def __init__(self, time: float, step: int, joint: str):
-        self.time = time
-        self.step = step
-        self.joint = joint
-        super().__init__(
-            f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
-        )
 
 
 @dataclass(frozen=True)
