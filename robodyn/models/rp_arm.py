@@ -13,7 +13,8 @@ The arm of ``shared/lecture/rp-arm.md``, as a rigid-body model:
   ``l1 + q2/2`` cannot be a rigid body: see the errata in ``rp-arm.md``.)
 - ``end_effector`` is a frame at the far end of link 2, ``l1 + q2 + l2`` from the shoulder.
 
-Both links are drawn as boxes of square cross-section ``width``.
+Both links are drawn as boxes of square cross-section ``width``; a thinner rod behind link 2
+shows the slider running inside link 1.
 """
 
 from __future__ import annotations
@@ -95,10 +96,23 @@ class RPArmParameters:
         return self.l2 / 2
 
 
-def _link(name: str, mass: float, length: float, width: float, inertia_axis: float) -> str:
-    """A bar along +X from the link origin; ``inertia_axis`` is about the joint (Y) axis."""
+def _link(name: str, mass: float, length: float, width: float, inertia_axis: float, sleeve: float = 0.0) -> str:
+    """A bar along +X from the link origin; ``inertia_axis`` is about the joint (Y) axis.
+
+    ``sleeve`` draws (only draws) a thinner rod reaching that far back from the origin, so
+    that the slider visibly stays in link 1 when extended.
+    """
     # Inertia about the bar's long axis: that of its square cross-section.
     inertia_long = mass * width**2 / 6
+    sleeve_visual = (
+        f"""
+    <visual>
+      <origin xyz="{-sleeve / 2!r} 0 0" rpy="0 0 0"/>
+      <geometry><box size="{sleeve!r} {0.6 * width!r} {0.6 * width!r}"/></geometry>
+    </visual>"""
+        if sleeve > 0
+        else ""
+    )
     return f"""  <link name="{name}">
     <inertial>
       <origin xyz="{length / 2!r} 0 0" rpy="0 0 0"/>
@@ -108,7 +122,7 @@ def _link(name: str, mass: float, length: float, width: float, inertia_axis: flo
     <visual>
       <origin xyz="{length / 2!r} 0 0" rpy="0 0 0"/>
       <geometry><box size="{length!r} {width!r} {width!r}"/></geometry>
-    </visual>
+    </visual>{sleeve_visual}
   </link>
 """
 
@@ -146,7 +160,7 @@ def rp_arm_urdf(parameters: RPArmParameters | None = None) -> str:
     <axis xyz="1 0 0"/>
     <limit lower="{p.q2_limits[0]!r}" upper="{p.q2_limits[1]!r}" effort="{p.effort_limits[1]!r}" velocity="{p.velocity_limits[1]!r}"/>
   </joint>
-{_link("link2", p.m2, p.l2, p.width, p.inertia2)}  <joint name="end_effector_joint" type="fixed">
+{_link("link2", p.m2, p.l2, p.width, p.inertia2, sleeve=p.q2_limits[1])}  <joint name="end_effector_joint" type="fixed">
     <parent link="link2"/>
     <child link="end_effector"/>
     <origin xyz="{p.l2!r} 0 0" rpy="0 0 0"/>
