@@ -30,7 +30,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.symbolic import _exact, joint_symbols
+from robodyn.reference.symbolic import _exact, exact_matrix, joint_symbols
 
 
 @dataclass
@@ -85,14 +85,9 @@ class _Program:
         return sp.Matrix(matrix.rows, matrix.cols, lambda i, j: self.let(matrix[i, j], prefix))
 
 
-def _exact_matrix(values: np.ndarray, snap: float) -> sp.Matrix:
-    values = np.atleast_2d(values)
-    return sp.Matrix(values.shape[0], values.shape[1], lambda i, j: _exact(float(values[i, j]), snap))
-
-
 def _constant(values: np.ndarray) -> sp.Matrix:
-    values = np.atleast_2d(values)
-    return sp.Matrix(values.shape[0], values.shape[1], lambda i, j: _exact(float(values[i, j]), 0.0))
+    """A matrix of URDF constants kept as given (exact only where exactly 0 or 1)."""
+    return exact_matrix(values, 0.0)
 
 
 def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
@@ -171,8 +166,8 @@ def derive_compact(
         if progress:
             progress("kinematics", b, count)
         parent = body.parent
-        axis[b] = _exact_matrix(body.axis[:, None], snap)
-        rotation = _exact_matrix(body.origin[:3, :3], snap)
+        axis[b] = exact_matrix(body.axis[:, None], snap)
+        rotation = exact_matrix(body.origin[:3, :3], snap)
         translation = _constant(body.origin[:3, 3:])
         if body.revolute:
             c = program.let(sp.cos(q[b]), f"c{b + 1}_")

@@ -108,7 +108,8 @@ def _exact(value: float, snap: float) -> sp.Expr:
     return sp.Float(value, 17)
 
 
-def _exact_array(values: np.ndarray, snap: float) -> sp.Matrix:
+def exact_matrix(values: np.ndarray, snap: float) -> sp.Matrix:
+    """A sympy matrix of numbers, each snapped to an exact value within ``snap``."""
     values = np.atleast_2d(values)
     return sp.Matrix(values.shape[0], values.shape[1], lambda i, j: _exact(float(values[i, j]), snap))
 
@@ -157,15 +158,15 @@ def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8, 
     tree = robot.tree
     keep: dict | None = {} if keep_params else None
     q, qd, qdd = joint_symbols(robot.joint_names)
-    selection = _exact_array(tree.selection, 0.0)
-    theta = selection * sp.Matrix(q) + _exact_array(tree.offset[:, None], 0.0)
+    selection = exact_matrix(tree.selection, 0.0)
+    theta = selection * sp.Matrix(q) + exact_matrix(tree.offset[:, None], 0.0)
     theta_dot = selection * sp.Matrix(qd)
-    gravity = _exact_array(robot.gravity_vector[:, None], 0.0)
+    gravity = exact_matrix(robot.gravity_vector[:, None], 0.0)
     if keep is not None:
         magnitude = float(np.linalg.norm(robot.gravity_vector))
         g = sp.Symbol("g", positive=True)
         keep[g] = magnitude
-        gravity = _exact_array(robot.gravity_vector[:, None] / magnitude, snap) * g if magnitude > 0 else gravity
+        gravity = exact_matrix(robot.gravity_vector[:, None] / magnitude, snap) * g if magnitude > 0 else gravity
     rotations: list[sp.Matrix] = []
     positions: list[sp.Matrix] = []
     axes: list[sp.Matrix] = []
@@ -175,10 +176,10 @@ def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8, 
     for index, body in enumerate(tree.bodies):
         parent_rotation = sp.eye(3) if body.parent < 0 else rotations[body.parent]
         parent_position = sp.zeros(3, 1) if body.parent < 0 else positions[body.parent]
-        joint_rotation = parent_rotation * _exact_array(body.origin[:3, :3], snap)
+        joint_rotation = parent_rotation * exact_matrix(body.origin[:3, :3], snap)
         offset = _parameter(body.origin[:3, 3], [f"d_{body.joint}_{a}" for a in "xyz"], keep)
         origin = parent_position + parent_rotation * offset
-        axis = _exact_array(body.axis[:, None], snap)
+        axis = exact_matrix(body.axis[:, None], snap)
         world_axis = joint_rotation * axis
         angle = theta[index]
         if body.revolute:
