@@ -166,6 +166,11 @@ class Robot:
         return list(self._frame_ids)
 
     @property
+    def frame_ids(self) -> dict[str, int]:
+        """Pinocchio index of every frame, by name (a copy)."""
+        return dict(self._frame_ids)
+
+    @property
     def end_effector(self) -> str:
         """The frame tasks refer to by default: ``end_effector`` if the URDF has that link,
         else the URDF's last link."""
@@ -349,11 +354,11 @@ class Robot:
         """:meth:`forward_dynamics` of one state without the boundary checks.
 
         For inner loops (simulation) whose inputs were checked once: float64 1-D arrays of
-        the right sizes. A singular mass matrix gives non-finite values here.
+        the right sizes. A singular mass matrix gives non-finite values here (ABA), or a
+        :class:`SingularMassMatrixError` for robots with mimic joints.
         """
         if self.mimic is not None:
-            mass = self._mass_matrix(q)
-            return np.linalg.solve(mass, tau - pin.nonLinearEffects(self.model, self.data, q, v))
+            return self._solve_dynamics(q, v, tau)
         return pin.aba(self.model, self.data, q, v, tau)
 
     def _solve_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:

@@ -123,11 +123,15 @@ def scene_commands(robot: Robot) -> list[dict]:
     return commands
 
 
-def link_placements(robot: Robot, q: np.ndarray) -> dict[str, np.ndarray]:
-    """World pose (4×4) of every URDF link at configuration ``q``."""
-    data = robot.model.createData()
+def link_placements(robot: Robot, q: np.ndarray, data: pin.Data | None = None) -> dict[str, np.ndarray]:
+    """World pose (4×4) of every URDF link at configuration ``q``.
+
+    Pass ``data`` (``robot.model.createData()``) when calling this for many frames.
+    """
+    data = robot.model.createData() if data is None else data
     pin.framesForwardKinematics(robot.model, data, q)
-    return {name: data.oMf[robot.frame_id(name)].homogeneous for name in robot.spec.links if name in robot.frame_names}
+    frames = robot.frame_ids
+    return {name: data.oMf[frames[name]].homogeneous for name in robot.spec.links if name in frames}
 
 
 def _resample(trajectory: Trajectory, fps: float) -> tuple[np.ndarray, np.ndarray]:
@@ -147,8 +151,9 @@ def animation_command(robot: Robot, trajectory: Trajectory, fps: float = 30.0) -
         configurations[:, 3:7] /= np.linalg.norm(configurations[:, 3:7], axis=1, keepdims=True)
     clips: dict[str, AnimationClip] = {}
     positions = []
+    data = robot.model.createData()
     for frame, q in enumerate(configurations):
-        for name, matrix in link_placements(robot, q).items():
+        for name, matrix in link_placements(robot, q, data).items():
             clip = clips.setdefault(name, AnimationClip(fps=fps))
             quaternion = pin.Quaternion(matrix[:3, :3]).coeffs()  # x, y, z, w
             clip.set_property(frame, "position", "vector3", matrix[:3, 3].tolist())

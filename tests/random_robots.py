@@ -5,13 +5,7 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import strategies as st
 
-
-def _rotation(rpy: np.ndarray) -> np.ndarray:
-    roll, pitch, yaw = rpy
-    rx = np.array([[1, 0, 0], [0, np.cos(roll), -np.sin(roll)], [0, np.sin(roll), np.cos(roll)]])
-    ry = np.array([[np.cos(pitch), 0, np.sin(pitch)], [0, 1, 0], [-np.sin(pitch), 0, np.cos(pitch)]])
-    rz = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
-    return rz @ ry @ rx
+from robodyn.urdf_edit import rpy_matrix
 
 
 def urdf_from_seed(seed: int, joints: int, types: list[str]) -> str:
@@ -34,7 +28,7 @@ def urdf_from_seed(seed: int, joints: int, types: list[str]) -> str:
         moments = (
             mass / 12 * np.array([sides[1] ** 2 + sides[2] ** 2, sides[0] ** 2 + sides[2] ** 2, sides[0] ** 2 + sides[1] ** 2])
         )
-        rotation = _rotation(rng.uniform(-np.pi, np.pi, 3))
+        rotation = rpy_matrix(rng.uniform(-np.pi, np.pi, 3))
         inertia = rotation @ np.diag(moments) @ rotation.T
         com = " ".join(f"{x:.6f}" for x in rng.uniform(-0.2, 0.2, 3))
         inertia_rpy = " ".join(f"{x:.6f}" for x in rng.uniform(-np.pi, np.pi, 3))
