@@ -26,23 +26,23 @@ from robodyn.exceptions import (
     UnknownRobotError,
     URDFError,
 )
-from robodyn.models import RPArmParameters, rp_arm_urdf
-from robodyn.sources import robot_names
+from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
+from robodyn.urdf.sources import robot_names
 
 __version__ = "0.1.0"
 
 # Public name -> module that defines it (imported lazily: these modules import Pinocchio).
 _LAZY = {
-    "load": "robodyn.loading",
-    "Robot": "robodyn.robot",
-    "JointInfo": "robodyn.robot",
-    "simulate": "robodyn.simulation",
-    "Trajectory": "robodyn.simulation",
-    "ExternalWrench": "robodyn.simulation",
-    "attach_payload": "robodyn.payload",
-    "record": "robodyn.viewer",
-    "check_robot": "robodyn.check",
-    "derive_equations": "robodyn.equations",
+    "load": "robodyn.dynamics.loading",
+    "Robot": "robodyn.dynamics.robot",
+    "JointInfo": "robodyn.dynamics.robot",
+    "simulate": "robodyn.sim.simulation",
+    "Trajectory": "robodyn.sim.simulation",
+    "ExternalWrench": "robodyn.sim.simulation",
+    "attach_payload": "robodyn.dynamics.payload",
+    "record": "robodyn.viz.viewer",
+    "check_robot": "robodyn.verify.check",
+    "derive_equations": "robodyn.equations.derive",
 }
 
 __all__ = [

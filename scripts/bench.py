@@ -34,7 +34,7 @@ import pinocchio as pin
 
 import robodyn
 from robodyn import reference
-from robodyn.simulation import SimulationError, simulate
+from robodyn.sim.simulation import SimulationError, simulate
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "bench"
@@ -170,7 +170,7 @@ def bench_reference(quick: bool) -> list[dict]:
 
 
 def bench_symbolic(quick: bool) -> list[dict]:
-    from robodyn.equations import derive_equations
+    from robodyn.equations.derive import derive_equations
 
     rows = []
     for name, lock in (("rp_arm", None), ("double_pendulum", None), ("ur5", None), ("panda", PANDA_ARM["lock"])):
@@ -194,7 +194,7 @@ def bench_codegen(quick: bool) -> list[dict]:
     import importlib.util
     import tempfile
 
-    from robodyn.equations import derive_equations, render
+    from robodyn.equations.derive import derive_equations, render
 
     rows = []
     for name, lock in (("ur5", None), ("panda", PANDA_ARM["lock"])):
@@ -291,7 +291,7 @@ def bench_simulation(quick: bool) -> list[dict]:
 def bench_recording(quick: bool) -> list[dict]:
     import tempfile
 
-    from robodyn.viewer import record
+    from robodyn.viz.viewer import record
 
     duration = 2.0 if quick else 10.0
     robot = robodyn.load("panda")

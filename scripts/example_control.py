@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 
 import robodyn
-from robodyn.control import TaskSpace
-from robodyn.experiment import controller_model
-from robodyn.plots import plot_simulation
-from robodyn.simulation import simulate
-from robodyn.viewer import record
+from robodyn.sim.control import TaskSpace
+from robodyn.sim.experiment import controller_model
+from robodyn.sim.simulation import simulate
+from robodyn.viz.plots import plot_simulation
+from robodyn.viz.viewer import record
 
 
 def main(folder: str = "out") -> None:

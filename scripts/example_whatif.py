@@ -4,8 +4,8 @@ Run: ``python scripts/example_whatif.py``.
 """
 
 import robodyn
-from robodyn.report import dof_units
-from robodyn.whatif import sweep, table_text
+from robodyn.cli.report import dof_units
+from robodyn.sim.whatif import sweep, table_text
 
 
 def main() -> None:

@@ -6,7 +6,7 @@ committed file equals the generator's output.
 
 from pathlib import Path
 
-from robodyn.models import GENERATED
+from robodyn.urdf.models import GENERATED
 
 FOLDER = Path(__file__).resolve().parent.parent / "urdf"
 

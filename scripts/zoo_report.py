@@ -1,7 +1,7 @@
 """Check every robot of the zoo against the reference and write ``docs/zoo.md``.
 
 Run from the repository root: ``python scripts/zoo_report.py``. Each fixed-base robot is
-loaded and compared with :func:`robodyn.check.check_robot`; a robot that cannot be compared
+loaded and compared with :func:`robodyn.verify.check.check_robot`; a robot that cannot be compared
 is listed with the reason. The slow test tier re-runs this and compares it with the file.
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from robodyn.zoo_status import zoo_markdown, zoo_statuses
+from robodyn.verify.zoo_status import zoo_markdown, zoo_statuses
 
 TARGET = Path(__file__).resolve().parent.parent / "docs" / "zoo.md"
 

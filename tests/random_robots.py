@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import strategies as st
 
-from robodyn.urdf_edit import rpy_matrix
+from robodyn.urdf.edit import rpy_matrix
 
 
 def urdf_from_seed(seed: int, joints: int, types: list[str]) -> str:

@@ -8,8 +8,8 @@ import pytest
 
 import robodyn
 from robodyn import reference
-from robodyn.cli import main
-from robodyn.validation import lint_source
+from robodyn.cli.app import main
+from robodyn.urdf.sources import lint_source
 from tests.conftest import ROOT
 
 BAD = ROOT / "tests" / "data" / "bad"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.cli import main
+from robodyn.cli.app import main
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:

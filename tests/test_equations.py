@@ -14,9 +14,9 @@ import sympy as sp
 from hypothesis import HealthCheck, given, settings
 
 import robodyn
-from robodyn.cli import main
-from robodyn.equations import derive_equations, render
-from robodyn.reference import lecture
+from robodyn.cli.app import main
+from robodyn.equations import lecture
+from robodyn.equations.derive import derive_equations, render
 from tests.random_robots import random_urdfs
 
 PANDA_ARM = {"panda_finger_joint1": 0.0}
@@ -131,7 +131,7 @@ def test_latex_is_a_complete_document(capsys):
 
 
 def test_progress_goes_to_stderr_and_json_stays_clean(capsys, monkeypatch):
-    import robodyn.cli as cli
+    import robodyn.cli.app as cli
 
     monkeypatch.setattr(cli._Progress, "DELAY", 0.0)
     assert main(["equations", "ur5", "--symbolic", "--format", "json"]) == 0

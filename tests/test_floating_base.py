@@ -8,8 +8,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 import robodyn
-from robodyn.check import check_robot
-from robodyn.simulation import simulate
+from robodyn.sim.simulation import simulate
+from robodyn.verify.check import check_robot
 from tests.random_robots import random_urdfs
 
 

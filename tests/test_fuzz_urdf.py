@@ -23,7 +23,7 @@ SEEDS = [
     robodyn.rp_arm_urdf(),
     (ROOT / "tests" / "data" / "two_branches.urdf").read_text(),
     (ROOT / "tests" / "data" / "gantry.urdf").read_text(),
-    robodyn.models.pendulum_urdf(3),
+    robodyn.urdf.models.pendulum_urdf(3),
 ]
 TOKENS = ["nan", "inf", "-inf", "-1", "0", "1e308", "-1e-308", "", "abc", "1 2", "1 2 3 4", "0 0 0", "  ", "1e-30", "3"]
 

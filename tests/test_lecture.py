@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from robodyn.reference import lecture
-from robodyn.reference.lecture import Iz1, Iz2, g, l1, m1, m2, q1, q2, qd1, qd2, qdd1, qdd2, split
+from robodyn.equations import lecture
+from robodyn.equations.lecture import Iz1, Iz2, g, l1, m1, m2, q1, q2, qd1, qd2, qdd1, qdd2, split
 
 
 def difference(a: sp.Matrix, b: sp.Matrix) -> dict[str, sp.Matrix]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from robodyn.check import check_robot
+from robodyn.verify.check import check_robot
 from tests.random_robots import random_urdfs
 
 

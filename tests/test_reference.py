@@ -13,10 +13,10 @@ import sympy as sp
 
 import robodyn
 from robodyn import reference
-from robodyn.check import check_robot
-from robodyn.models import RPArmParameters, rp_arm_urdf
 from robodyn.reference import rp_closed_form as closed
 from robodyn.reference.symbolic import derive
+from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
+from robodyn.verify.check import check_robot
 from tests.conftest import FAST_ZOO, ROOT, URDF_FILES
 
 REFERENCE_DIR = ROOT / "robodyn" / "reference"
@@ -38,7 +38,9 @@ def test_no_module_of_the_reference_imports_pinocchio():
         modules = imported_modules(path)
         assert not {m for m in modules if m.split(".")[0] in ("pinocchio", "coal", "hppfcl")}, path
         # Nor robodyn modules that do (loading, robot, check, cli).
-        assert not modules & {"robodyn.loading", "robodyn.robot", "robodyn.check", "robodyn.cli"}, path
+        assert not modules & {"robodyn.dynamics.loading", "robodyn.dynamics.robot", "robodyn.verify.check", "robodyn.cli.app"}, (
+            path
+        )
 
 
 def test_reference_runs_in_a_process_where_pinocchio_cannot_be_imported():

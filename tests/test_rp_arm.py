@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.models import GENERATED, RPArmParameters, rp_arm_urdf
 from robodyn.reference import rp_closed_form as closed
+from robodyn.urdf.models import GENERATED, RPArmParameters, rp_arm_urdf
 from tests.conftest import ROOT
 
 PARAMETERS = [

@@ -7,11 +7,11 @@ import pytest
 
 import robodyn
 from robodyn import InputError
-from robodyn.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
-from robodyn.experiment import controller_model
-from robodyn.models import pendulum_urdf
-from robodyn.payload import attach_payload
-from robodyn.simulation import ExternalWrench, SimulationError, Trajectory, simulate
+from robodyn.dynamics.payload import attach_payload
+from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
+from robodyn.sim.experiment import controller_model
+from robodyn.sim.simulation import ExternalWrench, SimulationError, Trajectory, simulate
+from robodyn.urdf.models import pendulum_urdf
 from tests.conftest import ROOT
 
 GANTRY = ROOT / "tests" / "data" / "gantry.urdf"

@@ -18,9 +18,9 @@ import umsgpack
 
 import robodyn
 from robodyn import RobodynError
-from robodyn.cli import main
-from robodyn.simulation import Trajectory, simulate
-from robodyn.viewer import chromium, record, screenshot
+from robodyn.cli.app import main
+from robodyn.sim.simulation import Trajectory, simulate
+from robodyn.viz.viewer import chromium, record, screenshot
 from tests.conftest import ROOT
 
 
@@ -100,7 +100,7 @@ def _port_open(url: str) -> bool:
 @pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT])
 def test_live_viewer_listens_on_localhost_and_leaves_no_server(stop):
     process = subprocess.Popen(
-        [sys.executable, "-m", "robodyn.cli", "view", "rp_arm", "--seconds", "60"],
+        [sys.executable, "-m", "robodyn.cli.app", "view", "rp_arm", "--seconds", "60"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

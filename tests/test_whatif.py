@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from robodyn import InputError
-from robodyn.cli import main
-from robodyn.materials import DENSITIES, box_inertia, density
-from robodyn.models import RPArmParameters
-from robodyn.simulation import Trajectory
-from robodyn.whatif import sweep
+from robodyn.cli.app import main
+from robodyn.sim.simulation import Trajectory
+from robodyn.sim.whatif import sweep
+from robodyn.urdf.materials import DENSITIES, box_inertia, density
+from robodyn.urdf.models import RPArmParameters
 
 
 def test_densities_and_aliases():

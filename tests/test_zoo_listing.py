@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from robodyn.zoo import zoo_names
-from robodyn.zoo_status import zoo_status
+from robodyn.urdf.zoo import zoo_names
+from robodyn.verify.zoo_status import zoo_status
 from tests.conftest import ROOT
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.zoo import zoo_names
+from robodyn.urdf.zoo import zoo_names
 from tests.conftest import random_state
 
 

@@ -18,11 +18,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from robodyn.inputs import as_state
+from robodyn.common.inputs import as_state
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.tree import KinematicTree, build_tree
-from robodyn.sources import locked_source, resolve_source
-from robodyn.validation import parse_urdf
+from robodyn.urdf.sources import locked_source, resolve_source
+from robodyn.urdf.validation import parse_urdf
 
 STANDARD_GRAVITY = (0.0, 0.0, -9.81)
 

@@ -28,9 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from robodyn.inputs import as_states
+from robodyn.common.inputs import as_states
 from robodyn.reference.tree import KinematicTree
-from robodyn.validation import URDFSpec
+from robodyn.urdf.validation import URDFSpec
 
 #: Largest number of states processed at once.
 CHUNK = 256

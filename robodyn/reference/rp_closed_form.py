@@ -1,6 +1,6 @@
 """The RP arm's equations of motion, written out by hand from ``rp-arm.md``.
 
-The rigid-body model of the generated arm (:mod:`robodyn.models.rp_arm`): link 2's centre
+The rigid-body model of the generated arm (:mod:`robodyn.urdf.models.rp_arm`): link 2's centre
 of mass is at ``r2 = l1 + q2 + c2`` from the shoulder. With ``g`` the magnitude of gravity:
 
     M(q)   = [[m1 l1²/4 + Iz1 + m2 r2² + Iz2, 0], [0, m2]]
@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robodyn.models.rp_arm import RPArmParameters
+from robodyn.urdf.models.rp_arm import RPArmParameters
 
 STANDARD_GRAVITY = 9.81
 

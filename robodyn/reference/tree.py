@@ -1,6 +1,6 @@
 """The kinematic tree the reference works on, read from the URDF with yourdfpy.
 
-The URDF first passes robodyn's strict validator (:mod:`robodyn.validation`); yourdfpy then
+The URDF first passes robodyn's strict validator (:mod:`robodyn.urdf.validation`); yourdfpy then
 reads it and this module turns it into a list of rigid :class:`Body` objects, one for each
 moving joint:
 
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import yourdfpy
 
-from robodyn.validation import URDFSpec
+from robodyn.urdf.validation import URDFSpec
 
 #: The six virtual joints of a floating base: translations then rotations about the base
 #: frame's x, y, z axes (the root link is carried by the last).
@@ -114,7 +114,7 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
     """Build the reference's kinematic tree from a validated URDF.
 
     Args:
-        spec: The validated URDF (from :func:`robodyn.validation.parse_urdf`).
+        spec: The validated URDF (from :func:`robodyn.urdf.validation.parse_urdf`).
         text: The same URDF text, read again here by yourdfpy.
         floating_base: Give the root link six degrees of freedom: three prismatic then
             three revolute "virtual" joints along the x, y, z axes of the base's own frame

@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from robodyn.models import rp_arm_urdf
+from robodyn.urdf.models import rp_arm_urdf
 
 FOLDER = Path(__file__).resolve().parent / "bad"
 GOOD = rp_arm_urdf()

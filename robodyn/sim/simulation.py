@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
+from robodyn.common.files import atomic_write_bytes, atomic_write_text
+from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, RobodynError, SimulationError
-from robodyn.files import atomic_write_bytes, atomic_write_text
-from robodyn.robot import Robot
 
 #: A controller maps time in [s], q and v to joint torques, shape (nv,).
 Controller = Callable[[float, np.ndarray, np.ndarray], np.ndarray]

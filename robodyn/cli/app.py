@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 
 import robodyn
-from robodyn import report
+from robodyn.cli import report
 from robodyn.exceptions import InputError, RobodynError
 
 
@@ -55,8 +55,8 @@ def _load(arguments: argparse.Namespace) -> robodyn.Robot:
 
 
 def _command_list(arguments: argparse.Namespace) -> int:
-    from robodyn.models import GENERATED
-    from robodyn.zoo import ZOO
+    from robodyn.urdf.models import GENERATED
+    from robodyn.urdf.zoo import ZOO
 
     names = robodyn.robot_names()
     if arguments.json:
@@ -134,7 +134,7 @@ class _Progress:
 
 
 def _command_symbolic(arguments: argparse.Namespace) -> int:
-    from robodyn.equations import derive_equations, lecture_text, render
+    from robodyn.equations.derive import derive_equations, lecture_text, render
 
     if arguments.lecture:
         print(lecture_text(), end="")
@@ -153,7 +153,7 @@ def _command_symbolic(arguments: argparse.Namespace) -> int:
         progress.close()
     output = render(equations, arguments.format)
     if arguments.out:
-        from robodyn.files import atomic_write_text
+        from robodyn.common.files import atomic_write_text
 
         atomic_write_text(arguments.out, output)
         print(f"wrote {arguments.out} ({equations.form} form, {equations.operation_count()} operations)", file=sys.stderr)
@@ -178,7 +178,7 @@ def _command_equations(arguments: argparse.Namespace) -> int:
 
 
 def _command_check(arguments: argparse.Namespace) -> int:
-    from robodyn.check import check_robot, report_dict, report_text
+    from robodyn.verify.check import check_robot, report_dict, report_text
 
     robot = _load(arguments)
     report = check_robot(
@@ -193,30 +193,42 @@ def _command_check(arguments: argparse.Namespace) -> int:
 
 
 def _command_simulate(arguments: argparse.Namespace) -> int:
-    from robodyn.experiment import run_simulation
+    from robodyn.sim.experiment import run_simulation
 
     robot = _load(arguments)
-    summary = run_simulation(
+    frame = arguments.frame or robot.end_effector
+    trajectory, summary = run_simulation(
         robot,
         controller=arguments.controller,
         target=arguments.target,
-        frame=arguments.frame or robot.end_effector,
+        frame=frame,
         q0=arguments.q0,
         duration=arguments.duration,
         dt=arguments.dt,
         integrator=arguments.integrator,
-        out=arguments.out,
-        plot=arguments.plot,
-        record=arguments.record,
-        png=arguments.png,
     )
+    if arguments.out:
+        summary["trajectory"] = str(trajectory.save(arguments.out))
+    if arguments.plot:
+        from robodyn.viz.plots import plot_simulation
+
+        task = np.asarray(summary["target_m"]) if "target_m" in summary else None
+        summary["plot"] = str(
+            plot_simulation(robot, trajectory, arguments.plot, frame=frame if task is not None else None, target=task)
+        )
+    if arguments.record:
+        from robodyn.viz.viewer import record
+
+        summary["recording"] = str(record(robot, trajectory, arguments.record, png=arguments.png))
+        if arguments.png:
+            summary["poster"] = str(arguments.png)
     print(json.dumps(summary, indent=2) if arguments.json else "\n".join(f"{key}: {value}" for key, value in summary.items()))
     return 0
 
 
 def _command_record(arguments: argparse.Namespace) -> int:
-    from robodyn.simulation import Trajectory
-    from robodyn.viewer import record
+    from robodyn.sim.simulation import Trajectory
+    from robodyn.viz.viewer import record
 
     robot = _load(arguments)
     trajectory = Trajectory.load(arguments.trajectory)
@@ -231,8 +243,8 @@ def _command_record(arguments: argparse.Namespace) -> int:
 
 
 def _command_view(arguments: argparse.Namespace) -> int:
-    from robodyn.simulation import Trajectory
-    from robodyn.viewer import LiveViewer, wait
+    from robodyn.sim.simulation import Trajectory
+    from robodyn.viz.viewer import LiveViewer, wait
 
     robot = _load(arguments)
     trajectory = Trajectory.load(arguments.trajectory) if arguments.trajectory else None
@@ -247,9 +259,9 @@ def _command_view(arguments: argparse.Namespace) -> int:
 
 
 def _command_whatif(arguments: argparse.Namespace) -> int:
-    from robodyn.plots import plot_whatif
-    from robodyn.report import dof_units
-    from robodyn.whatif import sweep, table_dict, table_text
+    from robodyn.cli.report import dof_units
+    from robodyn.sim.whatif import sweep, table_dict, table_text
+    from robodyn.viz.plots import plot_whatif
 
     materials = tuple(arguments.materials.split(",")) if arguments.materials else None
     forces = ((0.0, 0.0, 0.0),) + ((tuple(arguments.force),) if arguments.force else ())
@@ -273,7 +285,7 @@ def _command_whatif(arguments: argparse.Namespace) -> int:
 
 
 def _command_lint(arguments: argparse.Namespace) -> int:
-    from robodyn.validation import lint_source
+    from robodyn.urdf.sources import lint_source
 
     problems = lint_source(arguments.model, floating_base=arguments.floating_base)
     errors = sum(problem.severity == "error" for problem in problems)

@@ -18,7 +18,6 @@ This module does not import Pinocchio.
 from __future__ import annotations
 
 import math
-import os
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -28,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from robodyn.exceptions import URDFError
-from robodyn.meshes import mesh_problems
+from robodyn.urdf.meshes import mesh_problems
 
 #: Joint types robodyn knows. ``floating`` and ``planar`` are refused with a clear reason.
 MOVING_JOINT_TYPES = ("revolute", "continuous", "prismatic")
@@ -511,22 +510,3 @@ def parse_urdf(
             rule += " (check_inertia=False or --no-check-inertia loads it anyway)"
         raise URDFError(source, rule, first.element)
     return spec
-
-
-def lint_source(source: str | os.PathLike, *, floating_base: bool | None = None) -> list[Problem]:
-    """Every problem of a URDF (a path, text or robot name), errors and warnings.
-
-    A document that is not even well-formed XML gives one error problem.
-
-    Raises:
-        UnknownRobotError, URDFError: If the source cannot be found or read.
-    """
-    from robodyn.sources import resolve_source
-
-    resolved = resolve_source(source)
-    floating = resolved.floating_base if floating_base is None else floating_base
-    try:
-        _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, **resolved.mesh_context)
-    except URDFError as error:
-        return [Problem(error.element, error.rule)]
-    return problems

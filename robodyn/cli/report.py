@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robodyn.robot import Robot
+from robodyn.dynamics.robot import Robot
 
 
 @dataclass(frozen=True)

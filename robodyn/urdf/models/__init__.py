@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from robodyn.models.pendulum import pendulum_urdf
-from robodyn.models.rp_arm import RPArmParameters, rp_arm_urdf
+from robodyn.urdf.models.pendulum import pendulum_urdf
+from robodyn.urdf.models.rp_arm import RPArmParameters, rp_arm_urdf
 
 GENERATED: dict[str, Callable[[], str]] = {"rp_arm": rp_arm_urdf, "pendulum": pendulum_urdf}
 

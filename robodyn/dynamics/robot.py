@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from robodyn.common.inputs import as_states
 from robodyn.exceptions import FrameError, InputError, RobodynError, SingularMassMatrixError
-from robodyn.inputs import as_states
-from robodyn.validation import URDFSpec
+from robodyn.urdf.validation import URDFSpec
 
 #: Largest accepted deviation of a floating base's quaternion norm from 1.
 QUATERNION_TOLERANCE = 1e-6

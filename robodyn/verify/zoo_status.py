@@ -10,10 +10,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from robodyn.check import check_robot
+from robodyn.dynamics.loading import load
 from robodyn.exceptions import RobodynError, URDFError
-from robodyn.loading import load
-from robodyn.zoo import ZOO, zoo_names
+from robodyn.urdf.zoo import ZOO, zoo_names
+from robodyn.verify.check import check_robot
 
 
 #: Random states a robot, fewer for large robots (the reference's cost grows as n³-n⁴).

@@ -18,7 +18,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from robodyn.exceptions import InputError
-from robodyn.validation import URDFSpec
+from robodyn.urdf.validation import URDFSpec
 
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:

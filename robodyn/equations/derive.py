@@ -3,7 +3,7 @@
 :func:`derive_equations` asks the independent reference for the equations (never
 Pinocchio): small chains (up to three joints, ``form="closed"``) as fully simplified
 expressions from the symbolic Lagrangian; larger ones (``form="compact"``) as a short
-program of named intermediate variables (:mod:`robodyn.reference.compact`). The
+program of named intermediate variables (:mod:`robodyn.equations.compact`). The
 renderers turn them into text, LaTeX (a complete document), JSON, a standalone Python
 module (numpy only) or C source with the same functions as :class:`robodyn.Robot`.
 
@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from robodyn import reference
+from robodyn.equations.compact import derive_compact
 from robodyn.exceptions import InputError
-from robodyn.reference.compact import derive_compact
 from robodyn.reference.symbolic import derive
 
 FORMATS = ("text", "latex", "json", "python", "c")
@@ -68,7 +68,7 @@ class Equations:
 
 def _rp_arm_symbols() -> dict[sp.Symbol, sp.Expr]:
     """The lecture's parameters for the generic symbols of the generated RP arm."""
-    from robodyn.reference import lecture
+    from robodyn.equations import lecture
 
     real = {
         name: sp.Symbol(name, real=True)
@@ -109,7 +109,7 @@ def derive_equations(
     Raises:
         InputError: For a floating base, a bad form, or kept parameters in compact form.
     """
-    from robodyn.sources import resolve_source
+    from robodyn.urdf.sources import resolve_source
 
     if floating_base or (floating_base is None and resolve_source(source).floating_base):
         raise InputError("floating_base", "False: symbolic equations model fixed bases (--fixed-base)", f"a floating {source}")
@@ -426,7 +426,7 @@ def to_c(equations: Equations) -> str:
 def lecture_text() -> str:
     """The lecture's printed RP result, its corrected derivation, and the generated rigid
     arm's equations, entry by entry, with the errata named."""
-    from robodyn.reference import lecture
+    from robodyn.equations import lecture
 
     printed = lecture.printed()
     corrected = lecture.derived().tau

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from robodyn.files import atomic_write_bytes
-from robodyn.robot import Robot
-from robodyn.simulation import Trajectory
+from robodyn.common.files import atomic_write_bytes
+from robodyn.dynamics.robot import Robot
+from robodyn.sim.simulation import Trajectory
 
 
 def _figure(rows: int, columns: int = 1, size: tuple[float, float] = (8.0, 9.0)):

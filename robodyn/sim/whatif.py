@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robodyn.control import quintic_reference
-from robodyn.loading import load
-from robodyn.models import RPArmParameters, rp_arm_urdf
-from robodyn.payload import attach_payload
-from robodyn.robot import Robot
+from robodyn.dynamics.loading import load
+from robodyn.dynamics.payload import attach_payload
+from robodyn.dynamics.robot import Robot
+from robodyn.sim.control import quintic_reference
+from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
 
 DEFAULT_MATERIALS = ("abs", "aluminium", "steel")
 DEFAULT_PAYLOADS = (0.0, 0.5, 2.0)

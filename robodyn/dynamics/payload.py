@@ -12,11 +12,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from robodyn.dynamics.loading import build_robot
+from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import FrameError, InputError
-from robodyn.loading import build_robot
-from robodyn.robot import Robot
-from robodyn.sources import URDFSource
-from robodyn.urdf_edit import weld_link
+from robodyn.urdf.edit import weld_link
+from robodyn.urdf.sources import URDFSource
 
 
 def attach_payload(

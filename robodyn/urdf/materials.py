@@ -2,7 +2,7 @@
 
 Answers the lecture's first question (plastic, aluminium or steel links?) with numbers:
 a generated arm takes its links' geometry and a material and gets its masses and inertias
-from them (:meth:`robodyn.models.RPArmParameters.from_material`).
+from them (:meth:`robodyn.urdf.models.RPArmParameters.from_material`).
 """
 
 from __future__ import annotations

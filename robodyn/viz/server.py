@@ -1,4 +1,4 @@
-"""Meshcat's server, bound to 127.0.0.1 (run as ``python -m robodyn.viewer_server ZMQ_URL PORT``).
+"""Meshcat's server, bound to 127.0.0.1 (run as ``python -m robodyn.viz.server ZMQ_URL PORT``).
 
 Out of the box meshcat's web server listens on every interface; robodyn's live viewer
 runs this instead, so the viewer is reachable from this machine only. Prints

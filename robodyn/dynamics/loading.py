@@ -1,6 +1,6 @@
 """``robodyn.load``: the one door from a URDF (path, text, zoo or generated name) to a Robot.
 
-The URDF is validated first (:mod:`robodyn.validation`); Pinocchio then builds the model
+The URDF is validated first (:mod:`robodyn.urdf.validation`); Pinocchio then builds the model
 from a normalised copy of it:
 
 - continuous joints become revolute joints with unbounded limits, so that ``q`` holds
@@ -24,10 +24,10 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
+from robodyn.dynamics.robot import MimicExpansion, Robot
 from robodyn.exceptions import URDFError
-from robodyn.robot import MimicExpansion, Robot
-from robodyn.sources import URDFSource, locked_source, resolve_source
-from robodyn.validation import URDFSpec, parse_urdf
+from robodyn.urdf.sources import URDFSource, locked_source, resolve_source
+from robodyn.urdf.validation import URDFSpec, parse_urdf
 
 #: Limit written for continuous joints in the copy Pinocchio reads, in [rad].
 _UNBOUNDED = "1e10"
@@ -104,7 +104,7 @@ def build_robot(
 
     Arguments as for :func:`load`; used by tools that write URDF text (payloads).
     """
-    from robodyn.inputs import as_state
+    from robodyn.common.inputs import as_state
 
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia, **resolved.mesh_context)

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robodyn.robot import Robot
+from robodyn.dynamics.robot import Robot
 
 #: A joint reference: time in [s] -> (q_d, v_d, a_d).
 JointReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]

@@ -31,12 +31,12 @@ from meshcat.animation import AnimationClip
 from meshcat.commands import SetAnimation, SetObject, SetProperty, SetTransform
 from meshcat.path import Path as MeshcatPath
 
+from robodyn.common.files import atomic_write_text
+from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
-from robodyn.files import atomic_write_text
-from robodyn.meshes import MeshPathError, resolve_mesh
-from robodyn.robot import Robot
-from robodyn.simulation import Trajectory
-from robodyn.urdf_edit import rpy_matrix
+from robodyn.sim.simulation import Trajectory
+from robodyn.urdf.edit import rpy_matrix
+from robodyn.urdf.meshes import MeshPathError, resolve_mesh
 
 ROOT_PATH = ("robodyn",)
 DEFAULT_COLOR = 0xB0B8C0
@@ -291,7 +291,7 @@ def screenshot(
     """
     import tempfile
 
-    from robodyn.files import atomic_write_bytes
+    from robodyn.common.files import atomic_write_bytes
 
     browser = chromium()
     if browser is None:
@@ -337,7 +337,7 @@ class LiveViewer:
         web_port, zmq_port = _free_port(), _free_port()
         zmq_url = f"tcp://127.0.0.1:{zmq_port}"
         self._process = subprocess.Popen(
-            [sys.executable, "-m", "robodyn.viewer_server", zmq_url, str(web_port)],
+            [sys.executable, "-m", "robodyn.viz.server", zmq_url, str(web_port)],
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             start_new_session=True,

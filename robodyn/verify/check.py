@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from robodyn import reference
-from robodyn.loading import load
-from robodyn.robot import Robot
+from robodyn.dynamics.loading import load
+from robodyn.dynamics.robot import Robot
 
 #: Default tolerance on the relative error of every compared quantity.
 DEFAULT_TOLERANCE = 1e-9

@@ -1,8 +1,7 @@
 """A simulation experiment: a robot, a controller aiming at a target, and what came of it.
 
 :func:`run_simulation` builds the chosen controller (on its own copy of the model),
-simulates, writes the trajectory and the figure if asked (only after the run succeeded),
-and returns a summary with units: final error, peak torque, energy drift, real-time factor,
+simulates, and returns the trajectory with a summary with units: final error, peak torque, energy drift, real-time factor,
 and the joints that left their limits (the simulation has no joint stops or contacts).
 Used by ``robodyn simulate``.
 """
@@ -13,12 +12,12 @@ import time
 
 import numpy as np
 
-from robodyn.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
+from robodyn.dynamics.loading import build_robot
+from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
-from robodyn.loading import build_robot
-from robodyn.robot import Robot
-from robodyn.simulation import simulate
-from robodyn.sources import URDFSource
+from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
+from robodyn.sim.simulation import Trajectory, simulate
+from robodyn.urdf.sources import URDFSource
 
 CONTROLLERS = ("passive", "pd", "computed-torque", "task-space")
 
@@ -49,11 +48,7 @@ def run_simulation(
     duration: float = 3.0,
     dt: float = 1e-3,
     integrator: str = "rk4",
-    out: str | None = None,
-    plot: str | None = None,
-    record: str | None = None,
-    png: str | None = None,
-) -> dict:
+) -> tuple[Trajectory, dict]:
     """Simulate ``robot`` under a named controller and summarise.
 
     Args:
@@ -65,13 +60,9 @@ def run_simulation(
         frame: Controlled frame for task-space control.
         q0: Initial configuration; default neutral.
         duration, dt, integrator: As for :func:`robodyn.simulate`.
-        out: Trajectory file (.csv or .npz) to write.
-        plot: PNG file to write.
-        record: HTML animation to write (meshcat, self-contained).
-        png: Still of the animation's first frame (with ``record``; needs Chromium).
 
     Returns:
-        A JSON-ready summary with units in the keys.
+        The trajectory and a JSON-ready summary with units in the keys.
     """
     if controller not in CONTROLLERS:
         raise InputError("controller", f"one of {', '.join(CONTROLLERS)}", repr(controller))
@@ -119,16 +110,4 @@ def run_simulation(
         for index, joint in enumerate(joints)
         if positions[:, index].min() < joint.lower - 1e-9 or positions[:, index].max() > joint.upper + 1e-9
     ]
-    if out:
-        summary["trajectory"] = str(trajectory.save(out))
-    if plot:
-        from robodyn.plots import plot_simulation
-
-        summary["plot"] = str(plot_simulation(robot, trajectory, plot, frame=frame if task is not None else None, target=task))
-    if record:
-        from robodyn.viewer import record as record_html
-
-        summary["recording"] = str(record_html(robot, trajectory, record, png=png))
-        if png:
-            summary["poster"] = str(png)
-    return summary
+    return trajectory, summary

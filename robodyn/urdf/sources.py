@@ -13,9 +13,11 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from robodyn import zoo
 from robodyn.exceptions import UnknownRobotError, URDFError
-from robodyn.models import GENERATED
+from robodyn.urdf import zoo
+from robodyn.urdf.edit import lock_joints
+from robodyn.urdf.models import GENERATED
+from robodyn.urdf.validation import Problem, lint_urdf, parse_urdf
 
 
 @dataclass(frozen=True)
@@ -40,7 +42,7 @@ class URDFSource:
 
     @property
     def mesh_context(self) -> dict:
-        """Keyword arguments locating mesh files (for :func:`robodyn.validation.parse_urdf`)."""
+        """Keyword arguments locating mesh files (for :func:`robodyn.urdf.validation.parse_urdf`)."""
         return {"base_dir": self.path.parent if self.path is not None else None, "package_dirs": self.package_dirs}
 
 
@@ -92,11 +94,25 @@ def resolve_source(source: str | os.PathLike) -> URDFSource:
 def locked_source(
     resolved: URDFSource, lock: dict[str, float], *, floating_base: bool | None = None, check_inertia: bool = True
 ) -> URDFSource:
-    """The same source with joints frozen at positions (see :func:`robodyn.urdf_edit.lock_joints`)."""
-    from robodyn.urdf_edit import lock_joints
-    from robodyn.validation import parse_urdf
-
+    """The same source with joints frozen at positions (see :func:`robodyn.urdf.edit.lock_joints`)."""
     floating = resolved.floating_base if floating_base is None else floating_base
     spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia)
     text = lock_joints(spec, lock, resolved.label)
     return replace(resolved, text=text, label=f"{resolved.label} (locked {', '.join(lock)})")
+
+
+def lint_source(source: str | os.PathLike, *, floating_base: bool | None = None) -> list[Problem]:
+    """Every problem of a URDF (a path, text or robot name), errors and warnings.
+
+    A document that is not even well-formed XML gives one error problem.
+
+    Raises:
+        UnknownRobotError, URDFError: If the source cannot be found or read.
+    """
+    resolved = resolve_source(source)
+    floating = resolved.floating_base if floating_base is None else floating_base
+    try:
+        _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, **resolved.mesh_context)
+    except URDFError as error:
+        return [Problem(error.element, error.rule)]
+    return problems

@@ -1,0 +1,1 @@
+"""The description layer: where a URDF comes from (paths, text, the zoo, generated robots), the strict reader and its checks, meshes, edits (locks, welds, payloads) and materials. Never imports Pinocchio."""
