@@ -32,6 +32,7 @@ demo: $(STAMP) chromium
 # Everything CI runs: lint, the fast tier, then the slow tier.
 test: $(STAMP) chromium
 	$(BIN)/ruff check robodyn tests scripts
+	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -m "not slow"
 	$(BIN)/python -m pytest -m slow
 
@@ -41,6 +42,7 @@ test-fast: $(STAMP)
 lint: $(STAMP)
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/ruff format --check robodyn tests scripts
+	$(BIN)/lint-imports
 
 bench: $(STAMP)
 	$(BIN)/python scripts/bench.py
