@@ -131,9 +131,10 @@ def test_latex_is_a_complete_document(capsys):
 
 
 def test_progress_goes_to_stderr_and_json_stays_clean(capsys, monkeypatch):
-    import robodyn.cli.app as cli
 
-    monkeypatch.setattr(cli._Progress, "DELAY", 0.0)
+    import robodyn.cli.common as cli_common
+
+    monkeypatch.setattr(cli_common.Progress, "DELAY", 0.0)
     assert main(["equations", "ur5", "--symbolic", "--format", "json"]) == 0
     captured = capsys.readouterr()
     json.loads(captured.out)

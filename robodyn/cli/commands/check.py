@@ -1,0 +1,34 @@
+"""`robodyn check`: Pinocchio against the independent reference."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from robodyn.cli.common import add_model_arguments, load_robot
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser("check", help="compare Pinocchio with the independent Lagrangian reference")
+    add_model_arguments(parser)
+    parser.add_argument("--samples", type=int, default=100, help="random states within the joint limits (default 100)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the random states (default 0)")
+    parser.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error accepted (default 1e-9)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    from robodyn.verify.check import check_robot, report_dict, report_text
+
+    robot = load_robot(arguments)
+    report = check_robot(
+        robot,
+        samples=arguments.samples,
+        seed=arguments.seed,
+        tolerance=arguments.tolerance,
+        check_inertia=arguments.check_inertia,
+    )
+    print(json.dumps(report_dict(report), indent=2) if arguments.json else report_text(report))
+    return 0 if report.passed else 1

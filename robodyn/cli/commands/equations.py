@@ -1,0 +1,82 @@
+"""`robodyn equations`: tau, M, C, G at one state, or the symbolic equations."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+from robodyn.cli import report
+from robodyn.cli.common import Progress, add_model_arguments, load_robot, lock_values, state, vector
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser("equations", help="tau, M, C and G of a robot at one state")
+    add_model_arguments(parser)
+    parser.add_argument("--q", type=vector, help="configuration, comma-separated, in [rad] / [m] (default: neutral)")
+    parser.add_argument("--v", type=vector, help="velocity in [rad/s] / [m/s] (default: zeros)")
+    parser.add_argument("--a", type=vector, help="acceleration in [rad/s²] / [m/s²] (default: zeros)")
+    parser.add_argument("--json", action="store_true", help="print JSON (keys tau, M, C, G, joint_names, ...)")
+    parser.add_argument("--precision", type=int, default=6, help="significant digits in text output")
+    parser.add_argument("--symbolic", action="store_true", help="closed-form equations from the reference's symbolic Lagrangian")
+    parser.add_argument("--format", choices=["text", "latex", "json", "python", "c"], default="text", help="with --symbolic")
+    parser.add_argument("--out", help="with --symbolic: write to this file instead of stdout")
+    parser.add_argument(
+        "--form",
+        choices=["auto", "closed", "compact"],
+        default="auto",
+        help="closed (simplified) or compact (intermediate variables)",
+    )
+    parser.add_argument("--keep-params", action="store_true", help="keep masses, lengths, inertias and g as symbols")
+    parser.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
+    parser.add_argument(
+        "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
+    )
+    parser.set_defaults(run=run)
+
+
+def _symbolic(arguments: argparse.Namespace) -> int:
+    from robodyn.equations.derive import derive_equations, lecture_text, render
+
+    if arguments.lecture:
+        print(lecture_text(), end="")
+        return 0
+    progress = Progress(f"deriving {arguments.model}")
+    try:
+        equations = derive_equations(
+            arguments.model,
+            form=arguments.form,
+            keep_params=arguments.keep_params,
+            lock=lock_values(arguments.lock),
+            floating_base=arguments.floating_base,
+            progress=progress,
+        )
+    finally:
+        progress.close()
+    output = render(equations, arguments.format)
+    if arguments.out:
+        from robodyn.common.files import atomic_write_text
+
+        atomic_write_text(arguments.out, output)
+        print(f"wrote {arguments.out} ({equations.form} form, {equations.operation_count()} operations)", file=sys.stderr)
+    else:
+        print(output, end="")
+    return 0
+
+
+def run(arguments: argparse.Namespace) -> int:
+    if arguments.symbolic or arguments.lecture:
+        return _symbolic(arguments)
+    robot = load_robot(arguments)
+    q = state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
+    v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
+    a = state(robot, arguments.a, "a", robot.nv, np.zeros(robot.nv))
+    terms = report.equations_at(robot, q, v, a)
+    if arguments.json:
+        print(json.dumps(report.equations_dict(robot, terms), indent=2))
+    else:
+        print(report.equations_text(robot, terms, precision=arguments.precision))
+    return 0

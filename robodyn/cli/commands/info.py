@@ -1,0 +1,26 @@
+"""`robodyn info`: degrees of freedom, joints, limits and masses."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from robodyn.cli import report
+from robodyn.cli.common import add_model_arguments, load_robot
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser("info", help="degrees of freedom, joints, limits and masses of a robot")
+    add_model_arguments(parser)
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    robot = load_robot(arguments)
+    if arguments.json:
+        print(json.dumps(report.info_dict(robot), indent=2))
+    else:
+        print(report.info_text(robot))
+    return 0

@@ -1,0 +1,42 @@
+"""`robodyn lint`: every problem of a URDF."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser("lint", help="every problem of a URDF at once (exit 1 if any error)")
+    parser.add_argument("model", help="URDF path, robot name or URDF text")
+    parser.add_argument(
+        "--floating-base", dest="floating_base", action="store_true", default=None, help="check as a floating-base robot"
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    from robodyn.urdf.sources import lint_source
+
+    problems = lint_source(arguments.model, floating_base=arguments.floating_base)
+    errors = sum(problem.severity == "error" for problem in problems)
+    if arguments.json:
+        print(
+            json.dumps(
+                {
+                    "errors": errors,
+                    "warnings": len(problems) - errors,
+                    "problems": [{"severity": p.severity, "element": p.element, "rule": p.rule} for p in problems],
+                },
+                indent=2,
+            )
+        )
+    else:
+        for problem in problems:
+            print(f"{problem.severity}: {problem}")
+        print(
+            f"{arguments.model if len(arguments.model) < 80 else '<URDF text>'}: {errors} errors, {len(problems) - errors} warnings"
+        )
+    return 1 if errors else 0

@@ -1,0 +1,32 @@
+"""`robodyn view`: the live meshcat viewer."""
+
+from __future__ import annotations
+
+import argparse
+
+from robodyn.cli.common import add_model_arguments, load_robot
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser("view", help="show a robot (and a trajectory) in a live meshcat viewer on 127.0.0.1")
+    add_model_arguments(parser)
+    parser.add_argument("--trajectory", help="trajectory file to play")
+    parser.add_argument("--seconds", type=float, help="stop after this many seconds (default: until Ctrl-C)")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    from robodyn.sim.simulation import Trajectory
+    from robodyn.viz.viewer import LiveViewer, wait
+
+    robot = load_robot(arguments)
+    trajectory = Trajectory.load(arguments.trajectory) if arguments.trajectory else None
+    try:
+        with LiveViewer() as viewer:
+            viewer.show(robot, trajectory)
+            print(f"meshcat viewer: {viewer.url}  (Ctrl-C to stop)", flush=True)
+            wait(arguments.seconds)
+    except KeyboardInterrupt:
+        pass
+    return 0
