@@ -70,13 +70,29 @@ class FrameError(RobodynError, KeyError):
         robot: The robot's name.
     """
 
-    def __init__(self, frame: str, robot: str):
+    def __init__(self, frame: str, robot: str, close: list[str] | None = None):
         self.frame = frame
         self.robot = robot
-        super().__init__(f"robot {robot!r} has no frame named {frame!r}.")
+        self.close = list(close or [])
+        hint = f" (did you mean {', '.join(repr(name) for name in self.close)}?)" if self.close else ""
+        super().__init__(f"robot {robot!r} has no frame named {frame!r}{hint}.")
 
     def __str__(self) -> str:  # KeyError would quote the message
         return self.args[0]
+
+
+class NonFiniteResultError(RobodynError, ArithmeticError):
+    """Finite inputs gave a non-finite result (an overflow): refused, never returned.
+
+    Attributes:
+        robot: The robot's name.
+        quantity: What overflowed (``"tau"``, ``"M"``, ...).
+    """
+
+    def __init__(self, robot: str, quantity: str):
+        self.robot = robot
+        self.quantity = quantity
+        super().__init__(f"robot {robot!r}: {quantity} overflowed to a non-finite value for finite inputs.")
 
 
 class SingularMassMatrixError(RobodynError, ArithmeticError):

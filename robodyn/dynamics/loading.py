@@ -20,11 +20,13 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
+from dataclasses import replace
 
-import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics.robot import MimicExpansion, Robot
+from robodyn.common.inputs import as_state
+from robodyn.dynamics.mimic import has_mimic, mimic_expansion
+from robodyn.dynamics.robot import LoadOptions, Robot
 from robodyn.exceptions import URDFError
 from robodyn.urdf.sources import URDFSource, locked_source, resolve_source
 from robodyn.urdf.validation import URDFSpec, parse_urdf
@@ -63,6 +65,7 @@ def load(
     gravity: Sequence[float] | None = None,
     check_inertia: bool = True,
     lock: dict[str, float] | None = None,
+    threads: int | None = None,
 ) -> Robot:
     """Load a robot.
 
@@ -78,6 +81,7 @@ def load(
             to load published models that have them).
         lock: Joints to freeze, by name, at positions in [rad] / [m] (e.g. a gripper's
             fingers): they become fixed joints, and joints mimicking them follow.
+        threads: Native threads for batches of states; default every available core.
 
     Returns:
         The robot.
@@ -90,7 +94,25 @@ def load(
     resolved = resolve_source(source)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating_base, check_inertia=check_inertia)
-    return build_robot(resolved, floating_base=floating_base, gravity=gravity, check_inertia=check_inertia)
+    return build_robot(resolved, floating_base=floating_base, gravity=gravity, check_inertia=check_inertia, threads=threads)
+
+
+def rebuild(robot: Robot, *, urdf: str | None = None, label: str | None = None) -> Robot:
+    """A new robot from ``robot``'s source and options: an independent copy, or (with
+    ``urdf``) the same robot edited (a payload welded on, ...), named ``label``."""
+    source = (
+        robot.source
+        if urdf is None
+        else replace(robot.source, text=urdf, label=label or robot.source.label, name=label or robot.name)
+    )
+    options = robot.options
+    return build_robot(
+        source,
+        floating_base=options.floating_base,
+        gravity=options.gravity,
+        check_inertia=options.check_inertia,
+        threads=options.threads,
+    )
 
 
 def build_robot(
@@ -99,13 +121,12 @@ def build_robot(
     floating_base: bool | None = None,
     gravity: Sequence[float] | None = None,
     check_inertia: bool = True,
+    threads: int | None = None,
 ) -> Robot:
     """Build a robot from a resolved URDF source (what :func:`load` does after resolving).
 
-    Arguments as for :func:`load`; used by tools that write URDF text (payloads).
+    Arguments as for :func:`load`.
     """
-    from robodyn.common.inputs import as_state
-
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     spec = parse_urdf(resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia, **resolved.mesh_context)
     xml = pinocchio_xml(spec)
@@ -120,24 +141,16 @@ def build_robot(
     if model is None:
         reason = " ".join(line.strip() for line in captured.text().splitlines() if line.strip())
         raise URDFError(resolved.label, f"Pinocchio refused the model ({refusal}{'; ' + reason if reason else ''})")
-    mimic = _mimic_expansion(model, spec, xml, floating) if model.nq != _model_without_mimic_nq(spec, floating) else None
+    mimic = mimic_expansion(model, spec, xml, floating) if has_mimic(model, spec, floating) else None
     if gravity is not None:
         model.gravity.linear = as_state(gravity, "gravity", 3)
-        if mimic is not None:
-            mimic.model.gravity.linear = model.gravity.linear
+    if mimic is not None:
+        mimic.model.gravity.linear = model.gravity.linear
     if model.nv == 0:
         raise URDFError(resolved.label, "the robot has no moving joint")
     name = spec.name if resolved.name == "robot" else resolved.name
-    return Robot(
-        model,
-        name=name,
-        urdf=resolved.text,
-        spec=spec,
-        floating_base=floating,
-        source_path=resolved.path,
-        package_dirs=resolved.package_dirs,
-        mimic=mimic,
-    )
+    options = LoadOptions(floating, tuple(float(g) for g in model.gravity.linear), check_inertia, threads)  # type: ignore[arg-type]
+    return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
 
 
 class _Captured:
@@ -171,30 +184,4 @@ def _captured_stderr():
             captured.content = stream.read(4000).decode("utf-8", "replace")
 
 
-def _model_without_mimic_nq(spec: URDFSpec, floating: bool) -> int:
-    return (7 if floating else 0) + sum(joint.type != "fixed" for joint in spec.joints.values())
-
-
-def _mimic_expansion(model: pin.Model, spec: URDFSpec, xml: str, floating: bool) -> MimicExpansion:
-    """Build the expanded model (every joint free) and the linear map to it."""
-    full = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint") if floating else pin.buildModelFromXML(xml)
-    selection = np.zeros((full.nv, model.nv))
-    q_selection = np.zeros((full.nq, model.nq))
-    offset = np.zeros(full.nq)
-    for joint_id in range(1, full.njoints):
-        name = full.names[joint_id]
-        full_joint = full.joints[joint_id]
-        urdf_joint = spec.joints.get(name)
-        source, multiplier = name, 1.0
-        if urdf_joint is not None and urdf_joint.mimic is not None:
-            source, multiplier = urdf_joint.mimic.joint, urdf_joint.mimic.multiplier
-            offset[full_joint.idx_q] = urdf_joint.mimic.offset
-        source_joint = model.joints[model.getJointId(source)]
-        for k in range(full_joint.nv):
-            selection[full_joint.idx_v + k, source_joint.idx_v + k] = multiplier
-        for k in range(full_joint.nq):  # a free flyer: 7 position coordinates, copied
-            q_selection[full_joint.idx_q + k, source_joint.idx_q + k] = multiplier
-    return MimicExpansion(full, selection, offset, q_selection)
-
-
-__all__ = ["build_robot", "load", "pinocchio_xml"]
+__all__ = ["build_robot", "load", "pinocchio_xml", "rebuild"]

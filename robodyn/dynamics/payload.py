@@ -12,11 +12,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from robodyn.dynamics.loading import build_robot
+from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import FrameError, InputError
 from robodyn.urdf.edit import weld_link
-from robodyn.urdf.sources import URDFSource
 
 
 def attach_payload(
@@ -65,7 +64,4 @@ def attach_payload(
     ET.SubElement(visual, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
     ET.SubElement(ET.SubElement(visual, "geometry"), "sphere", radius="0.03")
     text = weld_link(robot.spec, link, payload_link)
-    source = URDFSource(
-        text, f"{robot.name}+{name}", f"{robot.name}+{name}", robot.source_path, robot.floating_base, robot.package_dirs
-    )
-    return build_robot(source, floating_base=robot.floating_base, gravity=robot.gravity_vector)
+    return rebuild(robot, urdf=text, label=f"{robot.name}+{name}")

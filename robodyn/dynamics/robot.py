@@ -17,8 +17,6 @@ Conventions, stated once:
 
 from __future__ import annotations
 
-import math
-import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -27,14 +25,13 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.common.inputs import as_states
-from robodyn.exceptions import FrameError, InputError, RobodynError, SingularMassMatrixError
+from robodyn.dynamics.batch import ParallelRunner
+from robodyn.dynamics.handle import per_state
+from robodyn.dynamics.kinematics import Kinematics
+from robodyn.dynamics.mimic import MimicExpansion
+from robodyn.exceptions import InputError, NonFiniteResultError, SingularMassMatrixError
+from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
-
-#: Largest accepted deviation of a floating base's quaternion norm from 1.
-QUATERNION_TOLERANCE = 1e-6
-#: What Pinocchio raises for arguments it refuses (wrong size, type, unsupported joint).
-_PINOCCHIO_ERRORS = (TypeError, ValueError, RuntimeError)
-_isfinite = math.isfinite
 
 
 @dataclass(frozen=True)
@@ -57,48 +54,41 @@ class JointInfo:
     velocity: float
 
 
-@dataclass
-class MimicExpansion:
-    """The map from a robot with mimic joints to the same robot with every joint free.
-
-    ``q_full = q_selection @ q + offset`` and ``v_full = selection @ v`` (the mimic relation
-    ``q_mimic = multiplier * q_source + offset`` is linear), so ``M = Sᵀ M_full S`` and
-    ``C = Sᵀ C_full S``.
+@dataclass(frozen=True)
+class LoadOptions:
+    """How a robot was built from its source (what :func:`robodyn.load` was given).
 
     Attributes:
-        model: The Pinocchio model with mimic joints as independent joints.
-        selection: Shape (nv_full, nv).
-        offset: Shape (nq_full,).
-        q_selection: Shape (nq_full, nq) (differs from ``selection`` with a floating base).
+        floating_base: Whether the root got a free-flyer joint.
+        gravity: Gravity in the world frame, in [m/s²].
+        check_inertia: Whether impossible inertias on moving links were refused.
+        threads: Native threads for batches (``None``: every available core).
     """
 
-    model: pin.Model
-    selection: np.ndarray
-    offset: np.ndarray
-    q_selection: np.ndarray
-
-    def __post_init__(self) -> None:
-        self.data = self.model.createData()
-
-    def q(self, q: np.ndarray) -> np.ndarray:
-        """Configuration of the expanded model."""
-        return self.q_selection @ q + self.offset
+    floating_base: bool
+    gravity: tuple[float, float, float]
+    check_inertia: bool = True
+    threads: int | None = None
 
 
-class Robot:
+class Robot(Kinematics):
     """A rigid-body robot and its dynamics (RNEA, CRBA, ABA through Pinocchio).
 
     Build one with :func:`robodyn.load`. The Pinocchio model is available as
-    :attr:`model` for anything robodyn does not wrap.
+    :attr:`model` for anything robodyn does not wrap. Kinematics (frames, Jacobians) come
+    from :class:`~robodyn.dynamics.kinematics.Kinematics`.
+
+    A robot may be used from several threads at once: each thread gets its own Pinocchio
+    data (see :mod:`robodyn.dynamics.handle`).
 
     Attributes:
         name: Robot name.
-        urdf: The URDF text it was built from (generated robots included).
         model: The Pinocchio model.
         spec: The validated URDF (links, joints, inertials).
+        source: Where the URDF came from (:attr:`urdf` is its text); copies and edits of
+            the robot are built from it (:func:`robodyn.dynamics.loading.rebuild`).
+        options: How it was built (floating base, gravity, inertia check, threads).
         floating_base: Whether the root is a free-flyer joint.
-        source_path: The URDF file, if it came from one.
-        package_dirs: Folders under which ``package://`` mesh paths resolve.
         mimic: For robots with mimic joints, the model with every joint independent and the
             map to it (Pinocchio supports mimic joints in RNEA and CRBA but not everywhere).
     """
@@ -107,31 +97,41 @@ class Robot:
         self,
         model: pin.Model,
         *,
-        name: str,
-        urdf: str,
         spec: URDFSpec,
-        floating_base: bool = False,
-        source_path: Path | None = None,
-        package_dirs: tuple[Path, ...] = (),
+        source: URDFSource,
+        options: LoadOptions,
+        name: str,
         mimic: MimicExpansion | None = None,
     ):
-        self.model = model
-        self.data = model.createData()
-        self.name = name
-        self.urdf = urdf
+        super().__init__(model, name=name, floating_base=options.floating_base)
         self.spec = spec
-        self.floating_base = floating_base
-        self._fixed_base = not floating_base
-        self.source_path = source_path
-        self.package_dirs = package_dirs
-        self.nq: int = model.nq
-        self.nv: int = model.nv
+        self.source = source
+        self.options = options
+        self.mimic = mimic
         self.joints: list[JointInfo] = self._joint_infos()
         self.joint_names: list[str] = [joint.name for joint in self.joints]
-        self._frame_ids = {frame.name: index for index, frame in enumerate(model.frames)}
-        self._pool: pin.ModelPool | None = None
-        self.mimic = mimic
+        self._parallel = ParallelRunner(model, threads=options.threads)
         self._lower_triangle = np.tri(self.nv, self.nv, -1, dtype=bool)
+
+    @property
+    def urdf(self) -> str:
+        """The URDF text the robot was built from (generated robots included)."""
+        return self.source.text
+
+    @property
+    def source_path(self) -> Path | None:
+        """The URDF file, if the robot came from one."""
+        return self.source.path
+
+    @property
+    def package_dirs(self) -> tuple[Path, ...]:
+        """Folders under which ``package://`` mesh paths resolve."""
+        return self.source.package_dirs
+
+    @property
+    def threads(self) -> int:
+        """Native threads used for batches of states."""
+        return self._parallel.threads
 
     def __repr__(self) -> str:
         return f"<Robot {self.name!r}: nq={self.nq}, nv={self.nv}, joints={self.joint_names}>"
@@ -159,16 +159,6 @@ class Robot:
     def gravity_vector(self) -> np.ndarray:
         """Gravity acceleration in the world frame, shape (3,), in [m/s²]."""
         return self.model.gravity.linear.copy()
-
-    @property
-    def frame_names(self) -> list[str]:
-        """Names of every frame: links, joints and fixed frames of the URDF."""
-        return list(self._frame_ids)
-
-    @property
-    def frame_ids(self) -> dict[str, int]:
-        """Pinocchio index of every frame, by name (a copy)."""
-        return dict(self._frame_ids)
 
     @property
     def end_effector(self) -> str:
@@ -259,34 +249,10 @@ class Robot:
         return joints[0] if count is None else joints
 
     # ----------------------------------------------------------------------------------
-    # Dynamics
-    #
-    # Each method first tries Pinocchio directly on 1-D float64 arrays: Pinocchio refuses
-    # wrong sizes and shapes (caught below), and a NaN or infinity anywhere in the inputs
-    # makes the result non-finite, which one dot product detects. Anything else goes
-    # through the full boundary check, which names the offending argument.
+    # Dynamics. Each method hands ModelHandle._evaluate a one-state function and, where
+    # Pinocchio has one, a parallel batch function: the fast path tries Pinocchio on the
+    # raw arguments first, anything doubtful goes through the full boundary check.
     # ----------------------------------------------------------------------------------
-    def _accept(self, result: np.ndarray, q: np.ndarray) -> bool:
-        """Whether a fast-path matrix result can be returned as it is (a NaN or inf makes
-        the sum of squares non-finite; a huge finite result is re-checked exactly)."""
-        flat = result.ravel()
-        return _isfinite(flat.dot(flat)) and (self._fixed_base or self._unit_quaternion(q))
-
-    @staticmethod
-    def _unit_quaternion(q: np.ndarray) -> bool:
-        quaternion = q[3:7]
-        return abs(quaternion.dot(quaternion) - 1.0) < QUATERNION_TOLERANCE
-
-    def _checked(self, **named: np.ndarray) -> tuple[list[np.ndarray], bool]:
-        """Full boundary check of state arguments (sizes by name: q has nq, others nv)."""
-        arrays, batch = as_states({name: (value, self.nq if name == "q" else self.nv) for name, value in named.items()})
-        if self.floating_base:
-            norms = np.linalg.norm(arrays[0][..., 3:7], axis=-1)
-            if np.any(np.abs(norms - 1.0) >= QUATERNION_TOLERANCE):
-                worst = float(np.atleast_1d(norms)[np.argmax(np.abs(np.atleast_1d(norms) - 1.0))])
-                raise InputError("q[3:7]", "a unit quaternion (x, y, z, w) for the floating base", f"norm {worst:.9g}")
-        return arrays, batch
-
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA).
 
@@ -298,17 +264,14 @@ class Robot:
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
-        try:
-            tau = pin.rnea(self.model, self.data, q, v, a)
-        except _PINOCCHIO_ERRORS:
-            pass
-        else:
-            if _isfinite(tau.dot(tau)) and (self._fixed_base or self._unit_quaternion(q)):
-                return tau
-        (q, v, a), batch = self._checked(q=q, v=v, a=a)
-        if batch:
-            return self._in_parallel(pin.rneaInParallel, q, v, a)
-        return self._finite(pin.rnea(self.model, self.data, q, v, a), "tau")
+        return self._evaluate(
+            "tau",
+            lambda q, v, a: pin.rnea(self.model, self.data, q, v, a),
+            lambda q, v, a: self._parallel.run(pin.rneaInParallel, q, v, a),
+            q=q,
+            v=v,
+            a=a,
+        )
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).
@@ -325,30 +288,14 @@ class Robot:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
         if self.mimic is None:
-            try:
-                a = pin.aba(self.model, self.data, q, v, tau)
-            except _PINOCCHIO_ERRORS:
-                pass
-            else:
-                if _isfinite(a.dot(a)) and (self._fixed_base or self._unit_quaternion(q)):
-                    return a
-        (q, v, tau), batch = self._checked(q=q, v=v, tau=tau)
-        if self.mimic is not None:  # Pinocchio's ABA does not support mimic joints
-            if batch:
-                result = (
-                    np.stack([self._solve_dynamics(*row) for row in zip(q, v, tau, strict=True)])
-                    if len(q)
-                    else np.zeros((0, self.nv))
-                )
-            else:
-                result = self._solve_dynamics(q, v, tau)
-        elif batch:
-            result = self._in_parallel(pin.abaInParallel, q, v, tau)
-        else:
-            result = pin.aba(self.model, self.data, q, v, tau)
-        if not np.isfinite(result).all():  # finite inputs: only a singular M gives this
-            raise SingularMassMatrixError(self.name, self.massless_joints)
-        return result
+            single = self.forward_dynamics_unchecked
+            batch = lambda q, v, tau: self._parallel.run(pin.abaInParallel, q, v, tau)  # noqa: E731
+        else:  # Pinocchio's ABA does not support mimic joints (and abaInParallel crashes on them)
+            single, batch = self._solve_dynamics, None
+        try:
+            return self._evaluate("a", single, batch, q=q, v=v, tau=tau)
+        except NonFiniteResultError:  # finite inputs, non-finite accelerations: only a singular M does that
+            raise SingularMassMatrixError(self.name, self.massless_joints) from None
 
     def forward_dynamics_unchecked(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """:meth:`forward_dynamics` of one state without the boundary checks.
@@ -379,15 +326,7 @@ class Robot:
         Returns:
             Shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
         """
-        try:
-            mass = self._mass_matrix(q)
-            # CRBA works in local frames: a NaN in q need not reach M, so check q too.
-            if self._accept(mass, q) and _isfinite(q.dot(q)):
-                return mass
-        except _PINOCCHIO_ERRORS:
-            pass
-        (q,), _ = self._checked(q=q)
-        return self._finite(self._per_state(self._mass_matrix, q), "M")
+        return self._evaluate("M", self._mass_matrix, None, q=q)
 
     def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
         mass = pin.crba(self.model, self.data, q)  # upper triangle only
@@ -404,19 +343,7 @@ class Robot:
         Returns:
             Shape (nv, nv) or (N, nv, nv).
         """
-        try:
-            coriolis = self._coriolis(q, v)
-        except _PINOCCHIO_ERRORS:
-            pass
-        else:
-            if self._accept(coriolis, q):
-                return coriolis
-        (q, v), batch = self._checked(q=q, v=v)
-        if batch:
-            if not len(q):
-                return np.zeros((0, self.nv, self.nv))
-            return self._finite(np.stack([self._coriolis(qi, vi) for qi, vi in zip(q, v, strict=True)]), "C")
-        return self._finite(self._coriolis(q, v), "C")
+        return self._evaluate("C", self._coriolis, None, q=q, v=v)
 
     def _coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self.mimic is not None:  # computeCoriolisMatrix mishandles mimic joints
@@ -435,18 +362,12 @@ class Robot:
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        try:
-            torques = pin.computeGeneralizedGravity(self.model, self.data, q)
-        except _PINOCCHIO_ERRORS:
-            pass
-        else:
-            if _isfinite(torques.dot(torques)) and (self._fixed_base or self._unit_quaternion(q)):
-                return torques
-        (q,), batch = self._checked(q=q)
-        if batch:
+
+        def batch(q: np.ndarray) -> np.ndarray:
             zeros = np.zeros((q.shape[0], self.nv))
-            return self._in_parallel(pin.rneaInParallel, q, zeros, zeros)
-        return self._finite(pin.computeGeneralizedGravity(self.model, self.data, q), "G")
+            return self._parallel.run(pin.rneaInParallel, q, zeros, zeros)
+
+        return self._evaluate("G", lambda q: pin.computeGeneralizedGravity(self.model, self.data, q), batch, q=q)
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``C(q, v) v + G(q)``: the torques at zero acceleration.
@@ -458,180 +379,36 @@ class Robot:
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        try:
-            torques = pin.nonLinearEffects(self.model, self.data, q, v)
-        except _PINOCCHIO_ERRORS:
-            pass
-        else:
-            if _isfinite(torques.dot(torques)) and (self._fixed_base or self._unit_quaternion(q)):
-                return torques
-        (q, v), batch = self._checked(q=q, v=v)
-        if batch:
-            return self._in_parallel(pin.rneaInParallel, q, v, np.zeros_like(v))
-        return self._finite(pin.nonLinearEffects(self.model, self.data, q, v), "C v + G")
+        return self._evaluate(
+            "C v + G",
+            lambda q, v: pin.nonLinearEffects(self.model, self.data, q, v),
+            lambda q, v: self._parallel.run(pin.rneaInParallel, q, v, np.zeros_like(v)),
+            q=q,
+            v=v,
+        )
 
+    # ----------------------------------------------------------------------------------
+    # Energies
+    # ----------------------------------------------------------------------------------
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
         """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch."""
-        (q, v), batch = self._checked(q=q, v=v)
+        (q, v), batch = self.validate(q=q, v=v)
         # From the mass matrix rather than computeKineticEnergy, which refuses mimic joints.
-        if batch:
-            return np.array([0.5 * vi @ self._mass_matrix(qi) @ vi for qi, vi in zip(q, v, strict=True)])
-        return float(0.5 * v @ self._mass_matrix(q) @ v)
+        energy = per_state(lambda qi, vi: np.array(0.5 * vi @ self._mass_matrix(qi) @ vi), q, v)
+        energy = self._finite(np.asarray(energy), "kinetic energy")
+        return energy if batch else float(energy)
 
     def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
         """Gravitational potential energy ``−Σ m_i gᵀ p_i`` in [J]: a float, or shape (N,).
 
         Zero when every centre of mass is at height zero (for the default gravity).
         """
-        (q,), _ = self._checked(q=q)
+        (q,), batch = self.validate(q=q)
         # computePotentialEnergy refuses mimic joints: use the expanded model for those.
-        model, data, expand = (
-            (self.model, self.data, None) if self.mimic is None else (self.mimic.model, self.mimic.data, self.mimic.q)
-        )
-        if q.ndim == 2:
-            return np.array([pin.computePotentialEnergy(model, data, qi if expand is None else expand(qi)) for qi in q])
-        return float(pin.computePotentialEnergy(model, data, q if expand is None else expand(q)))
-
-    # ----------------------------------------------------------------------------------
-    # Kinematics
-    # ----------------------------------------------------------------------------------
-    def frame_id(self, frame: str) -> int:
-        """Pinocchio index of a frame (link, joint or fixed frame) by name.
-
-        Raises:
-            FrameError: If the robot has no such frame.
-        """
-        try:
-            return self._frame_ids[frame]
-        except KeyError:
-            raise FrameError(frame, self.name) from None
-
-    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Position of a frame's origin in the world frame.
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq).
-            frame: Link or joint name, e.g. ``"end_effector"``.
-
-        Returns:
-            Shape (3,) or (N, 3), in [m].
-        """
-        frame_id = self.frame_id(frame)
-        (q,), _ = self._checked(q=q)
-        return self._per_state(lambda qi: self._placement(qi, frame_id).translation.copy(), q)
-
-    def frame_rotation(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Orientation of a frame in the world frame: shape (3, 3) or (N, 3, 3)."""
-        frame_id = self.frame_id(frame)
-        (q,), _ = self._checked(q=q)
-        return self._per_state(lambda qi: self._placement(qi, frame_id).rotation.copy(), q)
-
-    def _placement(self, q: np.ndarray, frame_id: int) -> pin.SE3:
-        pin.framesForwardKinematics(self.model, self.data, q)
-        return self.data.oMf[frame_id]
-
-    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Jacobian of a frame: its velocity is ``J v`` (linear first, then angular).
-
-        Both parts are expressed in world-aligned axes at the frame's origin (Pinocchio's
-        ``LOCAL_WORLD_ALIGNED``): rows 0-2 give the origin's velocity in [m/s], rows 3-5
-        the angular velocity in [rad/s].
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq).
-            frame: Link or joint name.
-
-        Returns:
-            Shape (6, nv) or (N, 6, nv).
-        """
-        frame_id = self.frame_id(frame)
-        (q,), _ = self._checked(q=q)
-        return self._per_state(
-            lambda qi: pin.computeFrameJacobian(self.model, self.data, qi, frame_id, pin.LOCAL_WORLD_ALIGNED).copy(), q
-        )
-
-    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str) -> np.ndarray:
-        """``J̇(q, v) v``: the acceleration of a frame's origin at zero joint acceleration.
-
-        The classical (not spatial) acceleration of the origin, in world axes, in [m/s²];
-        the frame's acceleration is ``J a + J̇ v`` with ``J`` from :meth:`frame_jacobian`.
-
-        Args:
-            q: Configuration, shape (nq,).
-            v: Velocity, shape (nv,).
-            frame: Link or joint name.
-
-        Returns:
-            Shape (3,).
-        """
-        frame_id = self.frame_id(frame)
-        (q, v), _ = self._checked(q=q, v=v)
-        pin.forwardKinematics(self.model, self.data, q, v, np.zeros(self.nv))
-        return pin.getFrameClassicalAcceleration(self.model, self.data, frame_id, pin.LOCAL_WORLD_ALIGNED).linear.copy()
-
-    def wrench_torques(self, q: np.ndarray, frame: str, wrench: np.ndarray) -> np.ndarray:
-        """Joint torques ``J(q)ᵀ w`` that an external wrench on a frame exerts on the joints.
-
-        Args:
-            q: Configuration, shape (nq,).
-            frame: Link or joint name; the wrench acts at its origin.
-            wrench: Force in [N] then torque in [N m], world axes, shape (6,) (or a force
-                alone, shape (3,)).
-
-        Returns:
-            Shape (nv,): add to the motor torques in forward dynamics, subtract from the
-            inverse dynamics' torques.
-        """
-        wrench = np.asarray(wrench, dtype=float)
-        if wrench.shape == (3,):
-            wrench = np.concatenate([wrench, np.zeros(3)])
-        if wrench.shape != (6,) or not np.isfinite(wrench).all():
-            raise InputError("wrench", "6 finite values (force in [N], torque in [N m])", f"shape {wrench.shape}")
-        return self.frame_jacobian(q, frame).T @ wrench
-
-    def integrate(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
-        """The configuration reached from ``q`` along the velocity ``dq`` in unit time.
-
-        ``q + dq`` for joints; the floating base's pose moves on SE(3) (Pinocchio's
-        ``integrate``), keeping its quaternion unit.
-        """
-        if self.floating_base:
-            return pin.integrate(self.model, q, dq)
-        return q + dq
-
-    # ----------------------------------------------------------------------------------
-    # Helpers
-    # ----------------------------------------------------------------------------------
-    @cached_property
-    def _threads(self) -> int:
-        return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-
-    def _model_pool(self) -> pin.ModelPool:
-        if self._pool is None:
-            self._pool = pin.ModelPool(self.model, self._threads)
-        return self._pool
-
-    def _in_parallel(self, algorithm, q: np.ndarray, v: np.ndarray, third: np.ndarray) -> np.ndarray:
-        """Run ``rneaInParallel`` or ``abaInParallel`` on stacks of states, shape (N, nv)."""
-        if q.shape[0] == 0:
-            return np.zeros((0, self.nv))
-        # Pinocchio wants one state a column: the transpose of a C-ordered stack, no copy.
-        columns = [np.ascontiguousarray(array).T for array in (q, v, third)]
-        result = algorithm(self._threads, self._model_pool(), *columns)
-        return self._finite(np.asarray(result).reshape(self.nv, q.shape[0]).T.copy(), algorithm.__name__)
-
-    def _finite(self, result: np.ndarray, what: str) -> np.ndarray:
-        """Refuse a non-finite result of finite inputs (an overflow), never return it."""
-        if not np.isfinite(result).all():
-            raise RobodynError(f"robot {self.name!r}: {what} overflowed to a non-finite value for finite inputs.")
-        return result
-
-    @staticmethod
-    def _per_state(function, q: np.ndarray) -> np.ndarray:
-        """Apply a one-state function to a 1-D state or to each row of a 2-D stack."""
-        if q.ndim == 1:
-            return function(q)
-        results = [function(row) for row in q]
-        if results:
-            return np.stack(results)
-        return np.zeros((0, *np.shape(function(np.zeros(q.shape[1])))))
+        if self.mimic is None:
+            energy = per_state(lambda qi: np.array(pin.computePotentialEnergy(self.model, self.data, qi)), q)
+        else:
+            mimic = self.mimic
+            energy = per_state(lambda qi: np.array(pin.computePotentialEnergy(mimic.model, mimic.data, mimic.q(qi))), q)
+        energy = self._finite(np.asarray(energy), "potential energy")
+        return energy if batch else float(energy)

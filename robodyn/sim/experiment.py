@@ -12,20 +12,18 @@ import time
 
 import numpy as np
 
-from robodyn.dynamics.loading import build_robot
+from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.simulation import Trajectory, simulate
-from robodyn.urdf.sources import URDFSource
 
 CONTROLLERS = ("passive", "pd", "computed-torque", "task-space")
 
 
 def controller_model(robot: Robot) -> Robot:
     """An independent copy of the robot for a controller (same URDF, its own data)."""
-    source = URDFSource(robot.urdf, robot.name, robot.name, robot.source_path, robot.floating_base, robot.package_dirs)
-    return build_robot(source, floating_base=robot.floating_base, gravity=robot.gravity_vector, check_inertia=False)
+    return rebuild(robot)
 
 
 def task_target(values: list[float] | np.ndarray) -> np.ndarray:

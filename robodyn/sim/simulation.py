@@ -211,7 +211,7 @@ def simulate(
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
-    (q, v), _ = robot._checked(q=q0, v=v0)
+    (q, v), _ = robot.validate(q=q0, v=v0)
     if q.ndim != 1:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     steps = round(duration / dt)
