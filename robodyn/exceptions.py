@@ -129,3 +129,19 @@ class SimulationError(RobodynError):
         super().__init__(
             f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
         )
+
+
+class MissingExtraError(RobodynError, ImportError):
+    """An optional dependency is not installed.
+
+    Attributes:
+        module: The module that could not be imported.
+        extra: The robodyn extra that installs it.
+        purpose: What it is needed for.
+    """
+
+    def __init__(self, module: str, extra: str, purpose: str):
+        self.module = module
+        self.extra = extra
+        self.purpose = purpose
+        super().__init__(f"{purpose} need {module!r}, which is not installed: pip install 'robodyn[{extra}]'.")

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from robodyn.exceptions import RobodynError, UnknownRobotError
+from robodyn.exceptions import MissingExtraError, RobodynError, UnknownRobotError
 
 
 @dataclass(frozen=True)
@@ -121,7 +121,7 @@ def robots_dir() -> Path:
     """Folder holding the zoo's robot packages (``.../share/example-robot-data/robots``).
 
     Raises:
-        RobodynError: If example-robot-data is not installed.
+        MissingExtraError: If example-robot-data is not installed (``robodyn[zoo]``).
     """
     tail = Path("cmeel.prefix", "share", "example-robot-data", "robots")
     candidates = [Path(sysconfig.get_paths()["purelib"]) / tail]
@@ -129,7 +129,7 @@ def robots_dir() -> Path:
     for candidate in candidates:
         if candidate.is_dir():
             return candidate
-    raise RobodynError("example-robot-data is not installed: 'pip install example-robot-data'.")
+    raise MissingExtraError("example_robot_data", "zoo", "zoo robots")
 
 
 def zoo_names() -> list[str]:
