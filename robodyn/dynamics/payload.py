@@ -46,13 +46,15 @@ def attach_payload(
         raise FrameError(link, robot.name)
     if not (np.isfinite(mass) and mass > 0):
         raise InputError("mass", "a positive number of kg", repr(mass))
-    com = np.asarray(com, dtype=float)
+    centre = np.asarray(com, dtype=float)
     inertia = np.eye(3) * (0.4 * mass * 0.03**2) if inertia is None else np.asarray(inertia, dtype=float)
-    if com.shape != (3,) or inertia.shape != (3, 3) or not (np.isfinite(com).all() and np.isfinite(inertia).all()):
-        raise InputError("com and inertia", "3 finite values and a finite 3×3 matrix", f"shapes {com.shape} and {inertia.shape}")
+    if centre.shape != (3,) or inertia.shape != (3, 3) or not (np.isfinite(centre).all() and np.isfinite(inertia).all()):
+        raise InputError(
+            "com and inertia", "3 finite values and a finite 3×3 matrix", f"shapes {centre.shape} and {inertia.shape}"
+        )
     payload_link = ET.Element("link", name=name)
     inertial = ET.SubElement(payload_link, "inertial")
-    ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
+    ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(x)) for x in centre), rpy="0 0 0")
     ET.SubElement(inertial, "mass", value=repr(float(mass)))
     ET.SubElement(
         inertial,
@@ -61,7 +63,7 @@ def attach_payload(
         iyy=repr(float(inertia[1, 1])), iyz=repr(float(inertia[1, 2])), izz=repr(float(inertia[2, 2])),
     )  # fmt: skip
     visual = ET.SubElement(payload_link, "visual")
-    ET.SubElement(visual, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
+    ET.SubElement(visual, "origin", xyz=" ".join(repr(float(x)) for x in centre), rpy="0 0 0")
     ET.SubElement(ET.SubElement(visual, "geometry"), "sphere", radius="0.03")
     text = weld_link(robot.spec, link, payload_link)
     return rebuild(robot, urdf=text, label=f"{robot.name}+{name}")

@@ -101,8 +101,8 @@ def _link_mass_properties(link: yourdfpy.Link) -> tuple[float, np.ndarray, np.nd
 
 def _combine(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, np.ndarray, np.ndarray]:
     """Merge rigidly attached masses (each: mass, centre, inertia about its centre)."""
-    mass = sum(part[0] for part in parts)
-    com = sum(part[0] * part[1] for part in parts) / mass if mass > 0 else np.zeros(3)
+    mass = float(sum(part[0] for part in parts))
+    com = np.sum([part[0] * part[1] for part in parts], axis=0) / mass if mass > 0 else np.zeros(3)
     inertia = np.zeros((3, 3))
     for part_mass, part_com, part_inertia in parts:
         d = part_com - com
