@@ -28,6 +28,21 @@ PINOCCHIO_ERRORS = (TypeError, ValueError, RuntimeError, AttributeError)
 _isfinite = math.isfinite
 
 
+class PerThreadData:
+    """One Pinocchio ``Data`` for ``model`` per thread, created on first use in that thread."""
+
+    def __init__(self, model: pin.Model) -> None:
+        self._model = model
+        self._local = threading.local()
+
+    def get(self) -> pin.Data:
+        """This thread's data."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self._model.createData()
+        return data
+
+
 class ModelHandle:
     """A Pinocchio model with per-thread data and robodyn's input checks.
 
@@ -44,16 +59,12 @@ class ModelHandle:
         self.floating_base = floating_base
         self.nq: int = model.nq
         self.nv: int = model.nv
-        self._local = threading.local()
+        self._data = PerThreadData(model)
 
     @property
     def data(self) -> pin.Data:
         """This thread's Pinocchio data for :attr:`model` (created on first use)."""
-        try:
-            return self._local.data
-        except AttributeError:
-            self._local.data = self.model.createData()
-            return self._local.data
+        return self._data.get()
 
     # ----------------------------------------------------------------------------------
     # The input boundary

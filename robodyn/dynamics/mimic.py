@@ -9,12 +9,12 @@ is linear, so ``q_full = Q q + offset``, ``v_full = S v``, ``M = Sᵀ M_full S``
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
+from robodyn.dynamics.handle import PerThreadData
 from robodyn.urdf.validation import URDFSpec
 
 
@@ -33,16 +33,15 @@ class MimicExpansion:
     selection: np.ndarray
     offset: np.ndarray
     q_selection: np.ndarray
-    _local: threading.local = field(default_factory=threading.local, repr=False)
+    _data: PerThreadData = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._data = PerThreadData(self.model)
 
     @property
     def data(self) -> pin.Data:
         """This thread's data for the expanded model."""
-        try:
-            return self._local.data
-        except AttributeError:
-            self._local.data = self.model.createData()
-            return self._local.data
+        return self._data.get()
 
     def q(self, q: np.ndarray) -> np.ndarray:
         """Configuration of the expanded model, shape (nq_full,)."""
