@@ -21,12 +21,13 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from robodyn.exceptions import URDFError
+from robodyn.exceptions import RobodynWarning, URDFError, printable, quoted
 from robodyn.urdf.meshes import mesh_problems
 
 #: Joint types robodyn knows. ``floating`` and ``planar`` are refused with a clear reason.
@@ -39,6 +40,11 @@ MAX_DEPTH = 1000
 MAX_MAGNITUDE = 1e12
 #: Relative tolerance on the triangle inequality of principal moments of inertia.
 TRIANGLE_TOLERANCE = 1e-6
+#: Smallest length that matters for a body's inertia, in [m]: a principal moment is
+#: compared with ``mass × BODY_SCALE²`` (see :func:`_check_inertias`).
+BODY_SCALE = 1e-3
+#: Deepest nesting of XML elements accepted (a URDF needs 5; xacro output about 10).
+MAX_XML_DEPTH = 100
 
 
 @dataclass(frozen=True)
@@ -49,14 +55,17 @@ class Problem:
         element: The offending element, e.g. ``'link "l1"'``, or ``None`` for the document.
         rule: The rule broken, as a sentence fragment.
         severity: ``"error"`` (the model is refused) or ``"warning"`` (legal but suspicious).
+        loud: A warning that loading shows (a :class:`~robodyn.exceptions.RobodynWarning`)
+            and that ``strict=True`` turns into an error; other warnings only ``lint`` shows.
     """
 
     element: str | None
     rule: str
     severity: str = "error"
+    loud: bool = False
 
     def __str__(self) -> str:
-        return f"{self.element}: {self.rule}" if self.element else self.rule
+        return printable(f"{self.element}: {self.rule}" if self.element else self.rule)
 
 
 @dataclass(frozen=True)
@@ -125,7 +134,17 @@ class URDFSpec:
 
     def child_joints(self, link: str) -> list[JointSpec]:
         """Joints whose parent is ``link``, in document order."""
-        return [joint for joint in self.joints.values() if joint.parent == link]
+        if not hasattr(self, "_children"):
+            self._children = _children(self.joints)
+        return list(self._children.get(link, []))
+
+
+def _children(joints: dict[str, JointSpec]) -> dict[str, list[JointSpec]]:
+    """Child joints of every link, in document order (one pass: linear time)."""
+    children: dict[str, list[JointSpec]] = {}
+    for joint in joints.values():
+        children.setdefault(joint.parent, []).append(joint)
+    return children
 
 
 _FORBIDDEN_XML = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
@@ -134,14 +153,28 @@ _FORBIDDEN_XML = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
 def parse_xml(text: str, source: str) -> ET.Element:
     """Parse URDF text strictly and return its ``<robot>`` element.
 
+    Whitespace (and a byte-order mark) before the XML declaration is accepted, as urdfdom
+    does. Elements nested deeper than :data:`MAX_XML_DEPTH` are refused while parsing
+    (the parser never recurses, nor does anything downstream get such a tree).
+
     Raises:
-        URDFError: If the text is not well-formed XML, declares a DOCTYPE or entities, or
-            its root element is not ``<robot>``.
+        URDFError: If the text is not well-formed XML, declares a DOCTYPE or entities,
+            nests elements too deeply, or its root element is not ``<robot>``.
     """
     if _FORBIDDEN_XML.search(text):
         raise URDFError(source, "DOCTYPE and entity declarations are not allowed in a URDF")
+    text = text.lstrip(" \t\r\n\ufeff")
+    parser = ET.XMLPullParser(events=("start", "end"))
+    depth, root = 0, None
     try:
-        root = ET.fromstring(text)
+        for start in range(0, max(len(text), 1), 1 << 16):
+            parser.feed(text[start : start + (1 << 16)])
+            for event, element in parser.read_events():
+                depth += 1 if event == "start" else -1
+                root = element if root is None else root
+                if depth > MAX_XML_DEPTH:
+                    raise URDFError(source, f"XML elements are nested deeper than {MAX_XML_DEPTH} levels (<{element.tag}>)")
+        parser.close()
     except ET.ParseError as error:
         raise URDFError(source, f"not well-formed XML ({error})") from None
     if root.tag != "robot":
@@ -158,26 +191,28 @@ class _Reader:
     def error(self, element: str | None, rule: str) -> None:
         self.problems.append(Problem(element, rule))
 
-    def warn(self, element: str | None, rule: str) -> None:
-        self.problems.append(Problem(element, rule, "warning"))
+    def warn(self, element: str | None, rule: str, *, loud: bool = False) -> None:
+        self.problems.append(Problem(element, rule, "warning", loud))
 
     def floats(self, where: str, node: ET.Element | None, attribute: str, default: str) -> np.ndarray:
         text = default if node is None else node.get(attribute, default)
-        try:
-            values = np.array([float(token) for token in text.split()], dtype=float)
-        except ValueError:
-            self.error(where, f"{attribute}={text!r} is not a list of numbers")
-            return np.array([float(token) for token in default.split()])
-        if values.size != len(default.split()):
-            self.error(where, f"{attribute}={text!r} must have {len(default.split())} numbers")
-            return np.array([float(token) for token in default.split()])
-        if not np.all(np.isfinite(values)):
-            self.error(where, f"{attribute}={text!r} must be finite")
-            return np.array([float(token) for token in default.split()])
-        if np.abs(values).max(initial=0.0) > MAX_MAGNITUDE:
-            self.error(where, f"{attribute}={text!r} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
-            return np.array([float(token) for token in default.split()])
-        return values
+        fallback = np.array([float(token) for token in default.split()])
+        tokens = _split(text)
+        values = [parse_number(token) for token in tokens]
+        if any(value is None for value in values):
+            self.error(where, f"{attribute}={quoted(text)} is not a list of numbers")
+            return fallback
+        if len(values) != fallback.size:
+            self.error(where, f"{attribute}={quoted(text)} must have {fallback.size} numbers")
+            return fallback
+        array = np.array(values, dtype=float)
+        if not np.all(np.isfinite(array)):
+            self.error(where, f"{attribute}={quoted(text)} must be finite")
+            return fallback
+        if np.abs(array).max(initial=0.0) > MAX_MAGNITUDE:
+            self.error(where, f"{attribute}={quoted(text)} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
+            return fallback
+        return array
 
     def number(
         self, where: str, node: ET.Element | None, attribute: str, default: float | None, *, bounded: bool = True
@@ -185,18 +220,42 @@ class _Reader:
         if node is None or node.get(attribute) is None:
             return default
         text = node.get(attribute)
-        try:
-            value = float(text)
-        except ValueError:
-            self.error(where, f"{attribute}={text!r} is not a number")
-            return default
-        if math.isnan(value):
-            self.error(where, f"{attribute}={text!r} is not a number")
+        value = parse_number(text)
+        if value is None or math.isnan(value):
+            self.error(where, f"{attribute}={quoted(text)} is not a number")
             return default
         if bounded and math.isfinite(value) and abs(value) > MAX_MAGNITUDE:
-            self.error(where, f"{attribute}={text!r} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
+            self.error(where, f"{attribute}={quoted(text)} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
             return default
         return value
+
+
+#: The number grammar of a URDF attribute, the only one robodyn accepts: an optional sign,
+#: ASCII decimal digits with an optional fraction and exponent, or ``inf`` / ``infinity``
+#: (any case; refused later wherever a finite value is needed) and ``nan`` (always
+#: refused), after stripping ASCII whitespace. No underscores, no other scripts' digits, no
+#: hexadecimal: what Python's ``float`` would also accept but a C++ URDF parser would read
+#: differently is refused, and Pinocchio only ever reads numbers robodyn wrote.
+_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)", re.IGNORECASE)
+_ASCII_SPACE = " \t\n\r"
+
+
+def parse_number(text: str) -> float | None:
+    """The value of one number in URDF text, or ``None`` if it is not in the grammar.
+
+    Args:
+        text: The attribute text (surrounding ASCII whitespace allowed).
+
+    Returns:
+        The float (``inf`` and ``nan`` included, for the caller to refuse), or ``None``.
+    """
+    token = text.strip(_ASCII_SPACE)
+    return float(token) if _NUMBER.fullmatch(token) else None
+
+
+def _split(text: str) -> list[str]:
+    """Tokens of a list of numbers separated by ASCII whitespace."""
+    return [token for token in re.split("[ \t\n\r]+", text.strip(_ASCII_SPACE)) if token]
 
 
 def _read_inertial(reader: _Reader, where: str, node: ET.Element) -> Inertial | None:
@@ -334,9 +393,7 @@ def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> s
         return None
     depth = {roots[0]: 0}
     stack = [roots[0]]
-    children: dict[str, list[JointSpec]] = {}
-    for joint in joints.values():
-        children.setdefault(joint.parent, []).append(joint)
+    children = _children(joints)
     while stack:
         link = stack.pop()
         for joint in children.get(link, []):
@@ -353,13 +410,19 @@ def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> s
 
 
 def _check_mimics(reader: _Reader, joints: dict[str, JointSpec]) -> None:
-    for joint in joints.values():
+    """Check mimic relations; a mimic of a joint that does not exist is dropped (loud warning)."""
+    for joint in list(joints.values()):
         if joint.mimic is None:
             continue
         where = f'joint "{joint.name}"'
         source = joints.get(joint.mimic.joint)
         if source is None:
-            reader.error(where, f"mimics joint {joint.mimic.joint!r}, which does not exist")
+            reader.warn(
+                where,
+                f"mimics joint {joint.mimic.joint!r}, which does not exist: it moves independently",
+                loud=True,
+            )
+            joints[joint.name] = replace(joint, mimic=None)
         elif joint.type == "fixed":
             reader.warn(where, "is fixed, so its <mimic> has no effect")
         elif source.type == "fixed":
@@ -370,56 +433,76 @@ def _check_mimics(reader: _Reader, joints: dict[str, JointSpec]) -> None:
             reader.error(where, f"a {joint.type} joint cannot mimic the {source.type} joint {source.name!r}")
 
 
-def _moving_links(root: str, joints: dict[str, JointSpec], floating_base: bool) -> set[str]:
-    """Links that move: below a moving joint, or every link on a floating base."""
+def _moving_links(root: str, children: dict[str, list[JointSpec]], floating_base: bool) -> set[str]:
+    """Links that move: below a moving joint, or every link on a floating base (linear time)."""
     moving = set()
     frontier = [(root, floating_base)]
     while frontier:
         link, moves = frontier.pop()
         if moves:
             moving.add(link)
-        frontier += [(j.child, moves or j.type != "fixed") for j in joints.values() if j.parent == link]
+        frontier += [(j.child, moves or j.type != "fixed") for j in children.get(link, ())]
     return moving
 
 
-def _check_inertias(reader: _Reader, links: dict[str, Inertial | None], moving: set[str], strict: bool) -> None:
-    """Physical consistency of each link's inertia: an error on links that move."""
+def _check_inertias(
+    reader: _Reader, links: dict[str, Inertial | None], moving: set[str], check_inertia: bool, strict: bool
+) -> None:
+    """Physical consistency of each link's inertia.
+
+    On a link that moves, an inertia that is not positive semi-definite is an error (a
+    warning with ``check_inertia=False``); one that is positive semi-definite but breaks
+    the triangle inequality is a loud warning (peers load it), an error when ``strict``.
+    The tolerance is relative to the body's scale: ``1e-9`` of the larger of its largest
+    principal moment and ``mass × (1 mm)²``, so rounding noise of ±1e-35 kg m² on a
+    point-like body is not a negative moment.
+    """
     for name, inertial in links.items():
         if inertial is None:
             continue
+        where = f'link "{name}"'
         if inertial.mass == 0:
             if np.abs(inertial.inertia).max() > 0:
-                reader.warn(
-                    f'link "{name}"', "has rotational inertia but no mass (no rigid body does); both dynamics keep the inertia"
-                )
+                reader.warn(where, "has rotational inertia but no mass (no rigid body does); both dynamics keep the inertia")
             continue
-        report = reader.error if strict and name in moving else reader.warn
-        where = f'link "{name}"'
+        is_moving = name in moving
         moments = np.linalg.eigvalsh(inertial.inertia)
-        tolerance = 1e-9 * max(abs(moments).max(), 1e-300)
+        tolerance = 1e-9 * max(abs(moments).max(), inertial.mass * BODY_SCALE**2)
         if moments[0] < -tolerance:
+            report = reader.error if check_inertia and is_moving else reader.warn
             report(where, f"inertia must be positive semi-definite (principal moments {_fmt(moments)} kg m²)")
         elif moments[2] > (moments[0] + moments[1]) * (1 + TRIANGLE_TOLERANCE) + tolerance:
-            report(
-                where,
-                f"principal moments of inertia {_fmt(moments)} kg m² break the triangle inequality (no rigid body has them)",
-            )
+            rule = f"principal moments of inertia {_fmt(moments)} kg m² break the triangle inequality (no rigid body has them)"
+            if strict and is_moving:
+                reader.error(where, rule)
+            else:
+                reader.warn(where, rule, loud=is_moving and check_inertia)
         elif moments[2] < 1e-10 * inertial.mass:
             reader.warn(where, f"tiny inertia (largest principal moment {moments[2]:.3g} kg m²) for mass {inertial.mass:.3g} kg")
+        elif is_moving and moments[0] <= tolerance:
+            reader.warn(
+                where, f"singular inertia (principal moments {_fmt(moments)} kg m²): the mass matrix may be singular"
+            )
 
 
-def _check_moving_masses(reader: _Reader, spec_links: dict, joints: dict[str, JointSpec]) -> None:
+def _check_moving_masses(reader: _Reader, spec_links: dict, joints: dict[str, JointSpec], children: dict) -> None:
+    """Warn about moving joints that carry a massless leaf body (linear time: each link is
+    visited once, by the moving joint whose rigid body holds it)."""
     for joint in joints.values():
         if joint.type == "fixed":
             continue
         # The rigid body a moving joint carries: its child plus links welded to it.
-        body, frontier = [], [joint.child]
+        mass, carries_joint, frontier = 0.0, False, [joint.child]
         while frontier:
             link = frontier.pop()
-            body.append(link)
-            frontier += [j.child for j in joints.values() if j.parent == link and j.type == "fixed"]
-        mass = sum(spec_links[link].mass for link in body if spec_links.get(link) is not None)
-        if mass == 0 and not any(j.parent in body and j.type != "fixed" for j in joints.values()):
+            inertial = spec_links.get(link)
+            mass += inertial.mass if inertial is not None else 0.0
+            for child in children.get(link, ()):
+                if child.type == "fixed":
+                    frontier.append(child.child)
+                else:
+                    carries_joint = True
+        if mass == 0 and not carries_joint:
             reader.warn(f'joint "{joint.name}"', "moves a massless leaf body: its mass matrix is singular")
 
 
@@ -429,6 +512,7 @@ def lint_urdf(
     *,
     floating_base: bool = False,
     check_inertia: bool = True,
+    strict: bool = False,
     base_dir: Path | None = None,
     package_dirs: Sequence[Path] = (),
 ) -> tuple[URDFSpec | None, list[Problem]]:
@@ -440,6 +524,8 @@ def lint_urdf(
         floating_base: Whether the root link moves freely (then every link moves).
         check_inertia: If false, physically impossible inertias of moving links are
             warnings instead of errors (some published URDFs have them).
+        strict: Loud warnings (an inertia breaking the triangle inequality, a mimic of a
+            joint that does not exist) are errors.
         base_dir: Folder of the URDF file, for relative mesh paths.
         package_dirs: Folders under which ``package://`` mesh paths resolve.
 
@@ -479,8 +565,15 @@ def lint_urdf(
     for element, rule, severity in mesh_problems(root, base_dir=base_dir, package_dirs=package_dirs):
         (reader.error if severity == "error" else reader.warn)(element, rule)
     if tree_root is not None:
-        _check_inertias(reader, links, _moving_links(tree_root, joints, floating_base), check_inertia)
-        _check_moving_masses(reader, links, joints)
+        children = _children(joints)
+        _check_inertias(reader, links, _moving_links(tree_root, children, floating_base), check_inertia, strict)
+        _check_moving_masses(reader, links, joints, children)
+        if not floating_base and all(joint.type == "fixed" for joint in joints.values()):
+            reader.error(None, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)")
+    if strict:
+        reader.problems = [
+            Problem(problem.element, problem.rule) if problem.loud else problem for problem in reader.problems
+        ]
     errors = [problem for problem in reader.problems if problem.severity == "error"]
     spec = None if errors else URDFSpec(root.get("name", "robot"), tree_root, links, joints, root)
     return spec, reader.problems
@@ -492,16 +585,25 @@ def parse_urdf(
     *,
     floating_base: bool = False,
     check_inertia: bool = True,
+    strict: bool = False,
     base_dir: Path | None = None,
     package_dirs: Sequence[Path] = (),
 ) -> URDFSpec:
     """Validate URDF text and return its spec (arguments as for :func:`lint_urdf`).
 
+    Loud warnings are shown as :class:`~robodyn.exceptions.RobodynWarning` (one each).
+
     Raises:
         URDFError: Naming the source, the element and the rule of the first error found.
     """
     spec, problems = lint_urdf(
-        text, source, floating_base=floating_base, check_inertia=check_inertia, base_dir=base_dir, package_dirs=package_dirs
+        text,
+        source,
+        floating_base=floating_base,
+        check_inertia=check_inertia,
+        strict=strict,
+        base_dir=base_dir,
+        package_dirs=package_dirs,
     )
     if spec is None:
         first = next(problem for problem in problems if problem.severity == "error")
@@ -509,4 +611,7 @@ def parse_urdf(
         if "inertia" in rule and check_inertia:
             rule += " (check_inertia=False or --no-check-inertia loads it anyway)"
         raise URDFError(source, rule, first.element)
+    for problem in problems:
+        if problem.loud:
+            warnings.warn(printable(f"{source}: {problem} (strict=True refuses it)"), RobodynWarning, stacklevel=3)
     return spec
