@@ -172,3 +172,20 @@ class SimulationError(RobodynError):
         super().__init__(
             f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
         )
+
+
+class OutputError(RobodynError, OSError):
+    """An output file that robodyn refuses to write or cannot write; nothing was replaced.
+
+    Attributes:
+        path: The output path as given.
+        reason: Why, e.g. ``"its folder does not exist"``.
+    """
+
+    def __init__(self, path: str, reason: str):
+        self.path = path
+        self.reason = reason
+        super().__init__(f"cannot write {quoted(path)}: {reason}.")
+
+    def __str__(self) -> str:  # OSError would format its own way
+        return printable(self.args[0])

@@ -31,12 +31,12 @@ from robodyn.urdf.normalised import normalised_urdf
 from robodyn.urdf.sources import URDFSource, locked_source, resolve_source
 from robodyn.urdf.validation import URDFSpec, parse_urdf
 
-#: Most degrees of freedom loaded by default. Pinocchio's data grows with nv² (and more:
-#: :func:`data_memory_estimate`); at this size a robot needs about 0.25 GB, so a few
-#: robots (copies, threads) fit on a 24 GB machine. ``max_dof=`` overrides it.
-MAX_DOF = 200
-#: Largest estimated data size accepted, in bytes, whatever ``max_dof`` says.
-MAX_DATA_BYTES = 8 * 1024**3
+#: Most degrees of freedom loaded by default. Pinocchio's data grows with njoints × nv²
+#: (:func:`data_memory_estimate`): about 1.8 GB a thread at 300, so the few copies a
+#: program holds (one a thread, the mimic expansion) fit on a 24 GB machine, where a
+#: 400-joint star needs 4 GB a copy and a 999-joint chain exhausted 24 GB. ``max_dof=``
+#: overrides it.
+MAX_DOF = 300
 
 
 def pinocchio_xml(spec: URDFSpec) -> str:
@@ -46,21 +46,13 @@ def pinocchio_xml(spec: URDFSpec) -> str:
 
 def data_memory_estimate(nv: int, njoints: int) -> int:
     """Bytes one Pinocchio ``Data`` needs for a model of ``nv`` velocities and ``njoints``
-    joints (measured on Pinocchio 4.1: chains and stars of 50 to 300 joints; see
-    tests/test_hostile_resources.py).
+    joints (universe included), an upper bound of ``60 njoints nv² + 1600 nv² + 2 MB``.
 
-    Args:
-        nv: Degrees of freedom.
-        njoints: Joints of the model (universe included).
-
-    Returns:
-        The estimate in bytes (an upper bound of what was measured).
+    Fitted on Pinocchio 4.1 (growth of the peak resident size in ``createData``): chains
+    and stars of 25, 50, 100 and 150 joints took 5.0, 13.5, 74.6 and 234 MB (chains and
+    stars alike); the fit gives 4.0 GB for a 400-joint star (measured: 4.1 GB).
     """
-    return int(_BYTES_PER_NV2 * nv * nv + _BYTES_PER_JOINT_NV * njoints * nv + 2_000_000)
-
-
-_BYTES_PER_NV2 = 40 * 8
-_BYTES_PER_JOINT_NV = 60 * 8
+    return int(60 * njoints * nv * nv + 1600 * nv * nv + 2_000_000)
 
 
 def load(
@@ -93,7 +85,9 @@ def load(
         lock: Joints to freeze, by name, at positions in [rad] / [m] (e.g. a gripper's
             fingers): they become fixed joints, and joints mimicking them follow.
         threads: Native threads for batches of states; default every available core.
-        max_dof: Most degrees of freedom accepted; default :data:`MAX_DOF` (200).
+        max_dof: Most degrees of freedom accepted; default :data:`MAX_DOF` (300). Above
+            it the model is refused before Pinocchio allocates its data (which grows with
+            the cube of the size: about 1.8 GB a thread at 300).
         max_bytes: Largest URDF accepted, in bytes; default 64 MiB or
             ``$ROBODYN_MAX_URDF_BYTES``.
 
@@ -208,7 +202,7 @@ def _check_size(spec: URDFSpec, label: str, floating: bool, max_dof: int) -> Non
     nv = (6 if floating else 0) + sum(joint.type != "fixed" for joint in spec.joints.values())
     njoints = 1 + (1 if floating else 0) + sum(joint.type != "fixed" for joint in spec.joints.values())
     estimate = data_memory_estimate(nv, njoints)
-    if nv > max_dof or estimate > MAX_DATA_BYTES:
+    if nv > max_dof:
         raise URDFError(
             label,
             f"{nv} degrees of freedom need about {estimate / 1e9:.2g} GB for Pinocchio's data per thread, "

@@ -182,6 +182,9 @@ def parse_xml(text: str, source: str) -> ET.Element:
     return root
 
 
+_DEFAULTS: dict[str, tuple[float, ...]] = {}
+
+
 class _Reader:
     """Collects problems while reading numbers and attributes out of elements."""
 
@@ -196,23 +199,21 @@ class _Reader:
 
     def floats(self, where: str, node: ET.Element | None, attribute: str, default: str) -> np.ndarray:
         text = default if node is None else node.get(attribute, default)
-        fallback = np.array([float(token) for token in default.split()])
-        tokens = _split(text)
-        values = [parse_number(token) for token in tokens]
+        fallback = _DEFAULTS.setdefault(default, tuple(float(token) for token in default.split()))
+        values = [parse_number(token) for token in _split(text)]
+        problem = None
         if any(value is None for value in values):
-            self.error(where, f"{attribute}={quoted(text)} is not a list of numbers")
-            return fallback
-        if len(values) != fallback.size:
-            self.error(where, f"{attribute}={quoted(text)} must have {fallback.size} numbers")
-            return fallback
-        array = np.array(values, dtype=float)
-        if not np.all(np.isfinite(array)):
-            self.error(where, f"{attribute}={quoted(text)} must be finite")
-            return fallback
-        if np.abs(array).max(initial=0.0) > MAX_MAGNITUDE:
-            self.error(where, f"{attribute}={quoted(text)} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
-            return fallback
-        return array
+            problem = "is not a list of numbers"
+        elif len(values) != len(fallback):
+            problem = f"must have {len(fallback)} numbers"
+        elif not all(math.isfinite(value) for value in values):
+            problem = "must be finite"
+        elif max(map(abs, values), default=0.0) > MAX_MAGNITUDE:
+            problem = f"is beyond ±{MAX_MAGNITUDE:g}: not a physical robot"
+        if problem is not None:
+            self.error(where, f"{attribute}={quoted(text)} {problem}")
+            values = list(fallback)
+        return np.array(values, dtype=float)
 
     def number(
         self, where: str, node: ET.Element | None, attribute: str, default: float | None, *, bounded: bool = True
