@@ -157,8 +157,8 @@ def build_model(spec: URDFSpec, label: str, *, floating: bool, mimic: bool) -> p
     for index, name in enumerate(model.names):
         if name in names:
             model.names[index] = names[name]
-    for frame in model.frames:
-        if frame.name in names:
+    for frame in model.frames:  # joint frames only: a link may be named like a canonical joint
+        if frame.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT) and frame.name in names:
             frame.name = names[frame.name]
     return model
 
