@@ -50,7 +50,11 @@ def urdfs(draw):
         mass = draw(POSITIVE)
         moments = sorted(draw(POSITIVE) for _ in range(3))
         moments[2] = min(moments[2], moments[0] + moments[1])  # a rigid body's moments
-        limit = "" if kind == "continuous" else f'<limit lower="{spell(-1.5)}" upper="{spell(1.25)}" effort="{spell(10.0)}" velocity="1"/>'
+        limit = (
+            ""
+            if kind == "continuous"
+            else f'<limit lower="{spell(-1.5)}" upper="{spell(1.25)}" effort="{spell(10.0)}" velocity="1"/>'
+        )
         parts.append(
             f'<joint name="j{i}" type="{kind}"><parent link="l{parent}"/><child link="l{i}"/>'
             f'<origin xyz="{" ".join(spell(v) for v in xyz)}" rpy="{" ".join(spell(v) for v in rpy)}"/>'

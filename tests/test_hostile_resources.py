@@ -100,7 +100,7 @@ def test_names_too_long_or_impossible_give_one_line(source):
 
 
 def test_deep_nesting_is_one_line_not_a_recursion_error():
-    text = robodyn.rp_arm_urdf().replace("<link name=\"link1\">", "<link name=\"link1\">" + "<a>" * 5000 + "</a>" * 5000, 1)
+    text = robodyn.rp_arm_urdf().replace('<link name="link1">', '<link name="link1">' + "<a>" * 5000 + "</a>" * 5000, 1)
     with pytest.raises(URDFError, match="nested deeper than 100 levels"):
         robodyn.load(text)
 

@@ -191,7 +191,9 @@ def build_robot(
     if mimic is not None:
         mimic.model.gravity.linear = model.gravity.linear
     if model.nv == 0:
-        raise URDFError(resolved.label, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)")
+        raise URDFError(
+            resolved.label, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)"
+        )
     name = spec.name if resolved.name == "robot" else resolved.name
     options = LoadOptions(floating, tuple(float(g) for g in model.gravity.linear), check_inertia, threads)  # type: ignore[arg-type]
     return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)

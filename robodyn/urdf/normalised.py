@@ -119,7 +119,9 @@ def normalised_urdf(spec: URDFSpec) -> tuple[str, dict[str, str]]:
         )
     for joint in order:
         moving = joint.type != "fixed"
-        node = ET.SubElement(root, "joint", name=canonical[joint.name], type="revolute" if joint.type == "continuous" else joint.type)
+        node = ET.SubElement(
+            root, "joint", name=canonical[joint.name], type="revolute" if joint.type == "continuous" else joint.type
+        )
         ET.SubElement(node, "origin", xyz=_numbers(joint.origin_xyz), rpy=_numbers(joint.origin_rpy))
         ET.SubElement(node, "parent", link=joint.parent)
         ET.SubElement(node, "child", link=joint.child)

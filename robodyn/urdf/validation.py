@@ -9,8 +9,16 @@ returns them all, warnings included.
 Conventions enforced here and relied on downstream:
     - joint axes are finite, non-zero and normalised to unit length;
     - ``<mimic>`` joints are honoured (``q_mimic = multiplier * q_source + offset``);
-    - masses are finite and non-negative; a link with positive mass has a symmetric
-      positive-definite inertia satisfying the triangle inequality.
+    - numbers follow one grammar (:func:`robodyn.urdf.xmltext.parse_number`); Pinocchio
+      later reads only numbers robodyn wrote (:mod:`robodyn.urdf.normalised`);
+    - masses are finite and non-negative; a moving link with positive mass has a
+      positive semi-definite inertia (tolerance relative to the body's scale); breaking
+      the triangle inequality is a loud warning (:class:`~robodyn.exceptions.RobodynWarning`),
+      an error with ``strict=True``;
+    - a ``<mimic>`` of a joint that does not exist is dropped with a loud warning.
+
+The pieces live in :mod:`robodyn.urdf.xmltext` (XML and numbers), :mod:`robodyn.urdf.spec`
+(the result types) and :mod:`robodyn.urdf.inertias` (mass properties).
 
 This module does not import Pinocchio.
 """
@@ -18,17 +26,19 @@ This module does not import Pinocchio.
 from __future__ import annotations
 
 import math
-import re
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from robodyn.exceptions import RobodynWarning, URDFError, printable, quoted
+from robodyn.urdf.inertias import BODY_SCALE, TRIANGLE_TOLERANCE, check_inertias, check_moving_masses, moving_links
 from robodyn.urdf.meshes import mesh_problems
+from robodyn.urdf.spec import Inertial, JointSpec, Mimic, Problem, URDFSpec, child_index
+from robodyn.urdf.xmltext import MAX_XML_DEPTH, parse_number, parse_xml, split_numbers
 
 #: Joint types robodyn knows. ``floating`` and ``planar`` are refused with a clear reason.
 MOVING_JOINT_TYPES = ("revolute", "continuous", "prismatic")
@@ -38,148 +48,6 @@ MAX_DEPTH = 1000
 #: Largest magnitude accepted for a length, angle, mass, inertia or limit (SI units):
 #: beyond it the dynamics overflow long before they mean anything.
 MAX_MAGNITUDE = 1e12
-#: Relative tolerance on the triangle inequality of principal moments of inertia.
-TRIANGLE_TOLERANCE = 1e-6
-#: Smallest length that matters for a body's inertia, in [m]: a principal moment is
-#: compared with ``mass × BODY_SCALE²`` (see :func:`_check_inertias`).
-BODY_SCALE = 1e-3
-#: Deepest nesting of XML elements accepted (a URDF needs 5; xacro output about 10).
-MAX_XML_DEPTH = 100
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One problem found in a URDF.
-
-    Attributes:
-        element: The offending element, e.g. ``'link "l1"'``, or ``None`` for the document.
-        rule: The rule broken, as a sentence fragment.
-        severity: ``"error"`` (the model is refused) or ``"warning"`` (legal but suspicious).
-        loud: A warning that loading shows (a :class:`~robodyn.exceptions.RobodynWarning`)
-            and that ``strict=True`` turns into an error; other warnings only ``lint`` shows.
-    """
-
-    element: str | None
-    rule: str
-    severity: str = "error"
-    loud: bool = False
-
-    def __str__(self) -> str:
-        return printable(f"{self.element}: {self.rule}" if self.element else self.rule)
-
-
-@dataclass(frozen=True)
-class Inertial:
-    """Mass properties of a link, in the link frame.
-
-    Attributes:
-        mass: Mass in [kg].
-        origin_xyz: Centre of mass in [m].
-        origin_rpy: Orientation of the inertia frame, roll-pitch-yaw in [rad].
-        inertia: 3×3 inertia about the centre of mass, in the inertia frame, in [kg m²].
-    """
-
-    mass: float
-    origin_xyz: np.ndarray
-    origin_rpy: np.ndarray
-    inertia: np.ndarray
-
-
-@dataclass(frozen=True)
-class Mimic:
-    """A joint driven by another: ``q = multiplier * q_source + offset``."""
-
-    joint: str
-    multiplier: float = 1.0
-    offset: float = 0.0
-
-
-@dataclass(frozen=True)
-class JointSpec:
-    """One URDF joint, validated.
-
-    Attributes:
-        name, type, parent, child: As in the URDF.
-        origin_xyz: Joint frame position in the parent link frame, in [m].
-        origin_rpy: Joint frame orientation, roll-pitch-yaw in [rad].
-        axis: Unit joint axis in the joint frame.
-        lower, upper: Position limits in [rad] or [m] (±inf for continuous joints).
-        effort, velocity: Effort limit in [N m] or [N], velocity limit in [rad/s] or [m/s].
-        mimic: The mimic relation, or ``None``.
-    """
-
-    name: str
-    type: str
-    parent: str
-    child: str
-    origin_xyz: np.ndarray
-    origin_rpy: np.ndarray
-    axis: np.ndarray
-    lower: float = -math.inf
-    upper: float = math.inf
-    effort: float = math.inf
-    velocity: float = math.inf
-    mimic: Mimic | None = None
-
-
-@dataclass
-class URDFSpec:
-    """A validated URDF: its links, joints (document order) and the parsed XML tree."""
-
-    name: str
-    root: str
-    links: dict[str, Inertial | None]
-    joints: dict[str, JointSpec]
-    xml: ET.Element = field(repr=False)
-
-    def child_joints(self, link: str) -> list[JointSpec]:
-        """Joints whose parent is ``link``, in document order."""
-        if not hasattr(self, "_children"):
-            self._children = _children(self.joints)
-        return list(self._children.get(link, []))
-
-
-def _children(joints: dict[str, JointSpec]) -> dict[str, list[JointSpec]]:
-    """Child joints of every link, in document order (one pass: linear time)."""
-    children: dict[str, list[JointSpec]] = {}
-    for joint in joints.values():
-        children.setdefault(joint.parent, []).append(joint)
-    return children
-
-
-_FORBIDDEN_XML = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
-
-
-def parse_xml(text: str, source: str) -> ET.Element:
-    """Parse URDF text strictly and return its ``<robot>`` element.
-
-    Whitespace (and a byte-order mark) before the XML declaration is accepted, as urdfdom
-    does. Elements nested deeper than :data:`MAX_XML_DEPTH` are refused while parsing
-    (the parser never recurses, nor does anything downstream get such a tree).
-
-    Raises:
-        URDFError: If the text is not well-formed XML, declares a DOCTYPE or entities,
-            nests elements too deeply, or its root element is not ``<robot>``.
-    """
-    if _FORBIDDEN_XML.search(text):
-        raise URDFError(source, "DOCTYPE and entity declarations are not allowed in a URDF")
-    text = text.lstrip(" \t\r\n\ufeff")
-    parser = ET.XMLPullParser(events=("start", "end"))
-    depth, root = 0, None
-    try:
-        for start in range(0, max(len(text), 1), 1 << 16):
-            parser.feed(text[start : start + (1 << 16)])
-            for event, element in parser.read_events():
-                depth += 1 if event == "start" else -1
-                root = element if root is None else root
-                if depth > MAX_XML_DEPTH:
-                    raise URDFError(source, f"XML elements are nested deeper than {MAX_XML_DEPTH} levels (<{element.tag}>)")
-        parser.close()
-    except ET.ParseError as error:
-        raise URDFError(source, f"not well-formed XML ({error})") from None
-    if root.tag != "robot":
-        raise URDFError(source, f"the root element must be <robot>, not <{root.tag}>")
-    return root
 
 
 _DEFAULTS: dict[str, tuple[float, ...]] = {}
@@ -200,7 +68,7 @@ class _Reader:
     def floats(self, where: str, node: ET.Element | None, attribute: str, default: str) -> np.ndarray:
         text = default if node is None else node.get(attribute, default)
         fallback = _DEFAULTS.setdefault(default, tuple(float(token) for token in default.split()))
-        values = [parse_number(token) for token in _split(text)]
+        values = [parse_number(token) for token in split_numbers(text)]
         problem = None
         if any(value is None for value in values):
             problem = "is not a list of numbers"
@@ -229,34 +97,6 @@ class _Reader:
             self.error(where, f"{attribute}={quoted(text)} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
             return default
         return value
-
-
-#: The number grammar of a URDF attribute, the only one robodyn accepts: an optional sign,
-#: ASCII decimal digits with an optional fraction and exponent, or ``inf`` / ``infinity``
-#: (any case; refused later wherever a finite value is needed) and ``nan`` (always
-#: refused), after stripping ASCII whitespace. No underscores, no other scripts' digits, no
-#: hexadecimal: what Python's ``float`` would also accept but a C++ URDF parser would read
-#: differently is refused, and Pinocchio only ever reads numbers robodyn wrote.
-_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)", re.IGNORECASE)
-_ASCII_SPACE = " \t\n\r"
-
-
-def parse_number(text: str) -> float | None:
-    """The value of one number in URDF text, or ``None`` if it is not in the grammar.
-
-    Args:
-        text: The attribute text (surrounding ASCII whitespace allowed).
-
-    Returns:
-        The float (``inf`` and ``nan`` included, for the caller to refuse), or ``None``.
-    """
-    token = text.strip(_ASCII_SPACE)
-    return float(token) if _NUMBER.fullmatch(token) else None
-
-
-def _split(text: str) -> list[str]:
-    """Tokens of a list of numbers separated by ASCII whitespace."""
-    return [token for token in re.split("[ \t\n\r]+", text.strip(_ASCII_SPACE)) if token]
 
 
 def _read_inertial(reader: _Reader, where: str, node: ET.Element) -> Inertial | None:
@@ -292,10 +132,6 @@ def _read_inertial(reader: _Reader, where: str, node: ET.Element) -> Inertial | 
         ]
     )
     return Inertial(mass, reader.floats(where, origin, "xyz", "0 0 0"), reader.floats(where, origin, "rpy", "0 0 0"), inertia)
-
-
-def _fmt(values: np.ndarray) -> str:
-    return "(" + ", ".join(f"{value:.4g}" for value in values) + ")"
 
 
 def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | None:
@@ -394,7 +230,7 @@ def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> s
         return None
     depth = {roots[0]: 0}
     stack = [roots[0]]
-    children = _children(joints)
+    children = child_index(joints)
     while stack:
         link = stack.pop()
         for joint in children.get(link, []):
@@ -432,79 +268,6 @@ def _check_mimics(reader: _Reader, joints: dict[str, JointSpec]) -> None:
             reader.error(where, f"mimics {source.name!r}, which is itself a mimic joint")
         elif source.type != joint.type:
             reader.error(where, f"a {joint.type} joint cannot mimic the {source.type} joint {source.name!r}")
-
-
-def _moving_links(root: str, children: dict[str, list[JointSpec]], floating_base: bool) -> set[str]:
-    """Links that move: below a moving joint, or every link on a floating base (linear time)."""
-    moving = set()
-    frontier = [(root, floating_base)]
-    while frontier:
-        link, moves = frontier.pop()
-        if moves:
-            moving.add(link)
-        frontier += [(j.child, moves or j.type != "fixed") for j in children.get(link, ())]
-    return moving
-
-
-def _check_inertias(
-    reader: _Reader, links: dict[str, Inertial | None], moving: set[str], check_inertia: bool, strict: bool
-) -> None:
-    """Physical consistency of each link's inertia.
-
-    On a link that moves, an inertia that is not positive semi-definite is an error (a
-    warning with ``check_inertia=False``); one that is positive semi-definite but breaks
-    the triangle inequality is a loud warning (peers load it), an error when ``strict``.
-    The tolerance is relative to the body's scale: ``1e-9`` of the larger of its largest
-    principal moment and ``mass × (1 mm)²``, so rounding noise of ±1e-35 kg m² on a
-    point-like body is not a negative moment.
-    """
-    for name, inertial in links.items():
-        if inertial is None:
-            continue
-        where = f'link "{name}"'
-        if inertial.mass == 0:
-            if np.abs(inertial.inertia).max() > 0:
-                reader.warn(where, "has rotational inertia but no mass (no rigid body does); both dynamics keep the inertia")
-            continue
-        is_moving = name in moving
-        moments = np.linalg.eigvalsh(inertial.inertia)
-        tolerance = 1e-9 * max(abs(moments).max(), inertial.mass * BODY_SCALE**2)
-        if moments[0] < -tolerance:
-            report = reader.error if check_inertia and is_moving else reader.warn
-            report(where, f"inertia must be positive semi-definite (principal moments {_fmt(moments)} kg m²)")
-        elif moments[2] > (moments[0] + moments[1]) * (1 + TRIANGLE_TOLERANCE) + tolerance:
-            rule = f"principal moments of inertia {_fmt(moments)} kg m² break the triangle inequality (no rigid body has them)"
-            if strict and is_moving:
-                reader.error(where, rule)
-            else:
-                reader.warn(where, rule, loud=is_moving and check_inertia)
-        elif moments[2] < 1e-10 * inertial.mass:
-            reader.warn(where, f"tiny inertia (largest principal moment {moments[2]:.3g} kg m²) for mass {inertial.mass:.3g} kg")
-        elif is_moving and moments[0] <= tolerance:
-            reader.warn(
-                where, f"singular inertia (principal moments {_fmt(moments)} kg m²): the mass matrix may be singular"
-            )
-
-
-def _check_moving_masses(reader: _Reader, spec_links: dict, joints: dict[str, JointSpec], children: dict) -> None:
-    """Warn about moving joints that carry a massless leaf body (linear time: each link is
-    visited once, by the moving joint whose rigid body holds it)."""
-    for joint in joints.values():
-        if joint.type == "fixed":
-            continue
-        # The rigid body a moving joint carries: its child plus links welded to it.
-        mass, carries_joint, frontier = 0.0, False, [joint.child]
-        while frontier:
-            link = frontier.pop()
-            inertial = spec_links.get(link)
-            mass += inertial.mass if inertial is not None else 0.0
-            for child in children.get(link, ()):
-                if child.type == "fixed":
-                    frontier.append(child.child)
-                else:
-                    carries_joint = True
-        if mass == 0 and not carries_joint:
-            reader.warn(f'joint "{joint.name}"', "moves a massless leaf body: its mass matrix is singular")
 
 
 def lint_urdf(
@@ -566,15 +329,13 @@ def lint_urdf(
     for element, rule, severity in mesh_problems(root, base_dir=base_dir, package_dirs=package_dirs):
         (reader.error if severity == "error" else reader.warn)(element, rule)
     if tree_root is not None:
-        children = _children(joints)
-        _check_inertias(reader, links, _moving_links(tree_root, children, floating_base), check_inertia, strict)
-        _check_moving_masses(reader, links, joints, children)
+        children = child_index(joints)
+        check_inertias(reader, links, moving_links(tree_root, children, floating_base), check_inertia, strict)
+        check_moving_masses(reader, links, joints, children)
         if not floating_base and all(joint.type == "fixed" for joint in joints.values()):
             reader.error(None, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)")
     if strict:
-        reader.problems = [
-            Problem(problem.element, problem.rule) if problem.loud else problem for problem in reader.problems
-        ]
+        reader.problems = [Problem(problem.element, problem.rule) if problem.loud else problem for problem in reader.problems]
     errors = [problem for problem in reader.problems if problem.severity == "error"]
     spec = None if errors else URDFSpec(root.get("name", "robot"), tree_root, links, joints, root)
     return spec, reader.problems
@@ -616,3 +377,23 @@ def parse_urdf(
         if problem.loud:
             warnings.warn(printable(f"{source}: {problem} (strict=True refuses it)"), RobodynWarning, stacklevel=3)
     return spec
+
+
+__all__ = [
+    "BODY_SCALE",
+    "KNOWN_JOINT_TYPES",
+    "MAX_DEPTH",
+    "MAX_MAGNITUDE",
+    "MAX_XML_DEPTH",
+    "MOVING_JOINT_TYPES",
+    "TRIANGLE_TOLERANCE",
+    "Inertial",
+    "JointSpec",
+    "Mimic",
+    "Problem",
+    "URDFSpec",
+    "lint_urdf",
+    "parse_number",
+    "parse_urdf",
+    "parse_xml",
+]

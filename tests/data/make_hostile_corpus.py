@@ -134,7 +134,13 @@ CASES: dict[str, tuple[str, str, str, str, bool]] = {
         "rpy='0 1_0 0' is not a list of numbers",
         True,
     ),
-    "axis_fullwidth": ("numbers", "error", sub('<axis xyz="1 0 0"/>', '<axis xyz="\uff11 0 0"/>'), "is not a list of numbers", True),
+    "axis_fullwidth": (
+        "numbers",
+        "error",
+        sub('<axis xyz="1 0 0"/>', '<axis xyz="\uff11 0 0"/>'),
+        "is not a list of numbers",
+        True,
+    ),
     "limit_underscore": (
         "numbers",
         "error",
