@@ -76,7 +76,7 @@ def test_pinocchio_holds_exactly_the_validators_numbers(case):
     spec = parse_urdf(text)
     robot = robodyn.load(text)
     model = robot.model
-    for name, xyz, rpy, com, com_rpy, mass, moments in truth:
+    for name, xyz, rpy, com, _com_rpy, mass, moments in truth:
         joint = spec.joints[name]
         inertial = spec.links[joint.child]
         # the validator read the numbers as written, whatever the spelling

@@ -12,7 +12,7 @@ import pytest
 
 import robodyn
 from robodyn.dynamics.loading import MAX_DOF, data_memory_estimate
-from robodyn.exceptions import RobodynError, URDFError, UnknownRobotError
+from robodyn.exceptions import RobodynError, UnknownRobotError, URDFError
 from robodyn.urdf.sources import MAX_URDF_BYTES
 from robodyn.urdf.validation import lint_urdf
 from tests.data.make_hostile_corpus import chain
@@ -112,7 +112,7 @@ def test_a_star_of_5000_links_validates_in_linear_time():
             f'<joint name="j{i}" type="fixed"><parent link="hub"/><child link="l{i}"/></joint>'
             f'<link name="l{i}"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
         )
-    spec, problems = lint_urdf("".join([*parts, "</robot>"]), floating_base=True)
+    spec, _ = lint_urdf("".join([*parts, "</robot>"]), floating_base=True)
     assert spec is not None and len(spec.links) == 5001
 
 

@@ -37,7 +37,7 @@ def one_line_warnings() -> Iterator[None]:
     with warnings.catch_warnings():
         previous = warnings.showwarning
 
-        def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        def show(message, category, filename, lineno, file=None, line=None):
             if issubclass(category, RobodynWarning):
                 print(f"robodyn: warning: {printable(message)}", file=file or sys.stderr)
             else:
