@@ -177,3 +177,32 @@ def test_a_long_name_gets_a_temporary_name_that_fits(tmp_path):
     path = tmp_path / ("n" * 250)
     atomic_write_text(path, "x")
     assert path.read_text() == "x"
+
+
+def test_a_command_writes_all_its_outputs_or_none(tmp_path, capsys):
+    from robodyn.cli.app import main
+    from robodyn.urdf.models import rp_arm_urdf
+
+    bare = tmp_path / "bare.urdf"  # no visual geometry: the recording is refused
+    text = rp_arm_urdf()
+    while "<visual>" in text:
+        start = text.index("<visual>")
+        text = text[:start] + text[text.index("</visual>", start) + len("</visual>") :]
+    bare.write_text(text)
+    csv, html = tmp_path / "m.csv", tmp_path / "m.html"
+    csv.write_text("the user's old trajectory")
+    assert main(["simulate", str(bare), "--duration", "0.05", "--out", str(csv), "--record", str(html)]) == 2
+    assert "no visual geometry" in capsys.readouterr().err
+    assert csv.read_text() == "the user's old trajectory" and not html.exists()
+    assert _leftovers(tmp_path) == []
+    assert main(["simulate", str(bare), "--duration", "0.05", "--out", str(csv)]) == 0
+    assert csv.read_text().startswith(("#", "t"))
+
+
+def test_dash_writes_a_command_output_to_stdout(tmp_path, capfd, monkeypatch):
+    from robodyn.cli.app import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["equations", "rp_arm", "--out", "-"]) == 0
+    assert not (tmp_path / "-").exists()
+    assert capfd.readouterr().out.strip()

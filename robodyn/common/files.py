@@ -15,17 +15,20 @@ the path before is left exactly as it was):
   folder: an error, the temporary file removed.
 - :class:`OutputSet` stages several outputs and renames them all only after every one of
   them was produced; an error before the commit (in robodyn or in any of the writes)
-  discards them all.
+  discards them all. :func:`outputs_together` makes every write of a block one such
+  transaction (the CLI runs each command in one).
 """
 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import errno
 import os
 import secrets
 import stat
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from types import TracebackType
 
@@ -175,15 +178,39 @@ def _is_system(path: str) -> bool:
     return any(path == folder or path.startswith(folder + "/") for folder in _SYSTEM)
 
 
+#: The transaction :func:`outputs_together` opened, if any.
+_AMBIENT: contextvars.ContextVar[OutputSet | None] = contextvars.ContextVar("robodyn_outputs", default=None)
+
+
+@contextlib.contextmanager
+def outputs_together() -> Iterator[OutputSet]:
+    """Make every :func:`atomic_write_bytes` / :func:`atomic_write_text` inside the block
+    part of one :class:`OutputSet`: committed when the block ends normally, discarded
+    when it raises. The CLI runs each command inside one, so that a command's outputs
+    are all written or none is (``simulate --out m.csv --record m.html``).
+    """
+    outputs = OutputSet()
+    token = _AMBIENT.set(outputs)
+    try:
+        with outputs:
+            yield outputs
+    finally:
+        _AMBIENT.reset(token)
+
+
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path | None:
-    """Write ``data`` to ``path`` atomically (one-output :class:`OutputSet`).
+    """Write ``data`` to ``path`` atomically: a one-output :class:`OutputSet`, or staged in
+    the enclosing :func:`outputs_together` block (then written when that block ends).
 
     Returns:
-        The file written, or ``None`` for standard output (``-``).
+        The file written (or to be written), or ``None`` for standard output (``-``).
 
     Raises:
         OutputError: If the path is refused or cannot be written; the old file is intact.
     """
+    ambient = _AMBIENT.get()
+    if ambient is not None:
+        return ambient.write_bytes(path, data)
     with OutputSet() as outputs:
         target = outputs.write_bytes(path, data)
     return target
@@ -279,4 +306,4 @@ def _umask() -> int:
     return mask
 
 
-__all__ = ["OutputSet", "atomic_write_bytes", "atomic_write_text", "output_target", "temporary_prefix"]
+__all__ = ["OutputSet", "atomic_write_bytes", "atomic_write_text", "output_target", "outputs_together", "temporary_prefix"]
