@@ -179,24 +179,21 @@ def test_a_long_name_gets_a_temporary_name_that_fits(tmp_path):
     assert path.read_text() == "x"
 
 
-def test_a_command_writes_all_its_outputs_or_none(tmp_path, capsys):
-    from robodyn.cli.app import main
-    from robodyn.urdf.models import rp_arm_urdf
+def test_outputs_together_makes_every_write_of_a_block_one_transaction(tmp_path):
+    from robodyn.common.files import outputs_together
 
-    bare = tmp_path / "bare.urdf"  # no visual geometry: the recording is refused
-    text = rp_arm_urdf()
-    while "<visual>" in text:
-        start = text.index("<visual>")
-        text = text[:start] + text[text.index("</visual>", start) + len("</visual>") :]
-    bare.write_text(text)
     csv, html = tmp_path / "m.csv", tmp_path / "m.html"
     csv.write_text("the user's old trajectory")
-    assert main(["simulate", str(bare), "--duration", "0.05", "--out", str(csv), "--record", str(html)]) == 2
-    assert "no visual geometry" in capsys.readouterr().err
+    with pytest.raises(RuntimeError), outputs_together():
+        atomic_write_text(csv, "new trajectory")  # e.g. Trajectory.save
+        raise RuntimeError("the recording is refused: no visual geometry")
     assert csv.read_text() == "the user's old trajectory" and not html.exists()
+    with outputs_together():
+        atomic_write_text(csv, "new trajectory")
+        atomic_write_text(html, "page")
+        assert csv.read_text() == "the user's old trajectory"
+    assert csv.read_text() == "new trajectory" and html.read_text() == "page"
     assert _leftovers(tmp_path) == []
-    assert main(["simulate", str(bare), "--duration", "0.05", "--out", str(csv)]) == 0
-    assert csv.read_text().startswith(("#", "t"))
 
 
 def test_dash_writes_a_command_output_to_stdout(tmp_path, capfd, monkeypatch):

@@ -15,7 +15,6 @@ from collections.abc import Sequence
 
 import robodyn
 from robodyn.cli.commands import check, equations, info, lint, listing, record, simulate, view, whatif
-from robodyn.common.files import outputs_together
 from robodyn.common.text import one_line_warnings, printable
 from robodyn.exceptions import RobodynError
 
@@ -50,7 +49,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exit_:
         return int(exit_.code or 0)
     try:
-        with one_line_warnings(), outputs_together():  # a command's files: all written or none
+        with one_line_warnings():
             return arguments.run(arguments)
     except RobodynError as error:
         if arguments.debug:
