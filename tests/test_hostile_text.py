@@ -74,3 +74,15 @@ def test_unknown_robot_name_from_the_command_line_is_escaped(capsys):
     assert main(["info", "nobody\x1b[31m\n robodyn: ok"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and not RAW.search(err[:-1])
+
+
+def test_a_closed_pipe_ends_quietly():
+    import subprocess
+    import sys
+
+    code = "import sys; from robodyn.cli.app import main; sys.exit(max(main(['list']) for _ in range(400)))"
+    reader = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    reader.stdout.read(10)
+    reader.stdout.close()  # like `robodyn list | head -c 10`
+    assert reader.wait(timeout=60) == 0
+    assert b"Traceback" not in reader.stderr.read()
