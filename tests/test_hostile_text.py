@@ -80,7 +80,7 @@ def test_a_closed_pipe_ends_quietly():
     import subprocess
     import sys
 
-    code = "import sys; from robodyn.cli.app import main; sys.exit(max(main(['list']) for _ in range(400)))"
+    code = "import sys; from robodyn.cli.app import main; sys.exit(max(main(['list']) for _ in range(150)))"
     reader = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     reader.stdout.read(10)
     reader.stdout.close()  # like `robodyn list | head -c 10`
