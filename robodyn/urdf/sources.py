@@ -81,6 +81,7 @@ def read_regular_file(path: Path, max_bytes: int, label: str | None = None) -> b
             ``max_bytes`` or cannot be read (the message names the reason).
     """
     label = str(path) if label is None else label
+    label = label if len(label) <= 300 else label[:300] + "..."  # a name too long to show
     try:
         if not stat.S_ISREG(os.stat(path).st_mode):
             raise URDFError(label, f"is not a regular file ({_kind(os.stat(path).st_mode)}); robodyn reads only files")
@@ -144,7 +145,7 @@ def resolve_source(source: str | os.PathLike, *, max_bytes: int | None = None) -
         return _read_file(Path(source), limit)
     if not isinstance(source, str):
         raise UnknownRobotError(f"{type(source).__name__} {source!r:.60}")
-    text = source.strip()
+    text = source.lstrip("\ufeff \t\r\n").strip()
     if text.startswith("<"):
         if len(source) > limit:  # characters: a lower bound of the UTF-8 size
             raise URDFError("<string>", f"is more than the limit of {limit} bytes ({_OVERRIDE})")
