@@ -7,9 +7,58 @@ attributes and a one-sentence message naming the thing and the rule it broke.
 
 from __future__ import annotations
 
+import re
+
+#: Characters that must never reach a terminal raw: C0 controls (newline and tab
+#: included) and DEL, C1 controls, bidi embeddings/overrides/isolates, line and paragraph
+#: separators, zero-width and other invisible format characters.
+_UNSAFE = re.compile("[\x00-\x1f\x7f-\x9f\u061c\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff]")
+
+
+_NAMED = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def _escape(match: re.Match[str]) -> str:
+    character = match.group()
+    if character in _NAMED:
+        return _NAMED[character]
+    code = ord(character)
+    return f"\\x{code:02x}" if code <= 0xFF else f"\\u{code:04x}"
+
+
+def printable(text: object) -> str:
+    """``text`` with every control, bidi and invisible format character escaped.
+
+    The one escaping function for terminal text (re-exported as
+    :func:`robodyn.common.text.printable`; it lives here because exceptions sit below
+    every other layer). Printable characters of any script are kept; the others become
+    ``\\xNN`` / ``\\uNNNN``, so the result holds no line break. Idempotent.
+    """
+    return _UNSAFE.sub(_escape, str(text))
+
+
+def quoted(name: object) -> str:
+    """A name from a URDF for a message: in single quotes, escaped like ``repr`` of a str."""
+    return "'" + printable(str(name).replace("\\", "\\\\").replace("'", "\\'")) + "'"
+
 
 class RobodynError(Exception):
-    """Base class of every error robodyn raises on purpose."""
+    """Base class of every error robodyn raises on purpose.
+
+    Its message is always one printable line: whatever a subclass puts into it (names
+    from a URDF included) passes through :func:`printable`.
+    """
+
+    def __str__(self) -> str:
+        return printable(super().__str__())
+
+
+class RobodynWarning(UserWarning):
+    """A legal but suspicious input that robodyn accepts (``strict=True`` refuses it).
+
+    Example: a positive semi-definite inertia that breaks the triangle inequality, which
+    Pinocchio, Drake, pybullet and urdfdom all load.
+    """
 
 
 class InputError(RobodynError, ValueError):
@@ -74,11 +123,11 @@ class FrameError(RobodynError, KeyError):
         self.frame = frame
         self.robot = robot
         self.close = list(close or [])
-        hint = f" (did you mean {', '.join(repr(name) for name in self.close)}?)" if self.close else ""
-        super().__init__(f"robot {robot!r} has no frame named {frame!r}{hint}.")
+        hint = f" (did you mean {', '.join(quoted(name) for name in self.close)}?)" if self.close else ""
+        super().__init__(f"robot {quoted(robot)} has no frame named {quoted(frame)}{hint}.")
 
     def __str__(self) -> str:  # KeyError would quote the message
-        return self.args[0]
+        return printable(self.args[0])
 
 
 class NonFiniteResultError(RobodynError, ArithmeticError):
@@ -92,7 +141,7 @@ class NonFiniteResultError(RobodynError, ArithmeticError):
     def __init__(self, robot: str, quantity: str):
         self.robot = robot
         self.quantity = quantity
-        super().__init__(f"robot {robot!r}: {quantity} overflowed to a non-finite value for finite inputs.")
+        super().__init__(f"robot {quoted(robot)}: {quantity} overflowed to a non-finite value for finite inputs.")
 
 
 class SingularMassMatrixError(RobodynError, ArithmeticError):
@@ -145,3 +194,20 @@ class MissingExtraError(RobodynError, ImportError):
         self.extra = extra
         self.purpose = purpose
         super().__init__(f"{purpose} need {module!r}, which is not installed: pip install 'robodyn[{extra}]'.")
+
+
+class OutputError(RobodynError, OSError):
+    """An output file that robodyn refuses to write or cannot write; nothing was replaced.
+
+    Attributes:
+        path: The output path as given.
+        reason: Why, e.g. ``"its folder does not exist"``.
+    """
+
+    def __init__(self, path: str, reason: str):
+        self.path = path
+        self.reason = reason
+        super().__init__(f"cannot write {quoted(path)}: {reason}.")
+
+    def __str__(self) -> str:  # OSError would format its own way
+        return printable(self.args[0])

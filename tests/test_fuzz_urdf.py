@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import subprocess
 import sys
+import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -17,6 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import robodyn
+from robodyn.common.text import is_printable
 from tests.conftest import ROOT
 
 SEEDS = [
@@ -26,6 +28,8 @@ SEEDS = [
     robodyn.urdf.models.pendulum_urdf(3),
 ]
 TOKENS = ["nan", "inf", "-inf", "-1", "0", "1e308", "-1e-308", "", "abc", "1 2", "1 2 3 4", "0 0 0", "  ", "1e-30", "3"]
+# hostile spellings and names (issue #14): other parsers read these differently
+TOKENS += [" 1.0 ", "1_000", "\uff12", "0x10", "1,5", "+.5", "\u00a01", "x\n robodyn: ok", "\x9b31m", "\u202eevil", "link1"]
 
 
 def mutate(text: str, operations: list[tuple[int, int, int]]) -> str:
@@ -62,8 +66,11 @@ def mutate(text: str, operations: list[tuple[int, int, int]]) -> str:
 def check_one(text: str) -> str:
     """Load a document; return "ok" or "refused", raise on anything else."""
     try:
-        robot = robodyn.load(text)
-    except robodyn.RobodynError:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", robodyn.exceptions.RobodynWarning)
+            robot = robodyn.load(text)
+    except robodyn.RobodynError as error:
+        assert is_printable(str(error)), repr(str(error))  # one printable line, whatever the input
         return "refused"
     q = robot.neutral_configuration()
     zeros = np.zeros(robot.nv)

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 import robodyn
 from robodyn.cli.commands import check, equations, info, lint, listing, record, simulate, view, whatif
+from robodyn.common.text import one_line_warnings, printable
 from robodyn.exceptions import RobodynError
 
 #: The commands, in the order ``robodyn --help`` lists them.
@@ -48,17 +49,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exit_:
         return int(exit_.code or 0)
     try:
-        return arguments.run(arguments)
+        with one_line_warnings():
+            return arguments.run(arguments)
     except RobodynError as error:
         if arguments.debug:
             traceback.print_exc()
-        print(f"robodyn: error: {error}", file=sys.stderr)
+        print(f"robodyn: error: {printable(error)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("robodyn: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # output piped into a reader that stopped (e.g. head)
-        sys.stdout = open(os.devnull, "w")  # noqa: SIM115
+        devnull = os.open(os.devnull, os.O_WRONLY)  # Python flushes stdout at exit: let it
+        os.dup2(devnull, 1)  # write into the void, not raise again
+        os.close(devnull)
         return 0
 
 

@@ -7,9 +7,11 @@ not import Pinocchio.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, printable
 
 
 def as_state(value: object, name: str, size: int) -> np.ndarray:
@@ -24,13 +26,10 @@ def as_state(value: object, name: str, size: int) -> np.ndarray:
         A float64 array of the same shape (no copy when already float64).
 
     Raises:
-        InputError: If the value is not numeric, has the wrong shape or length, or holds a
-            NaN or an infinity.
+        InputError: If the value is not real numbers (complex, strings, booleans are
+            refused), has the wrong shape or length, or holds a NaN or an infinity.
     """
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(name, f"an array of {size} numbers", f"{type(value).__name__} {value!r:.60}") from None
+    array = _real_array(value, name, size)
     if array.ndim == 1:
         if array.shape[0] != size:
             raise InputError(name, f"{size} values", f"{array.shape[0]} values")
@@ -47,6 +46,29 @@ def as_state(value: object, name: str, size: int) -> np.ndarray:
             name, "finite", f"{array[tuple(bad)]} at index {tuple(int(i) for i in bad) if array.ndim > 1 else int(bad[0])}"
         )
     return array
+
+
+def _real_array(value: object, name: str, size: int) -> np.ndarray:
+    """``value`` as float64 without any silent conversion: real numbers only.
+
+    Complex numbers (even with a zero imaginary part), strings, booleans, ``None`` and
+    ragged nestings are refused; no numpy warning is printed on the way.
+    """
+    expected = f"an array of {size} real numbers"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a ComplexWarning, an overflow...: refuse, never print
+        try:
+            raw = np.asarray(value)
+            if raw.dtype.kind == "O":  # e.g. Fractions, Decimals, or a mix
+                if any(isinstance(item, (complex, np.complexfloating, str, bytes, bool, np.bool_)) for item in raw.flat):
+                    raise TypeError
+                raw = raw.astype(np.float64)
+            if raw.dtype.kind not in "iuf":
+                raise TypeError
+            return raw.astype(np.float64, copy=False)
+        except (TypeError, ValueError, OverflowError, Warning):
+            received = f"{raw.dtype} values" if "raw" in locals() and raw.dtype.kind == "c" else type(value).__name__
+            raise InputError(name, expected, f"{received} {printable(repr(value))[:60]}") from None
 
 
 def as_states(named: dict[str, tuple[object, int]]) -> tuple[list[np.ndarray], bool]:

@@ -128,7 +128,14 @@ class Kinematics(ModelHandle):
 
         ``q + dq`` for joints; the floating base's pose moves on SE(3) (Pinocchio's
         ``integrate``), keeping its quaternion unit.
+
+        Raises:
+            InputError: For states of the wrong size, non-finite values or a base
+                quaternion that is not unit (an all-zero one included).
         """
+        (q, dq), _ = self.validate(q=q, v=dq)  # refuses a base quaternion that is not unit
         if self.floating_base:
+            if q.ndim == 2:
+                return np.array([pin.integrate(self.model, qi, dqi) for qi, dqi in zip(q, dq, strict=True)])
             return pin.integrate(self.model, q, dq)
         return q + dq

@@ -54,9 +54,9 @@ def has_mimic(model: pin.Model, spec: URDFSpec, floating: bool) -> bool:
     return model.nq != free
 
 
-def mimic_expansion(model: pin.Model, spec: URDFSpec, xml: str, floating: bool) -> MimicExpansion:
-    """Build the expanded model (every joint free) from the same XML, and the map to it."""
-    full = pin.buildModelFromXML(xml, pin.JointModelFreeFlyer(), "root_joint") if floating else pin.buildModelFromXML(xml)
+def mimic_expansion(model: pin.Model, spec: URDFSpec, full: pin.Model) -> MimicExpansion:
+    """The map from ``model`` (mimic joints folded) to ``full``, the model of the same
+    spec with every joint free (built by :func:`robodyn.dynamics.loading.build_model`)."""
     selection = np.zeros((full.nv, model.nv))
     q_selection = np.zeros((full.nq, model.nq))
     offset = np.zeros(full.nq)

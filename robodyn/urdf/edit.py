@@ -12,12 +12,13 @@ independent reference read alike. Nothing here imports Pinocchio.
 from __future__ import annotations
 
 import copy
+import difflib
 import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, quoted
 from robodyn.urdf.validation import URDFSpec
 
 
@@ -56,13 +57,21 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
         InputError: For an unknown or fixed joint, a non-finite position, or a position
             outside the joint's limits.
     """
-    values = dict(positions)
-    for name, value in values.items():
-        joint = spec.joints.get(name)
+    if not isinstance(positions, dict):
+        raise InputError("lock", "a dict {joint name: position}", type(positions).__name__)
+    values: dict[str, float] = {}
+    for name, value in positions.items():
+        joint = spec.joints.get(name) if isinstance(name, str) else None
         if joint is None or joint.type == "fixed":
-            raise InputError("lock", f"moving joints of {source}", f"{name!r}")
+            close = difflib.get_close_matches(str(name), [j.name for j in spec.joints.values() if j.type != "fixed"], n=3)
+            hint = f" (did you mean {', '.join(quoted(c) for c in close)}?)" if close else ""
+            raise InputError("lock", f"moving joints of {source}{hint}", quoted(name))
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise InputError(f"lock[{quoted(name)}]", "a number in [rad] or [m]", f"{type(value).__name__} {quoted(value)}")
+        value = float(value)
+        values[name] = value
         if not math.isfinite(value) or not (joint.lower - 1e-12 <= value <= joint.upper + 1e-12):
-            raise InputError("lock", f"a position of {name!r} within [{joint.lower}, {joint.upper}]", repr(value))
+            raise InputError("lock", f"a position of {quoted(name)} within [{joint.lower}, {joint.upper}]", repr(value))
     for joint in spec.joints.values():  # mimic joints follow their locked source
         if joint.mimic is not None and joint.mimic.joint in values and joint.name not in values:
             values[joint.name] = joint.mimic.multiplier * values[joint.mimic.joint] + joint.mimic.offset

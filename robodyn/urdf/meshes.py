@@ -11,6 +11,7 @@ read arbitrary files. A mesh that is simply missing is a warning; the model stil
 from __future__ import annotations
 
 import os
+import stat
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
@@ -24,7 +25,7 @@ class MeshPathError(ValueError):
 def _inside(path: Path, folder: Path) -> bool:
     try:
         path.resolve().relative_to(folder.resolve())
-    except ValueError:
+    except (ValueError, OSError):  # elsewhere, or a symlink loop / name too long
         return False
     return True
 
@@ -38,7 +39,8 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
         package_dirs: Folders holding the packages ``package://`` names.
 
     Raises:
-        MeshPathError: If the path leaves the URDF's folder or the package folders.
+        MeshPathError: If the path leaves the URDF's folder or the package folders, or
+            names something that is not a regular file (a FIFO, a device).
     """
     roots = [Path(d) for d in package_dirs] + ([Path(base_dir)] if base_dir is not None else [])
     if filename.startswith("package://"):
@@ -48,7 +50,7 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
             candidate = Path(folder) / relative
             if not _inside(candidate, Path(folder) / package):
                 raise MeshPathError(f"mesh {filename!r} leaves its package {package!r}")
-            if candidate.is_file():
+            if _regular(candidate, filename):
                 return candidate
         return None
     if filename.startswith("file://"):
@@ -63,7 +65,19 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
             raise MeshPathError(f"mesh {filename!r} leaves the URDF's folder")
     if not any(_inside(candidate, root) for root in roots):
         raise MeshPathError(f"mesh {filename!r} is outside the URDF's folder and package folders")
-    return candidate if candidate.is_file() else None
+    return candidate if _regular(candidate, filename) else None
+
+
+def _regular(candidate: Path, filename: str) -> bool:
+    """Whether the mesh file exists (``False`` if not); refuses a FIFO, a device or a
+    directory (through symlinks), which reading would block on or never finish."""
+    try:
+        mode = os.stat(candidate).st_mode
+    except (OSError, ValueError):  # missing, a name too long, a NUL byte
+        return False
+    if not stat.S_ISREG(mode):
+        raise MeshPathError(f"mesh {filename!r} is not a regular file (a FIFO, device or directory)")
+    return True
 
 
 def mesh_problems(root: ET.Element, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:

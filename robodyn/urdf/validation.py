@@ -9,8 +9,16 @@ returns them all, warnings included.
 Conventions enforced here and relied on downstream:
     - joint axes are finite, non-zero and normalised to unit length;
     - ``<mimic>`` joints are honoured (``q_mimic = multiplier * q_source + offset``);
-    - masses are finite and non-negative; a link with positive mass has a symmetric
-      positive-definite inertia satisfying the triangle inequality.
+    - numbers follow one grammar (:func:`robodyn.urdf.xmltext.parse_number`); Pinocchio
+      later reads only numbers robodyn wrote (:mod:`robodyn.urdf.normalised`);
+    - masses are finite and non-negative; a moving link with positive mass has a
+      positive semi-definite inertia (tolerance relative to the body's scale); breaking
+      the triangle inequality is a loud warning (:class:`~robodyn.exceptions.RobodynWarning`),
+      an error with ``strict=True``;
+    - a ``<mimic>`` of a joint that does not exist is dropped with a loud warning.
+
+The pieces live in :mod:`robodyn.urdf.xmltext` (XML and numbers), :mod:`robodyn.urdf.spec`
+(the result types) and :mod:`robodyn.urdf.inertias` (mass properties).
 
 This module does not import Pinocchio.
 """
@@ -18,16 +26,19 @@ This module does not import Pinocchio.
 from __future__ import annotations
 
 import math
-import re
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from robodyn.exceptions import URDFError
+from robodyn.exceptions import RobodynWarning, URDFError, printable, quoted
+from robodyn.urdf.inertias import BODY_SCALE, TRIANGLE_TOLERANCE, check_inertias, check_moving_masses, moving_links
 from robodyn.urdf.meshes import mesh_problems
+from robodyn.urdf.spec import Inertial, JointSpec, Mimic, Problem, URDFSpec, child_index
+from robodyn.urdf.xmltext import MAX_XML_DEPTH, parse_number, parse_xml, split_numbers
 
 #: Joint types robodyn knows. ``floating`` and ``planar`` are refused with a clear reason.
 MOVING_JOINT_TYPES = ("revolute", "continuous", "prismatic")
@@ -37,116 +48,9 @@ MAX_DEPTH = 1000
 #: Largest magnitude accepted for a length, angle, mass, inertia or limit (SI units):
 #: beyond it the dynamics overflow long before they mean anything.
 MAX_MAGNITUDE = 1e12
-#: Relative tolerance on the triangle inequality of principal moments of inertia.
-TRIANGLE_TOLERANCE = 1e-6
 
 
-@dataclass(frozen=True)
-class Problem:
-    """One problem found in a URDF.
-
-    Attributes:
-        element: The offending element, e.g. ``'link "l1"'``, or ``None`` for the document.
-        rule: The rule broken, as a sentence fragment.
-        severity: ``"error"`` (the model is refused) or ``"warning"`` (legal but suspicious).
-    """
-
-    element: str | None
-    rule: str
-    severity: str = "error"
-
-    def __str__(self) -> str:
-        return f"{self.element}: {self.rule}" if self.element else self.rule
-
-
-@dataclass(frozen=True)
-class Inertial:
-    """Mass properties of a link, in the link frame.
-
-    Attributes:
-        mass: Mass in [kg].
-        origin_xyz: Centre of mass in [m].
-        origin_rpy: Orientation of the inertia frame, roll-pitch-yaw in [rad].
-        inertia: 3×3 inertia about the centre of mass, in the inertia frame, in [kg m²].
-    """
-
-    mass: float
-    origin_xyz: np.ndarray
-    origin_rpy: np.ndarray
-    inertia: np.ndarray
-
-
-@dataclass(frozen=True)
-class Mimic:
-    """A joint driven by another: ``q = multiplier * q_source + offset``."""
-
-    joint: str
-    multiplier: float = 1.0
-    offset: float = 0.0
-
-
-@dataclass(frozen=True)
-class JointSpec:
-    """One URDF joint, validated.
-
-    Attributes:
-        name, type, parent, child: As in the URDF.
-        origin_xyz: Joint frame position in the parent link frame, in [m].
-        origin_rpy: Joint frame orientation, roll-pitch-yaw in [rad].
-        axis: Unit joint axis in the joint frame.
-        lower, upper: Position limits in [rad] or [m] (±inf for continuous joints).
-        effort, velocity: Effort limit in [N m] or [N], velocity limit in [rad/s] or [m/s].
-        mimic: The mimic relation, or ``None``.
-    """
-
-    name: str
-    type: str
-    parent: str
-    child: str
-    origin_xyz: np.ndarray
-    origin_rpy: np.ndarray
-    axis: np.ndarray
-    lower: float = -math.inf
-    upper: float = math.inf
-    effort: float = math.inf
-    velocity: float = math.inf
-    mimic: Mimic | None = None
-
-
-@dataclass
-class URDFSpec:
-    """A validated URDF: its links, joints (document order) and the parsed XML tree."""
-
-    name: str
-    root: str
-    links: dict[str, Inertial | None]
-    joints: dict[str, JointSpec]
-    xml: ET.Element = field(repr=False)
-
-    def child_joints(self, link: str) -> list[JointSpec]:
-        """Joints whose parent is ``link``, in document order."""
-        return [joint for joint in self.joints.values() if joint.parent == link]
-
-
-_FORBIDDEN_XML = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
-
-
-def parse_xml(text: str, source: str) -> ET.Element:
-    """Parse URDF text strictly and return its ``<robot>`` element.
-
-    Raises:
-        URDFError: If the text is not well-formed XML, declares a DOCTYPE or entities, or
-            its root element is not ``<robot>``.
-    """
-    if _FORBIDDEN_XML.search(text):
-        raise URDFError(source, "DOCTYPE and entity declarations are not allowed in a URDF")
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as error:
-        raise URDFError(source, f"not well-formed XML ({error})") from None
-    if root.tag != "robot":
-        raise URDFError(source, f"the root element must be <robot>, not <{root.tag}>")
-    return root
+_DEFAULTS: dict[str, tuple[float, ...]] = {}
 
 
 class _Reader:
@@ -158,26 +62,26 @@ class _Reader:
     def error(self, element: str | None, rule: str) -> None:
         self.problems.append(Problem(element, rule))
 
-    def warn(self, element: str | None, rule: str) -> None:
-        self.problems.append(Problem(element, rule, "warning"))
+    def warn(self, element: str | None, rule: str, *, loud: bool = False) -> None:
+        self.problems.append(Problem(element, rule, "warning", loud))
 
     def floats(self, where: str, node: ET.Element | None, attribute: str, default: str) -> np.ndarray:
         text = default if node is None else node.get(attribute, default)
-        try:
-            values = np.array([float(token) for token in text.split()], dtype=float)
-        except ValueError:
-            self.error(where, f"{attribute}={text!r} is not a list of numbers")
-            return np.array([float(token) for token in default.split()])
-        if values.size != len(default.split()):
-            self.error(where, f"{attribute}={text!r} must have {len(default.split())} numbers")
-            return np.array([float(token) for token in default.split()])
-        if not np.all(np.isfinite(values)):
-            self.error(where, f"{attribute}={text!r} must be finite")
-            return np.array([float(token) for token in default.split()])
-        if np.abs(values).max(initial=0.0) > MAX_MAGNITUDE:
-            self.error(where, f"{attribute}={text!r} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
-            return np.array([float(token) for token in default.split()])
-        return values
+        fallback = _DEFAULTS.setdefault(default, tuple(float(token) for token in default.split()))
+        values = [parse_number(token) for token in split_numbers(text)]
+        problem = None
+        if any(value is None for value in values):
+            problem = "is not a list of numbers"
+        elif len(values) != len(fallback):
+            problem = f"must have {len(fallback)} numbers"
+        elif not all(math.isfinite(value) for value in values):
+            problem = "must be finite"
+        elif max(map(abs, values), default=0.0) > MAX_MAGNITUDE:
+            problem = f"is beyond ±{MAX_MAGNITUDE:g}: not a physical robot"
+        if problem is not None:
+            self.error(where, f"{attribute}={quoted(text)} {problem}")
+            values = list(fallback)
+        return np.array(values, dtype=float)
 
     def number(
         self, where: str, node: ET.Element | None, attribute: str, default: float | None, *, bounded: bool = True
@@ -185,16 +89,12 @@ class _Reader:
         if node is None or node.get(attribute) is None:
             return default
         text = node.get(attribute)
-        try:
-            value = float(text)
-        except ValueError:
-            self.error(where, f"{attribute}={text!r} is not a number")
-            return default
-        if math.isnan(value):
-            self.error(where, f"{attribute}={text!r} is not a number")
+        value = parse_number(text)
+        if value is None or math.isnan(value):
+            self.error(where, f"{attribute}={quoted(text)} is not a number")
             return default
         if bounded and math.isfinite(value) and abs(value) > MAX_MAGNITUDE:
-            self.error(where, f"{attribute}={text!r} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
+            self.error(where, f"{attribute}={quoted(text)} is beyond ±{MAX_MAGNITUDE:g}: not a physical robot")
             return default
         return value
 
@@ -232,10 +132,6 @@ def _read_inertial(reader: _Reader, where: str, node: ET.Element) -> Inertial | 
         ]
     )
     return Inertial(mass, reader.floats(where, origin, "xyz", "0 0 0"), reader.floats(where, origin, "rpy", "0 0 0"), inertia)
-
-
-def _fmt(values: np.ndarray) -> str:
-    return "(" + ", ".join(f"{value:.4g}" for value in values) + ")"
 
 
 def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | None:
@@ -334,9 +230,7 @@ def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> s
         return None
     depth = {roots[0]: 0}
     stack = [roots[0]]
-    children: dict[str, list[JointSpec]] = {}
-    for joint in joints.values():
-        children.setdefault(joint.parent, []).append(joint)
+    children = child_index(joints)
     while stack:
         link = stack.pop()
         for joint in children.get(link, []):
@@ -353,13 +247,19 @@ def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> s
 
 
 def _check_mimics(reader: _Reader, joints: dict[str, JointSpec]) -> None:
-    for joint in joints.values():
+    """Check mimic relations; a mimic of a joint that does not exist is dropped (loud warning)."""
+    for joint in list(joints.values()):
         if joint.mimic is None:
             continue
         where = f'joint "{joint.name}"'
         source = joints.get(joint.mimic.joint)
         if source is None:
-            reader.error(where, f"mimics joint {joint.mimic.joint!r}, which does not exist")
+            reader.warn(
+                where,
+                f"mimics joint {joint.mimic.joint!r}, which does not exist: it moves independently",
+                loud=True,
+            )
+            joints[joint.name] = replace(joint, mimic=None)
         elif joint.type == "fixed":
             reader.warn(where, "is fixed, so its <mimic> has no effect")
         elif source.type == "fixed":
@@ -370,65 +270,13 @@ def _check_mimics(reader: _Reader, joints: dict[str, JointSpec]) -> None:
             reader.error(where, f"a {joint.type} joint cannot mimic the {source.type} joint {source.name!r}")
 
 
-def _moving_links(root: str, joints: dict[str, JointSpec], floating_base: bool) -> set[str]:
-    """Links that move: below a moving joint, or every link on a floating base."""
-    moving = set()
-    frontier = [(root, floating_base)]
-    while frontier:
-        link, moves = frontier.pop()
-        if moves:
-            moving.add(link)
-        frontier += [(j.child, moves or j.type != "fixed") for j in joints.values() if j.parent == link]
-    return moving
-
-
-def _check_inertias(reader: _Reader, links: dict[str, Inertial | None], moving: set[str], strict: bool) -> None:
-    """Physical consistency of each link's inertia: an error on links that move."""
-    for name, inertial in links.items():
-        if inertial is None:
-            continue
-        if inertial.mass == 0:
-            if np.abs(inertial.inertia).max() > 0:
-                reader.warn(
-                    f'link "{name}"', "has rotational inertia but no mass (no rigid body does); both dynamics keep the inertia"
-                )
-            continue
-        report = reader.error if strict and name in moving else reader.warn
-        where = f'link "{name}"'
-        moments = np.linalg.eigvalsh(inertial.inertia)
-        tolerance = 1e-9 * max(abs(moments).max(), 1e-300)
-        if moments[0] < -tolerance:
-            report(where, f"inertia must be positive semi-definite (principal moments {_fmt(moments)} kg m²)")
-        elif moments[2] > (moments[0] + moments[1]) * (1 + TRIANGLE_TOLERANCE) + tolerance:
-            report(
-                where,
-                f"principal moments of inertia {_fmt(moments)} kg m² break the triangle inequality (no rigid body has them)",
-            )
-        elif moments[2] < 1e-10 * inertial.mass:
-            reader.warn(where, f"tiny inertia (largest principal moment {moments[2]:.3g} kg m²) for mass {inertial.mass:.3g} kg")
-
-
-def _check_moving_masses(reader: _Reader, spec_links: dict, joints: dict[str, JointSpec]) -> None:
-    for joint in joints.values():
-        if joint.type == "fixed":
-            continue
-        # The rigid body a moving joint carries: its child plus links welded to it.
-        body, frontier = [], [joint.child]
-        while frontier:
-            link = frontier.pop()
-            body.append(link)
-            frontier += [j.child for j in joints.values() if j.parent == link and j.type == "fixed"]
-        mass = sum(spec_links[link].mass for link in body if spec_links.get(link) is not None)
-        if mass == 0 and not any(j.parent in body and j.type != "fixed" for j in joints.values()):
-            reader.warn(f'joint "{joint.name}"', "moves a massless leaf body: its mass matrix is singular")
-
-
 def lint_urdf(
     text: str,
     source: str = "<string>",
     *,
     floating_base: bool = False,
     check_inertia: bool = True,
+    strict: bool = False,
     base_dir: Path | None = None,
     package_dirs: Sequence[Path] = (),
 ) -> tuple[URDFSpec | None, list[Problem]]:
@@ -440,6 +288,8 @@ def lint_urdf(
         floating_base: Whether the root link moves freely (then every link moves).
         check_inertia: If false, physically impossible inertias of moving links are
             warnings instead of errors (some published URDFs have them).
+        strict: Loud warnings (an inertia breaking the triangle inequality, a mimic of a
+            joint that does not exist) are errors.
         base_dir: Folder of the URDF file, for relative mesh paths.
         package_dirs: Folders under which ``package://`` mesh paths resolve.
 
@@ -479,8 +329,13 @@ def lint_urdf(
     for element, rule, severity in mesh_problems(root, base_dir=base_dir, package_dirs=package_dirs):
         (reader.error if severity == "error" else reader.warn)(element, rule)
     if tree_root is not None:
-        _check_inertias(reader, links, _moving_links(tree_root, joints, floating_base), check_inertia)
-        _check_moving_masses(reader, links, joints)
+        children = child_index(joints)
+        check_inertias(reader, links, moving_links(tree_root, children, floating_base), check_inertia, strict)
+        check_moving_masses(reader, links, joints, children)
+        if not floating_base and all(joint.type == "fixed" for joint in joints.values()):
+            reader.error(None, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)")
+    if strict:
+        reader.problems = [Problem(problem.element, problem.rule) if problem.loud else problem for problem in reader.problems]
     errors = [problem for problem in reader.problems if problem.severity == "error"]
     spec = None if errors else URDFSpec(root.get("name", "robot"), tree_root, links, joints, root)
     return spec, reader.problems
@@ -492,16 +347,25 @@ def parse_urdf(
     *,
     floating_base: bool = False,
     check_inertia: bool = True,
+    strict: bool = False,
     base_dir: Path | None = None,
     package_dirs: Sequence[Path] = (),
 ) -> URDFSpec:
     """Validate URDF text and return its spec (arguments as for :func:`lint_urdf`).
 
+    Loud warnings are shown as :class:`~robodyn.exceptions.RobodynWarning` (one each).
+
     Raises:
         URDFError: Naming the source, the element and the rule of the first error found.
     """
     spec, problems = lint_urdf(
-        text, source, floating_base=floating_base, check_inertia=check_inertia, base_dir=base_dir, package_dirs=package_dirs
+        text,
+        source,
+        floating_base=floating_base,
+        check_inertia=check_inertia,
+        strict=strict,
+        base_dir=base_dir,
+        package_dirs=package_dirs,
     )
     if spec is None:
         first = next(problem for problem in problems if problem.severity == "error")
@@ -509,4 +373,27 @@ def parse_urdf(
         if "inertia" in rule and check_inertia:
             rule += " (check_inertia=False or --no-check-inertia loads it anyway)"
         raise URDFError(source, rule, first.element)
+    for problem in problems:
+        if problem.loud:
+            warnings.warn(printable(f"{source}: {problem} (strict=True refuses it)"), RobodynWarning, stacklevel=3)
     return spec
+
+
+__all__ = [
+    "BODY_SCALE",
+    "KNOWN_JOINT_TYPES",
+    "MAX_DEPTH",
+    "MAX_MAGNITUDE",
+    "MAX_XML_DEPTH",
+    "MOVING_JOINT_TYPES",
+    "TRIANGLE_TOLERANCE",
+    "Inertial",
+    "JointSpec",
+    "Mimic",
+    "Problem",
+    "URDFSpec",
+    "lint_urdf",
+    "parse_number",
+    "parse_urdf",
+    "parse_xml",
+]

@@ -111,18 +111,10 @@ CASES: dict[str, tuple[str, str]] = {
         sub(LINK2_INERTIA, LINK2_INERTIA.replace('iyy="0.013541666666666669"', 'iyy="-0.01"')),
         "inertia must be positive semi-definite",
     ),
-    "triangle_inequality": (
-        sub(LINK2_INERTIA, '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.03"/>'),
-        "break the triangle inequality",
-    ),
     "nan_inertia": (sub(LINK2_INERTIA, LINK2_INERTIA.replace('ixy="0"', 'ixy="nan"')), "ixy='nan' is not a number"),
     "joint_without_name": (sub('<joint name="joint2" type="prismatic">', '<joint type="prismatic">'), "joint #2: has no name"),
     "link_without_name": (add("<link/>"), "has no name"),
     "joint_without_parent": (sub('<parent link="link1"/>', ""), "needs <parent link=...> and <child link=...>"),
-    "mimic_missing_joint": (
-        sub(JOINT2_LIMIT, JOINT2_LIMIT + '<mimic joint="joint7"/>'),
-        "mimics joint 'joint7', which does not exist",
-    ),
     "mimic_of_fixed": (
         sub(JOINT2_LIMIT, JOINT2_LIMIT + '<mimic joint="end_effector_joint"/>'),
         "mimics the fixed joint 'end_effector_joint'",
@@ -156,9 +148,11 @@ CASES: dict[str, tuple[str, str]] = {
     "no_links": ('<robot name="nothing"/>', "the robot has no links"),
     "no_moving_joint": (
         '<robot name="statue"><link name="a"/><link name="b"/><joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint></robot>',
-        "the robot has no moving joint",
+        "the robot has no moving joint (floating_base=True gives",
     ),
 }
+# Moved to tests/data/hostile (they load with a RobodynWarning, see make_hostile_corpus.py):
+# mimic_missing_joint, triangle_inequality.
 
 
 def main() -> None:
