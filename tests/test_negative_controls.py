@@ -89,7 +89,9 @@ OBLIQUE_CONTROLS = {
 
 
 def _named_joints(where: str) -> set[str]:
-    return {name for name in ("j_yaw", "j_twist", "j_extend", "j_tool", "j_shoulder", "j_wrist", "j_slide") if repr(name) in where}
+    return {
+        name for name in ("j_yaw", "j_twist", "j_extend", "j_tool", "j_shoulder", "j_wrist", "j_slide") if repr(name) in where
+    }
 
 
 def test_the_true_model_passes():
@@ -130,9 +132,7 @@ def test_check_fails_on_a_dropped_mimic_relation():
     assert report.failures == ["joints: relative error 1.000e+00 > 0e+00 at joint 'j_elbow' only in the robot"]
 
 
-@pytest.mark.parametrize(
-    ("attribute", "value"), [("multiplier", "0.5"), ("offset", "0.2"), ("multiplier", "1"), ("offset", "0")]
-)
+@pytest.mark.parametrize(("attribute", "value"), [("multiplier", "0.5"), ("offset", "0.2"), ("multiplier", "1"), ("offset", "0")])
 def test_check_fails_on_a_wrong_mimic_multiplier_or_offset(attribute, value):
     """Every mimic of the true model has a multiplier != 1 and an offset != 0."""
 
