@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 import robodyn
+import robodyn.reference
 from robodyn.equations.derive import derive_equations, render
 from robodyn.exceptions import InputError, RobodynError, URDFError
 from robodyn.verify.check import check_robot, report_text
