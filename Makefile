@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint bench clean chromium
+.PHONY: demo test test-fast lint bench mutants clean chromium
 
 $(STAMP): pyproject.toml requirements.lock
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -47,5 +47,15 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python scripts/bench.py
 
+# Mutation testing of the core modules with the fast tier (slow: not part of `make test` or CI).
+# The modules are [tool.mutmut] only_mutate in pyproject.toml; MUTANTS="robodyn.sim.control*"
+# restricts a run to one module's mutants; MUTANT_JOBS sets the parallel workers (default 1:
+# the machine is shared). Results are cached in mutants/; docs/testing.md says how to read them.
+MUTANT_JOBS ?= 1
+MUTANTS ?=
+mutants: $(STAMP)
+	$(BIN)/mutmut run --max-children $(MUTANT_JOBS) $(MUTANTS)
+	$(BIN)/mutmut results
+
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache
+	rm -rf $(VENV) .pytest_cache .ruff_cache mutants

@@ -329,7 +329,13 @@ class Robot(Kinematics):
         return self._evaluate("M", self._mass_matrix, None, q=q)
 
     def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        mass = pin.crba(self.model, self.data, q)  # upper triangle only
+        # Upper triangle only. With a mimic joint between two free joints, Pinocchio 4.1's
+        # crba in its default LOCAL convention accumulates into data from call to call;
+        # the WORLD convention does not (tests/test_nondegenerate.py, mimic_tree).
+        if self.mimic is None:
+            mass = pin.crba(self.model, self.data, q)
+        else:
+            mass = pin.crba(self.model, self.data, q, pin.Convention.WORLD)
         np.copyto(mass, mass.T, where=self._lower_triangle)
         return mass
 

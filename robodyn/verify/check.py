@@ -45,11 +45,14 @@ class Comparison:
             ``max|M| max|v|²`` for ``C v``, ``max|tau|`` for ``G``), so that a term that
             vanishes is not compared with rounding noise.
         tolerance: Largest accepted ``max_rel``.
+        where: The joint (vectors) or pair of joints (matrices) of the largest absolute
+            difference, e.g. ``"joint 'elbow'"``; empty when there is nothing to compare.
     """
 
     max_abs: float
     max_rel: float
     tolerance: float
+    where: str = ""
 
     @property
     def passed(self) -> bool:
@@ -82,6 +85,16 @@ class CheckReport:
         return all(comparison.passed for comparison in self.comparisons.values())
 
     @property
+    def failures(self) -> list[str]:
+        """One line for each failed comparison: the quantity, its error and where it is largest."""
+        return [
+            f"{name}: relative error {comparison.max_rel:.3e} > {comparison.tolerance:.0e}"
+            + (f" at {comparison.where}" if comparison.where else "")
+            for name, comparison in self.comparisons.items()
+            if not comparison.passed
+        ]
+
+    @property
     def worst_relative_error(self) -> float:
         """Largest relative error of the reference-vs-Pinocchio comparisons."""
         return max(self.comparisons[name].max_rel for name in QUANTITIES if name in self.comparisons)
@@ -91,18 +104,45 @@ def _largest(values: np.ndarray) -> float:
     return float(np.max(np.abs(values))) if values.size else 0.0
 
 
-def _compare(actual: np.ndarray, expected: np.ndarray, tolerance: float, floor: float = 0.0) -> Comparison:
+def _location(difference: np.ndarray, dof_names: list[str], matrix: bool) -> str:
+    """Where a stack of differences is largest: a joint (vectors) or a pair of joints (matrices)."""
+    if not difference.size:
+        return ""
+    index = np.unravel_index(int(np.argmax(np.abs(difference))), difference.shape)
+    if matrix:
+        return f"joints ({dof_names[index[-2]]!r}, {dof_names[index[-1]]!r})"
+    return f"joint {dof_names[index[-1]]!r}"
+
+
+def _compare(
+    actual: np.ndarray, expected: np.ndarray, tolerance: float, floor: float = 0.0, dof_names: list[str] | None = None
+) -> Comparison:
     """Errors relative to the larger of the expected values' magnitude and ``floor``."""
-    max_abs = _largest(actual - expected)
+    difference = actual - expected
+    max_abs = _largest(difference)
     scale = max(_largest(expected), floor)
-    return Comparison(max_abs, max_abs / scale if scale > 0 else max_abs, tolerance)
+    where = _location(difference, dof_names, difference.ndim == 3) if dof_names else ""
+    return Comparison(max_abs, max_abs / scale if scale > 0 else max_abs, tolerance, where)
 
 
-def _skewness(matrices: np.ndarray, scale: float, tolerance: float) -> Comparison:
-    """How far matrices are from skew-symmetric: largest |S + Sᵀ|, relative to ``scale``."""
+def skewness(matrices: np.ndarray, scale: float, tolerance: float, dof_names: list[str] | None = None) -> Comparison:
+    """How far matrices are from skew-symmetric: largest ``|S + Sᵀ|``, relative to ``scale``.
+
+    Args:
+        matrices: Shape (n, n) or (N, n, n).
+        scale: The size the symmetric part is compared with (e.g. ``max |Ṁ|``).
+        tolerance: Largest accepted relative value.
+        dof_names: Names of the ``n`` coordinates, to say where the worst entry is.
+    """
     symmetric_part = matrices + np.swapaxes(matrices, -1, -2)
-    max_abs = float(np.max(np.abs(symmetric_part))) if matrices.size else 0.0
-    return Comparison(max_abs, max_abs / scale if scale > 0 else max_abs, tolerance)
+    max_abs = _largest(symmetric_part)
+    where = _location(symmetric_part, dof_names, True) if dof_names else ""
+    return Comparison(max_abs, max_abs / scale if scale > 0 else max_abs, tolerance, where)
+
+
+def _dof_names(robot: Robot) -> list[str]:
+    """The joint of every velocity coordinate (a floating base's six are its root joint)."""
+    return [joint.name for joint in robot.joints for _ in range(6 if joint.type == "floating" else 1)]
 
 
 def check_robot(
@@ -112,6 +152,7 @@ def check_robot(
     seed: int = 0,
     tolerance: float = DEFAULT_TOLERANCE,
     check_inertia: bool = True,
+    reference_source: str | os.PathLike | None = None,
 ) -> CheckReport:
     """Compare Pinocchio with the reference at random states within the joint limits.
 
@@ -119,20 +160,38 @@ def check_robot(
         source: Anything :func:`robodyn.load` takes, or a loaded ``Robot``. With a floating
             base ``tau``, ``M``, ``C v`` and ``G`` are compared (the reference's ``C`` is in
             its own coordinates there).
+        reference_source: The model the reference is built from (anything
+            :func:`robodyn.reference.load` takes); default the robot's own URDF. Given the
+            true URDF, ``check`` tells whether a robot built some other way (edited, locked,
+            loaded from another file) has the true dynamics.
         samples: Number of random states.
         seed: Seed of the random generator.
         tolerance: Largest accepted relative error.
         check_inertia: As for :func:`robodyn.load`.
 
     Returns:
-        The report; ``report.passed`` tells whether every error is within tolerance.
+        The report; ``report.passed`` tells whether every error is within tolerance, and
+        ``report.failures`` names each failed quantity and the joint where it is worst. When
+        the two models do not have the same joints, the report has one failed comparison,
+        ``joints``, naming them (``max_abs``: how many differ).
     """
     robot = source if isinstance(source, Robot) else load(source, check_inertia=check_inertia)
     model = reference.load(
-        robot.urdf, gravity=robot.gravity_vector, check_inertia=check_inertia, floating_base=robot.floating_base
+        robot.urdf if reference_source is None else reference_source,
+        gravity=robot.gravity_vector,
+        check_inertia=check_inertia,
+        floating_base=robot.floating_base,
     )
-    if sorted(model.joint_names) != sorted(robot.joint_names):
-        raise AssertionError(f"joint sets differ: {robot.joint_names} vs {model.joint_names}")
+    report = CheckReport(robot.name, samples, seed, list(robot.joint_names))
+    extra = [name for name in robot.joint_names if name not in model.joint_names]
+    missing = [name for name in model.joint_names if name not in robot.joint_names]
+    if extra or missing:
+        where = ", ".join(
+            [f"joint {name!r} only in the robot" for name in extra]
+            + [f"joint {name!r} only in the reference" for name in missing]
+        )
+        report.comparisons["joints"] = Comparison(float(len(extra) + len(missing)), float(len(extra) + len(missing)), 0.0, where)
+        return report
     # Index of each of robot's coordinates in the reference's (joints matched by name; a
     # floating base's 7 position and 6 velocity coordinates come first in both).
     base_q, base_v = (7, 6) if robot.floating_base else (0, 0)
@@ -168,26 +227,26 @@ def check_robot(
         "C": coriolis,
         "G": robot.gravity(q),
     }
-    report = CheckReport(robot.name, samples, seed, list(robot.joint_names))
     # A term that vanishes (C of a single joint, G of joints on vertical axes) is compared
     # relative to its natural size: M times speeds, or the torques of the same states.
     mass_scale, speed, torque_scale = _largest(reference_values["M"]), _largest(v), _largest(reference_values["tau"])
     floors = {"tau": 0.0, "M": 0.0, "Cv": mass_scale * speed**2, "C": mass_scale * speed, "G": torque_scale}
+    dofs = _dof_names(robot)
     for name in reference_values:
-        report.comparisons[name] = _compare(pinocchio_values[name], reference_values[name], tolerance, floors[name])
+        report.comparisons[name] = _compare(pinocchio_values[name], reference_values[name], tolerance, floors[name], dofs)
     if robot.floating_base:  # C (and Ṁ − 2C) are in other coordinates there: τ, M, C v, G suffice
         return report
 
     reference_values["C"] = from_reference(model.coriolis_matrix(q_ref, v_ref))
-    report.comparisons["C"] = _compare(coriolis, reference_values["C"], tolerance, floors["C"])
+    report.comparisons["C"] = _compare(coriolis, reference_values["C"], tolerance, floors["C"], dofs)
     step = 1e-6
     m_dot = (robot.mass_matrix(q + step * v) - robot.mass_matrix(q - step * v)) / (2 * step)
     # Relative to the size of Ṁ, or of M times the speeds when Ṁ happens to be tiny
     # (the finite difference's rounding error scales with M, not with Ṁ).
     scale = max(_largest(m_dot), mass_scale * speed)
-    report.comparisons["skew_pinocchio"] = _skewness(m_dot - 2 * coriolis, scale, FINITE_DIFFERENCE_TOLERANCE)
+    report.comparisons["skew_pinocchio"] = skewness(m_dot - 2 * coriolis, scale, FINITE_DIFFERENCE_TOLERANCE, dofs)
     m_dot_reference = from_reference(model.mass_matrix_derivative(q_ref, v_ref))
-    report.comparisons["skew_reference"] = _skewness(m_dot_reference - 2 * reference_values["C"], scale, tolerance)
+    report.comparisons["skew_reference"] = skewness(m_dot_reference - 2 * reference_values["C"], scale, tolerance, dofs)
     return report
 
 
@@ -200,7 +259,7 @@ def report_dict(report: CheckReport) -> dict:
         "joint_names": report.joint_names,
         "passed": report.passed,
         "comparisons": {
-            name: {"max_abs": c.max_abs, "max_rel": c.max_rel, "tolerance": c.tolerance, "passed": c.passed}
+            name: {"max_abs": c.max_abs, "max_rel": c.max_rel, "tolerance": c.tolerance, "passed": c.passed, "where": c.where}
             for name, c in report.comparisons.items()
         },
     }
@@ -214,6 +273,7 @@ _DESCRIPTIONS = {
     "G": "gravity G(q)",
     "skew_pinocchio": "Mdot - 2C skew (Pinocchio, Mdot by finite differences)",
     "skew_reference": "Mdot - 2C skew (reference, analytic Mdot)",
+    "joints": "joint names of the robot and the reference",
 }
 
 
@@ -231,4 +291,5 @@ def report_text(report: CheckReport) -> str:
             f"{'pass' if comparison.passed else 'FAIL'}"
         )
     lines += ["", "PASSED" if report.passed else "FAILED"]
+    lines += [f"  {failure}" for failure in report.failures]
     return "\n".join(lines)
