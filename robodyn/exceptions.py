@@ -129,3 +129,34 @@ class SimulationError(RobodynError):
         super().__init__(
             f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
         )
+
+
+class CompileError(RobodynError):
+    """A robot the compiled engine cannot compile (a floating base, a failed build).
+
+    Attributes:
+        robot: The robot's name.
+        reason: Why, in a few words.
+    """
+
+    def __init__(self, robot: str, reason: str):
+        self.robot = robot
+        self.reason = reason
+        super().__init__(f"cannot compile robot {robot!r}: {reason}.")
+
+
+class CompilerNotFoundError(CompileError):
+    """No C compiler for the compiled engine (the Pinocchio path keeps working).
+
+    Attributes:
+        compiler: The compiler looked for (``$CC`` or ``cc``).
+    """
+
+    def __init__(self, compiler: str, detail: str | None = None):
+        self.compiler = compiler
+        extra = f" ({detail})" if detail else ""
+        super().__init__(
+            "<any>",
+            f"no C compiler {compiler!r} found{extra}; install one (Debian/Ubuntu: apt-get install gcc, "
+            "or set CC) or use the Pinocchio methods of robodyn.Robot",
+        )
