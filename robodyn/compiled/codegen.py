@@ -32,10 +32,11 @@ from collections.abc import Iterable
 import numpy as np
 import sympy as sp
 
+from robodyn.compiled.rnea import NewtonEuler
 from robodyn.equations.compact import CompactDynamics
 
 #: Bumped whenever the generated code changes meaning (part of every cache key).
-CODEGEN_VERSION = "1"
+CODEGEN_VERSION = "2"
 
 
 def _number(value: float) -> str:
@@ -64,10 +65,20 @@ class KernelWriter:
         offset: Shape (n_bodies,).
         parents: For each of the robot's coordinates, the coordinate of its parent joint
             (-1 for a root), shape (nv,); a parent precedes its children.
+        newton_euler: ``tau`` as a Newton–Euler program over the same bodies (O(n));
+            without it ``tau = M a + C v + G``.
     """
 
-    def __init__(self, equations: CompactDynamics, selection: np.ndarray, offset: np.ndarray, parents: list[int]):
+    def __init__(
+        self,
+        equations: CompactDynamics,
+        selection: np.ndarray,
+        offset: np.ndarray,
+        parents: list[int],
+        newton_euler: NewtonEuler | None = None,
+    ):
         self.equations = equations
+        self.newton_euler = newton_euler
         self.selection = np.asarray(selection, float)
         self.offset = np.asarray(offset, float)
         self.parents = list(parents)
@@ -80,6 +91,11 @@ class KernelWriter:
         for b in range(self.bodies):
             self._names[equations.q[b]] = sp.Symbol(f"th{b}", real=True)
             self._names[equations.qd[b]] = sp.Symbol(f"thd{b}", real=True)
+        if newton_euler is not None:
+            for b in range(self.bodies):
+                self._names[newton_euler.q[b]] = sp.Symbol(f"th{b}", real=True)
+                self._names[newton_euler.qd[b]] = sp.Symbol(f"thd{b}", real=True)
+                self._names[newton_euler.qdd[b]] = sp.Symbol(f"thdd{b}", real=True)
 
     def _c(self, expr: sp.Expr) -> str:
         """C for an expression of the program (a small printer: ``sympy.ccode`` is the
@@ -174,6 +190,36 @@ class KernelWriter:
                 lines.append(f"    mb[{b * nb + c}] = mb[{c * nb + b}] = {self._c(M[b, c])};")
         return lines
 
+    def _tau_kernel(self) -> list[str]:
+        n, nb = self.nv, self.bodies
+        head = "static void rd_tau(const double *q, const double *v, const double *a, double *tau) {"
+        if self.newton_euler is None:
+            return [
+                head,
+                f"    double M[{n * n}];",
+                "    rd_mass_nle(q, v, M, tau);",
+                f"    for (int i = 0; i < {n}; ++i)",
+                f"        for (int j = 0; j < {n}; ++j) tau[i] += M[i * {n} + j] * a[j];",
+                "}",
+                "",
+            ]
+        ne = self.newton_euler
+        program = _needed(ne.assignments, ne.tau)
+        used = set().union(*(expr.free_symbols for expr in ne.tau), *(expr.free_symbols for _, expr in program))
+        lines = [head]
+        for b in range(nb):
+            for symbols, array, prefix, offset in ((ne.q, "q", "th", True), (ne.qd, "v", "thd", False), (ne.qdd, "a", "thdd", False)):
+                if symbols[b] not in used:
+                    continue
+                terms = [(self.selection[b, j], f"{array}[{j}]") for j in range(n) if self.selection[b, j] != 0]
+                value = self._combination(terms)
+                if offset and self.offset[b] != 0:
+                    value += f" + {_number(self.offset[b])}"
+                lines.append(f"    const double {prefix}{b} = {value};")
+        lines += [f"    const double {symbol} = {self._c(expr)};" for symbol, expr in program]
+        lines += [f"    double tb[{nb}];", *[f"    tb[{b}] = {self._c(ne.tau[b])};" for b in range(nb)]]
+        return [*lines, *self._project_vector("tb", "tau"), "}", ""]
+
     def source(self) -> str:
         """The kernels' C source (no includes; ``runtime.c`` is appended after it)."""
         e, nb, n = self.equations, self.bodies, self.nv
@@ -213,12 +259,6 @@ class KernelWriter:
             *self._project_vector("hb", "nle"),
             "}",
             "",
-            "static void rd_tau(const double *q, const double *v, const double *a, double *tau) {",
-            f"    double M[{n * n}];",
-            "    rd_mass_nle(q, v, M, tau);",
-            f"    for (int i = 0; i < {n}; ++i)",
-            f"        for (int j = 0; j < {n}; ++j) tau[i] += M[i * {n} + j] * a[j];",
-            "}",
-            "",
         ]
+        out += self._tau_kernel()
         return "\n".join(out)

@@ -24,6 +24,7 @@ import numpy as np
 
 from robodyn.compiled import build
 from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
+from robodyn.compiled.rnea import derive_newton_euler
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
 from robodyn.equations.compact import derive_compact
@@ -64,7 +65,8 @@ def generate_kernels(robot: Robot) -> str:
     )
     reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
     equations = derive_compact(reference, snap=SNAP)
-    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot)).source()
+    newton_euler = derive_newton_euler(reference, snap=SNAP)
+    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), newton_euler).source()
 
 
 def coordinate_parents(robot: Robot) -> list[int]:
