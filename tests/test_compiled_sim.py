@@ -145,13 +145,13 @@ def test_divergence_is_reported_like_python_simulate(pendulum):
 
 
 def test_bad_arguments_are_refused(pendulum):
-    robot, compiled = pendulum
+    _, compiled = pendulum
     zero = np.zeros(2)
     with pytest.raises(InputError, match="integrator"):
         simulate_compiled(compiled, zero, zero, 1.0, 1e-3, integrator="euler")
     with pytest.raises(InputError, match="control_period"):
         simulate_compiled(compiled, zero, zero, 1.0, 1e-3, controller=lambda t, q, v: zero, control_period=2.5e-3)
-    with pytest.raises(InputError, match="^q "):
+    with pytest.raises(InputError, match=r"^q "):
         simulate_compiled(compiled, np.zeros(3), zero, 1.0, 1e-3)
     with pytest.raises(InputError, match="controller output"):
         simulate_compiled(compiled, zero, zero, 1.0, 1e-3, controller=lambda t, q, v: np.zeros(5))

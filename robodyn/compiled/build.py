@@ -21,6 +21,7 @@ half-written file.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import importlib.machinery
@@ -105,7 +106,7 @@ def digest(*parts: str) -> str:
 
 def module_source(kernels: str, module_name: str) -> str:
     """The full C source: includes, the robot's kernels, the runtime and the module init."""
-    init = f"PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module(\"{module_name}\"); }}\n"
+    init = f'PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module("{module_name}"); }}\n'
     return _PRELUDE + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
 
 
@@ -120,10 +121,8 @@ def cached_kernels(key: str) -> str | None:
 
 def store_kernels(key: str, kernels: str) -> None:
     """Keep the generated kernels for a robot key (atomically; a read-only cache is skipped)."""
-    try:
+    with contextlib.suppress(OSError):
         atomic_write_text(cache_dir() / f"src-{key}.c", kernels)
-    except OSError:
-        pass
 
 
 def build_module(kernels: str, *, label: str) -> ModuleType:

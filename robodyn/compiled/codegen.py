@@ -208,7 +208,11 @@ class KernelWriter:
         used = set().union(*(expr.free_symbols for expr in ne.tau), *(expr.free_symbols for _, expr in program))
         lines = [head]
         for b in range(nb):
-            for symbols, array, prefix, offset in ((ne.q, "q", "th", True), (ne.qd, "v", "thd", False), (ne.qdd, "a", "thdd", False)):
+            for symbols, array, prefix, offset in (
+                (ne.q, "q", "th", True),
+                (ne.qd, "v", "thd", False),
+                (ne.qdd, "a", "thdd", False),
+            ):
                 if symbols[b] not in used:
                     continue
                 terms = [(self.selection[b, j], f"{array}[{j}]") for j in range(n) if self.selection[b, j] != 0]

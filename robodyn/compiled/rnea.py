@@ -46,7 +46,11 @@ class _Program:
 
     def let(self, expr: sp.Expr) -> sp.Expr:
         expr = sp.expand(expr)
-        if expr.is_Number or expr.is_Symbol or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol):
+        if (
+            expr.is_Number
+            or expr.is_Symbol
+            or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
+        ):
             return expr
         symbol = sp.Symbol(f"r{len(self.assignments)}", real=True)
         self.assignments.append((symbol, expr))

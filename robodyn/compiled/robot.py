@@ -52,7 +52,9 @@ def generate_kernels(robot: Robot) -> str:
         CompileError: For a floating base, or joints the reference does not map.
     """
     if robot.floating_base:
-        raise CompileError(robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)")
+        raise CompileError(
+            robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
+        )
     tree = build_tree(robot.spec, robot.urdf, floating_base=False)
     names = list(robot.joint_names)
     if sorted(tree.joint_names) != sorted(names):
@@ -60,9 +62,7 @@ def generate_kernels(robot: Robot) -> str:
     column = [tree.joint_names.index(name) for name in names]
     selection = tree.selection[:, column]  # bodies x robot coordinates
     count = len(tree.bodies)
-    free = dataclasses.replace(
-        tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)]
-    )
+    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
     reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
     equations = derive_compact(reference, snap=SNAP)
     newton_euler = derive_newton_euler(reference, snap=SNAP)
@@ -89,7 +89,7 @@ def coordinate_parents(robot: Robot) -> list[int]:
     return parents
 
 
-def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:  # noqa: A001 - the issue's name
+def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     """Compile a fixed-base robot's dynamics to native code (cached: fast the second time).
 
     Args:
@@ -106,7 +106,9 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:  # no
     """
     threads = check_threads(threads)
     if robot.floating_base:
-        raise CompileError(robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)")
+        raise CompileError(
+            robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
+        )
     build.find_compiler()  # fail early, before the slow derivation
     key = robot_key(robot)
     kernels = build.cached_kernels(key)

@@ -168,7 +168,9 @@ def simulate_compiled(
             if tau.shape != (nv,):
                 raise InputError("controller output", f"{nv} torques", f"shape {tau.shape}")
             views = [array[start : start + count + 1] for array in out]
-            failed = compiled.module.simulate(q, v, float(dt), count, start * dt, rk4, 0, 1, np.ascontiguousarray(tau), None, *views)
+            failed = compiled.module.simulate(
+                q, v, float(dt), count, start * dt, rk4, 0, 1, np.ascontiguousarray(tau), None, *views
+            )
             _raise_if_failed(compiled, failed, out, dt, start)
             q, v = out[0][start + count].copy(), out[1][start + count].copy()
     else:
