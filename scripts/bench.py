@@ -395,9 +395,9 @@ def bench_compiled_batch(quick: bool) -> list[dict]:
             ("mass_matrix", lambda: compiled.mass_matrix(q), loop(pin.crba, q), "(none: no crbaInParallel)", None),
         )
         for method, ours, python_loop, parallel_name, parallel in cases:
-            ours_s = median_once(ours, repeats=3 if quick else 5)
-            loop_s = median_once(python_loop, repeats=1 if quick else 3)
-            parallel_s = median_once(parallel, repeats=3 if quick else 5) if parallel else float("nan")
+            ours_s = median_once(ours, repeats=5)
+            loop_s = median_once(python_loop, repeats=1)  # seconds each: once is enough for a 5x gap
+            parallel_s = median_once(parallel, repeats=5) if parallel else float("nan")
             rows.append(
                 {
                     "robot": label,
@@ -416,10 +416,14 @@ def bench_compiled_batch(quick: bool) -> list[dict]:
 
 
 _CACHED_COMPILE = """
-import sys, time, robodyn
+import os, sys, time, robodyn
 from robodyn.compiled import compile
 robot = robodyn.load(sys.argv[1], **eval(sys.argv[2]))
-start = time.perf_counter(); compile(robot); print(time.perf_counter() - start)
+start, cpu, before = time.perf_counter(), time.process_time(), os.times()
+compile(robot)
+after = os.times()
+children = after.children_user + after.children_system - before.children_user - before.children_system
+print(time.perf_counter() - start, time.process_time() - cpu + children)
 """
 
 
@@ -432,14 +436,19 @@ def bench_compiled_compile(quick: bool) -> list[dict]:
         with tempfile.TemporaryDirectory() as folder:
             env = os.environ | {"ROBODYN_CACHE": folder}
             run = [sys.executable, "-c", _CACHED_COMPILE, name, repr(options)]
-            cold = float(subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout)
-            cached = [float(subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout) for _ in range(3)]
+            cold, cold_cpu = map(float, subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout.split())
+            cached = [
+                float(subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout.split()[0])
+                for _ in range(3)
+            ]
         rows.append(
             {
                 "robot": label,
                 "cold_compile_s": cold,
+                "cold_compile_cpu_s": cold_cpu,
                 "cached_compile_ms (new process)": statistics.median(cached) * 1e3,
-                "note": "cold = sympy derivation + cc -O1; cached = read kernels, hash, dlopen",
+                "load_average": os.getloadavg()[0],
+                "note": "cold = sympy derivation + cc -O1 (cpu: this process + the compiler); cached = read kernels, hash, dlopen",
             }
         )
     return rows

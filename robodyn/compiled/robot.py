@@ -109,6 +109,8 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
         raise CompileError(
             robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
         )
+    if robot.nv == 0:
+        raise CompileError(robot.name, "it has no moving joints")
     build.find_compiler()  # fail early, before the slow derivation
     key = robot_key(robot)
     kernels = build.cached_kernels(key)
