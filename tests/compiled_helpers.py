@@ -2,6 +2,13 @@
 
 from __future__ import annotations
 
+import atexit
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import numpy as np
 
 import robodyn
@@ -56,3 +63,22 @@ def compiled_pair(source, **load_options):
     """``(robot, compiled)`` for a source."""
     robot = robodyn.load(source, **load_options)
     return robot, compile(robot, threads=2)
+
+
+#: One compile cache for every compiled-engine test of a session (never the user's cache).
+_SHARED_CACHE = tempfile.mkdtemp(prefix="robodyn-test-cache-")
+atexit.register(shutil.rmtree, _SHARED_CACHE, True)
+
+
+@contextmanager
+def shared_cache() -> Iterator[str]:
+    """Point ``ROBODYN_CACHE`` at the session's test cache while the block runs."""
+    previous = os.environ.get("ROBODYN_CACHE")
+    os.environ["ROBODYN_CACHE"] = _SHARED_CACHE
+    try:
+        yield _SHARED_CACHE
+    finally:
+        if previous is None:
+            os.environ.pop("ROBODYN_CACHE", None)
+        else:
+            os.environ["ROBODYN_CACHE"] = previous

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 import robodyn
 from robodyn.compiled import build, compile
 from robodyn.exceptions import CompileError, CompilerNotFoundError, InputError, SingularMassMatrixError
-from tests.compiled_helpers import QUANTITIES, RTOL, arguments, compare, compiled_pair, relative_error
+from tests.compiled_helpers import QUANTITIES, RTOL, arguments, compare, compiled_pair, relative_error, shared_cache
 from tests.conftest import ROOT
 from tests.random_robots import JOINT_TYPES, urdf_from_seed
 
@@ -24,16 +24,10 @@ MIMIC_TREE = ROOT / "tests" / "data" / "compiled_mimic_tree.urdf"
 
 
 @pytest.fixture(scope="module", autouse=True)
-def cache(tmp_path_factory):
-    """A fresh compile cache for these tests (never the user's)."""
-    folder = tmp_path_factory.mktemp("robodyn-cache")
-    previous = os.environ.get("ROBODYN_CACHE")
-    os.environ["ROBODYN_CACHE"] = str(folder)
-    yield folder
-    if previous is None:
-        os.environ.pop("ROBODYN_CACHE", None)
-    else:
-        os.environ["ROBODYN_CACHE"] = previous
+def cache():
+    """The session's compile cache (never the user's)."""
+    with shared_cache() as folder:
+        yield folder
 
 
 @pytest.fixture(scope="module")
@@ -63,10 +57,11 @@ def test_mimic_map_is_exercised(mimic_tree):
 
 def test_negative_control_a_wrong_compiled_robot_fails_the_comparison(rng, tmp_path):
     """One link 1e-6 heavier: the comparison helper must notice (else it checks nothing)."""
-    text = MIMIC_TREE.read_text(encoding="utf-8").replace('<mass value="0.9"/>', '<mass value="0.9000009"/>')
+    robot = robodyn.load("rp_arm")
+    mass = re.search(r'<mass value="([^"]+)"', robot.urdf)
+    heavier = float(mass.group(1)) * (1 + 1e-6)
     path = tmp_path / "heavier.urdf"
-    path.write_text(text, encoding="utf-8")
-    robot = robodyn.load(MIMIC_TREE)
+    path.write_text(robot.urdf[: mass.start(1)] + repr(heavier) + robot.urdf[mass.end(1) :], encoding="utf-8")
     wrong = compile(robodyn.load(path))
     with pytest.raises(AssertionError, match="compiled differs"):
         compare(wrong, robot, rng)
@@ -75,15 +70,16 @@ def test_negative_control_a_wrong_compiled_robot_fails_the_comparison(rng, tmp_p
     assert relative_error(tau * (1 + 10 * RTOL), tau) > RTOL
 
 
-def test_fixed_zoo_arm_ur5(rng):
-    robot, compiled = compiled_pair("ur5")
-    compare(compiled, robot, rng, count=50)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize(
     ("source", "options"),
-    [("panda", {}), ("panda", {"lock": {"panda_finger_joint1": 0.013}}), ("double_pendulum_continuous", {}), ("z1", {})],
+    [
+        ("ur5", {}),
+        ("panda", {}),
+        ("panda", {"lock": {"panda_finger_joint1": 0.013}}),
+        ("double_pendulum_continuous", {}),
+        ("z1", {}),
+    ],
 )
 def test_compiled_zoo_arms_match_pinocchio(source, options, rng):
     robot, compiled = compiled_pair(source, **options)
@@ -272,6 +268,7 @@ def test_second_compile_uses_the_cache(rp_arm, monkeypatch):
     assert again.module is compiled.module
 
 
+@pytest.mark.slow
 def test_two_processes_compiling_at_once_both_succeed(tmp_path):
     script = textwrap.dedent(
         """

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 
@@ -12,7 +10,7 @@ from robodyn.compiled import CompiledComputedTorque, CompiledPDGravity, compile,
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.control import ComputedTorque, PDGravity, quintic_reference
 from robodyn.sim.simulation import simulate
-from tests.compiled_helpers import relative_error
+from tests.compiled_helpers import relative_error, shared_cache
 from tests.conftest import ROOT
 
 MIMIC_TREE = ROOT / "tests" / "data" / "compiled_mimic_tree.urdf"
@@ -23,15 +21,10 @@ STEP_TOLERANCE = 1e-9
 
 
 @pytest.fixture(scope="module", autouse=True)
-def cache(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("robodyn-cache")
-    previous = os.environ.get("ROBODYN_CACHE")
-    os.environ["ROBODYN_CACHE"] = str(folder)
-    yield folder
-    if previous is None:
-        os.environ.pop("ROBODYN_CACHE", None)
-    else:
-        os.environ["ROBODYN_CACHE"] = previous
+def cache():
+    """The session's compile cache (never the user's)."""
+    with shared_cache() as folder:
+        yield folder
 
 
 @pytest.fixture(scope="module")

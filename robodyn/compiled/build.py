@@ -32,6 +32,7 @@ import subprocess
 import sys
 import sysconfig
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 
@@ -117,6 +118,29 @@ def cached_kernels(key: str) -> str | None:
         return path.read_text(encoding="utf-8")
     except OSError:
         return None
+
+
+@contextlib.contextmanager
+def locked(key: str) -> Iterator[None]:
+    """Hold an exclusive lock on a robot key (``lock-<key>`` in the cache, ``flock``) while
+    deriving and building it: a second process compiling the same robot waits, then finds it
+    cached. (The derivation is not bit-for-bit deterministic across processes, so without the
+    lock two processes could each build a module.) No lock where the cache is read-only or
+    the platform has no ``fcntl``."""
+    try:
+        import fcntl
+
+        folder = cache_dir()
+        folder.mkdir(parents=True, exist_ok=True)
+        handle = open(folder / f"lock-{key}", "a")  # noqa: SIM115 - held across the yield
+    except (ImportError, OSError):
+        yield
+        return
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        handle.close()  # releases the lock
 
 
 def store_kernels(key: str, kernels: str) -> None:

@@ -113,11 +113,12 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
         raise CompileError(robot.name, "it has no moving joints")
     build.find_compiler()  # fail early, before the slow derivation
     key = robot_key(robot)
-    kernels = build.cached_kernels(key)
-    if kernels is None:
-        kernels = generate_kernels(robot)
-        build.store_kernels(key, kernels)
-    module = build.build_module(kernels, label=robot.name)
+    with build.locked(key):
+        kernels = build.cached_kernels(key)
+        if kernels is None:
+            kernels = generate_kernels(robot)
+            build.store_kernels(key, kernels)
+        module = build.build_module(kernels, label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached kernels do not match the robot; clear the cache folder")
     return CompiledRobot(robot, module, threads=threads)
