@@ -211,3 +211,34 @@ class OutputError(RobodynError, OSError):
 
     def __str__(self) -> str:  # OSError would format its own way
         return printable(self.args[0])
+
+
+class CompileError(RobodynError):
+    """A robot the compiled engine cannot compile (a floating base, a failed build).
+
+    Attributes:
+        robot: The robot's name.
+        reason: Why, in a few words.
+    """
+
+    def __init__(self, robot: str, reason: str):
+        self.robot = robot
+        self.reason = reason
+        super().__init__(f"cannot compile robot {robot!r}: {reason}.")
+
+
+class CompilerNotFoundError(CompileError):
+    """No C compiler for the compiled engine (the Pinocchio path keeps working).
+
+    Attributes:
+        compiler: The compiler looked for (``$CC`` or ``cc``).
+    """
+
+    def __init__(self, compiler: str, detail: str | None = None):
+        self.compiler = compiler
+        extra = f" ({detail})" if detail else ""
+        super().__init__(
+            "<any>",
+            f"no C compiler {compiler!r} found{extra}; install one (Debian/Ubuntu: apt-get install gcc, "
+            "or set CC) or use the Pinocchio methods of robodyn.Robot",
+        )

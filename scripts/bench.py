@@ -13,6 +13,10 @@ Sections:
     codegen    generated Python code's evaluation cost vs Pinocchio
     simulation real-time factor of 10 s of panda at 1 kHz
     recording  time and HTML size of a 10 s panda recording at 30 fps
+    compiled-single      robodyn.compiled single calls vs pin.rnea / pin.crba / pin.aba
+    compiled-batch       100 000 states, compiled vs rneaInParallel / abaInParallel / a Python loop
+    compiled-compile     cold and cached compile times
+    compiled-simulation  panda-arm real-time factor: compiled RK4 / Euler vs Python engine vs MuJoCo
 """
 
 from __future__ import annotations
@@ -312,6 +316,227 @@ def bench_recording(quick: bool) -> list[dict]:
     ]
 
 
+# --------------------------------------------------------------------------------------
+# robodyn.compiled (issue 16): same run, same thread count, medians of repeats
+# --------------------------------------------------------------------------------------
+COMPILED_ROBOTS = (("panda (arm, fingers locked)", "panda", PANDA_ARM), ("ur5", "ur5", {}))
+
+
+def _compiled(name: str, options: dict):
+    from robodyn.compiled import compile as compile_robot
+
+    robot = robodyn.load(name, **options)
+    return robot, compile_robot(robot)
+
+
+def bench_compiled_single(quick: bool) -> list[dict]:
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        robot, compiled = _compiled(name, options)
+        model, data = robot.model, robot.model.createData()
+        rng = np.random.default_rng(0)
+        q = robot.random_configuration(rng).copy()
+        v, a = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+        tau = robot.inverse_dynamics(q, v, a)
+        cases = {
+            "inverse_dynamics vs pin.rnea": (lambda: compiled.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a)),
+            "mass_matrix vs pin.crba": (lambda: compiled.mass_matrix(q), lambda: pin.crba(model, data, q)),
+            "forward_dynamics vs pin.aba": (
+                lambda: compiled.forward_dynamics(q, v, tau),
+                lambda: pin.aba(model, data, q, v, tau),
+            ),
+            "gravity vs pin.computeGeneralizedGravity": (
+                lambda: compiled.gravity(q),
+                lambda: pin.computeGeneralizedGravity(model, data, q),
+            ),
+        }
+        for method, (ours, raw) in cases.items():
+            ours_s, raw_s, ratio = paired(ours, raw, repeats=7 if quick else 15)
+            rows.append(
+                {"robot": label, "method": method, "compiled_us": ours_s * 1e6, "pinocchio_us": raw_s * 1e6, "ratio": ratio}
+            )
+    return rows
+
+
+def bench_compiled_batch(quick: bool) -> list[dict]:
+    count = 20_000 if quick else 100_000
+    threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        robot, compiled = _compiled(name, options)
+        compiled.threads = threads
+        model, data = robot.model, robot.model.createData()
+        rng = np.random.default_rng(1)
+        q = robot.random_configuration(rng, count)
+        v, a = rng.normal(size=(2, count, robot.nv))
+        tau = robot.inverse_dynamics(q, v, a)
+        pool = pin.ModelPool(model, threads)
+        qt, vt, at, taut = (np.ascontiguousarray(x.T) for x in (q, v, a, tau))
+
+        def loop(function, *stacks):
+            return lambda: [function(model, data, *(s[i] for s in stacks)) for i in range(count)]
+
+        cases = (
+            (
+                "inverse_dynamics",
+                lambda: compiled.inverse_dynamics(q, v, a),
+                loop(pin.rnea, q, v, a),
+                "rneaInParallel",
+                lambda: pin.rneaInParallel(threads, pool, qt, vt, at),
+            ),
+            (
+                "forward_dynamics",
+                lambda: compiled.forward_dynamics(q, v, tau),
+                loop(pin.aba, q, v, tau),
+                "abaInParallel",
+                lambda: pin.abaInParallel(threads, pool, qt, vt, taut),
+            ),
+            # Pinocchio has no parallel CRBA: the reference is its per-state call in a loop.
+            ("mass_matrix", lambda: compiled.mass_matrix(q), loop(pin.crba, q), "(none: no crbaInParallel)", None),
+        )
+        for method, ours, python_loop, parallel_name, parallel in cases:
+            ours_s = median_once(ours, repeats=5)
+            loop_s = median_once(python_loop, repeats=1)  # seconds each: once is enough for a 5x gap
+            parallel_s = median_once(parallel, repeats=5) if parallel else float("nan")
+            rows.append(
+                {
+                    "robot": label,
+                    "method": method,
+                    "states": count,
+                    "threads": threads,
+                    "compiled_states_per_s": count / ours_s,
+                    "pinocchio_parallel": parallel_name,
+                    "parallel_states_per_s": count / parallel_s,
+                    "python_loop_states_per_s": count / loop_s,
+                    "speedup_vs_parallel": parallel_s / ours_s,
+                    "speedup_vs_loop": loop_s / ours_s,
+                }
+            )
+    return rows
+
+
+_CACHED_COMPILE = """
+import os, sys, time, robodyn
+from robodyn.compiled import compile
+robot = robodyn.load(sys.argv[1], **eval(sys.argv[2]))
+start, cpu, before = time.perf_counter(), time.process_time(), os.times()
+compile(robot)
+after = os.times()
+children = after.children_user + after.children_system - before.children_user - before.children_system
+print(time.perf_counter() - start, time.process_time() - cpu + children)
+"""
+
+
+def bench_compiled_compile(quick: bool) -> list[dict]:
+    import subprocess
+    import tempfile
+
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        with tempfile.TemporaryDirectory() as folder:
+            env = os.environ | {"ROBODYN_CACHE": folder}
+            run = [sys.executable, "-c", _CACHED_COMPILE, name, repr(options)]
+            cold, cold_cpu = map(float, subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout.split())
+            cached = [
+                float(subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout.split()[0])
+                for _ in range(3)
+            ]
+        rows.append(
+            {
+                "robot": label,
+                "cold_compile_s": cold,
+                "cold_compile_cpu_s": cold_cpu,
+                "cached_compile_ms (new process)": statistics.median(cached) * 1e3,
+                "load_average": os.getloadavg()[0],
+                "note": "cold = sympy derivation + cc -O1 (cpu: this process + the compiler); cached = read kernels, hash, dlopen",
+            }
+        )
+    return rows
+
+
+def _mujoco_model(robot):
+    """MuJoCo from the same URDF: meshes dropped, contacts, limits, damping, armature, friction off."""
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+
+    root = ET.fromstring(robot.urdf)
+    for link in root.iter("link"):
+        for child in [c for c in link if c.tag in ("visual", "collision")]:
+            link.remove(child)
+    for joint in root.iter("joint"):
+        for child in [c for c in joint if c.tag in ("dynamics", "safety_controller", "calibration")]:
+            joint.remove(child)
+    extension = ET.SubElement(root, "mujoco")
+    ET.SubElement(extension, "compiler", {"discardvisual": "true", "fusestatic": "false", "balanceinertia": "false"})
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
+    model.opt.gravity[:] = robot.gravity_vector
+    model.dof_damping[:] = 0.0
+    model.dof_armature[:] = 0.0
+    model.dof_frictionloss[:] = 0.0
+    model.opt.timestep = 1e-3
+    return model
+
+
+def bench_compiled_simulation(quick: bool) -> list[dict]:
+    from robodyn.compiled import simulate_compiled
+
+    duration = 2.0 if quick else 10.0
+    robot, compiled = _compiled("panda", PANDA_ARM)
+    # A PD pose hold would hide the integrator behind the controller; the passive fall of the
+    # arm whips the wrist and diverges after a few seconds at 1 kHz, so start it moving gently.
+    q0, v0 = robot.neutral_configuration() + 0.3, np.full(robot.nv, 0.1)
+    rows = []
+    try:
+        import mujoco
+
+        model = _mujoco_model(robot)
+        data = mujoco.MjData(model)
+        data.qpos[:], data.qvel[:] = q0, v0
+        mujoco.mj_forward(model, data)
+        bias = robot.nonlinear_effects(q0, v0)
+        mujoco_note = f"MuJoCo {mujoco.__version__}: qfrc_bias vs C v + G, relative {np.abs(data.qfrc_bias - bias).max() / np.abs(bias).max():.1e}"
+    except ImportError:
+        mujoco, mujoco_note = None, "MuJoCo not installed (pip install mujoco)"
+    steps = round(duration / 1e-3)
+    for integrator, mj_integrator in (("rk4", "mjINT_RK4"), ("semi-implicit-euler", "mjINT_EULER")):
+        row = {"robot": "panda (arm, fingers locked)", "integrator": integrator, "duration_s": duration, "dt_s": 1e-3}
+        row["compiled_rtf"] = duration / median_once(
+            lambda: simulate_compiled(compiled, q0, v0, duration, 1e-3, integrator=integrator)
+        )
+        python_duration = min(duration, 2.0)
+        row["python_engine_rtf"] = python_duration / median_once(
+            lambda: simulate(robot, q0, v0, python_duration, 1e-3, integrator=integrator), repeats=1 if quick else 3
+        )
+        if mujoco is not None:
+            model.opt.integrator = getattr(mujoco.mjtIntegrator, mj_integrator)
+
+            def mj_loop():
+                data = mujoco.MjData(model)
+                data.qpos[:], data.qvel[:] = q0, v0
+                for _ in range(steps):
+                    mujoco.mj_step(model, data)
+
+            row["mujoco_mj_step_loop_rtf"] = duration / median_once(mj_loop)
+            try:
+                from mujoco import rollout
+
+                state = np.zeros((1, mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)))
+                data = mujoco.MjData(model)
+                data.qpos[:], data.qvel[:] = q0, v0
+                mujoco.mj_getState(model, data, state[0], mujoco.mjtState.mjSTATE_FULLPHYSICS)
+                row["mujoco_rollout_rtf"] = duration / median_once(lambda: rollout.rollout(model, data, state, nstep=steps))
+            except ImportError:
+                row["mujoco_rollout_rtf"] = float("nan")
+            best = max(row["mujoco_mj_step_loop_rtf"], row.get("mujoco_rollout_rtf", 0.0) or 0.0)
+            row["compiled_vs_best_mujoco"] = row["compiled_rtf"] / best
+        row["compiled_vs_python_engine"] = row["compiled_rtf"] / row["python_engine_rtf"]
+        row["note"] = mujoco_note
+        rows.append(row)
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -320,6 +545,10 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "codegen": bench_codegen,
     "simulation": bench_simulation,
     "recording": bench_recording,
+    "compiled-single": bench_compiled_single,
+    "compiled-batch": bench_compiled_batch,
+    "compiled-compile": bench_compiled_compile,
+    "compiled-simulation": bench_compiled_simulation,
 }
 
 

@@ -1,0 +1,219 @@
+"""``compile(robot)``: a robot's dynamics as native code, with the same API as :class:`robodyn.Robot`.
+
+A :class:`CompiledRobot` computes ``tau``, ``M``, ``C v + G``, ``G`` and the forward
+dynamics of a fixed-base robot in generated C (see :mod:`robodyn.compiled.codegen`),
+built once and cached (see :mod:`robodyn.compiled.build`). The rules are the
+:class:`~robodyn.Robot`'s: one state as 1-D arrays gives one result, a stack (one state a
+row) gives a stack; inputs go through the robot's own boundary
+(:meth:`robodyn.dynamics.handle.ModelHandle.validate`), so a wrong size, a NaN or a complex
+number gets the same :class:`~robodyn.exceptions.InputError`; a non-finite result of
+finite inputs is refused. Mimic joints go through the robot's linear map
+(``q_bodies = Q q + offset``, ``M = Sᵀ M_bodies S``).
+
+The single call goes straight to C when its arguments already are float64 C-contiguous
+arrays of the right shape (the C code also checks they are finite); anything else takes the
+checked path. Batches run across rows on ``threads`` native threads, the GIL released.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from types import ModuleType
+
+import numpy as np
+
+from robodyn.compiled import build
+from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
+from robodyn.compiled.rnea import derive_newton_euler
+from robodyn.dynamics.batch import check_threads
+from robodyn.dynamics.robot import Robot
+from robodyn.equations.compact import derive_compact
+from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
+from robodyn.reference.numeric import ReferenceRobot
+from robodyn.reference.tree import build_tree
+
+_ndarray = np.ndarray
+#: Rotation entries this close to 0, ±1, ±½, ... are taken as exact: only float rounding
+#: (cos(π/2) = 6e-17), so the compiled model is the URDF's, not a rounded one.
+SNAP = 1e-12
+_QUANTITIES = {"tau": "tau", "mass": "M", "nle": "C v + G", "gravity": "G", "fd": "a"}
+
+
+def robot_key(robot: Robot) -> str:
+    """The cache key of a robot's generated kernels: its URDF text, gravity and the generator."""
+    gravity = ",".join(repr(float(g)) for g in robot.gravity_vector)
+    return build.digest(robot.urdf, gravity, CODEGEN_VERSION, f"compact snap={SNAP}")
+
+
+def generate_kernels(robot: Robot) -> str:
+    """The C kernels of a fixed-base robot (the slow part: a sympy derivation).
+
+    Raises:
+        CompileError: For a floating base, or joints the reference does not map.
+    """
+    if robot.floating_base:
+        raise CompileError(
+            robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
+        )
+    tree = build_tree(robot.spec, robot.urdf, floating_base=False)
+    names = list(robot.joint_names)
+    if sorted(tree.joint_names) != sorted(names):
+        raise CompileError(robot.name, "the reference tree and the Pinocchio model disagree on the joints")
+    column = [tree.joint_names.index(name) for name in names]
+    selection = tree.selection[:, column]  # bodies x robot coordinates
+    count = len(tree.bodies)
+    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
+    reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
+    equations = derive_compact(reference, snap=SNAP)
+    newton_euler = derive_newton_euler(reference, snap=SNAP)
+    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), newton_euler).source()
+
+
+def coordinate_parents(robot: Robot) -> list[int]:
+    """The parent coordinate of each coordinate (-1 at the root), for the tree LDLᵀ.
+
+    With mimic joints ``M = Sᵀ M_bodies S`` need not keep the tree's sparsity, so the chain
+    ``i - 1`` (a dense factorisation) is used.
+    """
+    model = robot.model
+    if robot.mimic is not None:
+        return list(range(-1, robot.nv - 1))
+    parents = []
+    for joint_id in range(1, model.njoints):
+        if model.joints[joint_id].nv == 0:
+            continue
+        parent = model.parents[joint_id]
+        while parent > 0 and model.joints[parent].nv == 0:
+            parent = model.parents[parent]
+        parents.append(model.joints[parent].idx_v if parent > 0 else -1)
+    return parents
+
+
+def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
+    """Compile a fixed-base robot's dynamics to native code (cached: fast the second time).
+
+    Args:
+        robot: From :func:`robodyn.load` (fixed base; mimic joints are fine).
+        threads: Native threads for batches; ``None`` for every available core.
+
+    Returns:
+        The compiled robot.
+
+    Raises:
+        CompileError: For a floating base, or if the build fails.
+        CompilerNotFoundError: If there is no C compiler (``Robot`` keeps working).
+        InputError: For a bad ``threads``.
+    """
+    threads = check_threads(threads)
+    if robot.floating_base:
+        raise CompileError(
+            robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
+        )
+    if robot.nv == 0:
+        raise CompileError(robot.name, "it has no moving joints")
+    build.find_compiler()  # fail early, before the slow derivation
+    key = robot_key(robot)
+    with build.locked(key):
+        kernels = build.cached_kernels(key)
+        if kernels is None:
+            kernels = generate_kernels(robot)
+            build.store_kernels(key, kernels)
+        module = build.build_module(kernels, label=robot.name)
+    if module.info()["nv"] != robot.nv:
+        raise CompileError(robot.name, "the cached kernels do not match the robot; clear the cache folder")
+    return CompiledRobot(robot, module, threads=threads)
+
+
+class CompiledRobot:
+    """A robot's dynamics in compiled C; the methods and shape rules of :class:`robodyn.Robot`.
+
+    Attributes:
+        robot: The Pinocchio-backed robot it was compiled from (names, limits, checks).
+        name, nq, nv, joint_names: As the robot's.
+        threads: Native threads for batches.
+        module: The loaded extension module (``tau``, ``mass``, ``nle``, ``gravity``, ``fd``,
+            ``simulate``).
+    """
+
+    def __init__(self, robot: Robot, module: ModuleType, *, threads: int | None = None):
+        self.robot = robot
+        self.module = module
+        self.name = robot.name
+        self.nq = robot.nq
+        self.nv = robot.nv
+        self.joint_names = list(robot.joint_names)
+        self.threads = check_threads(threads)
+        self._tau, self._mass, self._nle = module.tau, module.mass, module.nle
+        self._gravity, self._fd = module.gravity, module.fd
+
+    def __repr__(self) -> str:
+        return f"<CompiledRobot {self.name!r}: nv={self.nv}, threads={self.threads}>"
+
+    def _checked(self, kind: str, function, status, **named: object) -> np.ndarray:
+        """The checked path: validate, convert, compute again, refuse what is not finite."""
+        arrays, _ = self.robot.validate(**named)
+        arrays = [np.ascontiguousarray(array, dtype=np.float64) for array in arrays]
+        result = function(*arrays, self.threads)
+        if result.__class__ is _ndarray:
+            return result
+        if result == 3 or kind == "fd":
+            raise SingularMassMatrixError(self.name, self.robot.massless_joints)
+        if result is None or result == 1:  # cannot happen after validate(): refuse rather than guess
+            raise CompileError(self.name, f"the compiled {kind} refused checked inputs (status {result})")
+        raise NonFiniteResultError(self.name, _QUANTITIES[kind])
+
+    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Joint torques ``tau = M(q) a + C(q, v) v + G(q)``.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv).
+            a: Acceleration, shape (nv,) or (N, nv).
+
+        Returns:
+            Torques in [N m] / [N], shape (nv,) or (N, nv).
+        """
+        result = self._tau(q, v, a, self.threads)
+        if result.__class__ is _ndarray:
+            return result
+        return self._checked("tau", self._tau, result, q=q, v=v, a=a)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """Joint-space inertia matrix ``M(q)``, symmetric, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg]."""
+        result = self._mass(q, self.threads)
+        if result.__class__ is _ndarray:
+            return result
+        return self._checked("mass", self._mass, result, q=q)
+
+    def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``C(q, v) v + G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
+        result = self._nle(q, v, self.threads)
+        if result.__class__ is _ndarray:
+            return result
+        return self._checked("nle", self._nle, result, q=q, v=v)
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        """Generalised gravity ``G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
+        result = self._gravity(q, self.threads)
+        if result.__class__ is _ndarray:
+            return result
+        return self._checked("gravity", self._gravity, result, q=q)
+
+    def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (LDLᵀ of ``M`` in C).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+            tau: Torques in [N m] / [N], shape (nv,) or (N, nv).
+
+        Returns:
+            Accelerations, shape (nv,) or (N, nv).
+
+        Raises:
+            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
+        """
+        result = self._fd(q, v, tau, self.threads)
+        if result.__class__ is _ndarray:
+            return result
+        return self._checked("fd", self._fd, result, q=q, v=v, tau=tau)
