@@ -51,7 +51,7 @@ def test_recording_is_self_contained_and_sends_each_shape_once(swinging, tmp_pat
         html = record(robot, motion, tmp_path / f"{name}.html").read_text()
         assert "MeshCat.Viewer" in html and "http://" not in html.split("<script>")[0]
         commands = commands_of(html)
-        counts.append(sum(c["type"] == "set_object" for c in commands))
+        counts.append(sum(c["type"] == "set_object" and c["path"].startswith("/robodyn/") for c in commands))
         animation = [c for c in commands if c["type"] == "set_animation"]
         assert len(animation) == 1 and animation[0]["options"]["play"] is True
         keys = animation[0]["animations"][0]["clip"]["tracks"][0]["keys"]
@@ -65,7 +65,7 @@ def test_zoo_meshes_are_embedded(tmp_path):
         np.array([0.0, 0.1]), np.zeros((2, 6)), np.zeros((2, 6)), np.zeros((2, 6)), np.zeros((2, 6)), robot.joint_names, "ur5"
     )
     commands = commands_of(record(robot, trajectory, tmp_path / "ur5.html").read_text())
-    meshes = [c for c in commands if c["type"] == "set_object"]
+    meshes = [c for c in commands if c["type"] == "set_object" and c["path"].startswith("/robodyn/")]
     assert len(meshes) == 7 and all(c["object"]["geometries"][0]["type"] == "_meshfile" for c in meshes)
 
 
