@@ -116,6 +116,10 @@ class LiveViewer:
 
     def show(self, robot: Robot, trajectory: Trajectory | None = None, *, fps: float = 30.0) -> None:
         """Draw the robot (at its neutral configuration or the trajectory's start) and play."""
+        if trajectory is not None and (trajectory.q.ndim != 2 or trajectory.q.shape[1] != robot.nq or len(trajectory) == 0):
+            raise RobodynError(
+                f"the trajectory has {trajectory.q.shape[-1]} coordinates a sample; {robot.name} needs {robot.nq}."
+            )
         q = robot.neutral_configuration() if trajectory is None else trajectory.q[0]
         points = np.array([m[:3, 3] for m in link_placements(robot, q).values()])
         animation = []

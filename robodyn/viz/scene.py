@@ -120,7 +120,7 @@ def _geometry(visual: ET.Element, robot: Robot, scene: Scene, link: str, max_mes
     try:
         found = resolve_mesh(filename, base_dir=base_dir, package_dirs=robot.package_dirs)
         if found is None:
-            raise MeshFileError(filename, "was not found")  # type: ignore[arg-type]
+            raise MeshFileError(filename, "was not found or is not a regular file")  # type: ignore[arg-type]
         mesh, bounds = read_mesh(found, max_bytes=max_mesh_bytes)
     except (MeshPathError, MeshFileError) as error:
         reason = f"link {link!r}: {error}"

@@ -18,7 +18,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.sim.simulation import Trajectory
-    from robodyn.viz.viewer import LiveViewer, wait
+    from robodyn.viz.live import LiveViewer, wait
 
     robot = load_robot(arguments)
     trajectory = Trajectory.load(arguments.trajectory) if arguments.trajectory else None
