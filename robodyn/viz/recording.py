@@ -6,8 +6,10 @@ plays once on open, offline, in any browser; meshcat's controls (top right, "Ope
 Controls" → Animations) play, pause and scrub it.
 
 The page also answers a capture request in its URL fragment, which the stills and videos
-of :mod:`robodyn.viz.stills` use: ``#capture=T1,T2,...`` pauses the animation, seeks each
-time, renders, and writes the frames as PNG data URLs into ``<pre id="frames">``.
+of :mod:`robodyn.viz.stills` use: ``#size=WxH&hide=A,B&capture=T1,T2,...`` hides the named
+top-level nodes (``task``, ``Axes``, ``Grid``, ``Background``: then the PNG is transparent
+where nothing is drawn), pauses the animation, seeks each time, renders at W×H, and writes
+the frames as PNG data URLs into ``<pre id="frames">``.
 Each command runs in its own ``try``: a command the browser cannot handle is counted in
 the title ("N commands failed") and the rest is still drawn.
 """
@@ -54,6 +56,8 @@ function robodyn_capture() {{
   var gui = document.querySelector(".dg.ac");
   if (gui) {{ gui.style.display = "none"; }}
   if (viewer.animator.actions.length) {{ viewer.animator.pause(); }}
+  var hide = /hide=([A-Za-z,]+)/.exec(location.hash);
+  if (hide) {{ hide[1].split(",").forEach(function (name) {{ viewer.set_property([name], "visible", false); }}); }}
   var size = /size=([0-9]+)x([0-9]+)/.exec(location.hash);
   if (size) {{ viewer.set_3d_pane_size(parseInt(size[1]), parseInt(size[2])); }}
   var frames = request[1].split(",").map(function (t) {{

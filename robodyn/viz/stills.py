@@ -71,14 +71,14 @@ def _browser() -> str:
     return browser
 
 
-def _decode(url: str) -> np.ndarray:
+def _decode(url: str, mode: str = "RGB") -> np.ndarray:
     from PIL import Image
 
     prefix = "data:image/png;base64,"
     if not url.startswith(prefix):
         raise RobodynError("Chromium returned no image: the page could not render (no WebGL?).")
     with Image.open(io.BytesIO(base64.b64decode(url[len(prefix) :]))) as image:
-        return np.asarray(image.convert("RGB"))
+        return np.asarray(image.convert(mode))
 
 
 def capture(
@@ -86,14 +86,19 @@ def capture(
     times: list[float],
     *,
     size: tuple[int, int] = (800, 600),
+    hide: tuple[str, ...] = (),
     progress: Progress | None = None,
 ) -> list[np.ndarray]:
     """Frames of a recording at the given times, as RGB arrays of shape (height, width, 3).
+
+    With ``"Background"`` in ``hide`` the frames are RGBA, shape (height, width, 4), and
+    transparent where nothing is drawn (a mask of the robot, measured not assumed).
 
     Args:
         page: The recording's HTML file (a path) or its text (a ``str`` holding ``<html``).
         times: Times in [s] from the motion's start.
         size: Width and height in [pixel].
+        hide: Top-level scene nodes not drawn: ``"task"``, ``"Axes"``, ``"Grid"``, ``"Background"``.
         progress: Called with (frames done, frames in all) after each browser run.
 
     Raises:
@@ -109,7 +114,8 @@ def capture(
         frames: list[np.ndarray] = []
         for start in range(0, len(times), BATCH):
             batch = times[start : start + BATCH]
-            url = f"{html.as_uri()}#size={size[0]}x{size[1]}&capture={','.join(f'{t:.6f}' for t in batch)}"
+            hidden = f"&hide={','.join(hide)}" if hide else ""
+            url = f"{html.as_uri()}#size={size[0]}x{size[1]}{hidden}&capture={','.join(f'{t:.6f}' for t in batch)}"
             command = [
                 browser, *CHROMIUM_FLAGS, f"--user-data-dir={Path(folder) / 'profile'}",
                 f"--window-size={size[0]},{size[1]}", "--virtual-time-budget=2000", "--dump-dom", url,
@@ -127,7 +133,7 @@ def capture(
                 raise RobodynError(
                     f"Chromium ({browser}) did not render the recording ({reason}); see CHROMIUM_FLAGS in robodyn.viz.stills."
                 )
-            decoded = [_decode(u) for u in urls]
+            decoded = [_decode(u, "RGBA" if "Background" in hide else "RGB") for u in urls]
             if any(frame.shape[:2] != (size[1], size[0]) for frame in decoded):
                 raise RobodynError(
                     f"Chromium rendered {decoded[0].shape[1]}x{decoded[0].shape[0]} frames, not {size[0]}x{size[1]}."
