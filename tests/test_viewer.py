@@ -20,7 +20,7 @@ import robodyn
 from robodyn import RobodynError
 from robodyn.cli.app import main
 from robodyn.sim.simulation import Trajectory, simulate
-from robodyn.viz.viewer import chromium, record, screenshot
+from robodyn.viz.viewer import capture, chromium, record, screenshot
 from tests.conftest import ROOT
 
 
@@ -130,10 +130,10 @@ def _need_chromium():
         pytest.skip("no Chromium here (make test installs it)")
 
 
-def _drawn_pixels(png_path) -> np.ndarray:
+def _drawn_pixels(png_or_image) -> np.ndarray:
     import matplotlib.image
 
-    image = matplotlib.image.imread(png_path)[..., :3]
+    image = png_or_image / 255.0 if isinstance(png_or_image, np.ndarray) else matplotlib.image.imread(png_or_image)[..., :3]
     # The background is a vertical blue gradient: compare each pixel with its row's mode.
     background = np.median(image, axis=1, keepdims=True)
     return np.abs(image - background).sum(axis=2) > 0.15
@@ -143,10 +143,10 @@ def test_recording_plays_in_a_real_browser(swinging, tmp_path):
     _need_chromium()
     robot, trajectory = swinging
     html = record(robot, trajectory, tmp_path / "swing.html", png=tmp_path / "poster.png")
-    early, late = tmp_path / "early.png", tmp_path / "late.png"
-    screenshot(html, early, at_seconds=0.3)
-    screenshot(html, late, at_seconds=1.3)
+    early, late = capture(html, [0.3, 1.3], size=(800, 600))
     drawn_early, drawn_late = _drawn_pixels(early), _drawn_pixels(late)
     assert drawn_early.sum() > 500 and drawn_late.sum() > 500  # the robot is drawn
     assert (drawn_early ^ drawn_late).sum() > 300  # and it moved
     assert _drawn_pixels(tmp_path / "poster.png").sum() > 500
+    screenshot(html, tmp_path / "again.png", at_seconds=0.3)  # the file-based still is the same frame
+    assert np.array_equal(_drawn_pixels(tmp_path / "again.png"), drawn_early)

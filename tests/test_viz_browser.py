@@ -127,3 +127,41 @@ def _ffmpeg_frames(path) -> list[np.ndarray]:
 
     with imageio.get_reader(path, format="FFMPEG") as reader:
         return [frame for frame in reader]
+
+
+@pytest.mark.slow
+def test_record_command_writes_still_filmstrip_and_video(tmp_path, capsys):
+    from PIL import Image
+
+    from robodyn.cli.app import main
+
+    robot = robodyn.load("rp_arm")
+    trajectory, _ = run_simulation(robot, controller="task-space", target=[0.7, 0.7], frame="end_effector", q0=[0.0, 0.1], duration=1.0)
+    trajectory.save(tmp_path / "m.npz")
+    common = ["record", "rp_arm", "--trajectory", str(tmp_path / "m.npz"), "--target", "0.7,0.7"]
+    assert main([*common, "--out", str(tmp_path / "a.html"), "--png", str(tmp_path / "at.png"), "--at", "0.5"]) == 0
+    with Image.open(tmp_path / "at.png") as image:
+        assert image.size == (800, 600)
+    strip = ["--out", str(tmp_path / "b.html"), "--png", str(tmp_path / "strip.png"), "--filmstrip", "3"]
+    assert main([*common, *strip, "--mp4", str(tmp_path / "m.mp4")]) == 0
+    with Image.open(tmp_path / "strip.png") as image:
+        assert image.size == (3 * 480, 360)
+    assert (tmp_path / "m.mp4").stat().st_size > 1000
+    assert "rendered 16/16 frames" in capsys.readouterr().err  # progress: 1 s at 15 fps
+
+
+def test_no_working_browser_is_one_line(tmp_path, monkeypatch, capsys, demo):
+    from robodyn.cli.app import main
+
+    robot = robodyn.load("rp_arm")
+    trajectory, _ = run_simulation(robot, duration=0.2)
+    trajectory.save(tmp_path / "m.npz")
+    command = ["record", "rp_arm", "--trajectory", str(tmp_path / "m.npz"), "--out", str(tmp_path / "m.html")]
+    for browser, message in (("/nonexistent/chromium", "no Chromium found"), ("/bin/false", "did not render")):
+        monkeypatch.setenv("ROBODYN_CHROMIUM", browser)
+        assert main([*command, "--png", str(tmp_path / "m.png")]) == 2
+        error = capsys.readouterr().err.strip()
+        assert message in error and len(error.splitlines()) == 1
+        assert not (tmp_path / "m.html").exists() and not (tmp_path / "m.png").exists()
+    assert main([*command, "--filmstrip", "3"]) == 2
+    assert "--filmstrip" in capsys.readouterr().err
