@@ -136,7 +136,9 @@ def test_record_command_writes_still_filmstrip_and_video(tmp_path, capsys):
     from robodyn.cli.app import main
 
     robot = robodyn.load("rp_arm")
-    trajectory, _ = run_simulation(robot, controller="task-space", target=[0.7, 0.7], frame="end_effector", q0=[0.0, 0.1], duration=1.0)
+    trajectory, _ = run_simulation(
+        robot, controller="task-space", target=[0.7, 0.7], frame="end_effector", q0=[0.0, 0.1], duration=1.0
+    )
     trajectory.save(tmp_path / "m.npz")
     common = ["record", "rp_arm", "--trajectory", str(tmp_path / "m.npz"), "--target", "0.7,0.7"]
     assert main([*common, "--out", str(tmp_path / "a.html"), "--png", str(tmp_path / "at.png"), "--at", "0.5"]) == 0

@@ -43,7 +43,7 @@ def test_robot_html_escapes_names_and_lists_joints():
     parsed = _parse(robot_html(robot))
     assert "script" not in parsed.tags and "img" not in parsed.tags
     text = "|".join(parsed.cells)
-    assert '<img src=x onerror=alert(2)>' in text and "<script>" in text  # shown as text
+    assert "<img src=x onerror=alert(2)>" in text and "<script>" in text  # shown as text
     assert "prismatic" in text and "-0.25 m … 0.5 m" in text and "40 N" in text and "1.5 kg" in text
 
 

@@ -53,7 +53,5 @@ def robot_html(robot) -> str:
         f"{'floating' if robot.floating_base else 'fixed'} base, total mass {robot.total_mass:.4g} kg, "
         f"end effector <code>{effector}</code></p>"
         "<table><thead><tr><th>joint</th><th>type</th><th>position limits</th><th>effort limit</th>"
-        "<th>child link</th><th>mass</th></tr></thead><tbody>"
-        + "".join(rows)
-        + "</tbody></table></div>"
+        "<th>child link</th><th>mass</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table></div>"
     )
