@@ -65,3 +65,20 @@ def test_recording_repr_html_is_one_sandboxed_iframe():
     parsed = _parse(made._repr_html_())
     assert parsed.tags == ["iframe"]
     assert "<title>robodyn: r&lt;script&gt;" in made.html
+
+
+def test_axes_ride_on_their_links():
+    from robodyn import FrameError
+    from tests.test_viewer import commands_of
+
+    robot = robodyn.load("rp_arm")
+    t = np.linspace(0, 0.5, 6)
+    q = np.column_stack([np.linspace(0, 0.3, 6), np.full(6, 0.1)])
+    motion = Trajectory(t, q, 0 * q, 0 * q, 0 * q, robot.joint_names, robot.name)
+    made = recording(robot, motion, axes=("end_effector",))
+    paths = [c["path"] for c in commands_of(made.html) if c["type"] == "set_object"]
+    assert "/robodyn/end_effector/axes" in paths
+    import pytest
+
+    with pytest.raises(FrameError, match="no frame named 'nowhere'"):
+        recording(robot, motion, axes=("nowhere",))

@@ -30,7 +30,15 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
-from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands, task_commands
+from robodyn.viz.scene import (
+    axis_commands,
+    build_scene,
+    camera_commands,
+    lower_animation,
+    motion,
+    pose_commands,
+    task_commands,
+)
 
 _PAGE = """<!DOCTYPE html>
 <html>
@@ -162,6 +170,7 @@ def recording(
     fps: float = 30.0,
     target=None,
     frame: str | None = None,
+    axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
 ) -> Recording:
     """Draw a trajectory: the robot, the ground, the target and the end effector's path.
@@ -173,6 +182,7 @@ def recording(
         target: Task target, X,Z (planar, Y = 0) or X,Y,Z in [m]; drawn as a red sphere.
         frame: The frame whose path is drawn (default ``robot.end_effector``; none when
             the robot has no default and none is given).
+        axes: Links (or frames) that carry a small x/y/z triad (red, green, blue).
         max_mesh_bytes: Largest mesh file drawn; larger ones become placeholder boxes.
 
     Raises:
@@ -201,6 +211,7 @@ def recording(
     task, task_clips = task_commands(points, target=target_m, path=path, path_frames=frames, fps=fps)
     commands = [
         *scene.commands,
+        *axis_commands(robot, axes, points),
         *task,
         *pose_commands(robot, moved.configurations[0]),
         *camera_commands(framed),
@@ -220,6 +231,7 @@ def record(
     at: float = 0.0,
     target=None,
     frame: str | None = None,
+    axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
 ) -> Path:
     """Write a self-contained HTML animation of a trajectory (plays on open).
@@ -233,6 +245,7 @@ def record(
         at: Time of the still in [s], from the motion's start.
         target: Task target drawn as a marker, X,Z or X,Y,Z in [m].
         frame: Frame whose path is drawn (default ``robot.end_effector``).
+        axes: Links that carry an x/y/z triad.
         max_mesh_bytes: Largest mesh file drawn (see :mod:`robodyn.viz.mesh_files`).
 
     Returns:
@@ -242,7 +255,7 @@ def record(
         RobodynError: If the trajectory is empty or does not fit the robot, or the still
             cannot be made.
     """
-    made = recording(robot, trajectory, fps=fps, target=target, frame=frame, max_mesh_bytes=max_mesh_bytes)
+    made = recording(robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes)
     if png is not None:
         made.still(png, at=at)
     return made.save(path)

@@ -176,6 +176,23 @@ def scene_commands(robot: Robot, *, max_mesh_bytes: int = MAX_MESH_BYTES) -> lis
     return build_scene(robot, max_mesh_bytes=max_mesh_bytes).commands
 
 
+def axis_commands(robot: Robot, links: tuple[str, ...] | list[str], points: np.ndarray) -> list[dict]:
+    """An x/y/z triad (red, green, blue lines; a tenth of the scene's size) on each link.
+
+    Raises:
+        FrameError: For a name that is not a URDF link.
+    """
+    from robodyn.exceptions import FrameError
+
+    size = max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 0.1)
+    commands = []
+    for link in links:
+        if link not in robot.spec.links:
+            raise FrameError(link, robot.name)
+        commands.append(SetObject(mg.triad(0.1 * size), path=_path(link, "axes")).lower())
+    return commands
+
+
 def link_placements(robot: Robot, q: np.ndarray, data: pin.Data | None = None) -> dict[str, np.ndarray]:
     """World pose (4×4) of every URDF link at configuration ``q``.
 

@@ -22,6 +22,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second of the animation (default 30)")
     parser.add_argument("--target", type=vector, metavar="X,Z|X,Y,Z", help="task target drawn as a red sphere, in [m]")
     parser.add_argument("--frame", help="frame whose path is drawn (default: the robot's end effector)")
+    parser.add_argument("--axes", help="comma-separated links that carry an x/y/z triad")
     parser.add_argument("--png", help="a still PNG (needs Chromium); with --filmstrip, the filmstrip")
     parser.add_argument("--at", type=float, default=0.0, help="time of the --png still in [s] from the start (default 0)")
     parser.add_argument("--filmstrip", type=int, metavar="N", help="with --png: N frames evenly over the motion, side by side")
@@ -45,7 +46,8 @@ def run(arguments: argparse.Namespace) -> int:
     started = time.perf_counter()
     with warnings.catch_warnings():  # reported below, one line each
         warnings.simplefilter("ignore", MeshWarning)
-        made = recording(robot, trajectory, fps=arguments.fps, target=arguments.target, frame=arguments.frame)
+        axes = tuple(name for name in (arguments.axes or "").split(",") if name)
+        made = recording(robot, trajectory, fps=arguments.fps, target=arguments.target, frame=arguments.frame, axes=axes)
     for reason in made.placeholders:
         print(f"robodyn: warning: {reason}; drawn as a placeholder box", file=sys.stderr)
     if arguments.png:  # stills before the HTML is written: a failed still leaves no half result
