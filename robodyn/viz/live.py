@@ -23,7 +23,6 @@ import umsgpack
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
-from robodyn.viz.scene import animation_command, camera_commands, link_placements, pose_commands, scene_commands
 
 #: Signals that end a live session normally (the server is stopped, exit status 0).
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
@@ -114,19 +113,17 @@ class LiveViewer:
             self._socket.send_multipart([command["type"].encode(), command.get("path", "").encode(), umsgpack.packb(command)])
             self._socket.recv()
 
-    def show(self, robot: Robot, trajectory: Trajectory | None = None, *, fps: float = 30.0) -> None:
-        """Draw the robot (at its neutral configuration or the trajectory's start) and play."""
-        if trajectory is not None and (trajectory.q.ndim != 2 or trajectory.q.shape[1] != robot.nq or len(trajectory) == 0):
-            raise RobodynError(
-                f"the trajectory has {trajectory.q.shape[-1]} coordinates a sample; {robot.name} needs {robot.nq}."
-            )
-        q = robot.neutral_configuration() if trajectory is None else trajectory.q[0]
-        points = np.array([m[:3, 3] for m in link_placements(robot, q).values()])
-        animation = []
-        if trajectory is not None:
-            command, points = animation_command(robot, trajectory, fps)
-            animation = [command]
-        self.send([*scene_commands(robot), *pose_commands(robot, q), *camera_commands(points), *animation])
+    def show(self, robot: Robot, trajectory: Trajectory | None = None, *, fps: float = 30.0, target=None, frame=None) -> None:
+        """Draw the robot (at its neutral configuration, or playing the trajectory) with its
+        task: ground grid, ``target`` marker (X,Z or X,Y,Z in [m]) and the frame's path."""
+        from robodyn.viz.recording import motion_commands
+
+        if trajectory is None:
+            q = robot.neutral_configuration()[None]
+            zeros = np.zeros((1, robot.nv))
+            trajectory = Trajectory(np.zeros(1), q, zeros, zeros, zeros, robot.joint_names, robot.name)
+        commands, _duration, _placeholders = motion_commands(robot, trajectory, fps=fps, target=target, frame=frame)
+        self.send(commands)
 
 
 def _raise_interrupt(signum, frame) -> None:

@@ -163,7 +163,7 @@ def _path_points(robot: Robot, trajectory: Trajectory, frame: str, fps: float) -
     return positions, np.round((trajectory.t[::step] - trajectory.t[0]) * fps)
 
 
-def recording(
+def motion_commands(
     robot: Robot,
     trajectory: Trajectory,
     *,
@@ -172,22 +172,11 @@ def recording(
     frame: str | None = None,
     axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
-) -> Recording:
-    """Draw a trajectory: the robot, the ground, the target and the end effector's path.
+) -> tuple[list[dict], float, list[str]]:
+    """The meshcat commands of a motion with its task (see :func:`recording`).
 
-    Args:
-        robot: The robot (its URDF visuals are drawn).
-        trajectory: The motion (``t`` in [s], ``q`` one configuration a row, shape (N, nq)).
-        fps: Frames per second of the animation.
-        target: Task target, X,Z (planar, Y = 0) or X,Y,Z in [m]; drawn as a red sphere.
-        frame: The frame whose path is drawn (default ``robot.end_effector``; none when
-            the robot has no default and none is given).
-        axes: Links (or frames) that carry a small x/y/z triad (red, green, blue).
-        max_mesh_bytes: Largest mesh file drawn; larger ones become placeholder boxes.
-
-    Raises:
-        RobodynError: If the trajectory is empty, does not fit the robot, or nothing of the
-            robot can be drawn.
+    Returns:
+        The commands, the animation's length in [s], and the placeholder reasons.
     """
     if trajectory.q.ndim != 2 or trajectory.q.shape[1] != robot.nq:
         raise RobodynError(f"the trajectory has {trajectory.q.shape[-1]} coordinates a sample; {robot.name} needs {robot.nq}.")
@@ -217,8 +206,39 @@ def recording(
         *camera_commands(framed),
         lower_animation({**clips, **task_clips}),
     ]
-    duration = float(moved.times[-1] - moved.times[0])
-    return Recording(page(commands, title=f"robodyn: {robot.name}"), duration, fps, robot.name, scene.placeholders)
+    return commands, float(moved.times[-1] - moved.times[0]), scene.placeholders
+
+
+def recording(
+    robot: Robot,
+    trajectory: Trajectory,
+    *,
+    fps: float = 30.0,
+    target=None,
+    frame: str | None = None,
+    axes: tuple[str, ...] = (),
+    max_mesh_bytes: int = MAX_MESH_BYTES,
+) -> Recording:
+    """Draw a trajectory: the robot, the ground, the target and the end effector's path.
+
+    Args:
+        robot: The robot (its URDF visuals are drawn).
+        trajectory: The motion (``t`` in [s], ``q`` one configuration a row, shape (N, nq)).
+        fps: Frames per second of the animation.
+        target: Task target, X,Z (planar, Y = 0) or X,Y,Z in [m]; drawn as a red sphere.
+        frame: The frame whose path is drawn (default ``robot.end_effector``; none when
+            the robot has no default and none is given).
+        axes: Links (or frames) that carry a small x/y/z triad (red, green, blue).
+        max_mesh_bytes: Largest mesh file drawn; larger ones become placeholder boxes.
+
+    Raises:
+        RobodynError: If the trajectory is empty, does not fit the robot, or nothing of the
+            robot can be drawn.
+    """
+    commands, duration, placeholders = motion_commands(
+        robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes
+    )
+    return Recording(page(commands, title=f"robodyn: {robot.name}"), duration, fps, robot.name, placeholders)
 
 
 def record(
