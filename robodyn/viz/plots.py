@@ -30,6 +30,7 @@ from matplotlib.transforms import Bbox
 
 from robodyn.common.files import atomic_write_bytes
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
 
 DPI = 110
@@ -240,8 +241,8 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         units: ``"N m"`` (a torque) or ``"N"`` (a force) a column.
         effort_limits: Effort limit a column (drawn as a dashed line when finite).
     """
-    if len(joint_names) != len(units):
-        raise ValueError(f"{len(joint_names)} joint names but {len(units)} units")
+    if len(joint_names) != len(units) or any(len(r.peak) != len(units) for r in rows):
+        raise RobodynError(f"the what-if plot needs one joint name a unit and a column: {len(joint_names)} names, {len(units)} units.")
     labels = [
         f"{r.material}\n{r.payload:g} kg" + (f"\nF={','.join(f'{f:g}' for f in r.force)} N" if np.any(r.force) else "")
         for r in rows
