@@ -242,7 +242,9 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         effort_limits: Effort limit a column (drawn as a dashed line when finite).
     """
     if len(joint_names) != len(units) or any(len(r.peak) != len(units) for r in rows):
-        raise RobodynError(f"the what-if plot needs one joint name a unit and a column: {len(joint_names)} names, {len(units)} units.")
+        raise RobodynError(
+            f"the what-if plot needs one joint name a unit and a column: {len(joint_names)} names, {len(units)} units."
+        )
     labels = [
         f"{r.material}\n{r.payload:g} kg" + (f"\nF={','.join(f'{f:g}' for f in r.force)} N" if np.any(r.force) else "")
         for r in rows
