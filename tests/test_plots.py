@@ -68,11 +68,11 @@ def test_simulation_figure_has_no_colliding_text_and_right_units(runs, name):
     assert unit_problems(figure, robot) == []
 
 
-@pytest.mark.parametrize("name", ["rp_arm", "panda", "solo12"])
-def test_plotted_curves_are_the_trajectory_columns(runs, name):
-    robot, trajectory, figure = _figure_of(runs, name)
+def column_problems(figure: Figure, robot, trajectory) -> list[str]:
+    """Each joint's curve equals its trajectory column (by Pinocchio's idx_q / idx_v), and
+    every moving joint has its position and its effort curve."""
     model = robot.model
-    seen = set()
+    problems, seen = [], set()
     for axis in figure.axes:
         quantity = axis.get_ylabel().split(" [")[0]
         for line in axis.get_lines():
@@ -83,16 +83,50 @@ def test_plotted_curves_are_the_trajectory_columns(runs, name):
             column = (
                 trajectory.q[:, model.idx_qs[joint_id]] if quantity == "position" else trajectory.tau[:, model.idx_vs[joint_id]]
             )
-            np.testing.assert_array_equal(line.get_xdata(), trajectory.t)
-            np.testing.assert_array_equal(line.get_ydata(), column)
+            if not (np.array_equal(line.get_xdata(), trajectory.t) and np.array_equal(line.get_ydata(), column)):
+                problems.append(f"{label} {quantity}")
             seen.add((label, quantity))
-    moving = [j.name for j in robot.joints if j.type != "floating"]
-    assert seen == {
-        (j, q) for j in moving for q in ("position", "torque" if robot.spec.joints[j].type != "prismatic" else "force")
-    }
+    for joint in robot.joints:
+        if joint.type == "floating":
+            continue
+        for quantity in ("position", "force" if joint.type == "prismatic" else "torque"):
+            if (joint.name, quantity) not in seen:
+                problems.append(f"{joint.name} {quantity} missing")
+    return problems
+
+
+@pytest.mark.parametrize("name", ["rp_arm", "panda", "solo12"])
+def test_plotted_curves_are_the_trajectory_columns(runs, name):
+    robot, trajectory, figure = _figure_of(runs, name)
+    assert column_problems(figure, robot, trajectory) == []
     if robot.floating_base:  # the old bug: a joint curve was the base height
+        moving = {j.name for j in robot.joints if j.type != "floating"}
         curves = [line.get_ydata() for axis in figure.axes for line in axis.get_lines() if line.get_label() in moving]
         assert not any(np.array_equal(c, trajectory.q[:, 2]) for c in curves)
+
+
+def test_column_checker_finds_the_old_offset_bug(runs):  # negative control
+    robot, trajectory, figure = _figure_of(runs, "solo12")
+    offset = robot.nq - robot.nv  # the old code drew column index + nq - nv
+    for axis in figure.axes:
+        for line in axis.get_lines():
+            if line.get_label() in robot.spec.joints and axis.get_ylabel().startswith("position"):
+                index = robot.joint_names.index(line.get_label())
+                line.set_ydata(trajectory.q[:, index + offset])
+    assert len(column_problems(figure, robot, trajectory)) == 12
+
+
+def test_hostile_joint_names_are_drawn_literally():
+    urdf = """<robot name="r$x$"><link name="a"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <link name="b"><inertial><origin xyz="0 0 0.3"/><mass value="0.5"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="j$\\frac{1}{0}$&#x9b;[31m" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0.6 0.8"/>
+      <limit lower="-1" upper="1" effort="5" velocity="2"/></joint></robot>"""
+    robot = robodyn.load(urdf)
+    trajectory, _ = run_simulation(robot, duration=0.1, dt=1e-2, q0=[0.2])
+    figure = simulation_figure(robot, trajectory)
+    assert text_overlaps(figure) == []  # draws (no mathtext error)
+    texts = [t.get_text() for legend in figure.legends for t in legend.get_texts()]
+    assert "j\\$\\frac{1}{0}\\$?[31m" in texts
 
 
 def test_limits_are_drawn_as_bands(runs):
