@@ -30,15 +30,8 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
-from robodyn.viz.scene import (
-    axis_commands,
-    build_scene,
-    camera_commands,
-    lower_animation,
-    motion,
-    pose_commands,
-    task_commands,
-)
+from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands
+from robodyn.viz.task import axis_commands, task_commands
 
 _PAGE = """<!DOCTYPE html>
 <html>

@@ -1,6 +1,6 @@
 """Watching motions: one import for the scene, recordings, stills and the live viewer.
 
-The work is split by concern: :mod:`robodyn.viz.scene` (meshcat scenes, the task drawing),
+The work is split by concern: :mod:`robodyn.viz.scene` (meshcat scenes), :mod:`robodyn.viz.task` (the task drawing),
 :mod:`robodyn.viz.recording` (self-contained HTML, :class:`Recording`),
 :mod:`robodyn.viz.stills` (headless Chromium: stills, filmstrips, videos) and
 :mod:`robodyn.viz.live` (the live viewer). This module re-exports their public names.
@@ -17,15 +17,16 @@ from robodyn.viz.scene import (
     link_placements,
     pose_commands,
     scene_commands,
-    task_commands,
 )
 from robodyn.viz.stills import CHROMIUM_FLAGS, capture, chromium, screenshot
+from robodyn.viz.task import axis_commands, task_commands
 
 __all__ = [
     "CHROMIUM_FLAGS",
     "LiveViewer",
     "Recording",
     "animation_command",
+    "axis_commands",
     "build_scene",
     "camera_commands",
     "capture",
