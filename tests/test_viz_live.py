@@ -90,3 +90,30 @@ def test_requests_from_other_origins_are_refused():
         assert _get(port, good, origin=f"http://127.0.0.1:{port + 1}", websocket=True) == 403
     assert (signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGHUP)) == previous
     assert _wait_closed(port)
+
+
+def test_a_loopback_websocket_gets_the_scene():
+    import asyncio
+
+    import numpy as np
+    import tornado.httpclient
+    import tornado.websocket
+
+    import robodyn
+
+    robot = robodyn.load("rp_arm")
+    with LiveViewer() as viewer:
+        viewer.show(robot, target=np.array([0.5, 0.5]))
+        port = int(re.search(r":(\d+)/", viewer.url).group(1))
+
+        async def first_messages(origin: str) -> list[bytes]:
+            request = tornado.httpclient.HTTPRequest(f"ws://127.0.0.1:{port}/", headers={"Origin": origin})
+            connection = await tornado.websocket.websocket_connect(request)
+            messages = [await asyncio.wait_for(connection.read_message(), 5) for _ in range(3)]
+            connection.close()
+            return messages
+
+        messages = asyncio.run(first_messages(f"http://127.0.0.1:{port}"))
+        assert all(isinstance(m, bytes) and len(m) > 10 for m in messages)
+        with pytest.raises(tornado.httpclient.HTTPClientError, match="403"):
+            asyncio.run(first_messages(f"http://evil.example:{port}"))

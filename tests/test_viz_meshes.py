@@ -119,3 +119,13 @@ def test_record_command_warns_in_one_line_and_does_not_block_on_a_fifo(tmp_path)
     assert len(lines) == 2 and all(line.startswith("robodyn: warning: link ") for line in lines)
     assert "not a regular file" in result.stderr and "not a valid DAE" in result.stderr
     assert (tmp_path / "m.html").stat().st_size > 100_000
+
+
+def test_record_command_cap_option(tmp_path):
+    from robodyn.cli.app import main
+
+    robot = _robot(tmp_path, "good.stl")
+    _motion(robot).save(tmp_path / "m.npz")
+    command = ["record", str(tmp_path / "meshy.urdf"), "--trajectory", str(tmp_path / "m.npz"), "--out", str(tmp_path / "m.html")]
+    assert main([*command, "--max-mesh-mb", "0.0001"]) == 0  # 100 bytes: both meshes become placeholders
+    assert main([*command, "--max-mesh-mb", "-1"]) == 2

@@ -28,6 +28,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--filmstrip", type=int, metavar="N", help="with --png: N frames evenly over the motion, side by side")
     parser.add_argument("--mp4", help="an MP4 video of the motion (needs Chromium and the viewer extra)")
     parser.add_argument("--gif", help="an animated GIF of the motion (needs Chromium and the viewer extra)")
+    parser.add_argument(
+        "--max-mesh-mb",
+        type=float,
+        help="largest mesh file drawn, in MB (default 64 or ROBODYN_MAX_MESH_MB); larger: a placeholder",
+    )
     parser.add_argument("--video-fps", type=float, default=15.0, help="frames per second of --mp4/--gif (default 15)")
     parser.set_defaults(run=run)
 
@@ -37,6 +42,8 @@ def run(arguments: argparse.Namespace) -> int:
     from robodyn.viz.mesh_files import MeshWarning
     from robodyn.viz.recording import recording
 
+    if arguments.max_mesh_mb is not None and not arguments.max_mesh_mb > 0:
+        raise InputError("--max-mesh-mb", "a positive size in MB", f"{arguments.max_mesh_mb:g}")
     if arguments.filmstrip is not None and not arguments.png:
         raise InputError("--filmstrip", "given with --png FILE (the filmstrip's file)", "no --png")
     if arguments.filmstrip is not None and arguments.at != 0.0:
@@ -47,7 +54,8 @@ def run(arguments: argparse.Namespace) -> int:
     with warnings.catch_warnings():  # reported below, one line each
         warnings.simplefilter("ignore", MeshWarning)
         axes = tuple(name for name in (arguments.axes or "").split(",") if name)
-        made = recording(robot, trajectory, fps=arguments.fps, target=arguments.target, frame=arguments.frame, axes=axes)
+        cap = {} if arguments.max_mesh_mb is None else {"max_mesh_bytes": int(arguments.max_mesh_mb * 1e6)}
+        made = recording(robot, trajectory, fps=arguments.fps, target=arguments.target, frame=arguments.frame, axes=axes, **cap)
     for reason in made.placeholders:
         print(f"robodyn: warning: {reason}; drawn as a placeholder box", file=sys.stderr)
     if arguments.png:  # stills before the HTML is written: a failed still leaves no half result
