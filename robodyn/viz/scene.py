@@ -33,8 +33,8 @@ ROOT_PATH = ("robodyn",)
 DEFAULT_COLOR = 0xB0B8C0
 PLACEHOLDER_COLOR = 0xFF00FF
 PLACEHOLDER_SIZE = 0.05
-#: Vertical field of view of meshcat's default camera, in [deg].
-CAMERA_FOV = 75.0
+#: Vertical field of view of the camera, in [deg] (meshcat's default 75° distorts the edges).
+CAMERA_FOV = 45.0
 _UNIT_CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 
 
@@ -262,14 +262,18 @@ def camera_commands(points: np.ndarray, *, fov_deg: float = CAMERA_FOV, margin: 
     """Aim meshcat's camera at the points' bounding sphere so that all of it is in view.
 
     The distance is ``margin × radius / sin(fov / 2)``: the sphere fits the vertical field
-    of view (the narrower one for a landscape picture). Meshcat's own grid is hidden (the
-    task grid replaces it).
+    of view (the narrower one for a landscape picture). A motion in the x-z plane (a planar
+    arm) is seen from the side, anything else from a corner above. Meshcat's own grid is
+    hidden (the task grid replaces it).
     """
     low, high = points.min(axis=0), points.max(axis=0)
     centre = (low + high) / 2
     radius = max(float(np.linalg.norm(high - low)) / 2, 0.05)
     distance = margin * radius / np.sin(np.radians(fov_deg) / 2)
-    direction = np.array([0.8, 0.6, 0.8]) / np.linalg.norm([0.8, 0.6, 0.8])
+    span = high - low
+    planar = span[1] < 0.25 * max(span[0], span[2])
+    direction = np.array([0.25, 0.35, 1.0] if planar else [0.8, 0.6, 0.8])
+    direction /= np.linalg.norm(direction)
     target = np.eye(4)
     target[:3, 3] = centre
     # The camera node's frame is y-up: (x, y, z) here is (x, z, -y) in the world.
@@ -277,5 +281,6 @@ def camera_commands(points: np.ndarray, *, fov_deg: float = CAMERA_FOV, margin: 
     return [
         SetTransform(target, path=MeshcatPath(("Cameras", "default"))).lower(),
         SetProperty("position", (distance * direction).tolist(), path=camera).lower(),
+        SetProperty("fov", fov_deg, path=camera).lower(),
         SetProperty("visible", False, path=MeshcatPath(("Grid",))).lower(),
     ]
