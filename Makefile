@@ -14,12 +14,15 @@ $(STAMP): pyproject.toml requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	touch $(STAMP)
 
-# Headless Chromium renders recordings (stills, and the browser test). Debian's package,
-# installed when missing and we may (root with apt); otherwise those steps say so.
+# Headless Chromium renders recordings (stills, filmstrips, videos, the browser tests).
+# Debian's package, installed when missing and we may (root with apt); otherwise those
+# steps say so. The flags robodyn runs it with: CHROMIUM_FLAGS in robodyn/viz/stills.py
+# (ROBODYN_CHROMIUM picks another browser). Videos encode with imageio-ffmpeg (in the lock).
 chromium:
 	@command -v chromium >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
 		(apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) || \
-		echo "note: no chromium (install Debian's 'chromium' for stills and the browser test)"; }
+		echo "note: no chromium (install Debian's 'chromium' for stills, videos and the browser tests)"; }
+	@command -v chromium >/dev/null 2>&1 && chromium --version 2>/dev/null | head -1 || true
 
 # The main job on the built-in robot: the RP arm's equations, then the lecture's control
 # story (drive the end effector to a target) as trajectory, plot, animation and still.

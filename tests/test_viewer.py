@@ -20,7 +20,7 @@ import robodyn
 from robodyn import RobodynError
 from robodyn.cli.app import main
 from robodyn.sim.simulation import Trajectory, simulate
-from robodyn.viz.viewer import chromium, record, screenshot
+from robodyn.viz.viewer import capture, chromium, record, screenshot
 from tests.conftest import ROOT
 
 
@@ -51,7 +51,7 @@ def test_recording_is_self_contained_and_sends_each_shape_once(swinging, tmp_pat
         html = record(robot, motion, tmp_path / f"{name}.html").read_text()
         assert "MeshCat.Viewer" in html and "http://" not in html.split("<script>")[0]
         commands = commands_of(html)
-        counts.append(sum(c["type"] == "set_object" for c in commands))
+        counts.append(sum(c["type"] == "set_object" and c["path"].startswith("/robodyn/") for c in commands))
         animation = [c for c in commands if c["type"] == "set_animation"]
         assert len(animation) == 1 and animation[0]["options"]["play"] is True
         keys = animation[0]["animations"][0]["clip"]["tracks"][0]["keys"]
@@ -65,7 +65,7 @@ def test_zoo_meshes_are_embedded(tmp_path):
         np.array([0.0, 0.1]), np.zeros((2, 6)), np.zeros((2, 6)), np.zeros((2, 6)), np.zeros((2, 6)), robot.joint_names, "ur5"
     )
     commands = commands_of(record(robot, trajectory, tmp_path / "ur5.html").read_text())
-    meshes = [c for c in commands if c["type"] == "set_object"]
+    meshes = [c for c in commands if c["type"] == "set_object" and c["path"].startswith("/robodyn/")]
     assert len(meshes) == 7 and all(c["object"]["geometries"][0]["type"] == "_meshfile" for c in meshes)
 
 
@@ -130,23 +130,24 @@ def _need_chromium():
         pytest.skip("no Chromium here (make test installs it)")
 
 
-def _drawn_pixels(png_path) -> np.ndarray:
+def _drawn_pixels(png_or_image) -> np.ndarray:
     import matplotlib.image
 
-    image = matplotlib.image.imread(png_path)[..., :3]
+    image = png_or_image / 255.0 if isinstance(png_or_image, np.ndarray) else matplotlib.image.imread(png_or_image)[..., :3]
     # The background is a vertical blue gradient: compare each pixel with its row's mode.
     background = np.median(image, axis=1, keepdims=True)
     return np.abs(image - background).sum(axis=2) > 0.15
 
 
+@pytest.mark.slow  # tests/test_viz_browser.py keeps a browser test in the fast tier
 def test_recording_plays_in_a_real_browser(swinging, tmp_path):
     _need_chromium()
     robot, trajectory = swinging
     html = record(robot, trajectory, tmp_path / "swing.html", png=tmp_path / "poster.png")
-    early, late = tmp_path / "early.png", tmp_path / "late.png"
-    screenshot(html, early, at_seconds=0.3)
-    screenshot(html, late, at_seconds=1.3)
+    early, late = capture(html, [0.3, 1.3], size=(800, 600))
     drawn_early, drawn_late = _drawn_pixels(early), _drawn_pixels(late)
     assert drawn_early.sum() > 500 and drawn_late.sum() > 500  # the robot is drawn
     assert (drawn_early ^ drawn_late).sum() > 300  # and it moved
     assert _drawn_pixels(tmp_path / "poster.png").sum() > 500
+    screenshot(html, tmp_path / "again.png", at_seconds=0.3)  # the file-based still is the same frame
+    assert np.array_equal(_drawn_pixels(tmp_path / "again.png"), drawn_early)

@@ -418,3 +418,9 @@ class Robot(Kinematics):
             energy = per_state(lambda qi: np.array(pin.computePotentialEnergy(mimic.model, mimic.data, mimic.q(qi))), q)
         energy = self._finite(np.asarray(energy), "potential energy")
         return energy if batch else float(energy)
+
+    def _repr_html_(self) -> str:
+        """The robot as an HTML table in notebooks (:func:`robodyn.dynamics.display.robot_html`)."""
+        from robodyn.dynamics.display import robot_html
+
+        return robot_html(self)

@@ -1,92 +1,361 @@
-"""Figures (matplotlib PNG, headless): a simulation's story and the what-if sweep.
+"""Figures (matplotlib, headless): a simulation's story and the what-if sweep.
 
-Every axis is labelled with its unit. Files are written atomically.
+Each figure is a :class:`matplotlib.figure.Figure` on its own Agg canvas, made with the
+object-oriented API: no global matplotlib state (backend, ``pyplot`` figures) is touched,
+so the figures are safe inside notebooks and other programs. ``*_figure`` functions return
+the figure (to show inline or inspect); ``plot_*`` write it as a PNG, atomically.
+
+Conventions:
+    - one axis a quantity and unit: positions in [rad] (revolute, continuous joints) and
+      [m] (prismatic joints, the floating base), torques in [N m] and forces in [N];
+    - a joint has one colour in every panel; the legend sits outside the data;
+    - position and effort limits are drawn as a light band in the joint's colour (with
+      dashed edges), and the axis is widened to show a limit close to the motion;
+    - :func:`text_overlaps` finds text that collides or leaves the figure (the tests run it
+      on every figure; :func:`whatif_figure` uses it to tilt crowded tick labels).
 """
 
 from __future__ import annotations
 
 import io
+import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.transforms import Bbox
 
 from robodyn.common.files import atomic_write_bytes
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
 
-
-def _figure(rows: int, columns: int = 1, size: tuple[float, float] = (8.0, 9.0)):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(rows, columns, figsize=size, squeeze=False)
+DPI = 110
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 
 
-def _save(figure, path: str | Path) -> Path:
-    import matplotlib.pyplot as plt
+def text_label(name: str) -> str:
+    """A name as matplotlib draws it literally: ``$`` escaped (no mathtext), control characters as ``?``."""
+    return _CONTROL.sub("?", str(name)).replace("$", r"\$")
 
+
+def new_figure(width: float, height: float) -> Figure:
+    """A figure with constrained layout on its own Agg canvas (sizes in [inch])."""
+    figure = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def save_png(figure: Figure, path: str | Path) -> Path:
+    """Write a figure as PNG, atomically."""
     buffer = io.BytesIO()
-    figure.tight_layout()
-    figure.savefig(buffer, format="png", dpi=110)
-    plt.close(figure)
+    figure.savefig(buffer, format="png", dpi=DPI)
     return atomic_write_bytes(path, buffer.getvalue())
 
 
-def _unit(robot: Robot, index: int, revolute: str, prismatic: str) -> str:
-    joint = robot.joints[index] if index < len(robot.joints) else None
-    return prismatic if joint is not None and joint.type == "prismatic" else revolute
+# --------------------------------------------------------------------------------------
+# Which column is which joint, and its units
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Dof:
+    """One actuated degree of freedom as plotted.
+
+    Attributes:
+        name: Joint name.
+        q_column, v_column: Column in ``Trajectory.q`` and in ``v``/``a``/``tau``.
+        linear: Prismatic (positions in [m], efforts in [N]) or not ([rad], [N m]).
+        lower, upper: Position limits (±inf when unlimited).
+        effort: Effort limit (inf when not given).
+    """
+
+    name: str
+    q_column: int
+    v_column: int
+    linear: bool
+    lower: float
+    upper: float
+    effort: float
+
+    @property
+    def position_unit(self) -> str:
+        return "m" if self.linear else "rad"
+
+    @property
+    def effort_unit(self) -> str:
+        return "N" if self.linear else "N m"
+
+    @property
+    def effort_word(self) -> str:
+        return "force" if self.linear else "torque"
+
+
+def joint_dofs(robot: Robot) -> list[Dof]:
+    """The robot's joints (not the floating base) with their columns, read from the model."""
+    dofs = []
+    for joint in robot.joints:
+        if joint.type == "floating":
+            continue
+        model_joint = robot.model.joints[robot.model.getJointId(joint.name)]
+        dofs.append(
+            Dof(
+                joint.name,
+                model_joint.idx_q,
+                model_joint.idx_v,
+                joint.type == "prismatic",
+                joint.lower,
+                joint.upper,
+                joint.effort,
+            )
+        )
+    return dofs
+
+
+# --------------------------------------------------------------------------------------
+# Limits
+# --------------------------------------------------------------------------------------
+def _band(axis: Axes, lower: float, upper: float, color, alpha: float) -> None:
+    if not (np.isfinite(lower) or np.isfinite(upper)):
+        return
+    low = lower if np.isfinite(lower) else -1e300
+    high = upper if np.isfinite(upper) else 1e300
+    axis.axhspan(low, high, color=color, alpha=alpha, linewidth=0, zorder=0)
+    for edge in (lower, upper):
+        if np.isfinite(edge):
+            axis.axhline(edge, color=color, linestyle="--", linewidth=0.8, alpha=0.7, zorder=1)
+
+
+def _fit(axis: Axes, data: list[np.ndarray], limits: list[float]) -> None:
+    """Y range: the data with a margin, widened to a limit within a quarter span of it."""
+    values = np.concatenate([np.ravel(d) for d in data])
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return
+    low, high = float(values.min()), float(values.max())
+    span = max(high - low, 0.05 * max(abs(low), abs(high)), 0.02)
+    for limit in limits:
+        if np.isfinite(limit) and low - 0.25 * span <= limit <= high + 0.25 * span:
+            low, high = min(low, limit), max(high, limit)
+    span = max(high - low, span)
+    axis.set_ylim(low - 0.08 * span, high + 0.08 * span)
+
+
+# --------------------------------------------------------------------------------------
+# The simulation figure
+# --------------------------------------------------------------------------------------
+def simulation_figure(
+    robot: Robot, trajectory: Trajectory, *, frame: str | None = None, target: np.ndarray | None = None
+) -> Figure:
+    """Joint positions, joint torques / forces, the frame's distance to its target, energy.
+
+    Args:
+        robot: The robot the trajectory belongs to.
+        trajectory: ``t`` in [s]; ``q`` shape (N, nq); ``v``, ``tau`` shape (N, nv).
+        frame: With ``target``: the frame whose distance to the target is drawn.
+        target: Target position in [m], shape (3,).
+
+    Returns:
+        The figure: one panel a quantity and unit; revolute and prismatic joints apart.
+    """
+    dofs = joint_dofs(robot)
+    revolute = [d for d in dofs if not d.linear]
+    prismatic = [d for d in dofs if d.linear]
+    panels: list[tuple[str, list[Dof]]] = []
+    if revolute:
+        panels.append(("position [rad]", revolute))
+    if prismatic or robot.floating_base:
+        panels.append(("position [m]", prismatic))
+    if revolute:
+        panels.append(("torque [N m]", revolute))
+    if prismatic:
+        panels.append(("force [N]", prismatic))
+    task = frame is not None and target is not None
+    rows = len(panels) + 1 + int(task)
+    figure = new_figure(9.0, 1.9 * rows + 0.6)
+    axes = figure.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
+    t = trajectory.t
+    colors = {d.name: f"C{i % 10}" for i, d in enumerate(dofs)}
+    for axis, (ylabel, group) in zip(axes, panels, strict=False):
+        effort = ylabel.startswith(("torque", "force"))
+        data, limits = [], []
+        for dof in group:
+            column = trajectory.tau[:, dof.v_column] if effort else trajectory.q[:, dof.q_column]
+            axis.plot(t, column, color=colors[dof.name], label=text_label(dof.name), linewidth=1.3)
+            low, high = (-dof.effort, dof.effort) if effort else (dof.lower, dof.upper)
+            _band(axis, low, high, colors[dof.name], min(0.07, 0.2 / len(group)))
+            data.append(column)
+            limits += [low, high]
+        if ylabel == "position [m]" and robot.floating_base:
+            for k, (axis_name, style) in enumerate(zip("xyz", (":", "-.", "--"), strict=True)):
+                column = trajectory.q[:, k]
+                axis.plot(t, column, color="0.3", linestyle=style, label=f"base {axis_name}", linewidth=1.3)
+                data.append(column)
+        _fit(axis, data, limits)
+        axis.set_ylabel(ylabel)
+        axis.grid(alpha=0.3)
+    row = len(panels)
+    if task:
+        error = np.linalg.norm(robot.frame_position(trajectory.q, frame) - np.asarray(target, dtype=float), axis=1)
+        axes[row].semilogy(t, np.maximum(error, 1e-16), color="tab:red", label=f"|{text_label(frame)} − target|")
+        axes[row].set_ylabel("distance [m]")
+        axes[row].grid(alpha=0.3, which="both")
+        row += 1
+    kinetic = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v))
+    potential = np.atleast_1d(robot.potential_energy(trajectory.q))
+    axes[row].plot(t, kinetic, label="kinetic", color="black", linestyle="--")
+    axes[row].plot(t, potential, label="potential", color="black", linestyle=":")
+    axes[row].plot(t, kinetic + potential, label="total", color="black")
+    axes[row].set_ylabel("energy [J]")
+    axes[row].grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    # One legend for the joints (a colour each, shared by every panel), one for the rest.
+    handles, labels = [], []
+    for axis in axes:
+        for handle, label in zip(*axis.get_legend_handles_labels(), strict=True):
+            if label not in labels:
+                handles.append(handle)
+                labels.append(label)
+    figure.legend(handles, labels, loc="outside right upper", fontsize="small", title="shaded: limits", title_fontsize="small")
+    figure.suptitle(f"{text_label(robot.name)}: simulation, {t[-1] - t[0]:.3g} s")
+    return figure
 
 
 def plot_simulation(
     robot: Robot, trajectory: Trajectory, path: str | Path, *, frame: str | None = None, target: np.ndarray | None = None
 ) -> Path:
-    """Joint positions, torques, the frame's distance to its target, and energy over time."""
-    figure, axes = _figure(4)
-    t = trajectory.t
-    offset = robot.nq - robot.nv
-    for index, name in enumerate(robot.joint_names):
-        if robot.joints[index].type == "floating":
-            continue
-        axes[0, 0].plot(t, trajectory.q[:, index + offset], label=f"{name} [{_unit(robot, index, 'rad', 'm')}]")
-        axes[1, 0].plot(t, trajectory.tau[:, index + offset], label=f"{name} [{_unit(robot, index, 'N m', 'N')}]")
-    axes[0, 0].set_ylabel("joint position [rad] / [m]")
-    axes[1, 0].set_ylabel("joint torque [N m] / force [N]")
-    for axis in axes[:2, 0]:
-        axis.legend(fontsize="small", ncol=2)
-    if frame is not None and target is not None:
-        error = np.linalg.norm(robot.frame_position(trajectory.q, frame) - np.asarray(target), axis=1)
-        axes[2, 0].semilogy(t, np.maximum(error, 1e-16))
-        axes[2, 0].set_ylabel(f"|{frame} − target| [m]")
-    else:
-        axes[2, 0].text(0.5, 0.5, "no task-space target", ha="center", va="center", transform=axes[2, 0].transAxes)
-    kinetic = robot.kinetic_energy(trajectory.q, trajectory.v)
-    potential = robot.potential_energy(trajectory.q)
-    axes[3, 0].plot(t, kinetic, label="kinetic")
-    axes[3, 0].plot(t, potential, label="potential")
-    axes[3, 0].plot(t, kinetic + potential, label="total", color="black")
-    axes[3, 0].set_ylabel("energy [J]")
-    axes[3, 0].set_xlabel("time [s]")
-    axes[3, 0].legend(fontsize="small")
-    axes[0, 0].set_title(f"{robot.name}: simulation")
-    return _save(figure, path)
+    """Write :func:`simulation_figure` as a PNG (atomically) and return its path."""
+    return save_png(simulation_figure(robot, trajectory, frame=frame, target=target), path)
 
 
-def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path) -> Path:
-    """Peak and RMS torque of each joint, one bar a variant (material, payload, force)."""
-    figure, axes = _figure(len(joint_names), 1, (9.0, 3.2 * len(joint_names)))
+# --------------------------------------------------------------------------------------
+# The what-if figure
+# --------------------------------------------------------------------------------------
+def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limits: list[float] | None = None) -> Figure:
+    """Peak and RMS effort of each joint, a pair of bars a variant (material, payload, force).
+
+    Args:
+        rows: :class:`robodyn.sim.whatif.Variant` rows (``peak``, ``rms`` shape (nv,)).
+        joint_names: One name a column of ``peak``.
+        units: ``"N m"`` (a torque) or ``"N"`` (a force) a column.
+        effort_limits: Effort limit a column (drawn as a dashed line when finite).
+    """
+    if len(joint_names) != len(units) or any(len(r.peak) != len(units) for r in rows):
+        raise RobodynError(
+            f"the what-if plot needs one joint name a unit and a column: {len(joint_names)} names, {len(units)} units."
+        )
     labels = [
-        f"{r.material}\n{r.payload:g} kg" + (f"\nF={','.join(f'{f:g}' for f in r.force)}" if np.any(r.force) else "")
+        f"{r.material}\n{r.payload:g} kg" + (f"\nF={','.join(f'{f:g}' for f in r.force)} N" if np.any(r.force) else "")
         for r in rows
     ]
+    count = len(joint_names)
+    figure = new_figure(min(max(7.0, 0.75 * len(rows) + 3.5), 12.0), 2.2 * count + 1.4)
+    axes = figure.subplots(count, 1, sharex=True, squeeze=False)[:, 0]
     positions = np.arange(len(rows))
     for index, (name, unit) in enumerate(zip(joint_names, units, strict=True)):
-        axis = axes[index, 0]
-        axis.bar(positions - 0.2, [r.peak[index] for r in rows], width=0.4, label="peak |torque|")
-        axis.bar(positions + 0.2, [r.rms[index] for r in rows], width=0.4, label="RMS torque")
-        axis.set_xticks(positions, labels, fontsize="x-small")
-        axis.set_ylabel(f"{name} [{unit}]")
-        axis.legend(fontsize="small")
-    axes[0, 0].set_title("What if: link material and payload over one motion")
-    return _save(figure, path)
+        axis = axes[index]
+        word = "force" if unit == "N" else "torque"
+        axis.bar(positions - 0.2, [r.peak[index] for r in rows], width=0.4, color="C0", label="peak |effort|")
+        axis.bar(positions + 0.2, [r.rms[index] for r in rows], width=0.4, color="C1", label="RMS effort")
+        limit = effort_limits[index] if effort_limits is not None else np.inf
+        if np.isfinite(limit):
+            axis.axhline(limit, color="red", linestyle="--", linewidth=1.0, label="effort limit")
+        axis.set_ylabel(f"{text_label(name)}\n{word} [{unit}]")
+        axis.grid(axis="y", alpha=0.3)
+    axes[-1].set_xticks(positions, labels, fontsize="small")
+    handles, legend_labels = [], []
+    for axis in axes:
+        for handle, label in zip(*axis.get_legend_handles_labels(), strict=True):
+            if label not in legend_labels:
+                handles.append(handle)
+                legend_labels.append(label)
+    figure.legend(handles, legend_labels, loc="outside right upper", fontsize="small")
+    figure.suptitle("What if: link material, payload and force, over one motion")
+    for angle in (45, 90):  # crowded: one line a label, tilted
+        if not any("tick" in a and "tick" in b for a, b in text_overlaps(figure)):
+            break
+        axes[-1].set_xticks(positions, [label.replace("\n", ", ") for label in labels], fontsize="small")
+        for label in axes[-1].get_xticklabels():
+            label.set(rotation=angle, horizontalalignment="right", rotation_mode="anchor")
+    return figure
+
+
+def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path, **options) -> Path:
+    """Write :func:`whatif_figure` as a PNG (atomically) and return its path."""
+    return save_png(whatif_figure(rows, joint_names, units, **options), path)
+
+
+# --------------------------------------------------------------------------------------
+# Layout check: text that collides or leaves the figure
+# --------------------------------------------------------------------------------------
+def _visible_ticks(axis) -> list:
+    low, high = sorted(axis.get_view_interval())
+    tolerance = 1e-9 * (high - low)
+    locations = axis.get_majorticklocs()
+    labels = []
+    for tick, location in zip(axis.get_major_ticks(len(locations)), locations, strict=True):
+        if low - tolerance <= location <= high + tolerance:
+            labels += [label for label in (tick.label1, tick.label2) if label.get_visible() and label.get_text()]
+    return labels
+
+
+def text_boxes(figure: Figure) -> list[tuple[str, Bbox]]:
+    """Every visible text and legend of a figure with its box in display pixels (draws it)."""
+    if not isinstance(figure.canvas, FigureCanvasAgg):
+        FigureCanvasAgg(figure)
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    boxes: list[tuple[str, object]] = []
+    for number, axis in enumerate(figure.axes):
+        if not axis.get_visible():
+            continue
+        texts = [
+            ("title", axis.title),
+            ("xlabel", axis.xaxis.label),
+            ("ylabel", axis.yaxis.label),
+            ("x offset", axis.xaxis.get_offset_text()),
+            ("y offset", axis.yaxis.get_offset_text()),
+            *(("text", text) for text in axis.texts),
+        ]
+        texts += [("x tick", label) for label in _visible_ticks(axis.xaxis)]
+        texts += [("y tick", label) for label in _visible_ticks(axis.yaxis)]
+        boxes += [(f"axes {number} {kind} {artist.get_text()!r}", artist) for kind, artist in texts]
+        if axis.get_legend() is not None:
+            boxes.append((f"axes {number} legend", axis.get_legend()))
+    boxes += [(f"figure legend {i}", legend) for i, legend in enumerate(figure.legends)]
+    boxes += [(f"figure text {text.get_text()!r}", text) for text in figure.texts if text is not figure._suptitle]
+    if figure._suptitle is not None:
+        boxes.append((f"suptitle {figure._suptitle.get_text()!r}", figure._suptitle))
+    found = []
+    for name, artist in boxes:
+        if artist.get_visible() and (not hasattr(artist, "get_text") or artist.get_text()):
+            found.append((name, artist.get_window_extent(renderer)))
+    return found
+
+
+def text_overlaps(figure: Figure, *, tolerance: float = 0.5) -> list[tuple[str, str]]:
+    """Pairs of texts/legends whose boxes intersect, legends over a plot, text cut off.
+
+    Args:
+        figure: The figure (it is drawn to measure).
+        tolerance: Overlap in [pixel] forgiven on each side.
+
+    Returns:
+        ``(a, b)`` descriptions of each problem; empty for a clean layout.
+    """
+    boxes = text_boxes(figure)
+    problems = []
+    for i, (name_a, a) in enumerate(boxes):
+        shrunk = Bbox.from_extents(a.x0 + tolerance, a.y0 + tolerance, a.x1 - tolerance, a.y1 - tolerance)
+        for name_b, b in boxes[i + 1 :]:
+            if shrunk.overlaps(b):
+                problems.append((name_a, name_b))
+        if a.x0 < -tolerance or a.y0 < -tolerance or a.x1 > figure.bbox.x1 + tolerance or a.y1 > figure.bbox.y1 + tolerance:
+            problems.append((name_a, "the figure's edge"))
+    for name, box in boxes:
+        if "legend" in name:
+            for number, axis in enumerate(figure.axes):
+                if box.overlaps(axis.get_window_extent()):
+                    problems.append((name, f"axes {number} data"))
+    return problems
