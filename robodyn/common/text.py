@@ -32,14 +32,20 @@ def one_line_warnings() -> Iterator[None]:
     """Show each :class:`~robodyn.exceptions.RobodynWarning` as one escaped stderr line.
 
     ``robodyn: warning: <message>`` instead of Python's two-line ``file:line: category``
-    format; other warnings keep Python's format. The previous hook is restored on exit.
+    format, each problem once (robodyn and the reference may both find it); other warnings
+    keep Python's format. The previous hook is restored on exit.
     """
     with warnings.catch_warnings():
         previous = warnings.showwarning
+        shown: set[str] = set()
 
         def show(message, category, filename, lineno, file=None, line=None):
             if issubclass(category, RobodynWarning):
-                print(f"robodyn: warning: {printable(message)}", file=file or sys.stderr)
+                text = printable(message)
+                problem = text.split(": ", 1)[-1]  # the same problem found by two loaders: once
+                if problem not in shown:
+                    shown.add(problem)
+                    print(f"robodyn: warning: {text}", file=file or sys.stderr)
             else:
                 previous(message, category, filename, lineno, file, line)
 
