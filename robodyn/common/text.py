@@ -27,6 +27,12 @@ def is_printable(text: str) -> bool:
     return printable(text) == text
 
 
+def printable_lines(text: object) -> str:
+    """Multi-line text (a table, a report) with :func:`printable` applied to each line:
+    its own line breaks are kept, any other control character is escaped."""
+    return "\n".join(printable(line) for line in str(text).split("\n"))
+
+
 @contextlib.contextmanager
 def one_line_warnings() -> Iterator[None]:
     """Show each :class:`~robodyn.exceptions.RobodynWarning` as one escaped stderr line.
@@ -53,4 +59,4 @@ def one_line_warnings() -> Iterator[None]:
         yield
 
 
-__all__ = ["is_printable", "one_line_warnings", "printable", "quoted"]
+__all__ = ["is_printable", "one_line_warnings", "printable", "printable_lines", "quoted"]
