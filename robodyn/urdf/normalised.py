@@ -55,6 +55,7 @@ def _ordered_joints(spec: URDFSpec) -> list[JointSpec]:
         return names
 
     sources = {joint.mimic.joint for joint in spec.joints.values() if joint.mimic is not None and joint.type != "fixed"}
+
     def ordered(link: str) -> list[JointSpec]:
         siblings = children.get(link, [])
         if sources and len(siblings) > 1:
