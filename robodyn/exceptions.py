@@ -90,7 +90,8 @@ class UnknownRobotError(RobodynError, LookupError):
         self.suggestions = list(suggestions or [])
         hint = f" (did you mean {', '.join(self.suggestions)}?)" if self.suggestions else ""
         super().__init__(
-            f"unknown robot {name!r}: not a file, URDF text, zoo robot or generated robot{hint}; 'robodyn list' shows the names."
+            f"unknown robot {quoted(name if len(name) <= 200 else name[:200] + '...')}: not a file, URDF text, zoo robot"
+            f" or generated robot{hint}; 'robodyn list' shows the names."
         )
 
 

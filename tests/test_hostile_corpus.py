@@ -58,6 +58,14 @@ def test_cli_prints_exactly_one_stderr_line_without_control_characters(name, cap
     assert EXPECTED[name]["fragment"] in err
 
 
+@pytest.mark.parametrize("name", _cases("error"))
+def test_lint_lines_are_printable(name, capsys):
+    assert main(["lint", str(HOSTILE / name)]) in (0, 1, 2)  # max_dof is a load limit, not lint
+    captured = capsys.readouterr()
+    for line in (captured.out + captured.err).splitlines():
+        assert not RAW.search(line), repr(line)
+
+
 @pytest.mark.parametrize("name", _cases("warning"))
 def test_warnings_load_and_strict_refuses(name):
     fragment = EXPECTED[name]["fragment"]

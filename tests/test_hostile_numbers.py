@@ -65,6 +65,16 @@ def urdfs(draw):
             "</inertial></link>"
         )
         truth.append((f"j{i}", xyz, rpy, com, com_rpy, mass, moments))
+    welded = draw(st.integers(0, 2))  # links welded on by fixed joints: Pinocchio merges them
+    for k in range(welded):
+        mass = draw(POSITIVE)
+        xyz = [draw(FINITE) / 10 for _ in range(3)]
+        parts.append(
+            f'<joint name="w{k}" type="fixed"><parent link="l{draw(st.integers(0, count))}"/><child link="w{k}"/>'
+            f'<origin xyz="{" ".join(spell(v) for v in xyz)}"/></joint>'
+            f'<link name="w{k}"><inertial><mass value="{spell(mass)}"/>'
+            f'<inertia ixx="{spell(0.5)}" ixy="0" ixz="0" iyy="{spell(0.5)}" iyz="0" izz="{spell(0.5)}"/></inertial></link>'
+        )
     parts.append("</robot>")
     return "".join(parts), truth
 
@@ -76,6 +86,12 @@ def test_pinocchio_holds_exactly_the_validators_numbers(case):
     spec = parse_urdf(text)
     robot = robodyn.load(text)
     model = robot.model
+    welded_to = {joint.parent for joint in spec.joints.values() if joint.type == "fixed"}
+    total = sum(inertial.mass for inertial in spec.links.values() if inertial is not None)
+    assert sum(body.mass for body in model.inertias) == pytest.approx(total, rel=1e-14)
+    for frame in model.frames:  # fixed joints: their origins as written
+        if frame.name in spec.joints and spec.joints[frame.name].type == "fixed":
+            assert list(frame.placement.translation) == pytest.approx(list(spec.joints[frame.name].origin_xyz), abs=1e-14)
     for name, xyz, rpy, com, _com_rpy, mass, moments in truth:
         joint = spec.joints[name]
         inertial = spec.links[joint.child]
@@ -85,15 +101,17 @@ def test_pinocchio_holds_exactly_the_validators_numbers(case):
         assert list(np.diag(inertial.inertia)) == moments
         # and Pinocchio holds those numbers
         index = model.getJointId(name)
+        placement = model.jointPlacements[index]
+        assert list(placement.translation) == list(joint.origin_xyz)
+        np.testing.assert_allclose(placement.rotation, rpy_matrix(joint.origin_rpy), atol=1e-14)
+        if joint.child in welded_to:  # its body also holds the welded links (checked by the total)
+            continue
         body = model.inertias[index]
         assert body.mass == inertial.mass
         # (Pinocchio composes the inertia's frame: rounding only, no other reading of the text)
         np.testing.assert_allclose(body.lever, inertial.origin_xyz, rtol=1e-13, atol=1e-15)
         rotation = rpy_matrix(inertial.origin_rpy)
         np.testing.assert_allclose(body.inertia, rotation @ inertial.inertia @ rotation.T, rtol=1e-12, atol=1e-14)
-        placement = model.jointPlacements[index]
-        assert list(placement.translation) == list(joint.origin_xyz)
-        np.testing.assert_allclose(placement.rotation, rpy_matrix(joint.origin_rpy), atol=1e-14)
         if joint.type != "continuous":
             assert (joint.lower, joint.upper) == (-1.5, 1.25)
 

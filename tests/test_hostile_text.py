@@ -86,3 +86,10 @@ def test_a_closed_pipe_ends_quietly():
     reader.stdout.close()  # like `robodyn list | head -c 10`
     assert reader.wait(timeout=60) == 0
     assert b"Traceback" not in reader.stderr.read()
+
+
+def test_printable_lines_keeps_line_breaks_only():
+    from robodyn.common.text import printable_lines
+
+    table = "joint  tau\nj\x1b[31m  1.0\nk\u202e\r  2.0"
+    assert printable_lines(table) == "joint  tau\nj\\x1b[31m  1.0\nk\\u202e\\r  2.0"

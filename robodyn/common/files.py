@@ -237,7 +237,7 @@ def _write_temporary(target: Path, data: bytes, given: str) -> Path:
         raise OutputError(given, _reason(error)) from None
     try:
         try:
-            existing = os.stat(target).st_mode & 0o7777
+            existing = os.stat(target).st_mode & 0o777  # never copy setuid/setgid bits
         except FileNotFoundError:
             existing = 0o666 & ~_umask()
         os.fchmod(descriptor, existing)

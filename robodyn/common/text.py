@@ -27,19 +27,31 @@ def is_printable(text: str) -> bool:
     return printable(text) == text
 
 
+def printable_lines(text: object) -> str:
+    """Multi-line text (a table, a report) with :func:`printable` applied to each line:
+    its own line breaks are kept, any other control character is escaped."""
+    return "\n".join(printable(line) for line in str(text).split("\n"))
+
+
 @contextlib.contextmanager
 def one_line_warnings() -> Iterator[None]:
     """Show each :class:`~robodyn.exceptions.RobodynWarning` as one escaped stderr line.
 
     ``robodyn: warning: <message>`` instead of Python's two-line ``file:line: category``
-    format; other warnings keep Python's format. The previous hook is restored on exit.
+    format, each problem once (robodyn and the reference may both find it); other warnings
+    keep Python's format. The previous hook is restored on exit.
     """
     with warnings.catch_warnings():
         previous = warnings.showwarning
+        shown: set[str] = set()
 
         def show(message, category, filename, lineno, file=None, line=None):
             if issubclass(category, RobodynWarning):
-                print(f"robodyn: warning: {printable(message)}", file=file or sys.stderr)
+                text = printable(message)
+                problem = text.split(": ", 1)[-1]  # the same problem found by two loaders: once
+                if problem not in shown:
+                    shown.add(problem)
+                    print(f"robodyn: warning: {text}", file=file or sys.stderr)
             else:
                 previous(message, category, filename, lineno, file, line)
 
@@ -47,4 +59,4 @@ def one_line_warnings() -> Iterator[None]:
         yield
 
 
-__all__ = ["is_printable", "one_line_warnings", "printable", "quoted"]
+__all__ = ["is_printable", "one_line_warnings", "printable", "printable_lines", "quoted"]

@@ -55,15 +55,19 @@ def _ordered_joints(spec: URDFSpec) -> list[JointSpec]:
         return names
 
     sources = {joint.mimic.joint for joint in spec.joints.values() if joint.mimic is not None and joint.type != "fixed"}
+
+    def ordered(link: str) -> list[JointSpec]:
+        siblings = children.get(link, [])
+        if sources and len(siblings) > 1:
+            siblings = _sources_first(siblings, spec, sources, below, subtree)
+        return siblings
+
     order: list[JointSpec] = []
-    stack = list(reversed(children.get(spec.root, [])))
+    stack = list(reversed(ordered(spec.root)))
     while stack:
         joint = stack.pop()
         order.append(joint)
-        siblings = children.get(joint.child, [])
-        if sources and len(siblings) > 1:
-            siblings = _sources_first(siblings, spec, sources, below, subtree)
-        stack += reversed(siblings)
+        stack += reversed(ordered(joint.child))
     return order
 
 
