@@ -27,6 +27,7 @@ chromium:
 # The main job on the built-in robot: the RP arm's equations, then the lecture's control
 # story (drive the end effector to a target) as trajectory, plot, animation and still.
 demo: $(STAMP) chromium
+	mkdir -p out
 	$(BIN)/robodyn equations rp_arm --q 0.5,0.1 --v 1.0,0.2 --a 0.5,-0.3
 	$(BIN)/robodyn simulate rp_arm --controller task-space --q0 0,0.1 --target 0.7,0.7 --duration 3 \
 		--out out/rp_arm.csv --plot out/rp_arm.png --record out/rp_arm.html \
