@@ -129,3 +129,18 @@ class SimulationError(RobodynError):
         super().__init__(
             f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
         )
+
+
+class IdentificationError(RobodynError):
+    """System identification cannot give a trustworthy answer (a rank-deficient excitation,
+    an unstable base-parameter set, a solver that did not converge, data of another robot).
+
+    Attributes:
+        robot: The robot's name.
+        reason: What went wrong, with the offending numbers.
+    """
+
+    def __init__(self, robot: str, reason: str):
+        self.robot = robot
+        self.reason = reason
+        super().__init__(f"robot {robot!r}: {reason}.")
