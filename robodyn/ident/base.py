@@ -5,6 +5,7 @@ stacked at ``samples`` random states (``q`` uniform within the joint limits, ``v
 standard normal) into ``W`` (samples·nv rows), each column scaled to unit length (columns
 of norm ≤ ``tolerance`` times the largest are zero: those parameters do not act on τ).
 
+  Joints whose URDF limits are equal are sampled in [−π, π] (:func:`joint_ranges`).
 - The rank ``r`` comes from a QR decomposition **with column pivoting** of ``W``: the
   number of ``|R_ii|`` above ``tolerance · |R_00|``.
 - The ``r`` independent columns are chosen in the standard order (first body first,
@@ -43,9 +44,23 @@ COEFFICIENT_ZERO = 1e-10
 SYMBOLIC_MAX_JOINTS = 7
 
 
+def joint_ranges(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Position ranges of the joints (a floating base's six coordinates left out), in [rad]
+    or [m]: the URDF's limits, except that unlimited joints and joints whose limits are
+    equal (``lower = upper``, which published URDFs write for "no limit") get [−π, π]."""
+    lower, upper = robot.lower_limits.copy(), robot.upper_limits.copy()
+    if robot.floating_base:
+        lower, upper = lower[6:], upper[6:]
+    free = ~(np.isfinite(lower) & np.isfinite(upper) & (upper > lower))
+    return np.where(free, -np.pi, lower), np.where(free, np.pi, upper)
+
+
 def random_states(robot: Robot, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``count`` random states: q within the limits, v and a standard normal."""
+    """``count`` random states: q uniform in :func:`joint_ranges` (a floating base's pose
+    as :meth:`Robot.random_configuration`), v and a standard normal."""
     q = robot.random_configuration(rng, count)
+    lower, upper = joint_ranges(robot)
+    q[:, q.shape[1] - lower.size :] = rng.uniform(lower, upper, size=(count, lower.size))
     return q, rng.standard_normal((count, robot.nv)), rng.standard_normal((count, robot.nv))
 
 
@@ -123,12 +138,11 @@ class BaseParameters:
 
         if self.robot.nv > SYMBOLIC_MAX_JOINTS:
             raise IdentificationError(
-                self.robot.name, f"symbolic base parameters are offered up to {SYMBOLIC_MAX_JOINTS} joints, it has {self.robot.nv}"
+                self.robot.name,
+                f"symbolic base parameters are offered up to {SYMBOLIC_MAX_JOINTS} joints, it has {self.robot.nv}",
             )
         symbols = [sp.Symbol(name, real=True) for name in self.standard_names]
-        return [
-            sp.Add(*[_exact(c) * symbols[j] for j, c in enumerate(row) if c != 0.0], evaluate=True) for row in self.mapping
-        ]
+        return [sp.Add(*[_exact(c) * symbols[j] for j, c in enumerate(row) if c != 0.0], evaluate=True) for row in self.mapping]
 
 
 def _exact(value: float):
@@ -163,7 +177,9 @@ def _decompose(w: np.ndarray, tolerance: float, robot: str) -> tuple[np.ndarray,
     residual = np.linalg.norm(w[:, independent] @ combination - w[:, dependent], axis=0)
     worst = float(np.max(residual[active[dependent]] / norms[dependent][active[dependent]], initial=0.0))
     if worst > 1e3 * tolerance:
-        raise IdentificationError(robot, f"a dependent column is not a combination of the independent ones (residual {worst:.3g})")
+        raise IdentificationError(
+            robot, f"a dependent column is not a combination of the independent ones (residual {worst:.3g})"
+        )
     combination[np.abs(combination) < COEFFICIENT_ZERO] = 0.0
     mapping = np.zeros((rank, w.shape[1]))
     mapping[:, independent] = np.eye(rank)

@@ -1,6 +1,6 @@
 """Identification of the base parameters from measured motion and torques.
 
-The data are N samples of ``(q, v, a, tau)`` (:class:`robodyn.sim.trajectory.Trajectory`).
+The data are N samples of ``(q, v, a, tau)`` (e.g. a :class:`robodyn.sim.trajectory.Trajectory`).
 Stacking the base regressor gives the overdetermined system ``W β = y`` with
 ``y = tau − known torque`` (N·nv rows).
 
@@ -22,18 +22,27 @@ The relative prediction error is ``|tau − tau_predicted| / |tau|`` (Frobenius 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import IdentificationError, InputError
 from robodyn.ident.base import BaseParameters, base_parameters
-from robodyn.sim.trajectory import Trajectory
+
+
+class Samples(Protocol):
+    """Measured data: anything with these attributes, e.g. a
+    :class:`robodyn.sim.trajectory.Trajectory` (``joint_names`` may be empty)."""
+
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    joint_names: list[str]
+
 
 METHODS = ("ls", "wls", "physical")
-#: Weight of the pull towards the URDF's standard parameters in the physical method,
-#: relative to the mean diagonal of the (weighted) normal matrix.
-PHYSICAL_REGULARISATION = 1e-6
 
 
 @dataclass
@@ -70,7 +79,7 @@ class Identification:
         """Predicted torques ``Y_b β + known``, shape (nv,) or (N, nv)."""
         return self.base.regressor(q, v, a) @ self.values + self.base.known_torque(q, v, a)
 
-    def prediction_error(self, trajectory: Trajectory, tau: np.ndarray | None = None) -> float:
+    def prediction_error(self, trajectory: Samples, tau: np.ndarray | None = None) -> float:
         """Relative torque prediction error on other data (a validation trajectory)."""
         measured = trajectory.tau if tau is None else np.asarray(tau, dtype=float)
         predicted = self.predict(trajectory.q, trajectory.v, trajectory.a)
@@ -99,7 +108,7 @@ class Identification:
         return result
 
 
-def _data(robot: Robot, trajectory: Trajectory, tau: np.ndarray | None) -> tuple[np.ndarray, ...]:
+def _data(robot: Robot, trajectory: Samples, tau: np.ndarray | None) -> tuple[np.ndarray, ...]:
     if trajectory.joint_names and list(trajectory.joint_names) != list(robot.joint_names):
         raise IdentificationError(
             robot.name, f"the data's joints {trajectory.joint_names!r} are not the robot's {robot.joint_names!r}"
@@ -113,7 +122,7 @@ def _data(robot: Robot, trajectory: Trajectory, tau: np.ndarray | None) -> tuple
 
 def identify(
     robot: Robot,
-    trajectory: Trajectory,
+    trajectory: Samples,
     tau: np.ndarray | None = None,
     *,
     method: str = "ls",
@@ -158,7 +167,8 @@ def identify(
     condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
     if not singular[-1] > 1e-10 * singular[0]:
         raise IdentificationError(
-            robot.name, f"the data do not excite every base parameter (condition number {condition:.3g}); use an exciting trajectory"
+            robot.name,
+            f"the data do not excite every base parameter (condition number {condition:.3g}); use an exciting trajectory",
         )
     values, covariance = _least_squares(w.reshape(-1, r), target.reshape(-1), np.ones(n * nv))
     weights = np.ones((n, nv))

@@ -20,6 +20,9 @@ import numpy as np
 from robodyn.exceptions import IdentificationError
 from robodyn.ident.base import BaseParameters
 
+#: Weight of the pull towards the URDF's standard parameters, relative to the mean
+#: diagonal of the (weighted) normal matrix.
+PHYSICAL_REGULARISATION = 1e-6
 #: Solvers tried in order (both install with cvxpy from PyPI).
 SOLVERS = ("CLARABEL", "SCS")
 
@@ -51,14 +54,10 @@ def physical_parameters(
     Raises:
         IdentificationError: If cvxpy is missing or no solver reaches an optimal solution.
     """
-    from robodyn.ident.identify import PHYSICAL_REGULARISATION
-
     try:
         import cvxpy as cp
     except ImportError:
-        raise IdentificationError(
-            base.robot.name, "the physical method needs cvxpy (pip install 'robodyn[ident]')"
-        ) from None
+        raise IdentificationError(base.robot.name, "the physical method needs cvxpy (pip install 'robodyn[ident]')") from None
     p = w.shape[-1]
     matrix = (w * weights[..., None]).reshape(-1, p)
     rhs = (target * weights).reshape(-1)
@@ -91,7 +90,9 @@ def physical_parameters(
         if problem.status == cp.OPTIMAL and variables.value is not None:
             return np.asarray(variables.value, dtype=float), solver
         failures.append(f"{solver}: {problem.status}")
-    raise IdentificationError(base.robot.name, f"the physical identification did not solve ({'; '.join(failures) or 'no solver'})")
+    raise IdentificationError(
+        base.robot.name, f"the physical identification did not solve ({'; '.join(failures) or 'no solver'})"
+    )
 
 
-__all__ = ["SOLVERS", "physical_parameters"]
+__all__ = ["PHYSICAL_REGULARISATION", "SOLVERS", "physical_parameters"]

@@ -78,7 +78,9 @@ def reference_regressor(reference: ReferenceRobot, q: np.ndarray, v: np.ndarray,
     def tau_with(index: int, parameters: np.ndarray) -> np.ndarray:
         bodies = list(zero)
         bodies[index] = _body_with(tree.bodies[index], parameters)
-        robot = ReferenceRobot(replace(tree, bodies=bodies), name=reference.name, urdf=reference.urdf, spec=reference.spec, gravity=gravity)
+        robot = ReferenceRobot(
+            replace(tree, bodies=bodies), name=reference.name, urdf=reference.urdf, spec=reference.spec, gravity=gravity
+        )
         return robot.inverse_dynamics(q, v, a)
 
     columns = []
