@@ -12,8 +12,9 @@ Stacking the base regressor gives the overdetermined system ``W β = y`` with
 - ``"physical"``: the standard parameters π themselves, constrained to physically consistent
   bodies — each body's pseudo-inertia ``J = [[½ tr(Ī) 1 − Ī, m c], [(m c)ᵀ, m]]`` positive
   semidefinite (Wensing, Kim, Slotine 2017), friction coefficients non-negative — minimising
-  the WLS residual plus a small pull ``λ |π − π_URDF|²`` that picks, among the standard sets
-  with the same base parameters, the one nearest the URDF. A semidefinite program solved by
+  the WLS residual of the base parameters ``K π`` plus a small pull ``λ |π − π_URDF|²``
+  that picks, among the standard sets with the same base parameters, the one nearest the
+  URDF. A semidefinite program solved by
   cvxpy (Clarabel, else SCS). Its standard deviations are those of the WLS estimate.
 
 The relative prediction error is ``|tau − tau_predicted| / |tau|`` (Frobenius norms).
@@ -182,7 +183,7 @@ def identify(
     if method == "physical":
         from robodyn.ident.physical import physical_parameters
 
-        standard, solver = physical_parameters(base, full[..., base.columns], target, weights)
+        standard, solver = physical_parameters(base, w, target, weights)
         values = base.to_base(standard)
     predicted = w @ values
     error = target - predicted

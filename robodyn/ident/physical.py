@@ -15,6 +15,8 @@ robodyn[ident]``).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from robodyn.exceptions import IdentificationError
@@ -40,13 +42,18 @@ def physical_parameters(
 ) -> tuple[np.ndarray, str]:
     """Physically consistent standard parameters over ``base.columns``.
 
+    The residual is that of the base parameters ``K π`` (the base regressor is well
+    conditioned where the standard one is rank-deficient), so the problem is
+    ``min |R_b K π − z|² + λ |π − π_URDF|²`` with ``W_b = Q_b R_b`` (weighted) and
+    ``z = Q_bᵀ y``, over the parameters of physically consistent bodies.
+
     Args:
         base: The base parameter set (its columns: 10 a body, then friction if any).
-        w: Standard regressor over ``base.columns``, shape (N, nv, p).
+        w: Base regressor of the data, shape (N, nv, count).
         target: Torques to explain, shape (N, nv).
         weights: Row weights (1/σ per joint), shape (N, nv).
-        regularisation: Weight of ``|π − π_URDF|²`` relative to the mean diagonal of the
-            weighted normal matrix (default ``PHYSICAL_REGULARISATION``).
+        regularisation: ``λ`` relative to the mean diagonal of ``R_bᵀ R_b``
+            (default ``PHYSICAL_REGULARISATION``).
 
     Returns:
         The standard parameters (p,) and the solver's name.
@@ -58,41 +65,37 @@ def physical_parameters(
         import cvxpy as cp
     except ImportError:
         raise IdentificationError(base.robot.name, "the physical method needs cvxpy (pip install 'robodyn[ident]')") from None
-    p = w.shape[-1]
-    matrix = (w * weights[..., None]).reshape(-1, p)
+    count = w.shape[-1]
+    matrix = (w * weights[..., None]).reshape(-1, count)
     rhs = (target * weights).reshape(-1)
     q_factor, r_factor = np.linalg.qr(matrix)
     projected = q_factor.T @ rhs
     scale = max(float(np.linalg.norm(projected)), 1e-300)
     nominal = base._standard[base.columns]
-    weight = (PHYSICAL_REGULARISATION if regularisation is None else regularisation) * float(np.sum(r_factor**2)) / p
+    p = nominal.size
+    weight = (PHYSICAL_REGULARISATION if regularisation is None else regularisation) * float(np.sum(r_factor**2)) / count
     friction = 2 * base.robot.nv if base.friction else 0
-    bodies = (p - friction) // 10
-    pseudo = [cp.Variable((4, 4), PSD=True) for _ in range(bodies)]
-    terms = [term for J in pseudo for term in _body_parameters(cp, J)]
-    variables = cp.hstack(terms)
-    constraints = []
+    pseudo = [cp.Variable((4, 4), PSD=True) for _ in range((p - friction) // 10)]
+    variables = cp.hstack([term for J in pseudo for term in _body_parameters(cp, J)])
     if friction:
-        coefficients = cp.Variable(friction, nonneg=True)
-        variables = cp.hstack([variables, coefficients])
-    objective = cp.sum_squares(r_factor @ variables - projected) / scale**2
-    objective = objective + weight * cp.sum_squares(variables - nominal) / scale**2
-    problem = cp.Problem(cp.Minimize(objective), constraints)
+        variables = cp.hstack([variables, cp.Variable(friction, nonneg=True)])
+    residual = cp.sum_squares((r_factor @ base.mapping) @ variables - projected)
+    problem = cp.Problem(cp.Minimize((residual + weight * cp.sum_squares(variables - nominal)) / scale**2))
     failures = []
     for solver in SOLVERS:
         if solver not in cp.installed_solvers():
             continue
         try:
-            problem.solve(solver=solver)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)  # "inaccurate" is reported below instead
+                problem.solve(solver=solver)
         except cp.error.SolverError as error:
             failures.append(f"{solver}: {error}")
             continue
         if problem.status == cp.OPTIMAL and variables.value is not None:
             return np.asarray(variables.value, dtype=float), solver
         failures.append(f"{solver}: {problem.status}")
-    raise IdentificationError(
-        base.robot.name, f"the physical identification did not solve ({'; '.join(failures) or 'no solver'})"
-    )
+    raise IdentificationError(base.robot.name, f"the physical identification did not solve ({'; '.join(failures) or 'no solver'})")
 
 
 __all__ = ["PHYSICAL_REGULARISATION", "SOLVERS", "physical_parameters"]
