@@ -106,11 +106,12 @@ def regressor(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, fric
 
 
 def _one(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    # (the Python binding returns a 1-D array when nv = 1: reshape)
     if robot.mimic is None:
-        return pin.computeJointTorqueRegressor(robot.model, robot.data, q, v, a).copy()
+        return np.array(pin.computeJointTorqueRegressor(robot.model, robot.data, q, v, a)).reshape(robot.nv, -1)
     mimic = robot.mimic
     full = pin.computeJointTorqueRegressor(mimic.model, mimic.data, mimic.q(q), mimic.selection @ v, mimic.selection @ a)
-    return mimic.selection.T @ full
+    return mimic.selection.T @ np.reshape(full, (mimic.model.nv, -1))
 
 
 __all__ = ["FRICTION_KINDS", "PARAMETER_KINDS", "body_links", "inertial_parameters", "parameter_names", "regressor"]
