@@ -155,14 +155,19 @@ def _exact(value: float):
 
 
 def _decompose(w: np.ndarray, tolerance: float, robot: str) -> tuple[np.ndarray, np.ndarray]:
-    """Independent column indices and ``K`` of a stacked regressor ``w`` (rows × p)."""
+    """Independent column indices and ``K`` of a stacked regressor ``w`` (rows × p).
+
+    Everything is done on the triangular factor ``R0`` of ``w = Q0 R0`` (p × p), which has
+    the same column geometry: the pivoted and ordered QRs and the least-squares fit of the
+    dependent columns are those of ``w``.
+    """
     norms = np.linalg.norm(w, axis=0)
     active = norms > tolerance * norms.max()
     scaled = np.where(active, w / np.where(active, norms, 1.0), 0.0)
-    _, r_pivoted, _ = scipy.linalg.qr(scaled, mode="economic", pivoting=True)
+    r_plain = scipy.linalg.qr(scaled, mode="r")[0][: w.shape[1]]
+    _, r_pivoted, _ = scipy.linalg.qr(r_plain, pivoting=True)
     diagonal = np.abs(np.diag(r_pivoted))
     rank = int(np.sum(diagonal > tolerance * diagonal[0]))
-    r_plain = scipy.linalg.qr(scaled, mode="r")[0]
     plain = np.abs(np.diag(r_plain))
     independent = np.flatnonzero((plain > tolerance * diagonal[0]) & active)
     if independent.size != rank:
@@ -172,14 +177,13 @@ def _decompose(w: np.ndarray, tolerance: float, robot: str) -> tuple[np.ndarray,
             f"(tolerance {tolerance:g}); draw more samples or change the tolerance",
         )
     dependent = np.setdiff1d(np.arange(w.shape[1]), independent)
-    combination = np.linalg.lstsq(w[:, independent], w[:, dependent], rcond=None)[0]
+    unscaled = r_plain * np.where(active, norms, 0.0)  # R0 of w itself (columns scaled back)
+    combination = np.linalg.lstsq(unscaled[:, independent], unscaled[:, dependent], rcond=None)[0]
     combination[:, ~active[dependent]] = 0.0  # columns that do not act on tau
-    residual = np.linalg.norm(w[:, independent] @ combination - w[:, dependent], axis=0)
+    residual = np.linalg.norm(unscaled[:, independent] @ combination - unscaled[:, dependent], axis=0)
     worst = float(np.max(residual[active[dependent]] / norms[dependent][active[dependent]], initial=0.0))
     if worst > 1e3 * tolerance:
-        raise IdentificationError(
-            robot, f"a dependent column is not a combination of the independent ones (residual {worst:.3g})"
-        )
+        raise IdentificationError(robot, f"a dependent column is not a combination of the independent ones (residual {worst:.3g})")
     combination[np.abs(combination) < COEFFICIENT_ZERO] = 0.0
     mapping = np.zeros((rank, w.shape[1]))
     mapping[:, independent] = np.eye(rank)
