@@ -61,7 +61,13 @@ def measure(real: robodyn.Robot, t, q, v, a, rng: np.random.Generator) -> Trajec
     a_est = (wrap[3:-1] - 2 * wrap[2:-2] + wrap[1:-3]) / dt**2
     keep = slice(None, None, DECIMATION)
     return Trajectory(
-        t[keep], q_filtered[keep], v_est[keep], a_est[keep], periodic_filter(tau_measured)[keep], list(real.joint_names), real.name
+        t[keep],
+        q_filtered[keep],
+        v_est[keep],
+        a_est[keep],
+        periodic_filter(tau_measured)[keep],
+        list(real.joint_names),
+        real.name,
     )
 
 

@@ -102,7 +102,9 @@ def test_one_body_of_a_six_joint_arm_has_ten_identifiable_parameters():
     assert base.count == 10 and base.names[0] == "m[wrist_3_link]"
     q, v, a = fresh_states(robot)
     tau = robot.inverse_dynamics(q, v, a)
-    np.testing.assert_allclose(base.regressor(q, v, a) @ base.values + base.known_torque(q, v, a), tau, atol=1e-10 * np.abs(tau).max())
+    np.testing.assert_allclose(
+        base.regressor(q, v, a) @ base.values + base.known_torque(q, v, a), tau, atol=1e-10 * np.abs(tau).max()
+    )
 
 
 def test_negative_controls():

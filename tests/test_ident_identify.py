@@ -34,7 +34,7 @@ def data_of(robot, excitation, rate=50.0):
 
 
 def test_excitation_within_limits_periodic_and_better_conditioned(rp_arm):
-    robot, base, excitation = rp_arm
+    robot, _base, excitation = rp_arm
     assert excitation.condition < excitation.initial_condition and excitation.condition < 100
     t = np.linspace(0, excitation.period, 4001)
     q, v, a = excitation.evaluate(t)
@@ -78,7 +78,9 @@ def test_with_noise_true_values_within_three_sigma(rp_arm, method):
     # Negative control: a value shifted by 10 σ is outside.
     assert np.abs((result.values + 10 * result.std - base.values) / result.std).max() > 3
     if method == "wls":  # per-joint noise levels estimated
-        np.testing.assert_allclose(np.sqrt(np.mean((noisy - result.predict(data.q, data.v, data.a)) ** 2, axis=0)), sigma, rtol=0.1)
+        np.testing.assert_allclose(
+            np.sqrt(np.mean((noisy - result.predict(data.q, data.v, data.a)) ** 2, axis=0)), sigma, rtol=0.1
+        )
 
 
 def test_physical_is_consistent_and_writes_a_urdf(rp_arm, tmp_path):
@@ -90,7 +92,11 @@ def test_physical_is_consistent_and_writes_a_urdf(rp_arm, tmp_path):
     assert result.solver in ("CLARABEL", "SCS")
     assert result.relative_error <= ls.relative_error * 1.01  # consistency costs (almost) nothing here
     for body in range(2):
-        m, h, (xx, xy, yy, xz, yz, zz) = result.standard[10 * body], result.standard[10 * body + 1 : 10 * body + 4], result.standard[10 * body + 4 : 10 * body + 10]
+        m, h, (xx, xy, yy, xz, yz, zz) = (
+            result.standard[10 * body],
+            result.standard[10 * body + 1 : 10 * body + 4],
+            result.standard[10 * body + 4 : 10 * body + 10],
+        )
         inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
         pseudo = np.block([[0.5 * np.trace(inertia) * np.eye(3) - inertia, h[:, None]], [h[None], np.array([[m]])]])
         assert np.linalg.eigvalsh(pseudo).min() >= -1e-7 * max(1.0, m)
@@ -121,11 +127,31 @@ def test_refusals(rp_arm):
 
 def test_cli_excite_then_identify(tmp_path, capsys):
     trajectory, params, urdf = tmp_path / "traj.csv", tmp_path / "params.json", tmp_path / "identified.urdf"
-    assert main(["excite", "rp_arm", "--duration", "3", "--harmonics", "2", "--iterations", "5", "--rate", "40", "--out", str(trajectory)]) == 0
+    assert (
+        main(
+            [
+                "excite",
+                "rp_arm",
+                "--duration",
+                "3",
+                "--harmonics",
+                "2",
+                "--iterations",
+                "5",
+                "--rate",
+                "40",
+                "--out",
+                str(trajectory),
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "condition number" in out and trajectory.exists()
     assert Trajectory.load(trajectory).tau.shape == (120, 2)
-    assert main(["identify", "rp_arm", str(trajectory), "--method", "physical", "--out", str(params), "--urdf-out", str(urdf)]) == 0
+    assert (
+        main(["identify", "rp_arm", str(trajectory), "--method", "physical", "--out", str(params), "--urdf-out", str(urdf)]) == 0
+    )
     summary = json.loads(params.read_text())
     assert summary["method"] == "physical" and len(summary["base_parameters"]) == 6 and summary["relative_error"] < 1e-6
     robodyn.load(str(urdf))

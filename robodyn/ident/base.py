@@ -183,7 +183,9 @@ def _decompose(w: np.ndarray, tolerance: float, robot: str) -> tuple[np.ndarray,
     residual = np.linalg.norm(unscaled[:, independent] @ combination - unscaled[:, dependent], axis=0)
     worst = float(np.max(residual[active[dependent]] / norms[dependent][active[dependent]], initial=0.0))
     if worst > 1e3 * tolerance:
-        raise IdentificationError(robot, f"a dependent column is not a combination of the independent ones (residual {worst:.3g})")
+        raise IdentificationError(
+            robot, f"a dependent column is not a combination of the independent ones (residual {worst:.3g})"
+        )
     combination[np.abs(combination) < COEFFICIENT_ZERO] = 0.0
     mapping = np.zeros((rank, w.shape[1]))
     mapping[:, independent] = np.eye(rank)

@@ -95,7 +95,9 @@ def physical_parameters(
         if problem.status == cp.OPTIMAL and variables.value is not None:
             return np.asarray(variables.value, dtype=float), solver
         failures.append(f"{solver}: {problem.status}")
-    raise IdentificationError(base.robot.name, f"the physical identification did not solve ({'; '.join(failures) or 'no solver'})")
+    raise IdentificationError(
+        base.robot.name, f"the physical identification did not solve ({'; '.join(failures) or 'no solver'})"
+    )
 
 
 __all__ = ["PHYSICAL_REGULARISATION", "SOLVERS", "physical_parameters"]
