@@ -128,3 +128,21 @@ def test_symbolic_refused_for_large_robots():
     robot = robodyn.load("panda")
     with pytest.raises(IdentificationError, match="symbolic"):
         base_parameters(robot).expressions()
+
+
+def test_rendering_escapes_hostile_names():
+    import json
+
+    from robodyn.ident.render import render_base_parameters
+
+    hostile = robodyn.rp_arm_urdf().replace('"link2"', '"l&#x202E;2$\\input{x}_%"')
+    robot = robodyn.load(hostile)
+    base = base_parameters(robot)
+    text = render_base_parameters(base, "text")
+    assert "\u202e" not in text and "\\u202e" in text and "Iyy[link1] + Iyy[l" in text
+    latex = render_base_parameters(base, "latex")
+    assert "\\input{x}" not in latex and r"\textbackslash{}input\{x\}\_\%" in latex
+    data = json.loads(render_base_parameters(base, "json"))
+    assert data["count"] == 6 and any("\u202e" in p["name"] for p in data["base_parameters"])
+    with pytest.raises(robodyn.InputError, match="format"):
+        render_base_parameters(base, "html")

@@ -176,7 +176,7 @@ def identify(
     if method in ("wls", "physical"):
         residual = (target - w @ values).reshape(n, nv)
         sigma = np.sqrt(np.sum(residual**2, axis=0) / max(n - r / nv, 1.0))
-        sigma = np.maximum(sigma, 1e-12 * max(float(sigma.max()), 1e-300))
+        sigma = np.maximum(sigma, 1e-12 * float(sigma.max())) if sigma.max() > 0 else np.ones(nv)  # exact data: LS
         weights = np.broadcast_to(1.0 / sigma, (n, nv))
         values, covariance = _least_squares(w.reshape(-1, r), target.reshape(-1), weights.reshape(-1), weighted=True)
     standard, solver = None, None

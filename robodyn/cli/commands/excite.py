@@ -32,6 +32,7 @@ def _limit(values: list[float] | None):
 def run(arguments: argparse.Namespace) -> int:
     import robodyn
     from robodyn.ident import base_parameters, excite
+    from robodyn.ident.render import printable
     from robodyn.sim.trajectory import Trajectory
 
     robot = robodyn.load(
@@ -54,7 +55,9 @@ def run(arguments: argparse.Namespace) -> int:
     )
     t, q, v, a, tau = excitation.sample(robot, rate=arguments.rate)
     Trajectory(t, q, v, a, tau, list(robot.joint_names), robot.name).save(arguments.out)
-    print(f"{robot.name}: {base.count} base parameters; excitation of {excitation.period:g} s, {arguments.harmonics} harmonics")
+    print(
+        f"{printable(robot.name)}: {base.count} base parameters; excitation of {excitation.period:g} s, {arguments.harmonics} harmonics"
+    )
     print(
         f"condition number of the stacked base regressor: {excitation.condition:.4g} (start {excitation.initial_condition:.4g})"
     )

@@ -18,31 +18,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", help="write the result as JSON to this file")
     parser.add_argument("--urdf-out", help="with --method physical: write the identified URDF to this file")
     parser.add_argument("--base-parameters", action="store_true", help="print the base parameters of the model and stop")
+    parser.add_argument("--format", choices=["text", "latex", "json"], default="text", help="with --base-parameters")
     parser.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
     parser.set_defaults(run=run)
-
-
-def printable(text: str) -> str:
-    """``text`` with control and other unprintable characters escaped (names from a URDF)."""
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
-
-
-def _base_text(base) -> str:
-    from robodyn.ident.base import SYMBOLIC_MAX_JOINTS
-
-    lines = [
-        f"{printable(base.robot.name)}: {base.count} base parameters of {len(base.standard_names)} standard "
-        f"({base.samples} random states, rank tolerance {base.tolerance:g}, checked on two draws)",
-        "",
-    ]
-    expressions = base.expressions() if base.robot.nv <= SYMBOLIC_MAX_JOINTS else [None] * base.count
-    width = max(len(printable(name)) for name in base.names)
-    for name, value, expression in zip(base.names, base.values, expressions, strict=True):
-        line = f"{printable(name):{width}s} {value:>12.6g}"
-        if expression is not None:
-            line += f"   = {printable(str(expression))}"
-        lines.append(line)
-    return "\n".join(lines)
 
 
 def run(arguments: argparse.Namespace) -> int:
@@ -50,6 +28,7 @@ def run(arguments: argparse.Namespace) -> int:
     from robodyn.common.files import atomic_write_text
     from robodyn.exceptions import InputError
     from robodyn.ident import base_parameters, identified_urdf, identify
+    from robodyn.ident.render import printable, render_base_parameters
     from robodyn.sim.trajectory import Trajectory
 
     if arguments.urdf_out and arguments.method != "physical":
@@ -67,7 +46,7 @@ def run(arguments: argparse.Namespace) -> int:
     )
     base = base_parameters(robot, friction=arguments.friction)
     if arguments.base_parameters:
-        print(_base_text(base))
+        print(render_base_parameters(base, arguments.format), end="")
         return 0
     data = Trajectory.load(arguments.data)
     result = identify(robot, data, method=arguments.method, base=base)
