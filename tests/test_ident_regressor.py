@@ -79,6 +79,13 @@ def test_y_pi_is_tau_with_mimic_locked_and_floating(rng):
     assert_regressor_reproduces_tau(robodyn.load(MIMIC_URDF, floating_base=True), rng)
 
 
+def test_without_mimic_joints_y_is_pinocchios_regressor(rng):
+    robot = robodyn.load("ur5")
+    q, v, a = random_state(robot, rng)
+    expected = pin.computeJointTorqueRegressor(robot.model, robot.model.createData(), q, v, a)
+    np.testing.assert_array_equal(regressor(robot, q, v, a), expected)
+
+
 @pytest.mark.parametrize("source", ["ur5", MIMIC_URDF, "panda"])
 def test_columns_are_pinocchio_rnea_of_one_parameter(source, rng):
     # Y's column k (Pinocchio's computeJointTorqueRegressor, through Sᵀ for mimic joints)

@@ -250,6 +250,8 @@ def base_parameters(
             f"the base parameters differ between two draws of states ({independent.size} and {independent_2.size} "
             f"parameters); use more samples or a looser tolerance than {tolerance:g}",
         )
+    if independent.size == 0:
+        raise IdentificationError(robot.name, "no inertial parameter acts on the joint torques (no mass moves, no gravity)")
     standard = inertial_parameters(robot, friction=friction)
     names = parameter_names(robot, friction=friction)
     return BaseParameters(

@@ -110,7 +110,9 @@ class Identification:
 
 
 def _data(robot: Robot, trajectory: Samples, tau: np.ndarray | None) -> tuple[np.ndarray, ...]:
-    if trajectory.joint_names and list(trajectory.joint_names) != list(robot.joint_names):
+    names = list(trajectory.joint_names)
+    per_coordinate = robot.floating_base and len(names) == robot.nv  # a floating base's six coordinates named apart
+    if names and names != list(robot.joint_names) and not per_coordinate:
         raise IdentificationError(
             robot.name, f"the data's joints {trajectory.joint_names!r} are not the robot's {robot.joint_names!r}"
         )
