@@ -179,3 +179,42 @@ def test_worked_example():
         assert abs(found["payload_mass_error"]) < 0.05  # of 2.5 kg
         assert found["payload_com_error"] < 0.005  # [m]
         assert found["validation_error"] < 0.1 * report["nominal_validation_error"]
+
+
+def test_friction_is_identified(rp_arm):
+    robot, _base, _excitation = rp_arm
+    with_friction = base_parameters(robot, friction=True)
+    # (the plain excitation may keep the slider still: its friction would be unidentifiable, and refused)
+    excitation = excite(robot, duration=4.0, harmonics=3, iterations=15, base=with_friction)
+    data = data_of(robot, excitation, rate=100.0)
+    viscous, coulomb = np.array([0.3, 2.0]), np.array([0.8, 1.5])
+    tau = data.tau + viscous * data.v + coulomb * np.sign(data.v)
+    for method in ("ls", "physical"):
+        result = identify(robot, data, tau, method=method, base=with_friction)
+        found = dict(zip(result.base.names, result.values, strict=True))
+        np.testing.assert_allclose([found["fv[joint1]"], found["fv[joint2]"]], viscous, rtol=1e-4)
+        np.testing.assert_allclose([found["fc[joint1]"], found["fc[joint2]"]], coulomb, rtol=1e-4)
+    # Negative control: without friction columns the same data are not explained.
+    assert identify(robot, data, tau).relative_error > 1e-3
+
+
+def test_written_urdf_merges_welded_links_and_the_reference_agrees(rng):
+    import robodyn.reference as reference
+    from robodyn.reference.regressor import reference_body_links, reference_parameters
+    from tests.test_ident_regressor import MIMIC_URDF
+
+    robot = robodyn.load(MIMIC_URDF)  # l3 carries the welded l4 (0.3 kg)
+    q, v, a = random_states(robot, 150, rng)
+    heavier = robodyn.attach_payload(robot, "l4", 0.4, com=(0.01, 0.02, -0.03))
+    data = Trajectory(np.arange(150.0), q, v, a, heavier.inverse_dynamics(q, v, a), list(robot.joint_names), robot.name)
+    result = identify(robot, data, method="physical")
+    assert result.relative_error < 1e-4
+    text = identified_urdf(robot, result.standard, result.base.columns)
+    assert text.count("<inertial>") == 3  # l1, l2, l3 (l4's moved into l3)
+    written = robodyn.load(text)
+    np.testing.assert_allclose(inertial_parameters(written), result.standard, atol=1e-9)
+    ref = reference.load(text)  # the independent reader merges the bodies the same way
+    links = reference_body_links(ref)
+    order = np.concatenate([10 * [lk for lk in ["l1", "l2", "l3"]].index(link) + np.arange(10) for link in links])
+    np.testing.assert_allclose(reference_parameters(ref), result.standard[order], atol=1e-9)
+    np.testing.assert_allclose(written.inverse_dynamics(q, v, a), data.tau, rtol=0, atol=1e-3 * np.abs(data.tau).max())

@@ -79,7 +79,9 @@ class Excitation:
         return t, q, v, a, robot.inverse_dynamics(q, v, a)
 
 
-def _series(offset, sine, cosine, omega, t):
+def _series(
+    offset: np.ndarray, sine: np.ndarray, cosine: np.ndarray, omega: float, t: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     harmonics = np.arange(1, sine.shape[1] + 1)
     phase = omega * np.outer(t, harmonics)  # (M, L)
     s, c = np.sin(phase), np.cos(phase)
@@ -102,7 +104,7 @@ def _basis(t: np.ndarray, nv: int, harmonics: int, omega: float) -> tuple[np.nda
     return basis[0].reshape(-1, dim), basis[1].reshape(-1, dim), basis[2].reshape(-1, dim)
 
 
-def _unpack(x: np.ndarray, nv: int, harmonics: int):
+def _unpack(x: np.ndarray, nv: int, harmonics: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     offset = x[:nv]
     sine = x[nv : nv + nv * harmonics].reshape(nv, harmonics)
     cosine = x[nv + nv * harmonics :].reshape(nv, harmonics)

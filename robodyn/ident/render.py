@@ -8,6 +8,7 @@ in ``\\texttt``), and JSON's own string escaping.
 from __future__ import annotations
 
 import json
+from typing import Any
 
 from robodyn.exceptions import InputError
 from robodyn.ident.base import SYMBOLIC_MAX_JOINTS, BaseParameters
@@ -26,7 +27,7 @@ def latex_text(text: str) -> str:
     return "".join(_LATEX_SPECIAL.get(c, c) for c in printable(text))
 
 
-def _terms(base: BaseParameters, row) -> list[tuple[object, str]]:
+def _terms(base: BaseParameters, row: Any) -> list[tuple[Any, str]]:
     """(exact coefficient, standard name) of a row of the map."""
     from robodyn.ident.base import _exact
 
@@ -87,7 +88,7 @@ def render_base_parameters(base: BaseParameters, format: str = "text") -> str:
     return "\n".join(lines) + "\n"
 
 
-def _signed(terms: list[tuple[object, str]], *, latex: bool) -> str:
+def _signed(terms: list[tuple[Any, str]], *, latex: bool) -> str:
     """``c1 a + c2 b − c3 c`` with exact coefficients (1 left out)."""
     import sympy as sp
 

@@ -50,7 +50,7 @@ def run(arguments: argparse.Namespace) -> int:
         return 0
     data = Trajectory.load(arguments.data)
     result = identify(robot, data, method=arguments.method, base=base)
-    urdf = identified_urdf(robot, result.standard, base.columns) if arguments.urdf_out else None
+    urdf = identified_urdf(robot, result.standard, base.columns) if arguments.urdf_out and result.standard is not None else None
     width = max(len(printable(name)) for name in base.names)
     print(
         f"{printable(robot.name)}: {arguments.method} identification of {base.count} base parameters from {result.samples} samples"
