@@ -189,7 +189,7 @@ def excite(
         q, v, a = _series(*_unpack(x, nv, harmonics), omega, t_objective)
         w = base.regressor(q, v, a).reshape(-1, base.count)
         eigenvalues = np.linalg.eigvalsh(w.T @ w)  # squared singular values, ascending
-        return float(0.5 * np.log(eigenvalues[-1] / max(eigenvalues[0], 1e-300)))
+        return float(0.5 * np.log(eigenvalues[-1] / max(eigenvalues[0], 1e-32 * eigenvalues[-1], 1e-300)))
 
     rng = np.random.default_rng(seed)
     x0 = np.concatenate([(lower + upper) / 2, rng.standard_normal(2 * nv * harmonics)])
