@@ -195,7 +195,7 @@ def identify(
         values=values,
         std=np.sqrt(np.maximum(np.diag(covariance), 0.0)),
         covariance=covariance,
-        relative_error=float(np.linalg.norm(error) / np.linalg.norm(measured)),
+        relative_error=float(np.linalg.norm(error) / (np.linalg.norm(measured) or 1.0)),
         rms_error=np.sqrt(np.mean(error**2, axis=0)),
         condition=condition,
         samples=n,
