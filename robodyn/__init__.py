@@ -51,6 +51,9 @@ _LAZY = {
     "compile": "robodyn.compiled.robot",
     "CompiledRobot": "robodyn.compiled.robot",
     "recording": "robodyn.viz.recording",
+    "base_parameters": "robodyn.ident",
+    "excite": "robodyn.ident",
+    "identify": "robodyn.ident",
     "Recording": "robodyn.viz.recording",
 }
 
@@ -76,9 +79,12 @@ __all__ = [
     "UnknownRobotError",
     "__version__",
     "attach_payload",
+    "base_parameters",
     "check_robot",
     "compile",
     "derive_equations",
+    "excite",
+    "identify",
     "load",
     "record",
     "recording",

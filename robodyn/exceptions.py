@@ -243,3 +243,18 @@ class CompilerNotFoundError(CompileError):
             f"no C compiler {compiler!r} found{extra}; install one (Debian/Ubuntu: apt-get install gcc, "
             "or set CC) or use the Pinocchio methods of robodyn.Robot",
         )
+
+
+class IdentificationError(RobodynError):
+    """System identification cannot give a trustworthy answer (a rank-deficient excitation,
+    an unstable base-parameter set, a solver that did not converge, data of another robot).
+
+    Attributes:
+        robot: The robot's name.
+        reason: What went wrong, with the offending numbers.
+    """
+
+    def __init__(self, robot: str, reason: str):
+        self.robot = robot
+        self.reason = reason
+        super().__init__(f"robot {quoted(robot)}: {reason}.")

@@ -419,6 +419,29 @@ class Robot(Kinematics):
         energy = self._finite(np.asarray(energy), "potential energy")
         return energy if batch else float(energy)
 
+    # ----------------------------------------------------------------------------------
+    # Identification (robodyn.dynamics.regressor)
+    # ----------------------------------------------------------------------------------
+    def regressor(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, friction: bool = False) -> np.ndarray:
+        """The inertial-parameter regressor ``Y`` with ``Y @ inertial_parameters() == tau``.
+
+        Per body (the links that move): m, m·c (3), inertia about the body origin in the
+        body frame (Ixx, Ixy, Iyy, Ixz, Iyz, Izz); optional viscous and Coulomb friction
+        columns per joint. See :func:`robodyn.dynamics.regressor.regressor`.
+
+        Returns:
+            Shape (nv, 10·n_bodies [+ 2·nv]) or (N, nv, …) for a batch.
+        """
+        from robodyn.dynamics.regressor import regressor
+
+        return regressor(self, q, v, a, friction=friction)
+
+    def inertial_parameters(self, *, friction: bool = False) -> np.ndarray:
+        """The URDF's standard inertial parameters π, in :meth:`regressor`'s order."""
+        from robodyn.dynamics.regressor import inertial_parameters
+
+        return inertial_parameters(self, friction=friction)
+
     def _repr_html_(self) -> str:
         """The robot as an HTML table in notebooks (:func:`robodyn.dynamics.display.robot_html`)."""
         from robodyn.dynamics.display import robot_html

@@ -1,0 +1,65 @@
+"""`robodyn excite`: an exciting periodic trajectory for identification, written to a file."""
+
+from __future__ import annotations
+
+import argparse
+
+from robodyn.cli.common import add_model_arguments, lock_values, vector
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser(
+        "excite", help="a periodic Fourier-series trajectory within the limits that conditions the base regressor"
+    )
+    add_model_arguments(parser)
+    parser.add_argument("--duration", type=float, default=10.0, help="period of the trajectory in [s] (default 10)")
+    parser.add_argument("--out", required=True, help="trajectory file (.csv or .npz), tau = the model's inverse dynamics")
+    parser.add_argument("--harmonics", type=int, default=5, help="harmonics per joint (default 5)")
+    parser.add_argument("--rate", type=float, default=100.0, help="sampling rate of the file in [Hz] (default 100)")
+    parser.add_argument("--velocity-limit", type=vector, help="per joint or one value (default: the URDF's)")
+    parser.add_argument("--acceleration-limit", type=vector, help="per joint or one value (default 5 rad/s², 0.5 m/s²)")
+    parser.add_argument("--iterations", type=int, default=60, help="optimiser iterations (default 60)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the random start")
+    parser.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
+    parser.set_defaults(run=run)
+
+
+def _limit(values: list[float] | None):
+    return None if values is None else (values[0] if len(values) == 1 else values)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    import robodyn
+    from robodyn.ident import base_parameters, excite
+    from robodyn.ident.render import printable
+    from robodyn.sim.trajectory import Trajectory
+
+    robot = robodyn.load(
+        arguments.model,
+        floating_base=arguments.floating_base,
+        gravity=arguments.gravity,
+        check_inertia=arguments.check_inertia,
+        lock=lock_values(arguments.lock),
+    )
+    base = base_parameters(robot)
+    excitation = excite(
+        robot,
+        duration=arguments.duration,
+        harmonics=arguments.harmonics,
+        velocity_limit=_limit(arguments.velocity_limit),
+        acceleration_limit=_limit(arguments.acceleration_limit),
+        iterations=arguments.iterations,
+        seed=arguments.seed,
+        base=base,
+    )
+    t, q, v, a, tau = excitation.sample(robot, rate=arguments.rate)
+    Trajectory(t, q, v, a, tau, list(robot.joint_names), robot.name).save(arguments.out)
+    print(
+        f"{printable(robot.name)}: {base.count} base parameters; excitation of {excitation.period:g} s, {arguments.harmonics} harmonics"
+    )
+    print(
+        f"condition number of the stacked base regressor: {excitation.condition:.4g} (start {excitation.initial_condition:.4g})"
+    )
+    print(f"wrote {arguments.out} ({len(t)} samples at {arguments.rate:g} Hz)")
+    return 0
