@@ -48,7 +48,9 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check robodyn tests scripts
 	$(BIN)/lint-imports
 
+# MuJoCo is the simulation reference of the benchmarks only (requirements-bench.lock).
 bench: $(STAMP)
+	$(BIN)/python -m pip install --quiet -r requirements-bench.lock || echo "note: MuJoCo not installed; its rows are skipped"
 	$(BIN)/python scripts/bench.py
 
 # Mutation testing of the core modules with the fast tier (slow: not part of `make test` or CI).

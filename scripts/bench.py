@@ -479,6 +479,17 @@ def _mujoco_model(robot):
     return model
 
 
+def median_cpu(function: Callable[[], object], repeats: int = 3) -> float:
+    """Median CPU time of this process over whole runs (on a loaded machine, less noisy than
+    wall time for single-threaded loops)."""
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        function()
+        times.append(time.process_time() - start)
+    return statistics.median(times)
+
+
 def bench_compiled_simulation(quick: bool) -> list[dict]:
     from robodyn.compiled import simulate_compiled
 
@@ -502,9 +513,9 @@ def bench_compiled_simulation(quick: bool) -> list[dict]:
     steps = round(duration / 1e-3)
     for integrator, mj_integrator in (("rk4", "mjINT_RK4"), ("semi-implicit-euler", "mjINT_EULER")):
         row = {"robot": "panda (arm, fingers locked)", "integrator": integrator, "duration_s": duration, "dt_s": 1e-3}
-        row["compiled_rtf"] = duration / median_once(
-            lambda: simulate_compiled(compiled, q0, v0, duration, 1e-3, integrator=integrator)
-        )
+        compiled_run = lambda: simulate_compiled(compiled, q0, v0, duration, 1e-3, integrator=integrator)  # noqa: E731
+        row["compiled_rtf"] = duration / median_once(compiled_run)
+        row["compiled_rtf_cpu"] = duration / median_cpu(compiled_run)
         python_duration = min(duration, 2.0)
         row["python_engine_rtf"] = python_duration / median_once(
             lambda: simulate(robot, q0, v0, python_duration, 1e-3, integrator=integrator), repeats=1 if quick else 3
@@ -519,6 +530,7 @@ def bench_compiled_simulation(quick: bool) -> list[dict]:
                     mujoco.mj_step(model, data)
 
             row["mujoco_mj_step_loop_rtf"] = duration / median_once(mj_loop)
+            row["mujoco_mj_step_loop_rtf_cpu"] = duration / median_cpu(mj_loop)
             try:
                 from mujoco import rollout
 
@@ -531,6 +543,7 @@ def bench_compiled_simulation(quick: bool) -> list[dict]:
                 row["mujoco_rollout_rtf"] = float("nan")
             best = max(row["mujoco_mj_step_loop_rtf"], row.get("mujoco_rollout_rtf", 0.0) or 0.0)
             row["compiled_vs_best_mujoco"] = row["compiled_rtf"] / best
+            row["compiled_vs_mj_step_cpu"] = row["compiled_rtf_cpu"] / row["mujoco_mj_step_loop_rtf_cpu"]
         row["compiled_vs_python_engine"] = row["compiled_rtf"] / row["python_engine_rtf"]
         row["note"] = mujoco_note
         rows.append(row)

@@ -49,12 +49,21 @@ def compare(compiled, robot, rng: np.random.Generator, count: int | None = None,
         The relative error of each quantity.
 
     Raises:
-        AssertionError: Naming the quantities beyond ``rtol``.
+        AssertionError: Naming the quantities beyond ``rtol`` (for forward dynamics,
+            beyond ``max(rtol, 64 eps cond(M))``).
     """
-    errors = {}
-    for name, args in arguments(robot, rng, count).items():
+    errors, tolerances = {}, {}
+    states = arguments(robot, rng, count)
+    for name, args in states.items():
         errors[name] = relative_error(getattr(compiled, name)(*args), getattr(robot, name)(*args))
-    bad = {name: error for name, error in errors.items() if not error <= rtol}
+        tolerances[name] = rtol
+    # Forward dynamics solves with M: both engines are accurate to ~cond(M) eps only (kinova,
+    # cond 1.4e4: Pinocchio's ABA is 7e-12 from the true accelerations, the compiled LDLᵀ
+    # 7e-13), so their difference is allowed to grow with the conditioning.
+    masses = np.reshape(robot.mass_matrix(states["mass_matrix"][0]), (-1, robot.nv, robot.nv))
+    condition = max(float(np.linalg.cond(mass)) for mass in masses)
+    tolerances["forward_dynamics"] = max(rtol, 64 * np.finfo(float).eps * condition)
+    bad = {name: error for name, error in errors.items() if not error <= tolerances[name]}
     assert not bad, f"{robot.name}: compiled differs from Pinocchio: {bad}"
     return errors
 

@@ -79,6 +79,8 @@ def test_negative_control_a_wrong_compiled_robot_fails_the_comparison(rng, tmp_p
         ("panda", {"lock": {"panda_finger_joint1": 0.013}}),
         ("double_pendulum_continuous", {}),
         ("z1", {}),
+        ("kinova", {"check_inertia": False}),
+        ("so101", {"check_inertia": False}),
     ],
 )
 def test_compiled_zoo_arms_match_pinocchio(source, options, rng):
@@ -286,3 +288,21 @@ def test_two_processes_compiling_at_once_both_succeed(tmp_path):
     leftovers = [path.name for path in (tmp_path / "compiled").iterdir() if path.name.startswith(".")]
     assert leftovers == []
     assert len(list((tmp_path / "compiled").glob("rd_*"))) == 1
+
+
+def test_an_unwritable_cache_is_a_one_line_error(rp_arm, monkeypatch, tmp_path):
+    robot, _ = rp_arm
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder", encoding="utf-8")
+    monkeypatch.setenv("ROBODYN_CACHE", str(blocker))
+    with pytest.raises(CompileError, match="ROBODYN_CACHE") as error:
+        compile(robot)
+    assert "\n" not in str(error.value)
+
+
+def test_threads_split_rows_without_changing_results(mimic_tree, rng):
+    robot, compiled = mimic_tree
+    q, v, tau = arguments(robot, rng, 1000)["forward_dynamics"]
+    one = compile(robot, threads=1).forward_dynamics(q, v, tau)
+    np.testing.assert_array_equal(compiled.forward_dynamics(q, v, tau), one)
+    np.testing.assert_array_equal(np.stack([compiled.forward_dynamics(*row) for row in zip(q, v, tau, strict=True)]), one)

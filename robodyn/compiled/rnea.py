@@ -66,7 +66,7 @@ def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
     return sp.eye(3) + s * skew + (1 - c) * skew * skew
 
 
-def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-12) -> NewtonEuler:
+def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> NewtonEuler:
     """``tau(q, q̇, q̈)`` of every body of a reference robot (mimic joints as bodies of their own).
 
     Args:

@@ -18,31 +18,44 @@ checked path. Batches run across rows on ``threads`` native threads, the GIL rel
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
-from robodyn.compiled import build
+from robodyn.compiled import build, codegen, rnea
 from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
 from robodyn.compiled.rnea import derive_newton_euler
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
+from robodyn.equations import compact
 from robodyn.equations.compact import derive_compact
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
+from robodyn.reference import symbolic as reference_symbolic
+from robodyn.reference import tree as reference_tree
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.tree import build_tree
 
 _ndarray = np.ndarray
-#: Rotation entries this close to 0, ±1, ±½, ... are taken as exact: only float rounding
-#: (cos(π/2) = 6e-17), so the compiled model is the URDF's, not a rounded one.
-SNAP = 1e-12
+#: Rotation entries this close to 0, ±1, ±½, ... are taken as exact: float rounding only
+#: (cos(π/2) = 6e-17, sin(π) = 1.2e-16), so the compiled model is the URDF's. Not more: URDFs
+#: write π to 12 digits (kinova's 3.14159265359, sin = -2e-13), and snapping that to 0 moved
+#: kinova's M by 8e-14 and, through cond(M) ~ 1e4, its forward dynamics by 5e-10.
+SNAP = 1e-15
 _QUANTITIES = {"tau": "tau", "mass": "M", "nle": "C v + G", "gravity": "G", "fd": "a"}
+
+
+def _generator_source() -> str:
+    """The code that turns a URDF into kernels (part of the key: a change there, by anyone,
+    must not reuse kernels generated before it)."""
+    modules = (codegen, rnea, compact, reference_tree, reference_symbolic)
+    return "".join(Path(module.__file__).read_text(encoding="utf-8") for module in modules)
 
 
 def robot_key(robot: Robot) -> str:
     """The cache key of a robot's generated kernels: its URDF text, gravity and the generator."""
     gravity = ",".join(repr(float(g)) for g in robot.gravity_vector)
-    return build.digest(robot.urdf, gravity, CODEGEN_VERSION, f"compact snap={SNAP}")
+    return build.digest(robot.urdf, gravity, CODEGEN_VERSION, f"compact snap={SNAP}", _generator_source())
 
 
 def generate_kernels(robot: Robot) -> str:
