@@ -25,10 +25,13 @@ links are welded). ``Y π = robot.inverse_dynamics`` to rounding.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics.robot import Robot
+if TYPE_CHECKING:  # Robot calls into this module (Robot.regressor): no import at run time
+    from robodyn.dynamics.robot import Robot
 
 #: Names of a body's 10 standard parameters, in order.
 PARAMETER_KINDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
