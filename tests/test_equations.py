@@ -24,7 +24,18 @@ CODE_ROBOTS = [("double_pendulum", None), ("rp_arm", None), ("ur5", None), ("pan
 
 
 def test_rp_arm_with_kept_parameters_is_the_hand_derived_rigid_form():
-    equations = derive_equations("rp_arm", keep_params=True)
+    generic = derive_equations("rp_arm", keep_params=True)
+    assert {str(s) for s in generic.parameters} == {
+        "m_link1",
+        "c_link1_x",
+        "I_link1_yy",
+        "d_joint2_x",
+        "m_link2",
+        "c_link2_x",
+        "I_link2_yy",
+        "g",
+    }
+    equations = lecture.in_lecture_symbols(generic)
     rigid = lecture.rigid()
     rename = {equations.q[0]: lecture.q1, equations.q[1]: lecture.q2, equations.qd[0]: lecture.qd1, equations.qd[1]: lecture.qd2}
     assert sp.simplify(equations.M.xreplace(rename) - rigid.M) == sp.zeros(2, 2)
