@@ -90,9 +90,10 @@ def lagrangian_dynamics(
         q, qd, qdd: Position, velocity and acceleration symbols.
         simplify: Trigonometric simplification of every entry (small systems only).
     """
-    tidy = (lambda e: sp.trigsimp(sp.expand(e))) if simplify else (lambda e: e)
+    tidy = (lambda e: sp.trigsimp(sp.expand(e))) if simplify else sp.expand
     n = len(q)
-    M = sp.Matrix(n, n, lambda i, j: tidy(sp.diff(T, qd[i], qd[j])))
+    quadratic = sp.expand(T)
+    M = sp.Matrix(n, n, lambda i, j: tidy(sp.diff(quadratic, qd[i], qd[j])))
     G = sp.Matrix(n, 1, lambda i, _: tidy(sp.diff(U, q[i])))
 
     def christoffel(i: int, j: int, k: int) -> sp.Expr:
