@@ -113,7 +113,7 @@ def test_generated_c_compiles_and_agrees_with_pinocchio(name, lock, tmp_path, rn
 def test_compact_form_is_small_and_fast_for_ur5():
     equations = derive_equations("ur5")
     assert equations.form == "compact"
-    assert equations.operation_count() <= 1500
+    assert equations.operation_count() <= 760
 
 
 def test_json_round_trips_through_sympy(rng, capsys):

@@ -90,7 +90,7 @@ def test_generated_python_imports_computes_and_runs_nothing(hostile, tmp_path, m
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     assert not (tmp_path / CANARY).exists()
-    assert module.JOINT_NAMES == hostile.joint_names
+    assert hostile.joint_names == module.JOINT_NAMES
     robot = robodyn.load(hostile_urdf())
     q = robot.random_configuration(rng, 5)
     v, a = rng.normal(size=(2, 5, robot.nv))

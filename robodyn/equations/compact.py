@@ -31,7 +31,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
-import numpy as np
 import sympy as sp
 
 from robodyn.reference.numeric import ReferenceRobot

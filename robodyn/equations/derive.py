@@ -25,9 +25,10 @@ import sympy as sp
 from robodyn import reference
 from robodyn.equations import simplify
 from robodyn.equations.compact import derive_compact
-from robodyn.equations.model import Equations
+from robodyn.equations.model import EquationsData
 from robodyn.equations.naming import identifier
 from robodyn.equations.output import FORMATS, render
+from robodyn.equations.render_latex import latex_math
 from robodyn.exceptions import DerivationTooExpensiveError, InputError
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import derive
@@ -38,6 +39,15 @@ __all__ = ["CLOSED_FORM_JOINTS", "FORMATS", "Equations", "derive_equations", "es
 CLOSED_FORM_JOINTS = 3
 #: A closed-form derivation estimated to take longer than this is refused, in [s].
 CLOSED_FORM_LIMIT_S = 60.0
+
+
+class Equations(EquationsData):
+    """Symbolic equations of motion (see :class:`robodyn.equations.model.EquationsData`),
+    shown as LaTeX in notebooks."""
+
+    def _repr_latex_(self) -> str:
+        """The equations for notebooks (Jupyter renders this with MathJax)."""
+        return latex_math(self)
 
 
 def estimate_closed_form_seconds(robot: ReferenceRobot, *, keep_params: bool = False) -> float:
@@ -166,7 +176,7 @@ def derive_equations(
     )
 
 
-def substitute_parameters(equations: Equations) -> Equations:
+def substitute_parameters(equations: EquationsData) -> EquationsData:
     """The equations with every kept parameter replaced by its (exact) value."""
     from dataclasses import replace
 

@@ -1,6 +1,7 @@
 """The symbolic equations of one robot, as the renderers receive them, and their size.
 
-Every symbol in an :class:`Equations` is a safe identifier (:mod:`robodyn.equations.naming`);
+Every symbol in an :class:`EquationsData` (:class:`robodyn.equations.Equations` adds the
+notebook display) is a safe identifier (:mod:`robodyn.equations.naming`);
 the raw joint and robot names are kept only for the renderers to escape. Numbers are exact
 (rationals, ``π``, ``√2``) until a renderer turns them into floats (:func:`numeric`).
 """
@@ -13,7 +14,7 @@ import sympy as sp
 
 
 @dataclass
-class Equations:
+class EquationsData:
     """Symbolic equations of motion ``tau = M(q) q̈ + C(q, q̇) q̇ + G(q)`` of one robot.
 
     Attributes:
@@ -50,12 +51,6 @@ class Equations:
         """See :func:`operation_count`."""
         return operation_count(self)
 
-    def _repr_latex_(self) -> str:
-        """The equations for notebooks (Jupyter renders this with MathJax)."""
-        from robodyn.equations.render_latex import latex_math
-
-        return latex_math(self)
-
 
 def numeric(expr: sp.Expr, digits: int = 17) -> sp.Expr:
     """``expr`` with its exact numbers (rationals, ``π``, ``√2``...) as floats of ``digits``
@@ -63,7 +58,7 @@ def numeric(expr: sp.Expr, digits: int = 17) -> sp.Expr:
     return expr.evalf(digits) if expr.free_symbols or not expr.is_Integer else expr
 
 
-def operation_count(equations: Equations) -> int:
+def operation_count(equations: EquationsData) -> int:
     """The size of the equations as printed: ``sympy.count_ops`` over every assignment and
     every entry of ``M``, ``C q̇`` and ``G``, numbers as floats (``0.41 q`` is one
     multiplication, not a multiplication and a division)."""

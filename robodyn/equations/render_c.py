@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import sympy as sp
 
-from robodyn.equations.model import Equations, numeric
+from robodyn.equations.model import EquationsData, numeric
 from robodyn.equations.naming import comment_text, identifier
-from robodyn.equations.output import code_ready, numbered
+from robodyn.equations.printing import code_ready, numbered
 
 
-def to_c(equations: Equations) -> str:
+def to_c(equations: EquationsData) -> str:
     """``mass_matrix``, ``coriolis_forces``, ``coriolis_matrix``, ``gravity`` and
     ``inverse_dynamics`` (one state; arrays of doubles, row-major)."""
     code_ready(equations)

@@ -3,11 +3,11 @@ with 17-digit floats (``sympy.sympify`` reads them back)."""
 
 from __future__ import annotations
 
-from robodyn.equations.model import Equations, numeric
+from robodyn.equations.model import EquationsData, numeric
 from robodyn.equations.naming import json_text
 
 
-def to_json(equations: Equations) -> str:
+def to_json(equations: EquationsData) -> str:
     """Symbols, assignments and entries (see the module)."""
     n = len(equations.q)
 

@@ -18,9 +18,9 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
-from robodyn.equations.model import Equations, numeric
+from robodyn.equations.model import EquationsData, numeric
 from robodyn.equations.naming import latex_text
-from robodyn.equations.output import format_float
+from robodyn.equations.printing import format_float
 from robodyn.exceptions import MissingToolError, RobodynError
 
 #: Width of a display line, in characters of typeset math (A4, 2 cm margins, 10 pt).
@@ -40,7 +40,7 @@ class _Printer(LatexPrinter):
         return text
 
 
-def _symbol_names(equations: Equations) -> dict[sp.Symbol, str]:
+def _symbol_names(equations: EquationsData) -> dict[sp.Symbol, str]:
     names = {}
     for index, (q, qd, qdd) in enumerate(zip(equations.q, equations.qd, equations.qdd, strict=True)):
         names[q], names[qd], names[qdd] = rf"q_{{{index + 1}}}", rf"\dot q_{{{index + 1}}}", rf"\ddot q_{{{index + 1}}}"
@@ -81,10 +81,7 @@ def _lines(printer: _Printer, expr: sp.Expr, width: float) -> list[str]:
         lines: list[str] = []
         for position, term in enumerate(terms):
             sign, body = _signed(printer, term)
-            if _width(body) > width:
-                pieces = _lines(printer, -term if sign == "-" else term, width - 4)
-            else:
-                pieces = [body]
+            pieces = _lines(printer, -term if sign == "-" else term, width - 4) if _width(body) > width else [body]
             prefix = ("" if sign == "+" else "-") if position == 0 else sign + " "
             for k, piece in enumerate(pieces):
                 piece = (prefix + piece) if k == 0 else piece
@@ -115,7 +112,7 @@ def _equation(printer: _Printer, left: str, expr: sp.Expr) -> str:
     return " \\\\\n".join(rows)
 
 
-def latex_math(equations: Equations, *, precision: int = 6) -> str:
+def latex_math(equations: EquationsData, *, precision: int = 6) -> str:
     """The equations as ``align*`` environments (for a document or a notebook)."""
     printer = _Printer(precision, _symbol_names(equations))
     n = len(equations.q)
@@ -128,7 +125,7 @@ def latex_math(equations: Equations, *, precision: int = 6) -> str:
     return "\n".join(r"\begin{align*}" + "\n" + " \\\\\n".join(block) + "\n" + r"\end{align*}" for block in rows)
 
 
-def to_latex(equations: Equations, *, precision: int = 6) -> str:
+def to_latex(equations: EquationsData, *, precision: int = 6) -> str:
     """A complete LaTeX document (amsmath): the joints' legend, parameters, equations."""
     names = _symbol_names(equations)
     legend = [
@@ -194,7 +191,7 @@ def compile_latex(tex: str, folder: Path) -> tuple[Path, str]:
     return folder / "equations.pdf", log
 
 
-def to_pdf(equations: Equations, *, precision: int = 6) -> bytes:
+def to_pdf(equations: EquationsData, *, precision: int = 6) -> bytes:
     """The document of :func:`to_latex`, compiled with pdflatex."""
     with tempfile.TemporaryDirectory(prefix="robodyn-tex-") as folder:
         pdf, _ = compile_latex(to_latex(equations, precision=precision), Path(folder))

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import sympy as sp
 
-from robodyn.equations.model import Equations, numeric
+from robodyn.equations.model import EquationsData, numeric
 from robodyn.equations.naming import comment_text
-from robodyn.equations.output import code_ready, numbered
+from robodyn.equations.printing import code_ready, numbered
 
 _FOOTER = '''
 
@@ -66,7 +66,7 @@ def inverse_dynamics(q, v, a):
 '''
 
 
-def to_python(equations: Equations) -> str:
+def to_python(equations: EquationsData) -> str:
     """A module with ``mass_matrix``, ``coriolis_matrix``, ``coriolis_forces``, ``gravity``,
     ``inverse_dynamics``, with :class:`robodyn.Robot`'s conventions (1-D state, or 2-D
     with one state a row)."""

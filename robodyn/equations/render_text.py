@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from robodyn.equations.model import Equations
+from robodyn.equations.model import EquationsData
 from robodyn.equations.naming import terminal_text
-from robodyn.equations.output import format_float, to_text_expr
+from robodyn.equations.printing import format_float, to_text_expr
 
 
-def header(equations: Equations, precision: int) -> list[str]:
+def header(equations: EquationsData, precision: int) -> list[str]:
     """The title, the joints and the kept parameters' values."""
     lines = [
         f"{terminal_text(equations.robot)}: tau = M(q) qdd + C(q, qd) qd + G(q)   "
@@ -22,7 +22,7 @@ def header(equations: Equations, precision: int) -> list[str]:
     return lines
 
 
-def to_text(equations: Equations, *, precision: int = 6) -> str:
+def to_text(equations: EquationsData, *, precision: int = 6) -> str:
     """Assignments (compact form), then every entry of M, C (closed form), C q̇ and G."""
 
     def text(expr) -> str:

@@ -14,6 +14,7 @@ largest is round-off (exact inputs leave none) and is dropped.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable
 
 import sympy as sp
@@ -59,7 +60,28 @@ def _collected(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
     return sp.Add(*(_horner(coefficient, q) * monomial for monomial, coefficient in parts.items()))
 
 
+def absorb(expr: sp.Expr) -> sp.Expr:
+    """A numeric factor in front of a product moved into one of its sums:
+    ``(2*q + 1.4)*x`` rather than ``2*(q + 0.7)*x`` or ``3.3e-16*(1e13*s + ...)``."""
+    if expr.is_Add:
+        return sp.Add(*(absorb(term) for term in expr.args))
+    if not expr.is_Mul:
+        return expr
+    number, rest = expr.as_coeff_Mul()
+    factors = [absorb(f) for f in sp.Mul.make_args(rest)]
+    sums = [i for i, f in enumerate(factors) if f.is_Add]
+    if number in (1, -1) or not sums:
+        return sp.Mul(number, *factors)
+    options = []
+    for i in sums:
+        moved = list(factors)
+        moved[i] = sp.expand(abs(number) * factors[i])
+        options.append(sp.Mul(sp.sign(number), *moved))
+    return min(options, key=lambda e: len(str(e.evalf(6))))
+
+
 def _best(candidates: list[sp.Expr]) -> sp.Expr:
+    candidates = [absorb(c) for c in candidates]
     return min(candidates, key=lambda e: (size(e), len(str(e))))
 
 
@@ -93,10 +115,8 @@ def coefficient(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
     merged = pythagoras(TR10i(reduced))  # cos a cos b - sin a sin b = cos(a + b), ...
     candidates = [reduced, _collected(reduced, q), merged, sp.factor_terms(merged), _collected(merged, q)]
     if sp.count_ops(reduced) < 200:
-        try:
+        with contextlib.suppress(sp.PolynomialError):
             candidates.append(sp.factor(reduced))
-        except sp.PolynomialError:
-            pass
     return _best(candidates)
 
 
@@ -111,8 +131,6 @@ def entry(expr: sp.Expr, q: list[sp.Symbol], qd: list[sp.Symbol]) -> sp.Expr:
         *(coefficient(c, q) * sp.Mul(*(v**k for v, k in zip(speeds, powers, strict=True))) for powers, c in terms)
     )
     candidates = [by_product, sp.factor_terms(by_product)]
-    try:
+    with contextlib.suppress(sp.PolynomialError):
         candidates.append(sp.factor(by_product))
-    except sp.PolynomialError:
-        pass
     return _best(candidates)
