@@ -236,28 +236,11 @@ def derive(
     q, qd, qdd = symbols or joint_symbols(robot.joint_names)
     theta, theta_dot = body_coordinates(robot, q, qd)
     gravity = params.gravity(robot.gravity_vector)
-    rotations: list[sp.Matrix] = []
-    positions: list[sp.Matrix] = []
-    axes: list[sp.Matrix] = []
+    rotations, positions, axes = body_poses(robot, theta, params, snap=snap)
     T = sp.Integer(0)
     U = sp.Integer(0)
     for index, body in enumerate(tree.bodies):
-        parent_rotation = sp.eye(3) if body.parent < 0 else rotations[body.parent]
-        parent_position = sp.zeros(3, 1) if body.parent < 0 else positions[body.parent]
-        joint_rotation = parent_rotation * exact_matrix(body.origin[:3, :3], snap)
-        origin = parent_position + parent_rotation * params.vector(body.origin[:3, 3], "d", body.joint)
-        axis = exact_matrix(body.axis[:, None], snap)
-        world_axis = joint_rotation * axis
-        angle = theta[index]
-        if body.revolute:
-            rotation = joint_rotation * axis_rotation(axis, sp.cos(angle), sp.sin(angle))
-            position = origin
-        else:
-            rotation = joint_rotation
-            position = origin + world_axis * angle
-        rotations.append(rotation)
-        positions.append(position)
-        axes.append(world_axis)
+        rotation, position = rotations[index], positions[index]
         if body.mass == 0 and not body.inertia.any():
             continue
         com = position + rotation * params.vector(body.com, "c", body.link)
@@ -272,6 +255,32 @@ def derive(
         U += -mass * (gravity.T * com)[0]
     dynamics = lagrangian_dynamics(T, U, q, qd, qdd, simplify=simplify)
     return replace(dynamics, parameters=params.values, labels=params.labels)
+
+
+def body_poses(
+    robot: ReferenceRobot, theta: sp.Matrix, params: Parameters | None = None, *, snap: float = 1e-8
+) -> tuple[list[sp.Matrix], list[sp.Matrix], list[sp.Matrix]]:
+    """World rotation, origin and joint axis of every body frame as functions of the bodies'
+    coordinates ``theta`` (forward kinematics in closed form, exact constants)."""
+    params = params or Parameters(False)
+    rotations: list[sp.Matrix] = []
+    positions: list[sp.Matrix] = []
+    axes: list[sp.Matrix] = []
+    for index, body in enumerate(robot.tree.bodies):
+        parent_rotation = sp.eye(3) if body.parent < 0 else rotations[body.parent]
+        parent_position = sp.zeros(3, 1) if body.parent < 0 else positions[body.parent]
+        joint_rotation = parent_rotation * exact_matrix(body.origin[:3, :3], snap)
+        origin = parent_position + parent_rotation * params.vector(body.origin[:3, 3], "d", body.joint)
+        axis = exact_matrix(body.axis[:, None], snap)
+        world_axis = joint_rotation * axis
+        if body.revolute:
+            rotations.append(joint_rotation * axis_rotation(axis, sp.cos(theta[index]), sp.sin(theta[index])))
+            positions.append(origin)
+        else:
+            rotations.append(joint_rotation)
+            positions.append(origin + world_axis * theta[index])
+        axes.append(world_axis)
+    return rotations, positions, axes
 
 
 def axis_rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:

@@ -43,6 +43,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
     parser.add_argument(
+        "--kinematics",
+        metavar="FRAME",
+        help="with --symbolic: forward kinematics and Jacobian of a link (formats text, latex, json, python)",
+    )
+    parser.add_argument(
         "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
     )
     parser.set_defaults(run=run)
@@ -70,6 +75,13 @@ def _symbolic(arguments: argparse.Namespace) -> int:
     if arguments.lecture:
         print(lecture_text(), end="")
         return 0
+    if arguments.kinematics is not None:
+        from robodyn.equations.kinematics import derive_kinematics, render_kinematics
+
+        if arguments.format not in ("text", "latex", "json", "python"):
+            raise InputError("--format", "text, latex, json or python with --kinematics", repr(arguments.format))
+        kinematics = derive_kinematics(arguments.model, arguments.kinematics, lock=lock_values(arguments.lock))
+        return _emit(arguments, render_kinematics(kinematics, arguments.format, precision=arguments.precision), "kinematics")
     progress = Progress(f"deriving {arguments.model}")
     try:
         equations = derive_equations(
@@ -84,6 +96,10 @@ def _symbolic(arguments: argparse.Namespace) -> int:
     finally:
         progress.close()
     output = render(equations, arguments.format, precision=arguments.precision)
+    return _emit(arguments, output, f"{equations.form} form, {equations.operation_count()} operations")
+
+
+def _emit(arguments: argparse.Namespace, output: str | bytes, what: str) -> int:
     if arguments.out:
         from robodyn.common.files import atomic_write_bytes, atomic_write_text
 
@@ -91,7 +107,7 @@ def _symbolic(arguments: argparse.Namespace) -> int:
             atomic_write_bytes(arguments.out, output)
         else:
             atomic_write_text(arguments.out, output)
-        print(f"wrote {arguments.out} ({equations.form} form, {equations.operation_count()} operations)", file=sys.stderr)
+        print(f"wrote {arguments.out} ({what})", file=sys.stderr)
     else:
         print(output, end="")
     return 0
