@@ -59,7 +59,7 @@ def test_text_has_short_numbers_and_no_unit_coefficients(capsys):
     assert "0.41*" in out or "+ 0.41" in out or "0.205" in out  # 0.4 + 0.01: written exactly
     assert main(["equations", "rp_arm", "--symbolic", "--precision", "3"]) == 0
     out = capsys.readouterr().out
-    assert "0.671" in out and "0.670625" not in out
+    assert "0.181" in out and "0.180625" not in out  # (q2 + 0.7)² + 0.180625
 
 
 def test_rrp_arm_reads_like_a_hand_derivation():

@@ -4,7 +4,8 @@ Joints are numbered, ``q_1``, ``\\dot q_1``, ``\\ddot q_1``, with a legend table
 joint names; kept parameters carry their link or joint as an upright subscript
 (``m_{\\text{link1}}``); every name passes :func:`naming.latex_text`. Long entries are
 broken across lines (at the sums, inside a parenthesised sum where needed) so nothing runs
-off the page; ``M`` is printed entry by entry (the upper triangle: it is symmetric).
+off the page; ``M`` is a matrix when it fits the line, else printed entry by entry (the
+upper triangle: it is symmetric).
 """
 
 from __future__ import annotations
@@ -119,7 +120,12 @@ def latex_math(equations: EquationsData, *, precision: int = 6) -> str:
     rows = []
     if equations.assignments:
         rows.append([_equation(printer, printer.doprint(s), e) for s, e in equations.assignments])
-    rows.append([_equation(printer, f"M_{{{i + 1}{j + 1}}}", equations.M[i, j]) for i in range(n) for j in range(i, n)])
+    entries = [[printer.doprint(numeric(equations.M[i, j])) for j in range(n)] for i in range(n)]
+    if not equations.assignments and max(sum(_width(e) + 3 for e in row) for row in entries) + 8 <= LINE_WIDTH:
+        matrix = r" \\ ".join(" & ".join(row) for row in entries)
+        rows.append([rf"M(q) &= \begin{{bmatrix}} {matrix} \end{{bmatrix}}"])
+    else:  # too wide for a matrix: entry by entry, the upper triangle (M is symmetric)
+        rows.append([_equation(printer, f"M_{{{i + 1}{j + 1}}}", equations.M[i, j]) for i in range(n) for j in range(i, n)])
     rows.append([_equation(printer, rf"(C\dot q)_{{{i + 1}}}", equations.Cv[i]) for i in range(n)])
     rows.append([_equation(printer, f"G_{{{i + 1}}}", equations.G[i]) for i in range(n)])
     return "\n".join(r"\begin{align*}" + "\n" + " \\\\\n".join(block) + "\n" + r"\end{align*}" for block in rows)

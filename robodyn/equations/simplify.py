@@ -105,6 +105,25 @@ def pythagoras(expr: sp.Expr) -> sp.Expr:
     return expr
 
 
+def completed_square(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
+    """``a q² + b q + c`` as ``a (q + b/2a)² + c − b²/4a`` for the first coordinate it is
+    quadratic in (a prismatic joint's ``r = q + offset``), else ``expr``."""
+    for variable in q:
+        if not expr.has(variable):
+            continue
+        try:
+            poly = sp.Poly(expr, variable)
+        except sp.PolynomialError:
+            continue
+        if poly.degree() != 2:
+            continue
+        a, b, c = poly.all_coeffs()
+        shift = sp.cancel(b / (2 * a))
+        rest = sp.expand(c - sp.cancel(b**2 / (4 * a)))
+        return a * (variable + shift) ** 2 + _collected(rest, q)
+    return expr
+
+
 def coefficient(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
     """The shortest of several equivalent forms of a function of ``q``."""
     from sympy.simplify.fu import TR10i
@@ -114,6 +133,7 @@ def coefficient(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
         return reduced
     merged = pythagoras(TR10i(reduced))  # cos a cos b - sin a sin b = cos(a + b), ...
     candidates = [reduced, _collected(reduced, q), merged, sp.factor_terms(merged), _collected(merged, q)]
+    candidates += [completed_square(reduced, q), completed_square(merged, q)]
     if sp.count_ops(reduced) < 200:
         with contextlib.suppress(sp.PolynomialError):
             candidates.append(sp.factor(reduced))
