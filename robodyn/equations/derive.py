@@ -38,7 +38,7 @@ __all__ = ["CLOSED_FORM_JOINTS", "FORMATS", "Equations", "derive_equations", "es
 #: Largest number of joints derived in closed form by ``form="auto"``.
 CLOSED_FORM_JOINTS = 3
 #: A closed-form derivation estimated to take longer than this is refused, in [s].
-CLOSED_FORM_LIMIT_S = 60.0
+CLOSED_FORM_LIMIT_S = 30.0
 
 
 class Equations(EquationsData):
@@ -54,13 +54,13 @@ def estimate_closed_form_seconds(robot: ReferenceRobot, *, keep_params: bool = F
     """A rough estimate of the closed form's derivation time, in [s].
 
     The Lagrangian's expressions grow about tenfold with each revolute joint of a chain
-    and threefold with each prismatic one (measured on this machine: rp_arm 0.2 s, a
-    revolute–revolute–prismatic arm 1.5 s, the double pendulum 0.9 s); kept parameters
-    cost about as much again.
+    and threefold with each prismatic one (CPU time measured: rp_arm 0.2 s, the double
+    pendulum 0.5 s, a revolute–revolute–prismatic arm 1.5 s, ur5's first four joints 52 s);
+    kept parameters cost about as much again.
     """
     bodies = robot.tree.bodies
     revolute = sum(body.revolute for body in bodies)
-    estimate = 0.01 * 10.0**revolute * 3.0 ** (len(bodies) - revolute)
+    estimate = 0.005 * 10.0**revolute * 3.0 ** (len(bodies) - revolute)
     return estimate * (3.0 if keep_params else 1.0)
 
 
