@@ -56,6 +56,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 def _symbolic(arguments: argparse.Namespace) -> int:
     from robodyn.equations.derive import derive_equations
     from robodyn.equations.lecture import lecture_text
+    from robodyn.equations.naming import terminal_text
     from robodyn.equations.output import check_precision, render
 
     given = [f"--{name}" for name in ("q", "v", "a") if getattr(arguments, name) is not None]
@@ -82,7 +83,8 @@ def _symbolic(arguments: argparse.Namespace) -> int:
             raise InputError("--format", "text, latex, json or python with --kinematics", repr(arguments.format))
         kinematics = derive_kinematics(arguments.model, arguments.kinematics, lock=lock_values(arguments.lock))
         return _emit(arguments, render_kinematics(kinematics, arguments.format, precision=arguments.precision), "kinematics")
-    progress = Progress(f"deriving {arguments.model}")
+    label = terminal_text(str(arguments.model))
+    progress = Progress(f"deriving {label if len(label) <= 60 else label[:57] + '...'}")
     try:
         equations = derive_equations(
             arguments.model,
