@@ -75,8 +75,12 @@ def test_rrp_arm_reads_like_a_hand_derivation():
     assert equations.operation_count() <= 120
 
 
-def test_compact_forms_meet_the_size_targets():
-    assert derive_equations("ur5").operation_count() <= 760
+def test_compact_forms_meet_the_size_targets_without_copy_lines():
+    equations = derive_equations("ur5")
+    assert equations.operation_count() <= 760
+    assert not [s for s, e in equations.assignments if e.is_Symbol or e.is_Number]  # no `a = b`
+    expressions = [e for _, e in equations.assignments]
+    assert len(set(expressions)) == len(expressions)  # nothing assigned twice
 
 
 @pytest.mark.slow
