@@ -27,6 +27,8 @@ NAMES = [
     "tex $\\ {} ^_&%#~ end",
 ]
 ROBOT = 'r"""\nimport os; os.system(\'touch CANARY\')\n"""*/ void y(){system("touch CANARY");} /*'
+#: The last link's name.
+LINK = 'tip"""\nimport os; os.system(\'touch CANARY\')\n#*/\x9b'
 #: Not representable in XML 1.0, so put into the equations after the derivation.
 ANSI = "\x1b[31mred\x1b[0m"
 
@@ -47,7 +49,8 @@ def hostile_urdf() -> str:
         '<limit lower="-1" upper="1" effort="10" velocity="1"/></joint>'
         for i, name in enumerate(NAMES, start=1)
     )
-    return f'<?xml version="1.0"?><robot name={_attr(ROBOT)}><link name="l0"/>{links}{joints}</robot>'
+    text = f'<?xml version="1.0"?><robot name={_attr(ROBOT)}><link name="l0"/>{links}{joints}</robot>'
+    return text.replace('"l4"', _attr(LINK))
 
 
 @pytest.fixture(scope="module")
@@ -151,3 +154,27 @@ def test_hostile_latex_compiles(hostile, tmp_path):
     pdf, log = compile_latex(render(hostile, "latex"), tmp_path)
     assert pdf.stat().st_size > 0 and "! " not in log
     assert not (tmp_path / CANARY).exists()
+
+
+def test_kept_parameters_named_after_a_hostile_link_are_safe(tmp_path):
+    equations = derive_equations(hostile_urdf(), form="compact", keep_params=True)
+    assert any(owner == LINK for _, owner, _ in equations.labels.values())
+    assert all(symbol.name.isidentifier() for symbol in equations.parameters)
+    text = render(equations, "text")
+    assert all(line.isprintable() for line in text.splitlines()) and "\x9b" not in text
+    assert render(equations, "latex").isascii()
+    assert all(name.isidentifier() for name in json.loads(render(equations, "json"))["parameters"])
+
+
+def test_kinematics_of_a_hostile_frame_are_safe(tmp_path, monkeypatch):
+    from robodyn.equations.kinematics import derive_kinematics, render_kinematics
+
+    monkeypatch.chdir(tmp_path)
+    kinematics = derive_kinematics(hostile_urdf(), LINK)
+    namespace: dict = {}
+    exec(compile(render_kinematics(kinematics, "python"), "kinematics.py", "exec"), namespace)
+    assert not (tmp_path / CANARY).exists()
+    assert namespace["frame_position"](np.zeros(4)).shape == (3,)
+    assert all(line.isprintable() for line in render_kinematics(kinematics, "text").splitlines())
+    assert render_kinematics(kinematics, "latex").isascii()
+    assert json.loads(render_kinematics(kinematics, "json"))["frame"] == LINK
