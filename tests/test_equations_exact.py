@@ -103,3 +103,22 @@ def test_kept_parameters_for_every_robot_give_the_robots_numbers(name, form, rng
     q = robot.random_configuration(rng, 10)
     v, a = rng.normal(size=(2, 10, robot.nv))
     assert relative(namespace["inverse_dynamics"](q, v, a), robot.inverse_dynamics(q, v, a)) < 1e-9
+
+
+@pytest.mark.parametrize("name", ["rp_arm", RRP], ids=["rp_arm", "rrp_arm"])
+def test_christoffel_symbols_rebuild_the_coriolis_matrix(name, capsys):
+    from robodyn.equations.christoffel import christoffel_symbols
+
+    equations = derive_equations(name)
+    gamma = christoffel_symbols(equations)
+    n = len(equations.q)
+    C = sp.zeros(n, n)
+    for (i, j, k), value in gamma.items():
+        C[i, j] += value * equations.qd[k]
+        if j != k:
+            C[i, k] += value * equations.qd[j]
+    assert sp.expand(sp.expand_trig(C - equations.C)) == sp.zeros(n, n)
+    assert main(["equations", name, "--symbolic", "--christoffel"]) == 0
+    assert "Gamma[1," in capsys.readouterr().out
+    with pytest.raises(InputError, match="closed"):
+        christoffel_symbols(derive_equations(name, form="compact"))

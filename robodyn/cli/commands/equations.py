@@ -48,6 +48,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="with --symbolic: forward kinematics and Jacobian of a link (formats text, latex, json, python)",
     )
     parser.add_argument(
+        "--christoffel", action="store_true", help="with --symbolic: the Christoffel symbols of M (closed form; text or json)"
+    )
+    parser.add_argument(
         "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
     )
     parser.set_defaults(run=run)
@@ -97,6 +100,10 @@ def _symbolic(arguments: argparse.Namespace) -> int:
         )
     finally:
         progress.close()
+    if arguments.christoffel:
+        from robodyn.equations.christoffel import render_christoffel
+
+        return _emit(arguments, render_christoffel(equations, arguments.format, precision=arguments.precision), "Christoffel")
     output = render(equations, arguments.format, precision=arguments.precision)
     return _emit(arguments, output, f"{equations.form} form, {equations.operation_count()} operations")
 
