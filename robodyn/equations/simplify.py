@@ -69,6 +69,9 @@ def absorb(expr: sp.Expr) -> sp.Expr:
         return expr
     number, rest = expr.as_coeff_Mul()
     factors = [absorb(f) for f in sp.Mul.make_args(rest)]
+    for i, f in enumerate(factors):  # -(a + b) x rather than (-a - b) x
+        if f.is_Add and f.could_extract_minus_sign():
+            factors[i], number = sp.expand(-f), -number
     sums = [i for i, f in enumerate(factors) if f.is_Add]
     if number in (1, -1) or not sums:
         return sp.Mul(number, *factors)
