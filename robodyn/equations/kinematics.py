@@ -11,6 +11,7 @@ like the dynamics (:mod:`robodyn.equations.simplify`). No Pinocchio here.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,8 +56,20 @@ def _rpy(rpy: np.ndarray) -> np.ndarray:
     return rz @ ry @ rx
 
 
-def derive_kinematics(source: str | os.PathLike, frame: str, *, lock: dict[str, float] | None = None) -> Kinematics:
+def derive_kinematics(
+    source: str | os.PathLike,
+    frame: str,
+    *,
+    lock: dict[str, float] | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> Kinematics:
     """Closed-form forward kinematics and Jacobian of ``frame`` (a link name).
+
+    Args:
+        source: Anything :func:`robodyn.load` takes.
+        frame: A link of the robot.
+        lock: Joints to freeze, by name, at positions.
+        progress: Called as ``progress(stage, done, total)`` while entries are simplified.
 
     Raises:
         FrameError: For a name that is not a link of the robot.
@@ -92,10 +105,20 @@ def derive_kinematics(source: str | os.PathLike, frame: str, *, lock: dict[str, 
                 angular += axes[ancestor] * selection[ancestor, :]
     else:  # a frame on the fixed base
         rotation, position, angular = fixed_rotation, fixed_offset, sp.zeros(3, n)
-    tidy = lambda e: simplify.coefficient(e, q)  # noqa: E731
+    total, done = 3 + 9 + 6 * n, [0]
+
+    def tidy(expr: sp.Expr) -> sp.Expr:
+        if progress:
+            progress("simplification", done[0], total)
+        done[0] += 1
+        return simplify.coefficient(expr, q)
+
     position = position.applyfunc(tidy)
+    rotation = rotation.applyfunc(tidy)
     jacobian = position.jacobian(q).applyfunc(tidy).col_join(angular.applyfunc(tidy))
-    return Kinematics(model.name, frame, list(model.joint_names), q, position, rotation.applyfunc(tidy), jacobian)
+    if progress:
+        progress("simplification", total, total)
+    return Kinematics(model.name, frame, list(model.joint_names), q, position, rotation, jacobian)
 
 
 def render_kinematics(kinematics: Kinematics, format: str = "text", *, precision: int = 6) -> str:

@@ -84,7 +84,13 @@ def _symbolic(arguments: argparse.Namespace) -> int:
 
         if arguments.format not in ("text", "latex", "json", "python"):
             raise InputError("--format", "text, latex, json or python with --kinematics", repr(arguments.format))
-        kinematics = derive_kinematics(arguments.model, arguments.kinematics, lock=lock_values(arguments.lock))
+        progress = Progress(f"kinematics of {terminal_text(arguments.kinematics)[:40]}")
+        try:
+            kinematics = derive_kinematics(
+                arguments.model, arguments.kinematics, lock=lock_values(arguments.lock), progress=progress
+            )
+        finally:
+            progress.close()
         return _emit(arguments, render_kinematics(kinematics, arguments.format, precision=arguments.precision), "kinematics")
     label = terminal_text(str(arguments.model))
     progress = Progress(f"deriving {label if len(label) <= 60 else label[:57] + '...'}")
