@@ -45,7 +45,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--kinematics",
         metavar="FRAME",
-        help="with --symbolic: forward kinematics and Jacobian of a link (formats text, latex, json, python)",
+        help="with --symbolic: forward kinematics and Jacobian of a link (formats text, latex, json, python, c)",
     )
     parser.add_argument(
         "--christoffel", action="store_true", help="with --symbolic: the Christoffel symbols of M (closed form; text or json)"
@@ -82,8 +82,8 @@ def _symbolic(arguments: argparse.Namespace) -> int:
     if arguments.kinematics is not None:
         from robodyn.equations.kinematics import derive_kinematics, render_kinematics
 
-        if arguments.format not in ("text", "latex", "json", "python"):
-            raise InputError("--format", "text, latex, json or python with --kinematics", repr(arguments.format))
+        if arguments.format not in ("text", "latex", "json", "python", "c"):
+            raise InputError("--format", "text, latex, json, python or c with --kinematics", repr(arguments.format))
         progress = Progress(f"kinematics of {terminal_text(arguments.kinematics)[:40]}")
         try:
             kinematics = derive_kinematics(
