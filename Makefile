@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint bench mutants clean chromium
+.PHONY: demo test test-fast lint bench mutants clean chromium tex
 
 $(STAMP): pyproject.toml requirements.lock
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -24,6 +24,14 @@ chromium:
 		echo "note: no chromium (install Debian's 'chromium' for stills, videos and the browser tests)"; }
 	@command -v chromium >/dev/null 2>&1 && chromium --version 2>/dev/null | head -1 || true
 
+# pdflatex compiles the equations' LaTeX (--format pdf, and the slow tier's typesetting
+# test). Debian's TeX Live, installed when missing and we may (root with apt).
+tex:
+	@command -v pdflatex >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
+		(apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+			texlive-latex-base texlive-latex-extra >/dev/null) || \
+		echo "note: no pdflatex (install Debian's texlive-latex-base for --format pdf and the typesetting test)"; }
+
 # The main job on the built-in robot: the RP arm's equations, then the lecture's control
 # story (drive the end effector to a target) as trajectory, plot, animation and still.
 demo: $(STAMP) chromium
@@ -34,7 +42,7 @@ demo: $(STAMP) chromium
 		$$(command -v chromium >/dev/null 2>&1 && echo --png out/rp_arm_poster.png)
 
 # Everything CI runs: lint, the fast tier, then the slow tier.
-test: $(STAMP) chromium
+test: $(STAMP) chromium tex
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -m "not slow"

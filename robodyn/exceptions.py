@@ -258,3 +258,38 @@ class IdentificationError(RobodynError):
         self.robot = robot
         self.reason = reason
         super().__init__(f"robot {quoted(robot)}: {reason}.")
+
+
+class DerivationTooExpensiveError(RobodynError):
+    """A closed-form derivation estimated to take too long (the compact form does not).
+
+    Attributes:
+        robot: Robot name.
+        joints: Number of joints.
+        estimate_s: Estimated derivation time in [s].
+        limit_s: The largest estimate accepted, in [s].
+    """
+
+    def __init__(self, robot: str, joints: int, estimate_s: float, limit_s: float):
+        self.robot = robot
+        self.joints = joints
+        self.estimate_s = estimate_s
+        self.limit_s = limit_s
+        super().__init__(
+            f"the closed form of {quoted(robot)} ({joints} joints) would take about {estimate_s:.3g} s to derive "
+            f"(limit {limit_s:g} s); use --form compact (form='compact')."
+        )
+
+
+class MissingToolError(RobodynError, OSError):
+    """An external program a feature needs is not installed.
+
+    Attributes:
+        tool: The program, e.g. ``"pdflatex"``.
+        purpose: What it was needed for.
+    """
+
+    def __init__(self, tool: str, purpose: str, hint: str = ""):
+        self.tool = tool
+        self.purpose = purpose
+        super().__init__(f"{purpose} needs {tool}, which is not installed{'; ' + hint if hint else ''}.")

@@ -9,7 +9,7 @@ Sections:
     batch    100 000 states: robodyn vs a Python loop over pin.rnea / pin.aba, and vs
              Pinocchio's parallel API called directly
     reference  the independent reference's numeric mode, states/s, vs Pinocchio
-    symbolic   closed-form derivation time and operation counts
+    symbolic   symbolic derivation time and operation counts against the targets of #17
     codegen    generated Python code's evaluation cost vs Pinocchio
     simulation real-time factor of 10 s of panda at 1 kHz
     recording  time and HTML size of a 10 s panda recording at 30 fps
@@ -173,21 +173,37 @@ def bench_reference(quick: bool) -> list[dict]:
     return rows
 
 
+#: The issue's targets (#17): operations over M, C q̇ and G, as ``Equations.operation_count``.
+SYMBOLIC_TARGETS = {
+    "rp_arm": 20,
+    "double_pendulum": 70,
+    "rrp_arm": 120,
+    "ur5": 760,
+    "panda (7 arm joints)": 1700,
+}
+
+
 def bench_symbolic(quick: bool) -> list[dict]:
     from robodyn.equations.derive import derive_equations
 
+    rrp = str(ROOT / "tests" / "data" / "rrp_arm.urdf")
+    cases = (("rp_arm", None), ("double_pendulum", None), (rrp, None), ("ur5", None), ("panda", PANDA_ARM["lock"]))
     rows = []
-    for name, lock in (("rp_arm", None), ("double_pendulum", None), ("ur5", None), ("panda", PANDA_ARM["lock"])):
-        start = time.perf_counter()
+    for name, lock in cases:
+        start, cpu = time.perf_counter(), time.process_time()
         equations = derive_equations(name, lock=lock)
-        elapsed = time.perf_counter() - start
-        label = name + (" (7 arm joints)" if lock else "")
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
+        label = Path(name).stem + (" (7 arm joints)" if lock else "")
+        operations = equations.operation_count()
         rows.append(
             {
                 "robot": label,
                 "form": equations.form,
                 "derive_s": elapsed,
-                "operations_M_Cv_G": equations.operation_count(),
+                "derive_cpu_s": cpu,
+                "operations_M_Cv_G": operations,
+                "target_operations": SYMBOLIC_TARGETS[label],
+                "within_target": operations <= SYMBOLIC_TARGETS[label] and cpu < 5.0,
                 "assignments": len(equations.assignments),
             }
         )

@@ -20,7 +20,7 @@ import pytest
 import robodyn
 import robodyn.reference
 from robodyn.equations.derive import derive_equations, render
-from robodyn.exceptions import InputError, RobodynError, URDFError
+from robodyn.exceptions import InputError, URDFError
 from robodyn.verify.check import check_robot, report_text
 
 ROBOTS = Path(__file__).parent / "data" / "robots"
@@ -288,6 +288,7 @@ EQUATION_CASES = {
     "oblique_locked_negative": "oblique_locked_negative",
     "gripper_locked_sources": "gripper_locked_sources",
     "mimic_tree_locked": "mimic_tree_locked",
+    "gripper": pytest.param("gripper", marks=pytest.mark.slow),  # mimic joints through the linear map
 }
 
 
@@ -307,17 +308,6 @@ def test_generated_code_matches_the_robot(name):
     np.testing.assert_allclose(tau, robot.inverse_dynamics(q, v, a), atol=1e-9 * scale(tau))
     np.testing.assert_allclose(mass, robot.mass_matrix(q), atol=1e-9 * scale(mass))
     np.testing.assert_allclose(gravity, robot.gravity(q), atol=1e-9 * scale(tau))
-
-
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: derive_equations(form='compact') on a robot with mimic joints raises NotImplementedError, not a "
-    "RobodynError (the CLI prints a traceback); fix: raise InputError('form', 'closed, or lock the mimic joints', ...) "
-    "in equations/compact.py",
-)
-def test_compact_equations_refuse_mimic_joints_cleanly():
-    with pytest.raises(RobodynError):
-        derive_equations(GRIPPER, form="compact")
 
 
 def test_equations_refuse_a_floating_base_cleanly():

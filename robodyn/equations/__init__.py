@@ -1,5 +1,7 @@
-"""Equations out: symbolic equations of motion from the independent reference (never Pinocchio), in closed or compact form, rendered as text, LaTeX, JSON, Python or C; the lecture's equations with their errata."""
+"""Equations out: symbolic equations of motion from the independent reference (never Pinocchio), in closed or compact form, rendered as text, LaTeX, PDF, JSON, Python or C; the lecture's equations with their errata."""
 
-from robodyn.equations.derive import Equations, derive_equations, render
+from robodyn.equations.derive import Equations, derive_equations
+from robodyn.equations.model import operation_count
+from robodyn.equations.output import FORMATS, render
 
-__all__ = ["Equations", "derive_equations", "render"]
+__all__ = ["FORMATS", "Equations", "derive_equations", "operation_count", "render"]

@@ -15,8 +15,13 @@ program of named assignments, the way SYMORO prints customised models:
   ``C q̇`` and once with gravity alone for ``G``;
 - ``M``: column ``i`` is the composite body beyond joint ``i`` moving along its axis,
   carried up to each ancestor ``j`` and projected on joint ``j``'s axis;
-- a variable is made only for a non-trivial expression, and ``sympy.cse`` then shares
-  what is still repeated.
+- a variable is made only for a non-trivial expression, ``cos²`` or ``sin²`` of a joint
+  is replaced by ``1 − sin²`` / ``1 − cos²`` where that shortens it, ``sympy.cse`` then
+  shares what is still repeated, and copies (``a = b``) are substituted away;
+- mimic joints: every body moves with ``theta = S q + offset``; the equations of the bodies
+  are mapped with ``M = Sᵀ M_full S``, ``C q̇ = Sᵀ (C q̇)_full``, ``G = Sᵀ G_full``;
+- with ``keep_params`` masses, centres of mass, inertias, joint offsets and gravity are
+  symbols (:class:`robodyn.reference.symbolic.Parameters`).
 
 No Pinocchio here.
 """
@@ -24,13 +29,12 @@ No Pinocchio here.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
-import numpy as np
 import sympy as sp
 
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.symbolic import _exact, exact_matrix, joint_symbols
+from robodyn.reference.symbolic import Parameters, axis_rotation, body_coordinates, exact_matrix, joint_symbols
 
 
 @dataclass
@@ -43,6 +47,8 @@ class CompactDynamics:
         M: Mass matrix entries in terms of the assigned symbols.
         Cv: ``C(q, q̇) q̇`` entries.
         G: Gravity entries.
+        parameters: Kept parameters and their values (``keep_params``).
+        labels: ``(kind, owner, component)`` of every kept parameter.
     """
 
     q: list[sp.Symbol]
@@ -52,10 +58,8 @@ class CompactDynamics:
     M: sp.Matrix | None = None
     Cv: sp.Matrix | None = None
     G: sp.Matrix | None = None
-
-    def operation_count(self) -> int:
-        """``sympy.count_ops`` over every assignment and output entry."""
-        return int(sum(sp.count_ops(e) for _, e in self.assignments) + sum(sp.count_ops(e) for e in (*self.M, *self.Cv, *self.G)))
+    parameters: dict = field(default_factory=dict)
+    labels: dict = field(default_factory=dict)
 
 
 class _Program:
@@ -63,10 +67,21 @@ class _Program:
 
     def __init__(self) -> None:
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
+        self.pairs: list[tuple[sp.Symbol, sp.Symbol]] = []  # (cos, sin) of a joint
         self._counter = 0
 
-    def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
+    def pythagoras(self, expr: sp.Expr) -> sp.Expr:
+        """``expr`` expanded, with ``c² = 1 − s²`` (or ``s² = 1 − c²``) of each joint where shorter."""
         expr = sp.expand(expr)
+        for c, s in self.pairs:
+            if not expr.has(c) or not expr.has(s):
+                continue
+            options = [expr, sp.expand(expr.subs(c**2, 1 - s**2)), sp.expand(expr.subs(s**2, 1 - c**2))]
+            expr = min(options, key=sp.count_ops)
+        return expr
+
+    def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
+        expr = self.pythagoras(expr)
         if (
             expr.is_Number
             or expr.is_Symbol
@@ -85,17 +100,6 @@ class _Program:
         return sp.Matrix(matrix.rows, matrix.cols, lambda i, j: self.let(matrix[i, j], prefix))
 
 
-def _constant(values: np.ndarray) -> sp.Matrix:
-    """A matrix of URDF constants kept as given (exact only where exactly 0 or 1)."""
-    return exact_matrix(values, 0.0)
-
-
-def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
-    x, y, z = axis
-    skew = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return sp.eye(3) + s * skew + (1 - c) * skew * skew
-
-
 def _shared(equations: CompactDynamics) -> CompactDynamics:
     """Share repeated subexpressions (``sympy.cse``) and keep only what the outputs need,
     in dependency order."""
@@ -111,7 +115,83 @@ def _shared(equations: CompactDynamics) -> CompactDynamics:
     M = sp.Matrix(n, n, outputs[: n * n])
     Cv = sp.Matrix(outputs[n * n : n * n + n])
     G = sp.Matrix(outputs[n * n + n :])
-    return CompactDynamics(equations.q, equations.qd, equations.qdd, _in_order(definitions, outputs), M, Cv, G)
+    return replace(equations, assignments=_in_order(definitions, outputs), M=M, Cv=Cv, G=G)
+
+
+def _reuse_products(equations: CompactDynamics) -> CompactDynamics:
+    """Where a product ``t = a*b`` is assigned, later products containing ``a*b`` use ``t``,
+    and each assignment is collected on a symbol where that saves operations."""
+    pairs: dict[frozenset, sp.Symbol] = {}
+
+    def reuse(expr: sp.Expr) -> sp.Expr:
+        def fold(mul: sp.Expr) -> sp.Expr:
+            factors = list(mul.args)
+            changed = True
+            while changed:
+                changed = False
+                symbols = [f for f in factors if f.is_Symbol]
+                for i, a in enumerate(symbols):
+                    for b in symbols[i + 1 :]:
+                        t = pairs.get(frozenset((a, b)))
+                        if t is not None:
+                            factors.remove(a)
+                            factors.remove(b)
+                            factors.append(t)
+                            changed = True
+                            break
+                    if changed:
+                        break
+            return sp.Mul(*factors)
+
+        return expr.replace(lambda e: e.is_Mul and len(e.args) > 2, fold) if pairs else expr
+
+    def collected(expr: sp.Expr) -> sp.Expr:
+        if not expr.is_Add:
+            return expr
+        best = expr
+        for symbol in sorted(expr.free_symbols, key=str):
+            candidate = sp.collect(best, symbol)
+            if sp.count_ops(candidate) < sp.count_ops(best):
+                best = candidate
+        return best
+
+    assignments = []
+    for symbol, expr in equations.assignments:
+        expr = collected(reuse(expr))
+        assignments.append((symbol, expr))
+        if expr.is_Mul and len(expr.args) == 2 and all(a.is_Symbol for a in expr.args):
+            pairs[frozenset(expr.args)] = symbol
+    return replace(
+        equations,
+        assignments=assignments,
+        M=equations.M.applyfunc(lambda e: collected(reuse(e))),
+        Cv=equations.Cv.applyfunc(lambda e: collected(reuse(e))),
+        G=equations.G.applyfunc(lambda e: collected(reuse(e))),
+    )
+
+
+def _without_copies(equations: CompactDynamics) -> CompactDynamics:
+    """Substitute away assignments of a bare symbol or number (``a = b``) and repeats of an
+    expression already assigned."""
+    copies: dict[sp.Symbol, sp.Expr] = {}
+    seen: dict[sp.Expr, sp.Symbol] = {}
+    kept = []
+    for symbol, expr in equations.assignments:
+        expr = expr.xreplace(copies)
+        if expr.is_Symbol or expr.is_Number:
+            copies[symbol] = expr
+        elif expr in seen:
+            copies[symbol] = seen[expr]
+        else:
+            seen[expr] = symbol
+            kept.append((symbol, expr))
+    return replace(
+        equations,
+        assignments=kept,
+        M=equations.M.xreplace(copies),
+        Cv=equations.Cv.xreplace(copies),
+        G=equations.G.xreplace(copies),
+    )
 
 
 def _in_order(definitions: dict[sp.Symbol, sp.Expr], outputs: list[sp.Expr]) -> list[tuple[sp.Symbol, sp.Expr]]:
@@ -138,20 +218,29 @@ def _in_order(definitions: dict[sp.Symbol, sp.Expr], outputs: list[sp.Expr]) -> 
 
 
 def derive_compact(
-    robot: ReferenceRobot, *, snap: float = 1e-8, cse: bool = True, progress: Callable[[str, int, int], None] | None = None
+    robot: ReferenceRobot,
+    *,
+    snap: float = 1e-8,
+    cse: bool = True,
+    keep_params: bool = False,
+    symbols: tuple[list[sp.Symbol], list[sp.Symbol], list[sp.Symbol]] | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> CompactDynamics:
     """Derive the compact (intermediate-variable) equations of a reference robot.
 
     Args:
-        robot: From :func:`robodyn.reference.load` (mimic joints are not supported here).
+        robot: From :func:`robodyn.reference.load` (mimic joints included).
         snap: Tolerance for exact rotation and axis entries.
         cse: Share repeated subexpressions with ``sympy.cse`` at the end.
+        keep_params: Keep masses, centres of mass, inertias, joint offsets and gravity as
+            symbols (see :class:`robodyn.reference.symbolic.Parameters`).
+        symbols: ``(q, qd, qdd)`` to use instead of the reference's joint symbols.
         progress: Called as ``progress(stage, done, total)``.
     """
     tree = robot.tree
-    if not np.array_equal(tree.selection, np.eye(len(tree.bodies))):
-        raise NotImplementedError("compact equations do not support mimic joints; lock them (--lock)")
-    q, qd, qdd = joint_symbols(robot.joint_names)
+    q, qd, qdd = symbols or joint_symbols(robot.joint_names)
+    theta, theta_dot = body_coordinates(robot, q, qd)
+    params = Parameters(keep_params)
     program = _Program()
     bodies = tree.bodies
     count = len(bodies)
@@ -161,22 +250,24 @@ def derive_compact(
     axis = [None] * count  # joint axis in the body frame
     w, dw, acc = ([zero] * count for _ in range(3))  # angular velocity, its bias rate, origin's bias acceleration
     gacc = [zero] * count  # the acceleration gravity amounts to, in the body frame
-    gravity = _constant(-robot.gravity_vector[:, None])  # the base "accelerates upwards"
+    gravity = -params.gravity(robot.gravity_vector)  # the base "accelerates upwards"
     for b, body in enumerate(bodies):
         if progress:
             progress("kinematics", b, count)
         parent = body.parent
         axis[b] = exact_matrix(body.axis[:, None], snap)
         rotation = exact_matrix(body.origin[:3, :3], snap)
-        translation = _constant(body.origin[:3, 3:])
+        translation = params.vector(body.origin[:3, 3], "d", body.joint)
         if body.revolute:
-            c = program.let(sp.cos(q[b]), f"c{b + 1}_")
-            s = program.let(sp.sin(q[b]), f"s{b + 1}_")
-            R[b] = program.matrix(rotation * _rotation(axis[b], c, s), f"R{b + 1}_")
+            c = program.let(sp.cos(theta[b]), f"c{b + 1}_")
+            s = program.let(sp.sin(theta[b]), f"s{b + 1}_")
+            if c.is_Symbol and s.is_Symbol:
+                program.pairs.append((c, s))
+            R[b] = program.matrix(rotation * axis_rotation(axis[b], c, s), f"R{b + 1}_")
             t[b] = translation
         else:
             R[b] = rotation
-            t[b] = program.vector(translation + rotation * axis[b] * q[b], f"t{b + 1}_")
+            t[b] = program.vector(translation + rotation * axis[b] * theta[b], f"t{b + 1}_")
         Rt = R[b].T
         w_par = zero if parent < 0 else w[parent]
         dw_par = zero if parent < 0 else dw[parent]
@@ -187,12 +278,12 @@ def derive_compact(
         origin_acc = a_par + dw_par.cross(t[b]) + w_par.cross(w_par.cross(t[b]))
         acc_b = Rt * origin_acc
         if body.revolute:
-            w[b] = program.vector(w_in + axis[b] * qd[b], f"w{b + 1}_")
-            dw[b] = program.vector(Rt * dw_par + w_in.cross(axis[b] * qd[b]), f"dw{b + 1}_")
+            w[b] = program.vector(w_in + axis[b] * theta_dot[b], f"w{b + 1}_")
+            dw[b] = program.vector(Rt * dw_par + w_in.cross(axis[b] * theta_dot[b]), f"dw{b + 1}_")
         else:
             w[b] = w_in
             dw[b] = program.vector(Rt * dw_par, f"dw{b + 1}_")
-            acc_b = acc_b + 2 * w_in.cross(axis[b] * qd[b])
+            acc_b = acc_b + 2 * w_in.cross(axis[b] * theta_dot[b])
         acc[b] = program.vector(acc_b, f"a{b + 1}_")
 
     # Backward: forces and moments (about each body's origin) of the subtrees, for C q̇ and
@@ -207,9 +298,9 @@ def derive_compact(
         if progress:
             progress("Lagrangian", count - b, count)
         if body.mass != 0 or body.inertia.any():
-            mass = _exact(body.mass, 0.0)
-            com = _constant(body.com[:, None])
-            inertia = _constant(body.inertia)
+            mass = params.symbol(body.mass, "m", body.link)
+            com = params.vector(body.com, "c", body.link)
+            inertia = params.inertia(body.inertia, body.link)
             com_acc = acc[b] + dw[b].cross(com) + w[b].cross(w[b].cross(com))
             f = program.vector(mass * com_acc, f"f{b + 1}_")
             n = inertia * dw[b] + w[b].cross(inertia * w[b]) + com.cross(f)
@@ -269,11 +360,22 @@ def derive_compact(
                 program.vector(f_up, f"Mf{i + 1}_{parent + 1}_"),
             )
             j = parent
+    selection = exact_matrix(tree.selection, 0.0)
+    if selection != sp.eye(count):  # mimic joints: tau = Sᵀ tau_full, theta'' = S q''
+        M, Cv, G = selection.T * M * selection, selection.T * Cv, selection.T * G
     equations = CompactDynamics(
-        q, qd, qdd, program.assignments, M.applyfunc(sp.expand), Cv.applyfunc(sp.expand), G.applyfunc(sp.expand)
+        q,
+        qd,
+        qdd,
+        program.assignments,
+        M.applyfunc(program.pythagoras),
+        Cv.applyfunc(program.pythagoras),
+        G.applyfunc(program.pythagoras),
+        params.values,
+        params.labels,
     )
     if cse:
         if progress:
             progress("common subexpressions", 0, 1)
-        equations = _shared(equations)
-    return equations
+        equations = _reuse_products(_without_copies(_shared(equations)))
+    return _without_copies(equations)

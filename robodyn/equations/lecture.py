@@ -78,3 +78,60 @@ def split(tau: sp.Matrix) -> dict[str, sp.Matrix]:
     at_rest = expanded.subs({qd1: 0, qd2: 0, qdd1: 0, qdd2: 0})
     inertial = expanded.subs({qd1: 0, qd2: 0}) - at_rest
     return {"M": sp.expand(inertial), "C": sp.expand(expanded.subs({qdd1: 0, qdd2: 0}) - at_rest), "G": sp.expand(at_rest)}
+
+
+def in_lecture_symbols(equations):
+    """The generated RP arm's equations (``keep_params``) in the lecture's symbols
+    ``l1, m1, m2, Iz1, Iz2, c2, g`` instead of the generic ``m_link1, c_link1_x, ...``.
+
+    Args:
+        equations: :class:`robodyn.equations.Equations` of ``rp_arm`` with kept parameters.
+    """
+    from dataclasses import replace
+
+    by_name = {symbol.name: symbol for symbol in equations.parameters}
+    lecture_names = {
+        "m_link1": m1,
+        "c_link1_x": l1 / 2,
+        "I_link1_yy": Iz1,
+        "d_joint2_x": l1,
+        "m_link2": m2,
+        "c_link2_x": c2,
+        "I_link2_yy": Iz2,
+        "g": g,
+    }
+    rename = {by_name[name]: value for name, value in lecture_names.items() if name in by_name}
+    parameters = {rename[s]: v for s, v in equations.parameters.items() if s in rename and rename[s].is_Symbol}
+    return replace(
+        equations,
+        M=equations.M.subs(rename).applyfunc(sp.factor_terms),
+        Cv=equations.Cv.subs(rename).applyfunc(sp.factor_terms),
+        G=equations.G.subs(rename).applyfunc(sp.factor_terms),
+        C=equations.C.subs(rename).applyfunc(sp.factor_terms),
+        parameters=parameters,
+        labels={},
+    )
+
+
+def lecture_text() -> str:
+    """The lecture's printed RP result, its corrected derivation, and the generated rigid
+    arm's equations, entry by entry, with the errata named."""
+    corrected = derived().tau
+    rigid_tau = rigid().tau
+    lines = [
+        "The lecture's RP arm: tau = M(q) qdd + C(q, qd) qd + G(q)   (symbols: l1, m1, m2, Iz1, Iz2, g;",
+        "the rigid arm's link-2 centre of mass is at l1 + q2 + c2)",
+        "",
+    ]
+    for i in range(2):
+        lines += [
+            f"tau{i + 1}",
+            f"  as printed (slide 34):            {sp.factor_terms(printed()[i])}",
+            f"  corrected, lecture's own model:   {sp.factor_terms(sp.expand(corrected[i]))}",
+            f"  rigid body (the generated URDF):  {sp.factor_terms(sp.expand(rigid_tau[i]))}",
+            "",
+        ]
+    lines.append("errata:")
+    for number, (text, terms) in ERRATA.items():
+        lines.append(f"  {number}. {text} (term {', '.join(terms)})")
+    return "\n".join(lines) + "\n"

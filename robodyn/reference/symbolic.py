@@ -44,6 +44,7 @@ class SymbolicDynamics:
         C: Coriolis matrix from the Christoffel symbols of ``M`` (n × n).
         G: Gravity vector (n × 1).
         parameters: Symbols kept for physical parameters, with their values.
+        labels: ``(kind, owner, component)`` of every kept parameter (see :class:`Parameters`).
     """
 
     q: list[sp.Symbol]
@@ -55,6 +56,7 @@ class SymbolicDynamics:
     C: sp.Matrix
     G: sp.Matrix
     parameters: dict = field(default_factory=dict)
+    labels: dict = field(default_factory=dict)
 
     @property
     def tau(self) -> sp.Matrix:
@@ -88,9 +90,10 @@ def lagrangian_dynamics(
         q, qd, qdd: Position, velocity and acceleration symbols.
         simplify: Trigonometric simplification of every entry (small systems only).
     """
-    tidy = (lambda e: sp.trigsimp(sp.expand(e))) if simplify else (lambda e: e)
+    tidy = (lambda e: sp.trigsimp(sp.expand(e))) if simplify else sp.expand
     n = len(q)
-    M = sp.Matrix(n, n, lambda i, j: tidy(sp.diff(T, qd[i], qd[j])))
+    quadratic = sp.expand(T)
+    M = sp.Matrix(n, n, lambda i, j: tidy(sp.diff(quadratic, qd[i], qd[j])))
     G = sp.Matrix(n, 1, lambda i, _: tidy(sp.diff(U, q[i])))
 
     def christoffel(i: int, j: int, k: int) -> sp.Expr:
@@ -100,12 +103,40 @@ def lagrangian_dynamics(
     return SymbolicDynamics(list(q), list(qd), list(qdd), T, U, M, C, G)
 
 
+#: Magnitudes below this (in SI units) are round-off of the URDF's preprocessing, made 0.
+ROUND_OFF = 1e-15
+
+
+def exact_number(value: float) -> sp.Rational:
+    """A URDF number as the exact rational it was written as: ``0.41`` is ``41/100``.
+
+    The float's shortest decimal of up to 15 significant digits (within 1e-15 of it,
+    relative) is taken, so ``0.30000000000000004`` is ``3/10``; magnitudes below
+    :data:`ROUND_OFF` are 0.
+    """
+    if not np.isfinite(value):
+        raise ValueError(f"not a finite number: {value!r}")
+    if abs(value) < ROUND_OFF:
+        return sp.Integer(0)
+    return sp.Rational(f"{value:.15g}")
+
+
+def exact_angle(value: float) -> sp.Expr:
+    """An angle in [rad], recognised as a fraction of π (``1.5707963267948966`` is ``π/2``)
+    when within 1e-12 of one with a denominator up to 12, else :func:`exact_number`."""
+    for denominator in range(1, 13):
+        numerator = round(value * denominator / np.pi)
+        if numerator and abs(value - numerator * np.pi / denominator) <= 1e-12:
+            return sp.pi * sp.Rational(numerator, denominator)
+    return exact_number(value)
+
+
 def _exact(value: float, snap: float) -> sp.Expr:
     for exact in _EXACT:
         for signed in (exact, -exact):
             if abs(value - float(signed)) <= snap:
                 return signed
-    return sp.Float(value, 17)
+    return exact_number(value)
 
 
 def exact_matrix(values: np.ndarray, snap: float) -> sp.Matrix:
@@ -127,85 +158,145 @@ def joint_symbols(names: list[str]) -> tuple[list[sp.Symbol], list[sp.Symbol], l
     )
 
 
-def _parameter(values: np.ndarray, names: list[str], keep: dict | None) -> sp.Matrix:
-    """Exact constants, or (when ``keep`` is a dict) symbols for the non-zero ones."""
-    flat = np.ravel(values)
-    entries = []
-    for value, name in zip(flat, names, strict=True):
-        if keep is None or value == 0:
-            entries.append(_exact(float(value), 0.0))
-        else:
-            symbol = sp.Symbol(name, real=True)
-            keep[symbol] = float(value)
-            entries.append(symbol)
-    return sp.Matrix(np.shape(values)[0], 1 if np.ndim(values) == 1 else np.shape(values)[1], entries)
+class Parameters:
+    """Physical constants of a robot as exact numbers, or (``keep=True``) as symbols.
+
+    A kept constant is a real symbol named ``<kind>_<owner>[_<component>]`` (``m_link1``,
+    ``c_link1_x``, ``I_link1_xy``, ``d_joint2_x``, ``g``); :attr:`values` maps it to its
+    number and :attr:`labels` to ``(kind, owner, component)`` for printing. Zeros stay 0.
+    """
+
+    def __init__(self, keep: bool) -> None:
+        self.keep = keep
+        self.values: dict[sp.Symbol, float] = {}
+        self.labels: dict[sp.Symbol, tuple[str, str, str]] = {}
+
+    def symbol(self, value: float, kind: str, owner: str = "", component: str = "") -> sp.Expr:
+        """One constant (exact), or its symbol."""
+        if not self.keep or value == 0:
+            return exact_number(float(value))
+        name = "_".join(part for part in (kind, owner, component) if part)
+        symbol = sp.Symbol(name, real=True)
+        self.values[symbol] = float(value)
+        self.labels[symbol] = (kind, owner, component)
+        return symbol
+
+    def vector(self, values: np.ndarray, kind: str, owner: str) -> sp.Matrix:
+        """A 3-vector (components ``x``, ``y``, ``z``)."""
+        return sp.Matrix([self.symbol(v, kind, owner, a) for v, a in zip(np.ravel(values), "xyz", strict=True)])
+
+    def inertia(self, values: np.ndarray, owner: str) -> sp.Matrix:
+        """A symmetric 3×3 inertia (components ``xx``, ``xy``, ...: one symbol a pair)."""
+        entries = {}
+        for i in range(3):
+            for j in range(i, 3):
+                entries[i, j] = entries[j, i] = self.symbol(values[i, j], "I", owner, "xyz"[i] + "xyz"[j])
+        return sp.Matrix(3, 3, lambda i, j: entries[i, j])
+
+    def gravity(self, vector: np.ndarray) -> sp.Matrix:
+        """The gravity vector: with ``keep``, ``g`` times an axis when along one, else
+        one symbol ``g_x``, ``g_y``, ``g_z`` a non-zero component."""
+        nonzero = np.flatnonzero(vector)
+        if self.keep and len(nonzero) == 1:
+            axis = sp.zeros(3, 1)
+            axis[nonzero[0]] = sp.sign(vector[nonzero[0]])
+            return axis * self.symbol(abs(float(vector[nonzero[0]])), "g")
+        return self.vector(vector, "g", "")
 
 
-def derive(robot: ReferenceRobot, *, simplify: bool = True, snap: float = 1e-8, keep_params: bool = False) -> SymbolicDynamics:
+def derive(
+    robot: ReferenceRobot,
+    *,
+    simplify: bool = True,
+    snap: float = 1e-8,
+    keep_params: bool = False,
+    symbols: tuple[list[sp.Symbol], list[sp.Symbol], list[sp.Symbol]] | None = None,
+) -> SymbolicDynamics:
     """Closed-form dynamics of a reference robot, by the Lagrangian of its bodies.
+
+    Numbers from the URDF enter as exact rationals (:func:`exact_number`), rotation
+    entries near 0, ±1, ±½, ±√2/2, ±√3/2 as those values, mimic offsets near a fraction
+    of π as that fraction, so no round-off term can appear.
 
     Args:
         robot: From :func:`robodyn.reference.load`.
         simplify: Trigonometric simplification (small chains only).
-        snap: Tolerance for making URDF constants exact (0 to keep every float as is).
+        snap: Tolerance for exact rotation and axis entries (0 to snap only exact values).
         keep_params: Keep masses (``m_<link>``), centres of mass (``c_<link>_x``...),
             inertias (``I_<link>_xx``...), joint offsets (``d_<joint>_x``...) and gravity
-            ``g`` as symbols; their values are in ``SymbolicDynamics.parameters``.
+            (``g``, or ``g_x``... off the axes) as symbols; their values are in
+            ``SymbolicDynamics.parameters``.
+        symbols: ``(q, qd, qdd)`` to use instead of :func:`joint_symbols`.
 
     Returns:
         The equations, in the order of ``robot.joint_names``.
     """
     tree = robot.tree
-    keep: dict | None = {} if keep_params else None
-    q, qd, qdd = joint_symbols(robot.joint_names)
-    selection = exact_matrix(tree.selection, 0.0)
-    theta = selection * sp.Matrix(q) + exact_matrix(tree.offset[:, None], 0.0)
-    theta_dot = selection * sp.Matrix(qd)
-    gravity = exact_matrix(robot.gravity_vector[:, None], 0.0)
-    if keep is not None:
-        magnitude = float(np.linalg.norm(robot.gravity_vector))
-        g = sp.Symbol("g", positive=True)
-        keep[g] = magnitude
-        gravity = exact_matrix(robot.gravity_vector[:, None] / magnitude, snap) * g if magnitude > 0 else gravity
-    rotations: list[sp.Matrix] = []
-    positions: list[sp.Matrix] = []
-    axes: list[sp.Matrix] = []
-    origins: list[sp.Matrix] = []
+    params = Parameters(keep_params)
+    q, qd, qdd = symbols or joint_symbols(robot.joint_names)
+    theta, theta_dot = body_coordinates(robot, q, qd)
+    gravity = params.gravity(robot.gravity_vector)
+    rotations, positions, axes = body_poses(robot, theta, params, snap=snap)
     T = sp.Integer(0)
     U = sp.Integer(0)
     for index, body in enumerate(tree.bodies):
-        parent_rotation = sp.eye(3) if body.parent < 0 else rotations[body.parent]
-        parent_position = sp.zeros(3, 1) if body.parent < 0 else positions[body.parent]
-        joint_rotation = parent_rotation * exact_matrix(body.origin[:3, :3], snap)
-        offset = _parameter(body.origin[:3, 3], [f"d_{body.joint}_{a}" for a in "xyz"], keep)
-        origin = parent_position + parent_rotation * offset
-        axis = exact_matrix(body.axis[:, None], snap)
-        world_axis = joint_rotation * axis
-        angle = theta[index]
-        if body.revolute:
-            skew = sp.Matrix([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-            rotation = joint_rotation * (sp.eye(3) + sp.sin(angle) * skew + (1 - sp.cos(angle)) * skew * skew)
-            position = origin
-        else:
-            rotation = joint_rotation
-            position = origin + world_axis * angle
-        rotations.append(rotation)
-        positions.append(position)
-        axes.append(world_axis)
-        origins.append(origin)
+        rotation, position = rotations[index], positions[index]
         if body.mass == 0 and not body.inertia.any():
             continue
-        com = position + rotation * _parameter(body.com, [f"c_{body.link}_{a}" for a in "xyz"], keep)
+        com = position + rotation * params.vector(body.com, "c", body.link)
         velocity = com.jacobian(q) * sp.Matrix(qd)
         omega = sp.zeros(3, 1)
         for ancestor in range(index + 1):
             if tree.ancestors[index, ancestor] and tree.bodies[ancestor].revolute:
                 omega += axes[ancestor] * theta_dot[ancestor]
-        names = [f"I_{body.link}_{a}{b}" for a in "xyz" for b in "xyz"]
-        names = [name if name[-2] <= name[-1] else name[:-2] + name[-1] + name[-2] for name in names]  # I_yx -> I_xy
-        inertia = rotation * _parameter(body.inertia, names, keep).reshape(3, 3) * rotation.T
-        mass = _parameter(np.array([body.mass]), [f"m_{body.link}"], keep)[0]
+        inertia = rotation * params.inertia(body.inertia, body.link) * rotation.T
+        mass = params.symbol(body.mass, "m", body.link)
         T += mass * (velocity.T * velocity)[0] / 2 + (omega.T * inertia * omega)[0] / 2
         U += -mass * (gravity.T * com)[0]
     dynamics = lagrangian_dynamics(T, U, q, qd, qdd, simplify=simplify)
-    return replace(dynamics, parameters=keep or {})
+    return replace(dynamics, parameters=params.values, labels=params.labels)
+
+
+def body_poses(
+    robot: ReferenceRobot, theta: sp.Matrix, params: Parameters | None = None, *, snap: float = 1e-8
+) -> tuple[list[sp.Matrix], list[sp.Matrix], list[sp.Matrix]]:
+    """World rotation, origin and joint axis of every body frame as functions of the bodies'
+    coordinates ``theta`` (forward kinematics in closed form, exact constants)."""
+    params = params or Parameters(False)
+    rotations: list[sp.Matrix] = []
+    positions: list[sp.Matrix] = []
+    axes: list[sp.Matrix] = []
+    for index, body in enumerate(robot.tree.bodies):
+        parent_rotation = sp.eye(3) if body.parent < 0 else rotations[body.parent]
+        parent_position = sp.zeros(3, 1) if body.parent < 0 else positions[body.parent]
+        joint_rotation = parent_rotation * exact_matrix(body.origin[:3, :3], snap)
+        origin = parent_position + parent_rotation * params.vector(body.origin[:3, 3], "d", body.joint)
+        axis = exact_matrix(body.axis[:, None], snap)
+        world_axis = joint_rotation * axis
+        if body.revolute:
+            rotations.append(joint_rotation * axis_rotation(axis, sp.cos(theta[index]), sp.sin(theta[index])))
+            positions.append(origin)
+        else:
+            rotations.append(joint_rotation)
+            positions.append(origin + world_axis * theta[index])
+        axes.append(world_axis)
+    return rotations, positions, axes
+
+
+def axis_rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
+    """Rodrigues' rotation about a unit ``axis`` by the angle whose cosine is ``c`` and sine ``s``."""
+    x, y, z = axis
+    skew = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return sp.eye(3) + s * skew + (1 - c) * skew * skew
+
+
+def body_coordinates(robot: ReferenceRobot, q: list[sp.Symbol], qd: list[sp.Symbol]) -> tuple[sp.Matrix, sp.Matrix]:
+    """Every body's joint coordinate and speed: ``theta = S q + offset``, ``theta_dot = S q̇``
+    (mimic joints through their exact multiplier and offset)."""
+    tree = robot.tree
+    selection = exact_matrix(tree.selection, 0.0)
+    offset = [
+        exact_angle(float(o)) if body.revolute else exact_number(float(o))
+        for o, body in zip(tree.offset, tree.bodies, strict=True)
+    ]
+    return selection * sp.Matrix(q) + sp.Matrix(offset), selection * sp.Matrix(qd)

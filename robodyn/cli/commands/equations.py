@@ -10,6 +10,7 @@ import numpy as np
 
 from robodyn.cli import report
 from robodyn.cli.common import Progress, add_model_arguments, load_robot, lock_values, state, vector
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -20,9 +21,14 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--v", type=vector, help="velocity in [rad/s] / [m/s] (default: zeros)")
     parser.add_argument("--a", type=vector, help="acceleration in [rad/s²] / [m/s²] (default: zeros)")
     parser.add_argument("--json", action="store_true", help="print JSON (keys tau, M, C, G, joint_names, ...)")
-    parser.add_argument("--precision", type=int, default=6, help="significant digits in text output")
+    parser.add_argument("--precision", type=int, default=6, help="significant digits of numbers in text and LaTeX, 1..17")
     parser.add_argument("--symbolic", action="store_true", help="closed-form equations from the reference's symbolic Lagrangian")
-    parser.add_argument("--format", choices=["text", "latex", "json", "python", "c"], default="text", help="with --symbolic")
+    parser.add_argument(
+        "--format",
+        choices=["text", "latex", "pdf", "json", "python", "c"],
+        default="text",
+        help="with --symbolic (pdf needs pdflatex and --out)",
+    )
     parser.add_argument("--out", help="with --symbolic: write to this file instead of stdout")
     parser.add_argument(
         "--form",
@@ -30,8 +36,20 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default="auto",
         help="closed (simplified) or compact (intermediate variables)",
     )
-    parser.add_argument("--keep-params", action="store_true", help="keep masses, lengths, inertias and g as symbols")
+    parser.add_argument(
+        "--keep-params",
+        action="store_true",
+        help="keep every link's mass, centre of mass, inertia, joint offsets and g as symbols",
+    )
     parser.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
+    parser.add_argument(
+        "--kinematics",
+        metavar="FRAME",
+        help="with --symbolic: forward kinematics and Jacobian of a link (formats text, latex, json, python, c)",
+    )
+    parser.add_argument(
+        "--christoffel", action="store_true", help="with --symbolic: the Christoffel symbols of M (closed form; text or json)"
+    )
     parser.add_argument(
         "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
     )
@@ -39,29 +57,72 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def _symbolic(arguments: argparse.Namespace) -> int:
-    from robodyn.equations.derive import derive_equations, lecture_text, render
+    from robodyn.equations.derive import derive_equations
+    from robodyn.equations.lecture import lecture_text
+    from robodyn.equations.naming import terminal_text
+    from robodyn.equations.output import check_precision, render
 
+    given = [f"--{name}" for name in ("q", "v", "a") if getattr(arguments, name) is not None]
+    if given:
+        raise InputError(", ".join(given), "left out with --symbolic (the equations hold for every state)", "a state")
+    check_precision(arguments.precision)
+    if arguments.format == "pdf":
+        from robodyn.equations.render_latex import tex_engine
+        from robodyn.exceptions import MissingToolError
+
+        if not arguments.out:
+            raise InputError("--out", "given with --format pdf (a PDF is not printed)", "no --out")
+        if tex_engine() is None:
+            raise MissingToolError(
+                "pdflatex", "--format pdf", "install TeX Live (Debian: texlive-latex-base) or use --format latex"
+            )
     if arguments.lecture:
         print(lecture_text(), end="")
         return 0
-    progress = Progress(f"deriving {arguments.model}")
+    if arguments.kinematics is not None:
+        from robodyn.equations.kinematics import derive_kinematics, render_kinematics
+
+        if arguments.format not in ("text", "latex", "json", "python", "c"):
+            raise InputError("--format", "text, latex, json, python or c with --kinematics", repr(arguments.format))
+        progress = Progress(f"kinematics of {terminal_text(arguments.kinematics)[:40]}")
+        try:
+            kinematics = derive_kinematics(
+                arguments.model, arguments.kinematics, lock=lock_values(arguments.lock), progress=progress
+            )
+        finally:
+            progress.close()
+        return _emit(arguments, render_kinematics(kinematics, arguments.format, precision=arguments.precision), "kinematics")
+    label = terminal_text(str(arguments.model))
+    progress = Progress(f"deriving {label if len(label) <= 60 else label[:57] + '...'}")
     try:
         equations = derive_equations(
             arguments.model,
             form=arguments.form,
             keep_params=arguments.keep_params,
+            gravity=arguments.gravity,
             lock=lock_values(arguments.lock),
             floating_base=arguments.floating_base,
             progress=progress,
         )
     finally:
         progress.close()
-    output = render(equations, arguments.format)
-    if arguments.out:
-        from robodyn.common.files import atomic_write_text
+    if arguments.christoffel:
+        from robodyn.equations.christoffel import render_christoffel
 
-        atomic_write_text(arguments.out, output)
-        print(f"wrote {arguments.out} ({equations.form} form, {equations.operation_count()} operations)", file=sys.stderr)
+        return _emit(arguments, render_christoffel(equations, arguments.format, precision=arguments.precision), "Christoffel")
+    output = render(equations, arguments.format, precision=arguments.precision)
+    return _emit(arguments, output, f"{equations.form} form, {equations.operation_count()} operations")
+
+
+def _emit(arguments: argparse.Namespace, output: str | bytes, what: str) -> int:
+    if arguments.out:
+        from robodyn.common.files import atomic_write_bytes, atomic_write_text
+
+        if isinstance(output, bytes):
+            atomic_write_bytes(arguments.out, output)
+        else:
+            atomic_write_text(arguments.out, output)
+        print(f"wrote {arguments.out} ({what})", file=sys.stderr)
     else:
         print(output, end="")
     return 0
@@ -70,6 +131,9 @@ def _symbolic(arguments: argparse.Namespace) -> int:
 def run(arguments: argparse.Namespace) -> int:
     if arguments.symbolic or arguments.lecture:
         return _symbolic(arguments)
+    from robodyn.equations.output import check_precision
+
+    check_precision(arguments.precision)
     robot = load_robot(arguments)
     q = state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
     v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))

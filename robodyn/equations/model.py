@@ -1,0 +1,66 @@
+"""The symbolic equations of one robot, as the renderers receive them, and their size.
+
+Every symbol in an :class:`EquationsData` (:class:`robodyn.equations.Equations` adds the
+notebook display) is a safe identifier (:mod:`robodyn.equations.naming`);
+the raw joint and robot names are kept only for the renderers to escape. Numbers are exact
+(rationals, ``π``, ``√2``) until a renderer turns them into floats (:func:`numeric`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+
+@dataclass
+class EquationsData:
+    """Symbolic equations of motion ``tau = M(q) q̈ + C(q, q̇) q̇ + G(q)`` of one robot.
+
+    Attributes:
+        robot: Robot name, as in the URDF (renderers escape it).
+        joint_names: Joints in the order of ``q``, as in the URDF.
+        form: ``"closed"`` (simplified entries) or ``"compact"`` (assignments first).
+        q, qd, qdd: Position, velocity and acceleration symbols (safe identifiers).
+        assignments: Intermediate variables ``(symbol, expression)``, in order.
+        M, Cv, G: Mass matrix, ``C q̇`` and gravity, in terms of ``q``, ``qd`` and the
+            intermediate variables.
+        C: The Coriolis matrix (Christoffel form) in closed form, else ``None``.
+        parameters: Kept physical parameters and their values (``keep_params``).
+        labels: For each kept parameter ``(kind, owner, component)``, e.g.
+            ``("m", "link1", "")``, with the owner's raw URDF name.
+        gravity: The gravity vector the equations were derived for, in [m/s²].
+    """
+
+    robot: str
+    joint_names: list[str]
+    form: str
+    q: list[sp.Symbol]
+    qd: list[sp.Symbol]
+    qdd: list[sp.Symbol]
+    assignments: list[tuple[sp.Symbol, sp.Expr]]
+    M: sp.Matrix
+    Cv: sp.Matrix
+    G: sp.Matrix
+    C: sp.Matrix | None = None
+    parameters: dict[sp.Symbol, float] = field(default_factory=dict)
+    labels: dict[sp.Symbol, tuple[str, str, str]] = field(default_factory=dict)
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+
+    def operation_count(self) -> int:
+        """See :func:`operation_count`."""
+        return operation_count(self)
+
+
+def numeric(expr: sp.Expr, digits: int = 17) -> sp.Expr:
+    """``expr`` with its exact numbers (rationals, ``π``, ``√2``...) as floats of ``digits``
+    significant digits; symbols and integers stay."""
+    return expr.evalf(digits) if expr.free_symbols or not expr.is_Integer else expr
+
+
+def operation_count(equations: EquationsData) -> int:
+    """The size of the equations as printed: ``sympy.count_ops`` over every assignment and
+    every entry of ``M``, ``C q̇`` and ``G``, numbers as floats (``0.41 q`` is one
+    multiplication, not a multiplication and a division)."""
+    expressions = [e for _, e in equations.assignments] + [*equations.M, *equations.Cv, *equations.G]
+    return int(sum(sp.count_ops(numeric(e)) for e in expressions))

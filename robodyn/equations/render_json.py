@@ -1,0 +1,34 @@
+"""The equations as JSON: names through :func:`naming.json_text`, entries as sympy strings
+with 17-digit floats (``sympy.sympify`` reads them back)."""
+
+from __future__ import annotations
+
+from robodyn.equations.model import EquationsData, numeric
+from robodyn.equations.naming import json_text
+
+
+def to_json(equations: EquationsData) -> str:
+    """Symbols, assignments and entries (see the module)."""
+    n = len(equations.q)
+
+    def text(expr) -> str:
+        return str(numeric(expr))
+
+    data = {
+        "robot": equations.robot,
+        "form": equations.form,
+        "equation": "tau = M(q) qdd + C(q, qd) qd + G(q)",
+        "joint_names": equations.joint_names,
+        "gravity": list(equations.gravity),
+        "q": [str(s) for s in equations.q],
+        "qd": [str(s) for s in equations.qd],
+        "qdd": [str(s) for s in equations.qdd],
+        "parameters": {str(k): v for k, v in equations.parameters.items()},
+        "assignments": [[str(s), text(e)] for s, e in equations.assignments],
+        "M": [[text(equations.M[i, j]) for j in range(n)] for i in range(n)],
+        "Cv": [text(e) for e in equations.Cv],
+        "G": [text(e) for e in equations.G],
+        "C": None if equations.C is None else [[text(equations.C[i, j]) for j in range(n)] for i in range(n)],
+        "operations": equations.operation_count(),
+    }
+    return json_text(data, indent=2) + "\n"
