@@ -129,3 +129,24 @@ class SimulationError(RobodynError):
         super().__init__(
             f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
         )
+
+
+class TrajectoryError(RobodynError, ValueError):
+    """A trajectory or dataset file that cannot be used as it is.
+
+    Attributes:
+        source: The file (or ``"the trajectory"``).
+        reason: What is wrong, naming the columns concerned.
+        rows: First and last data row concerned (1-based), or ``None``.
+    """
+
+    def __init__(self, source: str, reason: str, *, rows: tuple[int, int] | None = None):
+        self.source = source
+        self.reason = reason
+        self.rows = None if rows is None else (int(rows[0]), int(rows[1]))
+        where = (
+            ""
+            if self.rows is None
+            else (f", row {self.rows[0]}" if self.rows[0] == self.rows[1] else f", rows {self.rows[0]}-{self.rows[1]}")
+        )
+        super().__init__(f"{source}{where}: {reason}.")
