@@ -140,7 +140,7 @@ class TrajectoryError(RobodynError, ValueError):
         rows: First and last data row concerned (1-based), or ``None``.
     """
 
-    def __init__(self, source: str, reason: str, *, rows: tuple[int, int] | None = None):
+    def __init__(self, source: str, reason: str, rows: tuple[int, int] | None = None):
         self.source = source
         self.reason = reason
         self.rows = None if rows is None else (int(rows[0]), int(rows[1]))
@@ -150,3 +150,6 @@ class TrajectoryError(RobodynError, ValueError):
             else (f", row {self.rows[0]}" if self.rows[0] == self.rows[1] else f", rows {self.rows[0]}-{self.rows[1]}")
         )
         super().__init__(f"{source}{where}: {reason}.")
+
+    def __reduce__(self) -> tuple:  # crosses process boundaries (Dask workers) intact
+        return (self.__class__, (self.source, self.reason, self.rows))

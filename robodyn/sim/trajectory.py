@@ -41,6 +41,7 @@ from robodyn.exceptions import InputError, TrajectoryError
 from robodyn.sim.trajectory_columns import (
     BASE_Q,
     BASE_V,
+    EXTRA_KINDS,
     KINDS,
     ROOT_JOINT,
     Layout,
@@ -50,6 +51,11 @@ from robodyn.sim.trajectory_columns import (
     parse_header,
     short_list,
 )
+
+
+def coordinate_names_to_joints(v_names: list[str], floating_base: bool) -> list[str]:
+    """``Robot.joint_names`` from velocity coordinate names (inverse of :func:`coordinate_names`)."""
+    return [ROOT_JOINT, *v_names[len(BASE_V) :]] if floating_base else list(v_names)
 
 
 @dataclass
@@ -116,8 +122,29 @@ class Trajectory:
         if self.joint_names and have_q != expected_q:
             missing = [f"q[{n}]" for n in expected_q if n not in have_q]
             extra = [f"q[{n}]" for n in have_q if n not in expected_q]
-            detail = f"missing {short_list(missing)}; extra {short_list(extra)}" if missing else "its joints are in another order"
+            detail = (
+                f"missing {short_list(missing)}; extra {short_list(extra)}"
+                if missing
+                else "its joints are in another order (Trajectory.for_robot reorders them)"
+            )
             raise TrajectoryError(where, f"a trajectory{of} does not fit robot {robot.name!r}: {detail}")
+
+    def for_robot(self, robot) -> Trajectory:
+        """This trajectory with its columns in the robot's joint order (checked as :meth:`check`).
+
+        Raises:
+            TrajectoryError: If the joints are not the robot's.
+        """
+        expected_q, expected_v = coordinate_names(robot.joint_names, robot.floating_base)
+        have_q, have_v = self.coordinate_names
+        if not self.joint_names or have_q == expected_q or sorted(have_q) != sorted(expected_q):
+            self.check(robot)
+            return self
+        rows_q = [have_q.index(name) for name in expected_q]
+        rows_v = [have_v.index(name) for name in expected_v]
+        tau = None if self.tau is None else self.tau[:, rows_v]
+        joints = coordinate_names_to_joints(expected_v, robot.floating_base)
+        return Trajectory(self.t, self.q[:, rows_q], self.v[:, rows_v], self.a[:, rows_v], tau, joints, self.robot, self.source)
 
     # ----------------------------------------------------------------------------------
     # Tables
@@ -271,41 +298,42 @@ def _load_csv(path: Path) -> Trajectory:
     return Trajectory.from_table(table, layout, source, robot=robot)
 
 
-def npz_columns(data, source: str) -> tuple[list[str], list[str], str]:
+def npz_columns(shapes: dict[str, tuple[int, ...]], small, source: str) -> tuple[list[str], list[str], str]:
     """The header of an NPZ trajectory, the arrays whose columns make the table, the robot.
 
     Args:
-        data: An open ``np.load`` of the file.
+        shapes: Shape of every array of the file, by name (without loading them).
+        small: ``small(name)`` loads one of the small arrays (names, robot).
         source: The file, for messages.
 
     Returns:
-        ``(header, keys, robot)``: stacking ``data[key]`` (as columns) for ``key`` in
-        ``keys`` gives a table with the columns ``header``.
+        ``(header, keys, robot)``: stacking the arrays ``keys`` (as columns) gives a table
+        with the columns ``header``.
     """
-    keys = list(data.keys())
-    robot = str(data["robot"]) if "robot" in keys else ""
-    if "q" not in keys or data["q"].ndim != 2:  # one array a column
+    keys = list(shapes)
+    robot = str(small("robot")) if "robot" in keys else ""
+    if "q" not in keys or len(shapes["q"]) != 2:  # one array a column
         columns = [k for k in keys if k not in ("robot", "joint_names")]
         return columns, columns, robot
     if "t" not in keys:
         raise TrajectoryError(source, "no array 't' (time in [s])")
-    unknown = [k for k in keys if k not in (*KINDS, "t", "q_names", "v_names", "joint_names", "robot")]
+    unknown = [k for k in keys if k not in (*KINDS, *EXTRA_KINDS, "t", "q_names", "v_names", "joint_names", "robot")]
     if unknown:
         raise TrajectoryError(source, f"unknown arrays {short_list(unknown)}")
-    nq = data["q"].shape[1]
+    nq = shapes["q"][1]
     if "q_names" in keys:
-        q_names = [str(n) for n in data["q_names"]]
-        v_names = [str(n) for n in data["v_names"]] if "v_names" in keys else q_names
+        q_names = [str(n) for n in small("q_names")]
+        v_names = [str(n) for n in small("v_names")] if "v_names" in keys else q_names
     else:  # robodyn 0.1: joint_names only
-        joints = [str(n) for n in data["joint_names"]] if "joint_names" in keys else []
+        joints = [str(n) for n in small("joint_names")] if "joint_names" in keys else []
         floating = bool(joints) and nq == len(joints) + 6
         q_names, v_names = coordinate_names(joints, floating) if joints else ([str(i) for i in range(nq)],) * 2
     header, stacked = ["t"], ["t"]
     for kind in KINDS:
         if kind in keys:
             names = q_names if kind == "q" else v_names
-            if data[kind].ndim != 2 or data[kind].shape[1] != len(names):
-                raise TrajectoryError(source, f"array {kind!r} has shape {data[kind].shape} for {len(names)} names")
+            if len(shapes[kind]) != 2 or shapes[kind][1] != len(names):
+                raise TrajectoryError(source, f"array {kind!r} has shape {shapes[kind]} for {len(names)} names")
             header += [f"{kind}[{n}]" for n in names]
             stacked.append(kind)
     return header, stacked, robot
@@ -314,7 +342,7 @@ def npz_columns(data, source: str) -> tuple[list[str], list[str], str]:
 def _load_npz(path: Path) -> Trajectory:
     source = str(path)
     with np.load(path, allow_pickle=False) as data:
-        header, keys, robot = npz_columns(data, source)
+        header, keys, robot = npz_columns({k: data[k].shape for k in data}, data.__getitem__, source)
         arrays = [np.asarray(data[k], dtype=float) for k in keys]
     lengths = {len(array) for array in arrays}
     if len(lengths) > 1:
