@@ -14,11 +14,11 @@ import traceback
 from collections.abc import Sequence
 
 import robodyn
-from robodyn.cli.commands import check, equations, info, lint, listing, record, simulate, view, whatif
+from robodyn.cli.commands import check, equations, info, lint, listing, record, simulate, torques, view, whatif
 from robodyn.exceptions import RobodynError
 
 #: The commands, in the order ``robodyn --help`` lists them.
-COMMANDS = (listing, info, equations, check, lint, simulate, record, view, whatif)
+COMMANDS = (listing, info, equations, check, lint, simulate, record, view, whatif, torques)
 
 
 def build_parser() -> argparse.ArgumentParser:

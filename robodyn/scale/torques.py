@@ -168,7 +168,7 @@ def _names(robot: Robot) -> dict[str, np.ndarray]:
 
 def _probe(dataset: Dataset):
     """The first chunk (for the error message of a file of another robot)."""
-    return next(iter(dataset.chunks()))
+    return next(iter(dataset.chunks())).trajectory
 
 
 def _results(robot: Robot, dataset: Dataset, client, *, gravity: bool, mass_matrix: bool):
