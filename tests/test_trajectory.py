@@ -147,10 +147,10 @@ def test_six_q_columns_for_ur5_report_six(tmp_path, ur5):
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (lambda h: h + ["w[x]"], r"unknown columns w\[x\]"),
+        (lambda h: [*h, "w[x]"], r"unknown columns w\[x\]"),
         (lambda h: h[:8] + h[9:], r"missing columns v\[shoulder_lift_joint\]"),
-        (lambda h: h + ["tau[nope]"], r"tau\[nope\] have no matching q column"),
-        (lambda h: h + ["q[shoulder_pan_joint]"], r"duplicated columns q\[shoulder_pan_joint\]"),
+        (lambda h: [*h, "tau[nope]"], r"tau\[nope\] have no matching q column"),
+        (lambda h: [*h, "q[shoulder_pan_joint]"], r"duplicated columns q\[shoulder_pan_joint\]"),
         (lambda h: ["time", *h[1:]], r"unknown columns time"),
     ],
 )

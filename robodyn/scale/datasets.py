@@ -4,7 +4,7 @@ A :class:`Dataset` reads a trajectory file (CSV, NPZ, Parquet; the columns of
 :mod:`robodyn.sim.trajectory`) a chunk of rows at a time, with the same checks as
 :meth:`Trajectory.load` (columns named, NaN/inf and non-increasing time refused with the
 row) and the same derived ``v`` and ``a`` when the file has only positions: each chunk is
-differentiated with two rows of the chunks before and after it, so the result equals the
+differentiated with three rows of the chunks before and after it, so the result equals the
 whole file's, row for row. Memory is bounded by the chunk size, not the file size.
 
 :class:`DatasetWriter` writes chunks to a temporary file beside the target and renames it
@@ -39,8 +39,8 @@ from robodyn.sim.trajectory import (
 
 #: Rows a chunk by default (panda: about 15 MB of float64 a chunk).
 DEFAULT_ROWS = 65_536
-#: Rows of context each side for derived velocities and accelerations.
-_CONTEXT = 2
+#: Rows of context each side for derived v and a (a one-sided a at the last row reaches 3 rows back).
+_CONTEXT = 3
 SUFFIXES = (".csv", ".npz", ".parquet")
 
 
