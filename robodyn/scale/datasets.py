@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import shutil
 import tempfile
 import zipfile
 from collections.abc import Iterator
@@ -309,11 +310,12 @@ class DatasetWriter:
                     stream.close()
                 with zipfile.ZipFile(self._temporary, "w", zipfile.ZIP_STORED, allowZip64=True) as archive:
                     for key, part in zip(self._npy, self._parts[1:], strict=True):
-                        archive.write(part, key + ".npy")
+                        with part.open("rb") as stream, archive.open(_entry(key), "w", force_zip64=True) as member:
+                            shutil.copyfileobj(stream, member, 1 << 20)
                     for key, value in (small or {}).items():
                         buffer = io.BytesIO()
                         np.lib.format.write_array(buffer, np.asarray(value), allow_pickle=False)
-                        archive.writestr(key + ".npy", buffer.getvalue())
+                        archive.writestr(_entry(key), buffer.getvalue())
             else:
                 self._parquet.close()
             os.chmod(self._temporary, 0o666 & ~_umask())
@@ -332,6 +334,11 @@ class DatasetWriter:
                 self._parquet.close()
         for part in self._parts:
             part.unlink(missing_ok=True)
+
+
+def _entry(key: str) -> zipfile.ZipInfo:
+    """A zip entry with a fixed date: the same data give the same file, byte for byte."""
+    return zipfile.ZipInfo(key + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
 
 
 def _umask() -> int:
