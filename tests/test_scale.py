@@ -219,3 +219,20 @@ def test_cluster_sweeps_identical_to_local(client):
         np.testing.assert_array_equal(mine.rms, theirs.rms)
     names = ["double_pendulum", "ur5"]
     assert sweeps.zoo_statuses(client, names) == [zoo_status(name) for name in names]
+
+
+@pytest.mark.slow
+def test_cli_scheduler_local_identical_to_local(tmp_path, capsys):
+    from robodyn.cli import main
+
+    robot = robodyn.load("ur5")
+    q, v, a = _state(robot, 3000, seed=9)
+    np.savez(tmp_path / "m.npz", t=np.arange(3000) * 1e-3, q=q, v=v, a=a, joint_names=np.array(robot.joint_names))
+    assert main(["torques", "ur5", str(tmp_path / "m.npz"), "--out", str(tmp_path / "local.parquet"), "--chunk-rows", "500"]) == 0
+    remote = ["torques", "ur5", str(tmp_path / "m.npz"), "--out", str(tmp_path / "remote.parquet"), "--chunk-rows", "500"]
+    assert main([*remote, "--scheduler", "local:2"]) == 0
+    from robodyn.sim.trajectory import Trajectory
+
+    local, distributed = Trajectory.load(tmp_path / "local.parquet"), Trajectory.load(tmp_path / "remote.parquet")
+    np.testing.assert_array_equal(distributed.tau, local.tau)
+    np.testing.assert_array_equal(distributed.tau, robot.inverse_dynamics(q, v, a))

@@ -105,6 +105,19 @@ def test_cli_writes_tau_columns_and_json(tmp_path, panda, driven, capsys):
     np.testing.assert_allclose(summary["peak_abs_torque"]["panda_joint2"], np.abs(driven.tau[:, 1]).max(), atol=1e-9)
 
 
+def test_cli_progress_on_stderr_and_same_file_refused(tmp_path, driven, capsys, monkeypatch):
+    from robodyn.cli.common import Progress
+
+    driven.save(tmp_path / "m.npz")
+    monkeypatch.setattr(Progress, "DELAY", 0.0)
+    assert main(["torques", "panda", str(tmp_path / "m.npz"), "--chunk-rows", "100"]) == 0
+    captured = capsys.readouterr()
+    assert "torques: inverse dynamics" in captured.err and "301/301" in captured.err
+    assert "panda_joint4:" in captured.out and "samples: 301 (4 chunks)" in captured.out
+    assert main(["torques", "panda", str(tmp_path / "m.npz"), "--out", str(tmp_path / "m.npz")]) == 2
+    assert "--out must be a file other than the trajectory read" in capsys.readouterr().err
+
+
 def test_cli_another_robot_is_one_line(tmp_path, driven, capsys):
     driven.save(tmp_path / "m.csv")
     assert main(["torques", "ur5", str(tmp_path / "m.csv"), "--out", str(tmp_path / "x.csv")]) == 2

@@ -14,11 +14,12 @@ from __future__ import annotations
 import os
 from collections import deque
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import RobodynError, TrajectoryError
+from robodyn.exceptions import InputError, RobodynError, TrajectoryError
 from robodyn.scale.datasets import DEFAULT_ROWS, Dataset, DatasetWriter
 from robodyn.sim.trajectory import coordinate_names
 
@@ -108,6 +109,8 @@ def torques_file(
         TrajectoryError: For a file of another robot, or bad data (naming file and rows);
             no output file is left then.
     """
+    if out is not None and Path(out).resolve() == Path(source).resolve():
+        raise InputError("--out", "a file other than the trajectory read", repr(str(out)))
     dataset = Dataset(source, rows=rows)
     names = dataset.layout.joint_names
     expected = robot.joint_names
