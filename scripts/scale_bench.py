@@ -40,33 +40,29 @@ def local_threads(total: int, chunk: int) -> float:
     return total / elapsed
 
 
-def cluster_rates(client, total: int, chunks: list[int]) -> tuple[list[tuple[int, int, float]], float]:
-    """States/s for each chunk size with the data made on the workers (only sums come back),
-    and the seconds a state of making the data alone (subtracted by the reader)."""
+def cluster_rates(client, total: int, chunks: list[int]) -> list[tuple[int, int, float]]:
+    """States/s for each chunk size: the states are made and kept on the workers first (not
+    timed), then only the dynamics and the sums that come back are timed."""
     import dask.array as da
+    from dask.distributed import wait
 
     import robodyn.scale as scale
 
     robot = robodyn.load("panda", threads=1)  # one Pinocchio thread a worker process
-
-    def graph(chunk: int, dynamics: bool):
-        shape = (total // chunk * chunk, robot.nq)
-        q = da.random.default_rng(0).uniform(-1, 1, shape, chunks=(chunk, -1))
-        v = da.random.default_rng(1).normal(size=(shape[0], robot.nv), chunks=(chunk, -1))
-        a = da.random.default_rng(2).normal(size=(shape[0], robot.nv), chunks=(chunk, -1))
-        return (scale.inverse_dynamics(robot, q, v, a) if dynamics else q[:, : robot.nv] + v + a).sum(), shape[0]
-
-    client.compute(graph(chunks[0], True)[0]).result()  # warm up: robot built on every worker
     rows = []
     for chunk in chunks:
-        work, count = graph(chunk, True)
+        count = total // chunk * chunk
+        q = da.random.default_rng(0).uniform(-1, 1, (count, robot.nq), chunks=(chunk, -1))
+        v = da.random.default_rng(1).normal(size=(count, robot.nv), chunks=(chunk, -1))
+        a = da.random.default_rng(2).normal(size=(count, robot.nv), chunks=(chunk, -1))
+        q, v, a = client.persist([q, v, a])
+        wait([q, v, a])
+        client.compute(scale.inverse_dynamics(robot, q[:chunk], v[:chunk], a[:chunk]).sum()).result()  # robot built
         started = time.perf_counter()
-        client.compute(work).result()
+        client.compute(scale.inverse_dynamics(robot, q, v, a).sum()).result()
         rows.append((chunk, count // chunk, count / (time.perf_counter() - started)))
-    data, count = graph(chunks[0], False)
-    started = time.perf_counter()
-    client.compute(data).result()
-    return rows, (time.perf_counter() - started) / count
+        del q, v, a
+    return rows
 
 
 def empty_task_overhead(client, count: int = 2000) -> float:
@@ -121,6 +117,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--states", type=int, default=10_000_000)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--cluster-states", type=int, help="states kept on the workers (default --states; 200 B each)")
     parser.add_argument("--memory", action="store_true", help="also measure the memory peak (writes ~1 GB to a temporary folder)")
     arguments = parser.parse_args()
     print(f"machine: {os.cpu_count()} cores; panda, {arguments.states:,} states\n")
@@ -135,14 +132,13 @@ def main() -> int:
         Client(cluster) as client,
     ):
         print(f"| scheduler round trip, empty task | {empty_task_overhead(client) * 1e3:.2f} ms a task |")
-        rows, data_cost = cluster_rates(client, arguments.states, [1_000_000, 100_000, 10_000])
+        rows = cluster_rates(client, arguments.cluster_states or arguments.states, [250_000, 25_000, 2_500])
         for chunk, count, states_per_s in rows:
             print(f"| LocalCluster {arguments.workers}×1 thread, {count} chunks of {chunk:,} | {states_per_s:,.0f} states/s |")
         (c1, n1, r1), (_, n2, r2) = rows[0], rows[-1]
         total = n1 * c1
         overhead = (total / r2 - total / r1) / (n2 - n1)
         print(f"| overhead a chunk, from the two extremes | {overhead * 1e3:.2f} ms |")
-        print(f"| making the random states on the workers alone | {1 / data_cost:,.0f} states/s |")
     if arguments.memory:
         with tempfile.TemporaryDirectory(dir=".") as folder:
             print(json.dumps(memory_peak(Path(folder), 400, 2_600_000)))

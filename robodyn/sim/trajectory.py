@@ -117,7 +117,7 @@ class Trajectory:
             raise TrajectoryError(
                 where,
                 f"a trajectory{of} with {self.q.shape[1]} q and {self.v.shape[1]} v columns does not fit robot "
-                f"{robot.name!r} (nq = {robot.nq}, nv = {robot.nv}: q[{'], q['.join(expected_q[:4])}]...)",
+                f"{robot.name!r} (nq = {robot.nq}, nv = {robot.nv}: {short_list([f'q[{n}]' for n in expected_q])})",
             )
         if self.joint_names and have_q != expected_q:
             missing = [f"q[{n}]" for n in expected_q if n not in have_q]

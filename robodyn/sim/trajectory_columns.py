@@ -45,8 +45,14 @@ def coordinate_names(joint_names: list[str], floating_base: bool) -> tuple[list[
     return list(joint_names), list(joint_names)
 
 
+def printable(name: str) -> str:
+    """A name as it may reach a terminal: control characters escaped (``\\n``, ``\\x1b``)."""
+    return name if name.isprintable() else name.encode("unicode_escape").decode("ascii")
+
+
 def short_list(names: list[str], limit: int = 4) -> str:
-    shown = ", ".join(names[:limit])
+    """The first ``limit`` names (escaped), and how many more."""
+    shown = ", ".join(printable(name) for name in names[:limit])
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
 
 

@@ -48,6 +48,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.scale.torques import torques_file
+    from robodyn.sim.trajectory_columns import printable
 
     robot = load_robot(arguments)
     progress = Progress("torques")
@@ -76,12 +77,12 @@ def run(arguments: argparse.Namespace) -> int:
         return 0
     units = {name: "N" if joint.type == "prismatic" else "N m" for joint in robot.joints for name in [joint.name]}
     print(
-        f"robot: {summary['robot']}\ntrajectory: {summary['trajectory']}\nsamples: {summary['samples']} ({summary['chunks']} chunks)"
+        f"robot: {printable(summary['robot'])}\ntrajectory: {printable(summary['trajectory'])}\nsamples: {summary['samples']} ({summary['chunks']} chunks)"
     )
     print("joint: peak |tau|, rms tau")
     for name, peak in summary["peak_abs_torque"].items():
         unit = units.get(name, "N" if name in ("base.x", "base.y", "base.z") else "N m")
-        print(f"  {name}: {peak:.6g} {unit}, {summary['rms_torque'][name]:.6g} {unit}")
+        print(f"  {printable(name)}: {peak:.6g} {unit}, {summary['rms_torque'][name]:.6g} {unit}")
     if "out" in summary:
         print(f"wrote {summary['out']}")
     return 0
