@@ -113,6 +113,53 @@ def memory_peak(folder: Path, limit_mb: int, rows: int) -> dict:
     }
 
 
+def rss_by_size(folder: Path, suffix: str, sizes: list[int]) -> list[dict]:
+    """Peak RSS of `robodyn torques` (same format in and out) for files of several sizes."""
+    results = []
+    for rows in sizes:
+        source, out = folder / f"in{suffix}", folder / f"out{suffix}"
+        make = textwrap.dedent(
+            f"""
+            import numpy as np, robodyn
+            from robodyn.scale.datasets import DatasetWriter
+            robot = robodyn.load("panda")
+            names = [f"q[{{j}}]" for j in robot.joint_names]
+            header = ["t", *names, *(n.replace("q[", k + "[") for k in ("v", "a") for n in names)]
+            writer = DatasetWriter({str(source)!r}, header, length={rows}, robot="panda")
+            rng = np.random.default_rng(0)
+            for start in range(0, {rows}, 50_000):
+                n = min(50_000, {rows} - start)
+                writer.write(np.column_stack([(start + np.arange(n)) * 1e-3, rng.uniform(-1, 1, (n, 8)), rng.normal(size=(n, 16))]))
+            writer.close()
+            """
+        )
+        subprocess.run([sys.executable, "-c", make], check=True)
+        run = textwrap.dedent(
+            f"""
+            import resource, sys, time
+            from robodyn.cli import main
+            started = time.perf_counter()
+            code = main(["torques", "panda", {str(source)!r}, "--out", {str(out)!r}, "--json"])
+            print("result", time.perf_counter() - started, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)
+            sys.exit(code)
+            """
+        )
+        done = subprocess.run([sys.executable, "-c", run], capture_output=True, text=True, check=True)
+        seconds, peak_kb = done.stderr.split("result")[1].split()[:2]
+        results.append(
+            {
+                "format": suffix,
+                "rows": rows,
+                "file_MB": source.stat().st_size / 2**20,
+                "peak_rss_MB": int(peak_kb) / 1024,
+                "seconds": float(seconds),
+            }
+        )
+        source.unlink()
+        out.unlink()
+    return results
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--states", type=int, default=10_000_000)
@@ -142,6 +189,9 @@ def main() -> int:
     if arguments.memory:
         with tempfile.TemporaryDirectory(dir=".") as folder:
             print(json.dumps(memory_peak(Path(folder), 400, 2_600_000)))
+            for suffix, sizes in ((".csv", [50_000, 400_000]), (".parquet", [100_000, 1_000_000])):
+                for row in rss_by_size(Path(folder), suffix, sizes):
+                    print(json.dumps(row))
     return 0
 
 
