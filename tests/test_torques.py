@@ -92,6 +92,15 @@ def test_chunked_derivatives_equal_the_whole_file(tmp_path, panda, driven):
         assert [c.first_row for c in parts] == list(range(1, len(whole) + 1, rows))
 
 
+def test_blank_lines_and_crlf_in_csv(tmp_path, panda, driven):
+    driven.save(tmp_path / "m.csv")
+    text = (tmp_path / "m.csv").read_text().replace("\n", "\r\n") + "\r\n\r\n"
+    (tmp_path / "w.csv").write_bytes(text.encode())
+    torques_file(panda, tmp_path / "w.csv", tmp_path / "o.npz", rows=100)
+    with np.load(tmp_path / "o.npz") as data:
+        np.testing.assert_allclose(data["tau"], driven.tau, atol=1e-9)
+
+
 def test_cli_writes_tau_columns_and_json(tmp_path, panda, driven, capsys):
     driven.save(tmp_path / "m.csv")
     assert (

@@ -247,12 +247,14 @@ class DatasetWriter:
     Args:
         path: Target ``.csv``, ``.npz`` or ``.parquet`` file.
         header: Column names (``t``, ``q[...]``, ..., ``tau[...]``, ``G[...]``, ``M[...]``).
-        length: Total rows (needed for ``.npz``).
+        length: Total rows expected, if known (checked at the end; ``None``: any).
         robot: Robot name for the file's comment / metadata.
         arrays: For ``.npz``: array name -> (column slice of the rows, shape of one row).
     """
 
-    def __init__(self, path, header: list[str], *, length: int, robot: str = "", arrays: dict | None = None) -> None:
+    def __init__(
+        self, path, header: list[str], *, length: int | None = None, robot: str = "", arrays: dict | None = None
+    ) -> None:
         self.path = Path(path)
         if self.path.suffix not in SUFFIXES:
             raise InputError("--out", "a .csv, .npz or .parquet file", repr(str(path)))
@@ -268,12 +270,10 @@ class DatasetWriter:
             self._stream.write(csv_preamble(robot, header))
         elif self.path.suffix == ".npz":
             self._npy = {}
-            for key, (_, shape) in self.arrays.items():
+            for key in self.arrays:
                 part = self._temporary.with_name(self._temporary.name + f".{key}.npy")
                 self._parts.append(part)
-                stream = part.open("wb")
-                np.lib.format.write_array_header_1_0(stream, {"descr": "<f8", "fortran_order": False, "shape": (length, *shape)})
-                self._npy[key] = stream
+                self._npy[key] = part.open("wb")  # raw rows; the .npy header is written at the end
         else:
             import pyarrow as pa
             import pyarrow.parquet as pq
@@ -301,16 +301,18 @@ class DatasetWriter:
     def close(self, *, small: dict[str, np.ndarray] | None = None) -> Path:
         """Finish the file and put it in place; ``small`` adds arrays to an NPZ (names)."""
         try:
+            if self.length is not None and self._written != self.length:
+                raise TrajectoryError(str(self.path), f"wrote {self._written} rows of {self.length}")
             if self.path.suffix == ".csv":
                 self._stream.close()
             elif self.path.suffix == ".npz":
-                if self._written != self.length:
-                    raise TrajectoryError(str(self.path), f"wrote {self._written} rows of {self.length}")
                 for stream in self._npy.values():
                     stream.close()
                 with zipfile.ZipFile(self._temporary, "w", zipfile.ZIP_STORED, allowZip64=True) as archive:
-                    for key, part in zip(self._npy, self._parts[1:], strict=True):
+                    for (key, (_, shape)), part in zip(self.arrays.items(), self._parts[1:], strict=True):
                         with part.open("rb") as stream, archive.open(_entry(key), "w", force_zip64=True) as member:
+                            header = {"descr": "<f8", "fortran_order": False, "shape": (self._written, *shape)}
+                            np.lib.format.write_array_header_1_0(member, header)
                             shutil.copyfileobj(stream, member, 1 << 20)
                     for key, value in (small or {}).items():
                         buffer = io.BytesIO()

@@ -117,9 +117,9 @@ def torques_file(
     if sorted(names) != sorted(expected) or len(dataset.layout.q_names) != robot.nq:
         probe = _probe(dataset)
         probe.check(robot)  # raises, naming the columns
-    total = len(dataset)
+    total = len(dataset)  # for progress (a CSV's lines, counted)
     header, arrays = output_header(robot, gravity=gravity, mass_matrix=mass_matrix)
-    writer = DatasetWriter(out, header, length=total, robot=dataset.robot or robot.name, arrays=arrays) if out else None
+    writer = DatasetWriter(out, header, robot=dataset.robot or robot.name, arrays=arrays) if out else None
     nv = robot.nv
     peak, squares, done, chunks = np.zeros(nv), np.zeros(nv), 0, 0
     try:
