@@ -184,8 +184,13 @@ class Dataset:
                 yield np.column_stack([reader.read(start, count) for reader in readers])
 
     def _parquet_tables(self) -> Iterator[np.ndarray]:
-        for batch in self._parquet.iter_batches(batch_size=self.rows):
-            yield np.column_stack([np.asarray(column.to_numpy(zero_copy_only=False), dtype=float) for column in batch.columns])
+        # One row group at a time (iter_batches reads ahead: its memory grows with the file).
+        for group in range(self._parquet.num_row_groups):
+            table = self._parquet.read_row_group(group, use_threads=False)
+            for start in range(0, table.num_rows, self.rows):
+                batch = table.slice(start, self.rows)
+                yield np.column_stack([np.asarray(column.to_numpy(), dtype=float) for column in batch.columns])
+            del table
 
     def chunks(self) -> Iterator[Chunk]:
         """Checked chunks as trajectories (``v``, ``a`` derived as for the whole file when absent).
