@@ -189,7 +189,7 @@ def main() -> int:
     if arguments.memory:
         with tempfile.TemporaryDirectory(dir=".") as folder:
             print(json.dumps(memory_peak(Path(folder), 400, 2_600_000)))
-            for suffix, sizes in ((".csv", [50_000, 400_000]), (".parquet", [100_000, 1_000_000])):
+            for suffix, sizes in ((".parquet", [200_000, 1_600_000]), (".csv", [140_000, 280_000])):
                 for row in rss_by_size(Path(folder), suffix, sizes):
                     print(json.dumps(row))
     return 0

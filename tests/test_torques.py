@@ -233,3 +233,23 @@ def test_memory_stays_bounded_on_a_file_larger_than_the_limit(tmp_path):
     assert json.loads(done.stdout)["samples"] == 3_000_000
     with np.load(tmp_path / "tau.npz", mmap_mode=None) as data:
         assert data["tau"].shape == (3_000_000, 8)
+
+
+@pytest.mark.parametrize("layout", ["compressed", "columns", "fortran"])
+def test_npz_variants_stream_like_a_whole_load(tmp_path, panda, driven, layout):
+    path = tmp_path / "m.npz"
+    names = np.array(panda.joint_names)
+    if layout == "compressed":
+        np.savez_compressed(path, t=driven.t, q=driven.q, v=driven.v, a=driven.a, q_names=names, v_names=names)
+    elif layout == "columns":
+        columns = {
+            f"{kind}[{j}]": getattr(driven, kind)[:, i] for kind in ("q", "v", "a") for i, j in enumerate(panda.joint_names)
+        }
+        np.savez(path, t=driven.t, **columns)
+    else:
+        np.savez(path, t=driven.t, q=np.asfortranarray(driven.q), v=driven.v, a=driven.a, q_names=names, v_names=names)
+    parts = list(Dataset(path, rows=40).chunks())
+    whole = Trajectory.load(path)
+    for kind in ("t", "q", "v", "a"):
+        np.testing.assert_array_equal(np.concatenate([getattr(c.trajectory, kind) for c in parts]), getattr(whole, kind))
+    np.testing.assert_array_equal(whole.q, driven.q)
