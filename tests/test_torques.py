@@ -74,7 +74,18 @@ def _save(trajectory, path):
         trajectory.save(path)
 
 
-def test_chunked_derivatives_equal_the_whole_file(tmp_path, panda, driven):
+@pytest.fixture(params=["arrow", "numpy"])
+def csv_reader(request, monkeypatch):
+    """Both CSV paths: pyarrow's reader/writer and the numpy fallback."""
+    from robodyn.scale import csvio
+
+    if request.param == "arrow":
+        pytest.importorskip("pyarrow")
+    monkeypatch.setattr(csvio, "USE_ARROW", request.param == "arrow")
+    return request.param
+
+
+def test_chunked_derivatives_equal_the_whole_file(tmp_path, panda, driven, csv_reader):
     """A file with only t and q: each chunk is differentiated with its neighbours' rows, so chunks change nothing."""
     t = np.concatenate([[0.0], np.cumsum(np.random.default_rng(0).uniform(0.5e-3, 1.5e-3, len(driven) - 1))])  # non-uniform steps
     path = tmp_path / "q.csv"
@@ -152,7 +163,25 @@ def test_bad_rows_name_file_and_row_and_leave_no_output(tmp_path, solo_trajector
     assert {p.name for p in tmp_path.iterdir()} == {source.name, "out.npz"}  # no temporary left
 
 
-def test_nan_in_a_later_chunk_leaves_no_output(tmp_path, panda, driven):
+def test_csv_writers_agree_to_the_bit(tmp_path, panda, driven, csv_reader):
+    driven.save(tmp_path / "m.csv")
+    torques_file(panda, tmp_path / "m.csv", tmp_path / "o.csv", rows=50, mass_matrix=True)
+    back = Trajectory.load(tmp_path / "o.csv")
+    np.testing.assert_array_equal(back.tau, panda.inverse_dynamics(driven.q, driven.v, driven.a))
+
+
+def test_csv_row_that_is_not_numbers(tmp_path, panda, driven, csv_reader):
+    driven.save(tmp_path / "m.csv")
+    lines = (tmp_path / "m.csv").read_text().splitlines()
+    lines[1 + 120] = lines[1 + 120].replace(",", ",x", 1)
+    (tmp_path / "m.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(TrajectoryError, match=r"m\.csv, rows? [\d-]+: a row is not 33 numbers") as error:
+        torques_file(panda, tmp_path / "m.csv", tmp_path / "o.csv", rows=64)
+    assert error.value.rows[0] <= 120 <= error.value.rows[1]
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_nan_in_a_later_chunk_leaves_no_output(tmp_path, panda, driven, csv_reader):
     driven.save(tmp_path / "m.csv")
     lines = (tmp_path / "m.csv").read_text().splitlines()
     cells = lines[1 + 251].split(",")  # comment, header, then data row 1

@@ -21,18 +21,17 @@ import tempfile
 import zipfile
 from collections.abc import Iterator
 from dataclasses import dataclass
-from itertools import islice
 from pathlib import Path
 
 import numpy as np
 
 from robodyn.exceptions import InputError, TrajectoryError
+from robodyn.scale.csvio import csv_tables, write_rows
 from robodyn.sim.trajectory import (
     Layout,
     Trajectory,
     check_table,
     csv_preamble,
-    format_rows,
     npz_columns,
     parse_header,
     read_csv_header,
@@ -153,22 +152,7 @@ class Dataset:
         yield from reader()
 
     def _csv_tables(self) -> Iterator[np.ndarray]:
-        first_row = 1
-        with self.path.open(encoding="utf-8") as stream:
-            read_csv_header(stream, self.source)
-            while lines := list(islice(stream, self.rows)):
-                try:
-                    table = np.loadtxt(lines, delimiter=",", ndmin=2)
-                except ValueError as error:
-                    rows = (first_row, first_row + len(lines) - 1)
-                    raise TrajectoryError(self.source, f"a row is not {self.layout.width} numbers ({error})", rows=rows) from None
-                if table.shape[1] != self.layout.width:
-                    rows = (first_row, first_row + len(lines) - 1)
-                    raise TrajectoryError(
-                        self.source, f"rows have {table.shape[1]} values for {self.layout.width} columns", rows=rows
-                    )
-                first_row += len(table)
-                yield table
+        yield from csv_tables(self.path, self.source, width=self.layout.width, rows=self.rows, header_lines=self._header_lines)
 
     def _npz_tables(self) -> Iterator[np.ndarray]:
         with zipfile.ZipFile(self.path) as archive, contextlib.ExitStack() as stack:
@@ -271,8 +255,8 @@ class DatasetWriter:
         self._parts: list[Path] = [self._temporary]
         self._written = 0
         if self.path.suffix == ".csv":
-            self._stream = self._temporary.open("w", encoding="utf-8")
-            self._stream.write(csv_preamble(robot, header))
+            self._stream = self._temporary.open("wb")
+            self._stream.write(csv_preamble(robot, header).encode("utf-8"))
         elif self.path.suffix == ".npz":
             self._npy = {}
             for key in self.arrays:
@@ -290,8 +274,7 @@ class DatasetWriter:
     def write(self, table: np.ndarray) -> None:
         """Append rows (shape (n, len(header)))."""
         if self.path.suffix == ".csv":
-            for start in range(0, len(table), 4096):
-                self._stream.write(format_rows(table[start : start + 4096]))
+            write_rows(self._stream, table)
         elif self.path.suffix == ".npz":
             for key, (columns, shape) in self.arrays.items():
                 self._npy[key].write(np.ascontiguousarray(table[:, columns], dtype="<f8").reshape(len(table), *shape).tobytes())
