@@ -58,8 +58,8 @@ def _arrow_tables(path: Path, source: str, width: int, rows: int, header_lines: 
 
     try:
         reader = pc.open_csv(
-            path,
-            read_options=pc.ReadOptions(skip_rows=header_lines, column_names=names, block_size=1 << 22, use_threads=False),
+            pa.OSFile(str(path)),  # a plain file: a path would be memory-mapped (RSS and address space grow with the file)
+            read_options=pc.ReadOptions(skip_rows=header_lines, column_names=names, block_size=1 << 20, use_threads=False),
             convert_options=pc.ConvertOptions(column_types=dict.fromkeys(names, pa.float64())),
         )
     except pa.ArrowInvalid as error:
