@@ -236,3 +236,17 @@ def test_cli_scheduler_local_identical_to_local(tmp_path, capsys):
     local, distributed = Trajectory.load(tmp_path / "local.parquet"), Trajectory.load(tmp_path / "remote.parquet")
     np.testing.assert_array_equal(distributed.tau, local.tau)
     np.testing.assert_array_equal(distributed.tau, robot.inverse_dynamics(q, v, a))
+
+
+@pytest.mark.slow
+def test_zoo_report_with_a_scheduler_writes_the_same_listing(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parent.parent / "scripts" / "zoo_report.py"
+    only = ["--only", "double_pendulum,ur5,z1"]
+    subprocess.run([sys.executable, str(script), *only, "--out", str(tmp_path / "local.md")], check=True)
+    subprocess.run([sys.executable, str(script), *only, "--scheduler", "local:2", "--out", str(tmp_path / "dask.md")], check=True)
+    listing = (tmp_path / "local.md").read_text()
+    assert "| ur5 | pass |" in listing and (tmp_path / "dask.md").read_text() == listing
