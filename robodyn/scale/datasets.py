@@ -163,8 +163,9 @@ class Dataset:
                 version = np.lib.format.read_magic(member)
                 (np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0)(member)
                 readers.append(_NpyRows(member, shape, fortran, dtype, self.path, key))
-            for start in range(0, self._length or 0, self.rows):
-                count = min(self.rows, self._length - start)
+            length = self._length or 0
+            for start in range(0, length, self.rows):
+                count = min(self.rows, length - start)
                 yield np.column_stack([reader.read(start, count) for reader in readers])
 
     def _parquet_tables(self) -> Iterator[np.ndarray]:
@@ -298,10 +299,10 @@ class DatasetWriter:
                     stream.close()
                 with zipfile.ZipFile(self._temporary, "w", zipfile.ZIP_STORED, allowZip64=True) as archive:
                     for (key, (_, shape)), part in zip(self.arrays.items(), self._parts[1:], strict=True):
-                        with part.open("rb") as stream, archive.open(_entry(key), "w", force_zip64=True) as member:
+                        with part.open("rb") as raw, archive.open(_entry(key), "w", force_zip64=True) as member:
                             header = {"descr": "<f8", "fortran_order": False, "shape": (self._written, *shape)}
                             np.lib.format.write_array_header_1_0(member, header)
-                            shutil.copyfileobj(stream, member, 1 << 20)
+                            shutil.copyfileobj(raw, member, 1 << 20)
                     for key, value in (small or {}).items():
                         buffer = io.BytesIO()
                         np.lib.format.write_array(buffer, np.asarray(value), allow_pickle=False)

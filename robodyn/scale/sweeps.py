@@ -30,7 +30,7 @@ def sweep(
     """
     if model == "rp_arm":
         materials = tuple(materials or whatif.DEFAULT_MATERIALS)
-        per_material = [(material,) for material in materials]
+        per_material: list[tuple[str, ...] | None] = [(material,) for material in materials]
     else:
         if materials:
             return whatif.sweep(model, materials=materials, payloads=payloads, forces=forces, **options)  # raises

@@ -15,6 +15,7 @@ import os
 from collections import deque
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -176,7 +177,7 @@ def _probe(dataset: Dataset):
 
 def _results(robot: Robot, dataset: Dataset, client, *, gravity: bool, mass_matrix: bool):
     """(chunk, result) in file order, computed here or on the client's workers."""
-    options = {"gravity": gravity, "mass_matrix": mass_matrix, "source": dataset.source}
+    options: dict[str, Any] = {"gravity": gravity, "mass_matrix": mass_matrix, "source": dataset.source}
     if client is None:
         for chunk in dataset.chunks():
             trajectory = chunk.trajectory.for_robot(robot)

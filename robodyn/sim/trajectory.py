@@ -171,12 +171,12 @@ class Trajectory:
         if check:
             check_table(table, layout, source, first_row=first_row)
         columns = {kind: None if index is None else table[:, index] for kind, index in layout.columns.items()}
-        t = table[:, layout.time]
+        t, q = table[:, layout.time], table[:, layout.columns["q"]]
         v = columns["v"]
         if v is None:
-            v = derive_velocities(t, columns["q"], floating_base=layout.floating_base)
+            v = derive_velocities(t, q, floating_base=layout.floating_base)
         a = columns["a"] if columns["a"] is not None else derive_velocities(t, v, floating_base=False)
-        return cls(t, columns["q"], v, a, columns["tau"], layout.joint_names, robot, source)
+        return cls(t, q, v, a, columns["tau"], layout.joint_names, robot, source)
 
     # ----------------------------------------------------------------------------------
     # Files
@@ -196,7 +196,7 @@ class Trajectory:
                 arrays["tau"] = self.tau
             np.savez(
                 buffer,
-                **arrays,
+                **arrays,  # type: ignore[arg-type]
                 q_names=np.array(q_names),
                 v_names=np.array(v_names),
                 joint_names=np.array(self.joint_names),
