@@ -6,7 +6,9 @@
   on a ``dask.distributed`` cluster (``robodyn torques``);
 - :mod:`robodyn.scale.arrays`: ``inverse_dynamics``, ``forward_dynamics``, ``gravity``,
   ``mass_matrix`` accepting Dask arrays;
-- :mod:`robodyn.scale.cluster`: ``--scheduler ADDRESS|local:N``.
+- :mod:`robodyn.scale.cluster`: ``--scheduler ADDRESS|local:N``;
+- :mod:`robodyn.scale.sweeps`: the what-if table and the zoo check, one Dask task a row;
+- :mod:`robodyn.scale.csvio`: CSV rows through pyarrow when installed, numpy otherwise.
 
 Dask and pyarrow are optional (``pip install 'robodyn[scale]'``); CSV and NPZ need neither.
 Layer: above :mod:`robodyn.sim`, below :mod:`robodyn.viz`.

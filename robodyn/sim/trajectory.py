@@ -33,11 +33,15 @@ import csv
 import io
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robodyn.common.files import atomic_write_bytes, atomic_write_text
 from robodyn.exceptions import InputError, TrajectoryError
+
+if TYPE_CHECKING:
+    from robodyn.dynamics.robot import Robot
 from robodyn.sim.trajectory_columns import (
     BASE_Q,
     BASE_V,
@@ -100,7 +104,7 @@ class Trajectory:
         joints = [str(i) for i in range(nv - (6 if self.floating_base else 0))]  # unnamed: numbered
         return (list(BASE_Q) if self.floating_base else []) + joints, (list(BASE_V) if self.floating_base else []) + joints
 
-    def check(self, robot) -> None:
+    def check(self, robot: Robot) -> None:
         """Refuse a trajectory of another robot (one sentence naming the columns).
 
         Args:
@@ -129,7 +133,7 @@ class Trajectory:
             )
             raise TrajectoryError(where, f"a trajectory{of} does not fit robot {robot.name!r}: {detail}")
 
-    def for_robot(self, robot) -> Trajectory:
+    def for_robot(self, robot: Robot) -> Trajectory:
         """This trajectory with its columns in the robot's joint order (checked as :meth:`check`).
 
         Raises:
