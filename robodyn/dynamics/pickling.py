@@ -6,7 +6,8 @@ keyed by the source (URDF text, label, name, file, package folders) and the load
 so a robot sent to 100 tasks of one worker process is parsed there once, and every task
 of that process gets the same (thread-safe) :class:`Robot`. A robot's Pinocchio model
 changed by hand after loading does not travel: edits go through its source
-(:func:`robodyn.dynamics.loading.rebuild`).
+(:func:`robodyn.dynamics.loading.rebuild`). ``copy.copy`` and ``copy.deepcopy`` of a robot go
+the same way and give the process's shared robot: for an independent copy use ``rebuild(robot)``.
 """
 
 from __future__ import annotations
