@@ -293,3 +293,27 @@ class MissingToolError(RobodynError, OSError):
         self.tool = tool
         self.purpose = purpose
         super().__init__(f"{purpose} needs {tool}, which is not installed{'; ' + hint if hint else ''}.")
+
+
+class TrajectoryError(RobodynError, ValueError):
+    """A trajectory or dataset file that cannot be used as it is.
+
+    Attributes:
+        source: The file (or ``"the trajectory"``).
+        reason: What is wrong, naming the columns concerned.
+        rows: First and last data row concerned (1-based), or ``None``.
+    """
+
+    def __init__(self, source: str, reason: str, rows: tuple[int, int] | None = None):
+        self.source = source
+        self.reason = reason
+        self.rows = None if rows is None else (int(rows[0]), int(rows[1]))
+        where = (
+            ""
+            if self.rows is None
+            else (f", row {self.rows[0]}" if self.rows[0] == self.rows[1] else f", rows {self.rows[0]}-{self.rows[1]}")
+        )
+        super().__init__(f"{source}{where}: {reason}.")
+
+    def __reduce__(self) -> tuple:  # crosses process boundaries (Dask workers) intact
+        return (self.__class__, (self.source, self.reason, self.rows))

@@ -161,8 +161,10 @@ def test_cli_excite_then_identify(tmp_path, capsys):
     assert main(["identify", "rp_arm", str(trajectory), "--urdf-out", str(urdf)]) == 2
     assert "--urdf-out" in capsys.readouterr().err
     assert main(["identify", "rp_arm"]) == 2
+    capsys.readouterr()
     assert main(["identify", "ur5", str(trajectory)]) == 2  # data of another robot
-    assert "joints" in capsys.readouterr().err
+    error = capsys.readouterr().err
+    assert "ur5" in error and "q[shoulder_pan_joint]" in error and error.count("\n") == 1
 
 
 @pytest.mark.slow

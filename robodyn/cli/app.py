@@ -14,12 +14,12 @@ import traceback
 from collections.abc import Sequence
 
 import robodyn
-from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, view, whatif
+from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, torques, view, whatif
 from robodyn.common.text import one_line_warnings, printable
 from robodyn.exceptions import RobodynError
 
 #: The commands, in the order ``robodyn --help`` lists them.
-COMMANDS = (listing, info, equations, check, lint, simulate, record, view, whatif, excite, identify)
+COMMANDS = (listing, info, equations, check, lint, simulate, record, view, torques, whatif, excite, identify)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -136,6 +136,13 @@ class Robot(Kinematics):
     def __repr__(self) -> str:
         return f"<Robot {self.name!r}: nq={self.nq}, nv={self.nv}, joints={self.joint_names}>"
 
+    def __reduce__(self) -> tuple:
+        """Pickle by source and options; unpickling rebuilds the robot once per process
+        (:func:`robodyn.dynamics.pickling.restore`)."""
+        from robodyn.dynamics.pickling import restore
+
+        return restore, (self.source, self.options)
+
     def _joint_infos(self) -> list[JointInfo]:
         infos = []
         for joint_id in range(1, self.model.njoints):

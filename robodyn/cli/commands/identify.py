@@ -48,7 +48,7 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.base_parameters:
         print(render_base_parameters(base, arguments.format), end="")
         return 0
-    data = Trajectory.load(arguments.data)
+    data = Trajectory.load(arguments.data).for_robot(robot)
     result = identify(robot, data, method=arguments.method, base=base)
     urdf = identified_urdf(robot, result.standard, base.columns) if arguments.urdf_out and result.standard is not None else None
     width = max(len(printable(name)) for name in base.names)

@@ -49,7 +49,7 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.filmstrip is not None and arguments.at != 0.0:
         raise InputError("--at", "not given with --filmstrip (its frames spread over the motion)", f"--at {arguments.at:g}")
     robot = load_robot(arguments)
-    trajectory = Trajectory.load(arguments.trajectory)
+    trajectory = Trajectory.load(arguments.trajectory).for_robot(robot)
     started = time.perf_counter()
     with warnings.catch_warnings():  # reported below, one line each
         warnings.simplefilter("ignore", MeshWarning)

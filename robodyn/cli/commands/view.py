@@ -23,7 +23,7 @@ def run(arguments: argparse.Namespace) -> int:
     from robodyn.viz.live import LiveViewer, wait
 
     robot = load_robot(arguments)
-    trajectory = Trajectory.load(arguments.trajectory) if arguments.trajectory else None
+    trajectory = Trajectory.load(arguments.trajectory).for_robot(robot) if arguments.trajectory else None
     try:
         with LiveViewer() as viewer:
             viewer.show(robot, trajectory, target=arguments.target, frame=arguments.frame)

@@ -1,0 +1,88 @@
+"""`robodyn torques`: inverse dynamics over a whole trajectory file (and optionally G, M)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+
+from robodyn.cli.common import Progress, add_model_arguments, load_robot
+from robodyn.exceptions import InputError
+
+
+def _rows(text: str) -> int:
+    try:
+        rows = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if not 3 <= rows <= 10_000_000:
+        raise argparse.ArgumentTypeError(f"must be between 3 and 10000000, got {rows}")
+    return rows
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser(
+        "torques",
+        help="inverse dynamics over a trajectory file (CSV, NPZ, Parquet), in chunks; writes tau[<joint>] columns",
+        description="Inverse dynamics tau = M(q) a + C(q, v) v + G(q) of every sample of a trajectory file, "
+        "read in chunks (files larger than memory are fine). Without v or a columns they are derived from q "
+        "(second-order finite differences; see docs/trajectory-format.md).",
+    )
+    add_model_arguments(parser)
+    parser.add_argument("trajectory", help="trajectory file (.csv, .npz or .parquet; columns t, q[<joint>], v[...], a[...])")
+    parser.add_argument("--out", help="output file (.csv, .npz or .parquet): the input's columns plus tau[<joint>]")
+    parser.add_argument("--gravity-torques", action="store_true", help="also write G(q) as G[<joint>] columns")
+    parser.add_argument(
+        "--mass-matrix", action="store_true", help="also write M(q): upper triangle M[<row>,<col>] (NPZ: N×nv×nv)"
+    )
+    parser.add_argument("--chunk-rows", type=_rows, default=65_536, metavar="N", help="rows a chunk (default 65536)")
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS|local:N",
+        help="compute on Dask: a scheduler address (tcp://host:8786) or local:N worker processes on 127.0.0.1",
+    )
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    from robodyn.scale.torques import torques_file
+    from robodyn.sim.trajectory_columns import printable
+
+    robot = load_robot(arguments)
+    progress = Progress("torques")
+    options = {
+        "gravity": arguments.gravity_torques,
+        "mass_matrix": arguments.mass_matrix,
+        "rows": arguments.chunk_rows,
+        "progress": lambda done, total: progress("inverse dynamics", done, total),
+    }
+    try:
+        if arguments.scheduler:
+            from robodyn.scale.cluster import check_scheduler, connect
+
+            check_scheduler(arguments.scheduler)
+            with connect(arguments.scheduler) as client:
+                summary = torques_file(robot, arguments.trajectory, arguments.out, client=client, **options)
+        else:
+            summary = torques_file(robot, arguments.trajectory, arguments.out, **options)
+    finally:
+        progress.close()
+    for key in ("peak_abs_torque", "rms_torque"):
+        if not all(math.isfinite(value) for value in summary[key].values()):
+            raise InputError("trajectory", "states whose torques are finite", "an overflow")
+    if arguments.json:
+        print(json.dumps(summary, indent=2))
+        return 0
+    units = {name: "N" if joint.type == "prismatic" else "N m" for joint in robot.joints for name in [joint.name]}
+    print(
+        f"robot: {printable(summary['robot'])}\ntrajectory: {printable(summary['trajectory'])}\nsamples: {summary['samples']} ({summary['chunks']} chunks)"
+    )
+    print("joint: peak |tau|, rms tau")
+    for name, peak in summary["peak_abs_torque"].items():
+        unit = units.get(name, "N" if name in ("base.x", "base.y", "base.z") else "N m")
+        print(f"  {printable(name)}: {peak:.6g} {unit}, {summary['rms_torque'][name]:.6g} {unit}")
+    if "out" in summary:
+        print(f"wrote {summary['out']}")
+    return 0

@@ -1,0 +1,236 @@
+"""The columns of a trajectory file: names, layout, checks, derived velocities.
+
+The format itself is described in :mod:`robodyn.sim.trajectory` and
+``docs/trajectory-format.md``; this module turns a header into a :class:`Layout` (every
+error names the columns), refuses NaN/inf and non-increasing time with the row, and derives
+velocities from positions (:func:`derive_velocities`).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from robodyn.exceptions import InputError, TrajectoryError
+
+#: Names of a floating base's configuration coordinates (position [m], quaternion x, y, z, w).
+BASE_Q = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
+#: Names of a floating base's velocity coordinates (linear [m/s], angular [rad/s], base frame).
+BASE_V = ("base.x", "base.y", "base.z", "base.rx", "base.ry", "base.rz")
+#: The name robodyn's loader gives a floating base's joint (first of ``Robot.joint_names``).
+ROOT_JOINT = "root_joint"
+KINDS = ("q", "v", "a", "tau")
+#: Columns ``robodyn torques`` may add (gravity torques, mass-matrix entries); read back, they are skipped.
+EXTRA_KINDS = ("G", "M")
+_COLUMN = re.compile(r"^(q|v|a|tau)\[(.*)\]$", re.DOTALL)
+_EXTRA = re.compile(r"^(G|M)\[(.*)\]$", re.DOTALL)
+_LEGACY_Q = re.compile(r"^q(\d+)$")
+
+
+def coordinate_names(joint_names: list[str], floating_base: bool) -> tuple[list[str], list[str]]:
+    """Names of the configuration and velocity coordinates (what goes in the brackets).
+
+    Args:
+        joint_names: ``Robot.joint_names`` (a floating base's root joint first).
+        floating_base: Whether the first joint is a free-flyer.
+
+    Returns:
+        ``(q_names, v_names)`` of lengths nq and nv.
+    """
+    if floating_base:
+        joints = list(joint_names[1:])
+        return [*BASE_Q, *joints], [*BASE_V, *joints]
+    return list(joint_names), list(joint_names)
+
+
+def printable(name: str) -> str:
+    """A name as it may reach a terminal: control characters escaped (``\\n``, ``\\x1b``)."""
+    return name if name.isprintable() else name.encode("unicode_escape").decode("ascii")
+
+
+def short_list(names: list[str], limit: int = 4) -> str:
+    """The first ``limit`` names (escaped), and how many more."""
+    shown = ", ".join(printable(name) for name in names[:limit])
+    return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where each kind of column is in a table (from a header).
+
+    Attributes:
+        q_names: Configuration coordinate names (nq), in file order of the joints.
+        v_names: Velocity coordinate names (nv).
+        time: Index of the ``t`` column.
+        columns: Kind -> column indices in coordinate order, or ``None`` when absent.
+        floating_base: Whether the table has the seven base coordinates.
+    """
+
+    q_names: tuple[str, ...]
+    v_names: tuple[str, ...]
+    time: int
+    columns: dict[str, np.ndarray | None]
+    floating_base: bool
+    header: tuple[str, ...] = ()
+
+    @property
+    def width(self) -> int:
+        """Number of columns a row has."""
+        return len(self.header)
+
+    @property
+    def joint_names(self) -> list[str]:
+        """``Robot.joint_names`` of the robot this layout belongs to."""
+        joints = list(self.q_names[len(BASE_Q) :] if self.floating_base else self.q_names)
+        return [ROOT_JOINT, *joints] if self.floating_base else joints
+
+
+def parse_header(header: list[str], source: str, *, width: int | None = None) -> Layout:
+    """The :class:`Layout` of a header (column names), with every error named.
+
+    Args:
+        header: Column names, e.g. ``["t", "q[j1]", "v[j1]"]``.
+        source: The file, for messages.
+        width: Number of values a data row has, if known (reads robodyn 0.1 floating files).
+
+    Raises:
+        TrajectoryError: Naming the missing, duplicated, unknown or extra columns.
+    """
+    header = [name.strip() for name in header]
+    if width is not None and width != len(header):
+        header = _legacy_header(header, width, source)
+    duplicates = sorted({name for name in header if header.count(name) > 1})
+    if duplicates:
+        raise TrajectoryError(source, f"duplicated columns {short_list(duplicates)}")
+    found: dict[str, dict[str, int]] = {kind: {} for kind in KINDS}
+    unknown = []
+    for index, name in enumerate(header):
+        match = _COLUMN.match(name)
+        if match:
+            found[match.group(1)][match.group(2)] = index
+        elif name != "t" and not _EXTRA.match(name):
+            unknown.append(name)
+    if unknown:
+        raise TrajectoryError(
+            source, f"unknown columns {short_list(unknown)} (expected t, q[<joint>], v[<joint>], a[<joint>], tau[<joint>])"
+        )
+    if "t" not in header:
+        count = len(found["q"]) or len(header)
+        raise TrajectoryError(source, f"no 't' column (time in [s]); the file has {count} q columns, and t must be one of them")
+    if not found["q"]:
+        raise TrajectoryError(source, "no q[<joint>] columns (joint positions)")
+    q_names = list(found["q"])
+    base = [name for name in q_names if name.startswith("base.")]
+    floating = any(name in BASE_Q for name in base)
+    if floating:
+        missing = [f"q[{name}]" for name in BASE_Q if name not in found["q"]]
+        if missing:
+            raise TrajectoryError(source, f"missing columns {short_list(missing)} (a floating base has 7 coordinates)")
+    joints = [name for name in q_names if not (floating and name in BASE_Q)]
+    q_names = [*BASE_Q, *joints] if floating else joints
+    v_names = [*BASE_V, *joints] if floating else joints
+    columns: dict[str, np.ndarray | None] = {"q": np.array([found["q"][name] for name in q_names])}
+    for kind in ("v", "a", "tau"):
+        present = found[kind]
+        if not present:
+            columns[kind] = None
+            continue
+        missing = [f"{kind}[{name}]" for name in v_names if name not in present]
+        extra = [f"{kind}[{name}]" for name in present if name not in v_names]
+        if extra:
+            raise TrajectoryError(source, f"columns {short_list(extra)} have no matching q column")
+        if missing:
+            raise TrajectoryError(source, f"missing columns {short_list(missing)}")
+        columns[kind] = np.array([present[name] for name in v_names])
+    return Layout(tuple(q_names), tuple(v_names), header.index("t"), columns, floating, tuple(header))
+
+
+def _legacy_header(header: list[str], width: int, source: str) -> list[str]:
+    """A robodyn 0.1 floating-base header (``q0 ... q<nq-1>``, one v name for the base)."""
+    nq = sum(bool(_LEGACY_Q.match(name)) for name in header)
+    names = [name[2:-1] for name in header if name.startswith("v[")]
+    if nq and names and (width - 1 - nq) % 3 == 0:
+        nv = (width - 1 - nq) // 3
+        if nv == len(names) + 5 and nq == nv + 1:
+            q_names, v_names = coordinate_names(names, True)
+            return ["t"] + [f"q[{n}]" for n in q_names] + [f"{kind}[{n}]" for kind in ("v", "a", "tau") for n in v_names]
+    raise TrajectoryError(source, f"the header names {len(header)} columns but the rows have {width} values")
+
+
+def check_table(
+    table: np.ndarray, layout: Layout, source: str, *, first_row: int = 1, previous_time: float | None = None
+) -> None:
+    """Refuse NaN, inf and non-increasing time, naming the row (1-based data rows).
+
+    Args:
+        table: Rows of values, shape (N, width).
+        layout: Its columns.
+        source: The file, for messages.
+        first_row: Data row number of ``table[0]`` (for chunks of a larger file).
+        previous_time: Time of the row before ``table[0]``, if any.
+
+    Raises:
+        TrajectoryError: Naming the file, the row and the column.
+    """
+    finite = np.isfinite(table)
+    if not finite.all():
+        row, column = np.argwhere(~finite)[0]
+        name = layout.header[column] if column < len(layout.header) else f"column {column + 1}"
+        raise TrajectoryError(source, f"{name} is {table[row, column]} (values must be finite)", rows=(first_row + row,) * 2)
+    times = table[:, layout.time]
+    if previous_time is not None:
+        times = np.concatenate([[previous_time], times])
+        first_row -= 1
+    steps = np.diff(times)
+    if (steps <= 0).any():
+        row = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise TrajectoryError(
+            source, f"time does not increase (t = {times[row]!r} after {times[row - 1]!r})", rows=(first_row + row,) * 2
+        )
+
+
+def _quaternion_product(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """Hamilton product of quaternions stored (x, y, z, w), row by row."""
+    lv, lw = left[:, :3], left[:, 3:]
+    rv, rw = right[:, :3], right[:, 3:]
+    return np.hstack([lw * rv + rw * lv + np.cross(lv, rv), lw * rw - np.sum(lv * rv, axis=1, keepdims=True)])
+
+
+def _rotate_inverse(quaternion: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """``R(quaternion)ᵀ vector`` row by row (world -> base frame)."""
+    conjugate = quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
+    pure = np.hstack([vectors, np.zeros((len(vectors), 1))])
+    return _quaternion_product(_quaternion_product(conjugate, pure), quaternion)[:, :3]
+
+
+def derive_velocities(t: np.ndarray, q: np.ndarray, *, floating_base: bool) -> np.ndarray:
+    """Velocities from sampled positions by second-order finite differences.
+
+    ``np.gradient(q, t, axis=0, edge_order=2)``: central differences inside (error
+    O(h²) for a step h, non-uniform steps allowed), one-sided second-order differences at
+    the first and last sample. A floating base's linear velocity is ``Rᵀ ṗ`` and its angular
+    velocity ``2 (q̄ ⊗ q̇)`` (vector part), both in the base frame, as Pinocchio's ``v``.
+    Applied to ``v`` this gives ``a`` (O(h²) inside, O(h) on the first and last two samples).
+
+    Args:
+        t: Times in [s], shape (N,), strictly increasing, N ≥ 3.
+        q: Positions, shape (N, nq).
+        floating_base: Whether ``q[:, :7]`` is a base pose.
+
+    Returns:
+        Shape (N, nv).
+    """
+    if len(t) < 3:
+        raise InputError("trajectory", "at least 3 samples to derive velocities from positions", f"{len(t)} samples")
+    if not floating_base:
+        return np.gradient(q, t, axis=0, edge_order=2)
+    quaternion = q[:, 3:7].copy()
+    flips = np.cumsum(np.sum(quaternion[1:] * quaternion[:-1], axis=1) < 0) % 2  # q and -q are one rotation
+    quaternion[1:][flips == 1] *= -1.0
+    rates = np.gradient(np.hstack([q[:, :3], quaternion, q[:, 7:]]), t, axis=0, edge_order=2)
+    linear = _rotate_inverse(quaternion, rates[:, :3])
+    conjugate = quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
+    angular = 2.0 * _quaternion_product(conjugate, rates[:, 3:7])[:, :3]
+    return np.hstack([linear, angular, rates[:, 7:]])
