@@ -293,3 +293,58 @@ class MissingToolError(RobodynError, OSError):
         self.tool = tool
         self.purpose = purpose
         super().__init__(f"{purpose} needs {tool}, which is not installed{'; ' + hint if hint else ''}.")
+
+
+class StaticFrameError(FrameError):
+    """A task (target, payload, force) on a frame that no joint moves: it would do nothing.
+
+    Attributes:
+        robot: The robot's name.
+        frame: The frame asked for.
+        purpose: What the frame was for, e.g. ``"a payload"``.
+        moving: Some frames that do move (hints).
+    """
+
+    def __init__(self, robot: str, frame: str, purpose: str, moving: list[str] | None = None):
+        self.robot = robot
+        self.frame = frame
+        self.purpose = purpose
+        self.moving = list(moving or [])
+        self.close = self.moving
+        hint = f" (moving frames: {', '.join(repr(name) for name in self.moving)})" if self.moving else ""
+        Exception.__init__(
+            self,
+            f"robot {robot!r}: frame {frame!r} is fixed to the world (no joint moves it), so {purpose} on it would have no effect{hint}.",
+        )
+
+
+class AmbiguousEndEffectorError(FrameError):
+    """A robot whose moving joints form several chains (legs, fingers): no default end effector.
+
+    Attributes:
+        robot: The robot's name.
+        candidates: The tip of every chain.
+    """
+
+    def __init__(self, robot: str, candidates: list[str]):
+        self.robot = robot
+        self.frame = None
+        self.candidates = list(candidates)
+        self.close = self.candidates
+        Exception.__init__(
+            self,
+            f"robot {robot!r} has {len(self.candidates)} chain tips and no default end effector: "
+            f"name one (frame=... / --frame) of {', '.join(repr(name) for name in self.candidates)}.",
+        )
+
+
+class JointLimitWarning(RobodynWarning):
+    """A simulation or motion left a joint's position, velocity or effort limits.
+
+    Attributes:
+        violations: The violations (joint, quantity, first time, worst value, limit).
+    """
+
+    def __init__(self, message: str, violations: list | None = None):
+        self.violations = list(violations or [])
+        super().__init__(message)

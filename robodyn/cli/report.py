@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
 
 
@@ -56,8 +57,19 @@ def dof_units(robot: Robot) -> dict[str, list[str]]:
     }
 
 
+def end_effector_text(robot: Robot) -> tuple[str | None, str]:
+    """The default end effector, or ``None`` and why there is none."""
+    from robodyn.exceptions import AmbiguousEndEffectorError
+
+    try:
+        return robot.end_effector, ""
+    except AmbiguousEndEffectorError as error:
+        return None, f"none: {len(error.candidates)} chain tips ({', '.join(error.candidates)}); pass --frame"
+
+
 def info_dict(robot: Robot) -> dict:
-    """A JSON-ready description of a robot: joints, limits, masses."""
+    """A JSON-ready description of a robot: joints, limits, masses, default end effector
+    (``null`` with ``end_effector_candidates`` when it has several chains)."""
 
     def finite(value: float) -> float | None:
         return float(value) if np.isfinite(value) else None
@@ -68,6 +80,8 @@ def info_dict(robot: Robot) -> dict:
         "nv": robot.nv,
         "floating_base": robot.floating_base,
         "gravity_m_s2": robot.gravity_vector.tolist(),
+        "end_effector": end_effector_text(robot)[0],
+        "end_effector_candidates": frames.end_effector_candidates(robot.model),
         "joints": [
             {
                 "name": j.name,
@@ -86,9 +100,11 @@ def info_dict(robot: Robot) -> dict:
 
 def info_text(robot: Robot) -> str:
     """A readable description of a robot: joints with types and limits, link masses."""
+    end_effector, reason = end_effector_text(robot)
     lines = [
         f"robot {robot.name}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
         f"{'floating' if robot.floating_base else 'fixed'} base, gravity {_vector(robot.gravity_vector, 4)} m/s²",
+        f"end effector (default task frame): {end_effector or reason}",
         "",
         f"{'joint':30s} {'type':11s} {'lower':>10s} {'upper':>10s} {'effort':>10s} {'velocity':>10s}",
     ]
@@ -163,3 +179,54 @@ def equations_text(robot: Robot, terms: DynamicsTerms, *, precision: int = 6) ->
 def _dof_labels(robot: Robot) -> list[str]:
     base = [f"base {axis}" for axis in ("vx", "vy", "vz", "wx", "wy", "wz")]
     return base + robot.joint_names[1:]
+
+
+def _number(value: object, digits: int = 6) -> str:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return str(value)
+    return "unlimited" if not np.isfinite(value) else f"{value:.{digits}g}"
+
+
+def simulation_text(summary: dict) -> str:
+    """A simulation summary (from :func:`robodyn.sim.experiment.run_simulation`) as text.
+
+    Numbers with six significant digits and their units; one line a limit violation.
+    """
+    from robodyn.sim.limits import LimitViolation
+
+    units = summary.get("torque_units", [])
+    names = summary.get("joint_names", [])
+    lines = [
+        f"robot: {summary['robot']}",
+        f"controller: {summary['controller']} (integrator {summary['integrator']}, limits {summary['limits']})",
+        f"simulated: {_number(summary['duration_s'])} s in {summary['steps']} steps of {_number(summary['dt_s'])} s"
+        + (f", {_number(summary['real_time_factor'], 3)}× real time" if summary.get("real_time_factor") else ""),
+    ]
+    if "frame" in summary:
+        lines += [
+            f"frame: {summary['frame']}",
+            f"target: {_vector(np.array(summary['target_m']), 6)} m",
+            f"final position: {_vector(np.array(summary['final_position_m']), 6)} m",
+            f"final error: {_number(summary['final_error_m'], 3)} m ({'reached' if summary['target_reached'] else 'NOT reached'})",
+        ]
+    if "final_joint_error" in summary:
+        lines.append(f"final joint error: {_number(summary['final_joint_error'], 3)} (largest |q - target|, rad or m)")
+    lines.append(f"final q: {_vector(np.array(summary['final_q']), 6)} (rad / m)")
+    peaks = [
+        f"{name} {_number(peak, 4)} {unit}" for name, peak, unit in zip(names, summary["peak_abs_torque"], units, strict=False)
+    ]
+    lines.append(f"peak |torque|: {', '.join(peaks)}")
+    lines.append(f"energy change: {_number(summary['energy_change_J'], 4)} J")
+    violations = summary.get("limit_violations", [])
+    if summary["limits"] == "ignore":
+        lines.append("limits: not checked (--limits ignore)")
+    elif not violations:
+        lines.append("limits: every position, velocity and effort limit kept")
+    for item in violations:
+        fields = {**item, "first_time": item["first_time_s"]}
+        del fields["first_time_s"]
+        lines.append(f"limit violation: {LimitViolation(**fields).text()}")
+    for key in ("trajectory", "plot", "recording", "poster"):
+        if key in summary:
+            lines.append(f"{key}: {summary[key]}")
+    return "\n".join(lines)

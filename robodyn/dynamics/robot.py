@@ -25,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.common.inputs import as_states
+from robodyn.dynamics import frames
 from robodyn.dynamics.batch import ParallelRunner
 from robodyn.dynamics.handle import per_state
 from robodyn.dynamics.kinematics import Kinematics
@@ -32,6 +33,10 @@ from robodyn.dynamics.mimic import MimicExpansion
 from robodyn.exceptions import InputError, NonFiniteResultError, SingularMassMatrixError
 from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
+
+#: Position limits at least this large in magnitude (1e3 m or rad) are placeholders for
+#: "unlimited" (URDFs write ±999 999 where the format demands a number).
+PLACEHOLDER_LIMIT = 1e3
 
 
 @dataclass(frozen=True)
@@ -162,9 +167,31 @@ class Robot(Kinematics):
 
     @property
     def end_effector(self) -> str:
-        """The frame tasks refer to by default: ``end_effector`` if the URDF has that link,
-        else the URDF's last link."""
-        return "end_effector" if "end_effector" in self.spec.links else list(self.spec.links)[-1]
+        """The frame tasks refer to by default: the tip of the chain the last moving joint
+        drives (see :mod:`robodyn.dynamics.frames` for the rule; a link named
+        ``end_effector`` that moves is taken as given).
+
+        Raises:
+            AmbiguousEndEffectorError: For robots with several chains (legs, fingers, two
+                arms): the message lists the tips to choose from.
+        """
+        return frames.default_end_effector(self.model, self.name)
+
+    def task_frame(self, frame: str | None, purpose: str) -> str:
+        """A frame for a task, checked: ``frame`` (default :attr:`end_effector`) must exist
+        and some joint must move it.
+
+        Args:
+            frame: Link or joint name; ``None`` for the default end effector.
+            purpose: What the frame is for, for the message (e.g. ``"a payload"``).
+
+        Raises:
+            FrameError: Unknown frame. StaticFrameError: no joint moves it.
+            AmbiguousEndEffectorError: No ``frame`` and no default end effector.
+        """
+        name = self.end_effector if frame is None else frame
+        frames.require_moving(self.model, self.name, name, self.frame_id(name), purpose)
+        return name
 
     @cached_property
     def link_masses(self) -> dict[str, float]:
@@ -198,8 +225,41 @@ class Robot(Kinematics):
         return np.array([joint.upper for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
 
     def neutral_configuration(self) -> np.ndarray:
-        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
+        """The neutral configuration (zero joint positions, identity base), shape (nq,).
+
+        It may lie outside the joint limits (panda's joint 4 lives in [-3.07, -0.07] rad);
+        :meth:`default_configuration` does not.
+        """
         return pin.neutral(self.model)
+
+    def default_configuration(self) -> np.ndarray:
+        """The neutral configuration clipped into the joint position limits, shape (nq,).
+
+        The initial state of simulations and motions when none is given: every joint at
+        zero, or at its nearest limit when zero is outside them (placeholder limits, see
+        :meth:`random_configuration`, are ignored).
+        """
+        q = self.neutral_configuration()
+        lower, upper = self.physical_limits()
+        start = self.nq - lower.size
+        q[start:] = np.clip(q[start:], lower, upper)
+        return q
+
+    def physical_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Position limits of the joints (floating base excluded), placeholders as ±inf.
+
+        A limit of magnitude at least :data:`PLACEHOLDER_LIMIT` (1e3 m or rad, e.g.
+        ridgeback's ±999 999 m) stands for "unlimited" and becomes ±inf.
+
+        Returns:
+            ``(lower, upper)``, each of shape (nv,), or (nv − 6,) with a floating base.
+        """
+        lower, upper = self.lower_limits, self.upper_limits
+        if self.floating_base:
+            lower, upper = lower[6:], upper[6:]
+        lower = np.where(np.abs(lower) >= PLACEHOLDER_LIMIT, -np.inf, lower)
+        upper = np.where(np.abs(upper) >= PLACEHOLDER_LIMIT, np.inf, upper)
+        return lower, upper
 
     def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
         """A floating-base configuration from the base pose and the joint positions.
@@ -224,23 +284,32 @@ class Robot(Kinematics):
         return np.concatenate([position, quaternion, joints])
 
     def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
-        """Configurations drawn uniformly within the joint limits.
+        """Configurations drawn uniformly within the joint limits, in a physical range.
 
-        Unlimited joints draw from [-π, π]; a floating base draws its position from
-        [-1, 1] m and a uniform random orientation.
+        The rule: a joint with both limits draws between them. A limit that is missing,
+        infinite or a placeholder (magnitude ≥ 1e3 m or rad, :data:`PLACEHOLDER_LIMIT`)
+        counts as absent: a joint with no limit draws from [-π, π] (in [rad] or [m]), a
+        joint with one limit from the 2π-wide interval on its side of it. A floating base
+        draws its position from [-1, 1] m and a uniform random orientation.
 
         Args:
             rng: Random generator (for reproducible draws).
-            count: Number of configurations; ``None`` for a single one.
+            count: Number of configurations (≥ 0); ``None`` for a single one.
 
         Returns:
             Shape (nq,) or (count, nq).
+
+        Raises:
+            InputError: If ``count`` is not a non-negative integer.
         """
-        rows = 1 if count is None else count
-        lower = np.where(np.isfinite(self.lower_limits), self.lower_limits, -np.pi)
-        upper = np.where(np.isfinite(self.upper_limits), self.upper_limits, np.pi)
-        if self.floating_base:
-            lower, upper = lower[6:], upper[6:]
+        if count is not None and (isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0):
+            raise InputError("count", "a non-negative integer or None", repr(count))
+        rows = 1 if count is None else int(count)
+        lower, upper = self.physical_limits()
+        lower, upper = (
+            np.where(np.isfinite(lower), lower, np.where(np.isfinite(upper), upper - 2 * np.pi, -np.pi)),
+            np.where(np.isfinite(upper), upper, np.where(np.isfinite(lower), lower + 2 * np.pi, np.pi)),
+        )
         joints = rng.uniform(lower, upper, size=(rows, lower.size))
         if self.floating_base:
             quaternion = rng.normal(size=(rows, 4))

@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import json
 
-from robodyn.cli.common import add_model_arguments, load_robot
+from robodyn.cli.common import add_model_arguments, json_text, load_robot
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -30,5 +29,5 @@ def run(arguments: argparse.Namespace) -> int:
         tolerance=arguments.tolerance,
         check_inertia=arguments.check_inertia,
     )
-    print(json.dumps(report_dict(report), indent=2) if arguments.json else report_text(report))
+    print(json_text(report_dict(report)) if arguments.json else report_text(report))
     return 0 if report.passed else 1
