@@ -127,7 +127,7 @@ def simulate(
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     for item in external:
         robot.task_frame(item.frame, "an external wrench")
-    if robot.massless_joints:
+    if robot.massless_joints or _singular(robot, q):
         raise SingularMassMatrixError(robot.name, robot.massless_joints)
     joint_limits = JointLimits(robot)
     enforce = limits == "enforce"
@@ -220,9 +220,14 @@ def _check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: n
             )
             joint = robot.joint_names[min(int(bad[0]) if bad.size else 0, len(robot.joint_names) - 1)]
             step = first + offset - 1
-            if offset > 0 and _singular(robot, states[offset - 1][0]):
+            if offset > 0 and _moderate(*states[offset - 1]) and _singular(robot, states[offset - 1][0]):
                 raise SingularMassMatrixError(robot.name, robot.massless_joints)
             raise SimulationError(step * dt, step, joint)
+
+
+def _moderate(q: np.ndarray, v: np.ndarray) -> bool:
+    """A state that did not blow up (where a singular ``M`` is the reason, not overflow)."""
+    return bool(np.abs(q).max(initial=0.0) < 1e6 and np.abs(v).max(initial=0.0) < 1e6)
 
 
 def _singular(robot: Robot, q: np.ndarray) -> bool:

@@ -30,8 +30,7 @@ def run(arguments: argparse.Namespace) -> int:
                         "floating_base": name in ZOO and ZOO[name].floating_base,
                     }
                     for name in names
-                ],
-                indent=2,
+                ]
             )
         )
         return 0
