@@ -81,7 +81,7 @@ def test_fixed_frames_after_the_tip_are_followed_when_unique():
 def test_several_chains_have_no_silent_default(name, tips):
     robot = robodyn.load(name)
     with pytest.raises(AmbiguousEndEffectorError) as caught:
-        robot.end_effector
+        _ = robot.end_effector
     assert len(caught.value.candidates) == tips
     assert "\n" not in str(caught.value) and all(tip in str(caught.value) for tip in caught.value.candidates)
     for tip in caught.value.candidates:  # each candidate is a real, moving frame
