@@ -151,3 +151,10 @@ def test_info_shows_the_default_frame(capsys):
     assert f"end effector (default task frame): {robodyn.load('ur5').end_effector}" in capsys.readouterr().out
     assert main(["info", "solo12"]) == 0
     assert "FL_FOOT" in capsys.readouterr().out
+
+
+def test_attach_payload_refuses_a_link_nothing_moves():
+    from robodyn.dynamics.payload import attach_payload
+
+    with pytest.raises(StaticFrameError):
+        attach_payload(robodyn.load("ur5"), "base_link", 1.0)

@@ -195,7 +195,7 @@ def simulation_text(summary: dict) -> str:
     from robodyn.sim.limits import LimitViolation
 
     units = summary.get("torque_units", [])
-    names = summary.get("joint_names", [])
+    names = summary.get("dof_names", summary.get("joint_names", []))
     lines = [
         f"robot: {summary['robot']}",
         f"controller: {summary['controller']} (integrator {summary['integrator']}, limits {summary['limits']})",
@@ -211,7 +211,9 @@ def simulation_text(summary: dict) -> str:
         ]
     if "final_joint_error" in summary:
         lines.append(f"final joint error: {_number(summary['final_joint_error'], 3)} (largest |q - target|, rad or m)")
-    lines.append(f"final q: {_vector(np.array(summary['final_q']), 6)} (rad / m)")
+    floating = any(name.startswith("base ") for name in names)
+    q_units = "base position in m, quaternion x y z w, then joints in rad / m" if floating else "rad / m"
+    lines.append(f"final q: {_vector(np.array(summary['final_q']), 6)} ({q_units})")
     peaks = [
         f"{name} {_number(peak, 4)} {unit}" for name, peak, unit in zip(names, summary["peak_abs_torque"], units, strict=False)
     ]

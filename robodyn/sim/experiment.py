@@ -109,6 +109,7 @@ def run_simulation(
         "steps": len(trajectory) - 1,
         "real_time_factor": duration / elapsed if elapsed > 0 else None,
         "joint_names": list(robot.joint_names),
+        "dof_names": _dof_names(robot),
         "final_q": trajectory.q[-1].tolist(),
         "peak_abs_torque": np.abs(trajectory.tau).max(axis=0).tolist(),
         "torque_units": ["N" if kind == "prismatic" else "N m" for kind in _dof_kinds(robot)],
@@ -143,6 +144,13 @@ def _check_reach(robot: Robot, frame: str, target: np.ndarray) -> None:
             f"within the reach of {frame!r} ({radius:.3f} m of its first joint at ({where}) m)",
             f"a point {distance:.3f} m away",
         )
+
+
+def _dof_names(robot: Robot) -> list[str]:
+    """A name for each velocity coordinate (a floating base: base vx ... base wz)."""
+    if not robot.floating_base:
+        return list(robot.joint_names)
+    return [f"base {axis}" for axis in ("vx", "vy", "vz", "wx", "wy", "wz")] + list(robot.joint_names[1:])
 
 
 def _dof_kinds(robot: Robot) -> list[str]:
