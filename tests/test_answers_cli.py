@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn.cli import common
 from robodyn.cli.app import main
-from robodyn.cli.common import json_text
 
 
 def run(capsys, *argv):
@@ -36,7 +36,10 @@ def strict_json(text: str):
     [
         (["equations", "rp_arm", "--q", "-0.5,0.1", "--json"], ["equations", "rp_arm", "--q=-0.5,0.1", "--json"]),
         (["equations", "rp_arm", "--gravity", "-9.81,0,0", "--json"], ["equations", "rp_arm", "--gravity=-9.81,0,0", "--json"]),
-        (["equations", "rp_arm", "--v", "-1,0", "--a", "-2,1", "--json"], ["equations", "rp_arm", "--v=-1,0", "--a=-2,1", "--json"]),
+        (
+            ["equations", "rp_arm", "--v", "-1,0", "--a", "-2,1", "--json"],
+            ["equations", "rp_arm", "--v=-1,0", "--a=-2,1", "--json"],
+        ),
         (["equations", "rp_arm", "--a", "-.5,-1e-3", "--json"], ["equations", "rp_arm", "--a=-.5,-1e-3", "--json"]),
     ],
 )
@@ -106,7 +109,7 @@ def test_json_is_always_strict(capsys):
     status, out, _ = run(capsys, "simulate", "rp_arm", "--duration", "0.5", "--json")
     summary = strict_json(out)
     assert summary["duration_s"] == 0.5 and summary["steps"] == 500
-    assert json_text({"a": float("inf"), "b": [float("nan"), 1.0]}) == json_text({"a": None, "b": [None, 1.0]})
+    assert common.json_text({"a": float("inf"), "b": [float("nan"), 1.0]}) == common.json_text({"a": None, "b": [None, 1.0]})
 
 
 def test_simulate_summary_has_units_and_sensible_precision(capsys):

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn import exceptions
 from robodyn.cli.app import main
-from robodyn.exceptions import AmbiguousEndEffectorError, FrameError, StaticFrameError
+from robodyn.exceptions import FrameError
 from robodyn.sim.control import TaskSpace
 from robodyn.sim.experiment import controller_model, run_simulation
 from robodyn.sim.simulation import ExternalWrench, simulate
@@ -80,7 +81,7 @@ def test_fixed_frames_after_the_tip_are_followed_when_unique():
 @pytest.mark.parametrize(("name", "tips"), [("solo12", 4), ("baxter", 5), ("tiago", 11)])
 def test_several_chains_have_no_silent_default(name, tips):
     robot = robodyn.load(name)
-    with pytest.raises(AmbiguousEndEffectorError) as caught:
+    with pytest.raises(exceptions.AmbiguousEndEffectorError) as caught:
         _ = robot.end_effector
     assert len(caught.value.candidates) == tips
     assert "\n" not in str(caught.value) and all(tip in str(caught.value) for tip in caught.value.candidates)
@@ -90,17 +91,17 @@ def test_several_chains_have_no_silent_default(name, tips):
 
 def test_static_frames_are_refused_everywhere():
     robot = robodyn.load("ur5")
-    with pytest.raises(StaticFrameError, match="no joint moves it"):
+    with pytest.raises(exceptions.StaticFrameError, match="no joint moves it"):
         robot.task_frame("world", "a payload")
-    with pytest.raises(StaticFrameError):
+    with pytest.raises(exceptions.StaticFrameError):
         TaskSpace(controller_model(robot), "base_link", np.array([0.3, 0.2, 0.4]))
-    with pytest.raises(StaticFrameError):
+    with pytest.raises(exceptions.StaticFrameError):
         simulate(robot, np.zeros(6), np.zeros(6), 0.01, 1e-3, external=[ExternalWrench("world", [0, 0, -10])])
-    with pytest.raises(StaticFrameError):
+    with pytest.raises(exceptions.StaticFrameError):
         sweep("ur5", payloads=(0.0, 1.0), frame="world")
     with pytest.raises(FrameError):
         robot.task_frame("no_such_frame", "a payload")
-    assert isinstance(StaticFrameError("r", "f", "x"), FrameError)
+    assert isinstance(exceptions.StaticFrameError("r", "f", "x"), FrameError)
 
 
 def test_payload_adds_its_weight_through_the_frame_jacobian_by_finite_differences():
@@ -156,5 +157,5 @@ def test_info_shows_the_default_frame(capsys):
 def test_attach_payload_refuses_a_link_nothing_moves():
     from robodyn.dynamics.payload import attach_payload
 
-    with pytest.raises(StaticFrameError):
+    with pytest.raises(exceptions.StaticFrameError):
         attach_payload(robodyn.load("ur5"), "base_link", 1.0)

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn import exceptions
 from robodyn.cli.app import main
-from robodyn.exceptions import InputError, JointLimitWarning, SingularMassMatrixError
+from robodyn.exceptions import InputError, SingularMassMatrixError
 from robodyn.sim.control import PDGravity
 from robodyn.sim.experiment import controller_model, run_simulation
-from robodyn.sim.limits import limit_violations
 from robodyn.sim.simulation import simulate
 from robodyn.sim.whatif import sweep
 
@@ -26,7 +26,7 @@ from robodyn.sim.whatif import sweep
 def test_passive_slider_leaving_its_limit_is_reported():
     robot = robodyn.load("rp_arm")
     q0 = np.array([-1.2, 0.1])  # hanging down-ish: the slider slides out under gravity
-    with pytest.warns(JointLimitWarning, match="joint2 position") as record:
+    with pytest.warns(exceptions.JointLimitWarning, match="joint2 position") as record:
         trajectory = simulate(robot, q0, np.zeros(2), 1.0, 1e-3)
     upper = robot.joints[1].upper
     violations = record[0].message.violations
@@ -42,7 +42,7 @@ def test_enforce_stops_the_slider_at_its_limit_and_keeps_it_there():
     robot = robodyn.load("rp_arm")
     q0 = np.array([-1.2, 0.1])
     with warnings.catch_warnings(record=True) as record:
-        warnings.simplefilter("always", JointLimitWarning)
+        warnings.simplefilter("always", exceptions.JointLimitWarning)
         trajectory = simulate(robot, q0, np.zeros(2), 1.0, 1e-3, limits="enforce")
     reported = [v for w in record for v in w.message.violations]
     assert reported and {v.quantity for v in reported} == {"velocity"}  # velocity limits: reported only
@@ -56,7 +56,7 @@ def test_enforce_stops_the_slider_at_its_limit_and_keeps_it_there():
 def test_enforce_saturates_torques_at_the_effort_limits():
     robot = robodyn.load("panda")
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", JointLimitWarning)  # velocity limits are only reported
+        warnings.simplefilter("ignore", exceptions.JointLimitWarning)  # velocity limits are only reported
         trajectory, summary = run_simulation(robot, controller="task-space", target=[0.4, 0.2, 0.5], limits="enforce")
     effort = np.array([joint.effort for joint in robot.joints])
     assert np.all(np.abs(trajectory.tau) <= effort + 1e-12)
@@ -78,8 +78,10 @@ def test_warn_mode_summary_lists_every_violation_with_its_worst_value():
     still = simulate(robot, robot.default_configuration(), np.zeros(8), 0.2, 1e-3, limits="ignore")
     quiet = PDGravity(controller_model(robot), robot.default_configuration())
     with warnings.catch_warnings():
-        warnings.simplefilter("error", JointLimitWarning)
+        warnings.simplefilter("error", exceptions.JointLimitWarning)
         held = simulate(robot, robot.default_configuration(), np.zeros(8), 0.2, 1e-3, controller=quiet)
+    from robodyn.sim.limits import limit_violations
+
     assert limit_violations(robot, held) == []
     assert len(still) == 201
 
@@ -87,7 +89,7 @@ def test_warn_mode_summary_lists_every_violation_with_its_worst_value():
 def test_ignore_mode_says_nothing():
     robot = robodyn.load("rp_arm")
     with warnings.catch_warnings():
-        warnings.simplefilter("error", JointLimitWarning)
+        warnings.simplefilter("error", exceptions.JointLimitWarning)
         simulate(robot, np.array([-1.2, 0.1]), np.zeros(2), 1.0, 1e-3, limits="ignore")
     with pytest.raises(InputError, match="limits"):
         simulate(robot, np.zeros(2), np.zeros(2), 0.1, 1e-3, limits="clamp")

@@ -62,7 +62,8 @@ def _children(model: pin.Model) -> dict[int, list[int]]:
 def _body_of_joint(model: pin.Model, joint: int) -> int:
     """The link frame carried directly by a joint."""
     joint_frame = next(i for i, f in enumerate(model.frames) if f.type == pin.FrameType.JOINT and f.parentJoint == joint)
-    return next(i for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY and f.parentFrame == joint_frame)
+    bodies = [i for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY and f.parentFrame == joint_frame]
+    return bodies[0] if bodies else joint_frame
 
 
 def _attached_to(model: pin.Model, joint: int) -> int:

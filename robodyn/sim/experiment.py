@@ -77,6 +77,10 @@ def run_simulation(
     check_mode(limits)
     if controller != "passive" and target is None:
         raise InputError("--target", f"given for the {controller} controller", "nothing")
+    if controller == "passive" and target is not None:
+        raise InputError("--target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
+    if controller != "task-space" and frame is not None:
+        raise InputError("--frame", "given only with the task-space controller", repr(frame))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
     task = None
     law = None
