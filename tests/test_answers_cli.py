@@ -119,3 +119,23 @@ def test_simulate_summary_has_units_and_sensible_precision(capsys):
     assert "peak |torque|: joint1" in out and "N m" in out and "joint2" in out
     assert "energy change:" in out and " J" in out
     assert "0.700000000" not in out  # six significant digits, not seventeen
+
+
+HOSTILE = """<robot name="evil&#10;robot&#x202E;">
+  <link name="base"/>
+  <joint name="j&#10;1&#x202E;" type="revolute"><parent link="base"/><child link="l&#10;1"/><axis xyz="0 0 1"/>
+    <origin rpy="1.2 0 0"/><limit lower="-0.5" upper="0.5" effort="1" velocity="1"/></joint>
+  <link name="l&#10;1"><inertial><origin xyz="0.3 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+</robot>"""
+
+
+def test_names_from_the_urdf_reach_the_terminal_escaped(capsys, tmp_path):
+    path = tmp_path / "evil.urdf"
+    path.write_text(HOSTILE)
+    for argv in (["info", str(path)], ["simulate", str(path), "--duration", "0.5"], ["whatif", str(path), "--payloads", "0,1"]):
+        status, out, err = run(capsys, *argv)
+        assert status == 0
+        assert "\u202e" not in out + err and "j\\x0a1\\u202e" in out
+        assert all(not line.startswith("1") for line in out.splitlines())  # no name broken over two lines
+    assert err.count("\n") <= 1

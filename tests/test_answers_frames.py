@@ -159,3 +159,55 @@ def test_attach_payload_refuses_a_link_nothing_moves():
 
     with pytest.raises(exceptions.StaticFrameError):
         attach_payload(robodyn.load("ur5"), "base_link", 1.0)
+
+
+def _zoo_robots():
+    import warnings
+
+    from robodyn.exceptions import RobodynError
+
+    robots = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name in robodyn.robot_names():
+            try:
+                robots.append(robodyn.load(name))
+            except RobodynError:
+                continue  # item 9 (loading) is another engineer's
+    return robots
+
+
+@pytest.mark.slow
+def test_every_zoo_robot_has_a_moving_default_or_names_its_tips():
+    for robot in _zoo_robots():
+        try:
+            frame = robot.end_effector
+        except exceptions.AmbiguousEndEffectorError as error:
+            assert len(error.candidates) >= 2, robot.name
+            for tip in error.candidates:
+                assert robot.task_frame(tip, "a test") == tip
+            continue
+        assert moved_by_every_joint(robot, frame), (robot.name, frame)
+
+
+@pytest.mark.slow
+def test_task_space_control_reaches_a_reachable_target_on_every_zoo_arm():
+    """The target: the end effector's position at a configuration 0.1 rad (or m) inside the
+    limits (a task-space law does not know the stops; a goal on one is reached only slowly)."""
+    for robot in _zoo_robots():
+        if robot.floating_base:
+            continue
+        try:
+            frame = robot.end_effector
+        except exceptions.AmbiguousEndEffectorError:
+            continue
+        rng = np.random.default_rng(0)
+        lower, upper = robot.physical_limits()
+        q = np.clip(robot.default_configuration() + rng.uniform(-0.3, 0.3, robot.nq), lower + 0.1, upper - 0.1)
+        target = robot.frame_position(q, frame)
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            _, summary = run_simulation(robot, controller="task-space", target=target.tolist(), limits="enforce")
+        assert summary["target_reached"], (robot.name, summary["final_error_m"])

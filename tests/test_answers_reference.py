@@ -90,3 +90,18 @@ def test_random_configuration_refuses_a_bad_count(count):
 
 def test_random_configuration_of_zero_states_is_empty():
     assert robodyn.load("ur5").random_configuration(np.random.default_rng(0), 0).shape == (0, 6)
+
+
+def test_empty_limit_ranges_are_no_limits():
+    """The zoo's double pendulum writes lower = upper = 0 on joints that swing freely: its
+    states must not all be q = 0, and a swing is not a limit violation."""
+    import warnings
+
+    from robodyn.sim.simulation import simulate
+
+    robot = robodyn.load("double_pendulum")
+    assert np.ptp(robot.random_configuration(np.random.default_rng(0), 100), axis=0).min() > 3
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        trajectory = simulate(robot, np.array([1.0, 0.5]), np.zeros(2), 0.5, 1e-3)
+    assert np.ptp(trajectory.q[:, 0]) > 0.1

@@ -12,6 +12,7 @@ import numpy as np
 
 from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
+from robodyn.sim.limits import printable
 
 
 @dataclass(frozen=True)
@@ -64,7 +65,8 @@ def end_effector_text(robot: Robot) -> tuple[str | None, str]:
     try:
         return robot.end_effector, ""
     except AmbiguousEndEffectorError as error:
-        return None, f"none: {len(error.candidates)} chain tips ({', '.join(error.candidates)}); pass --frame"
+        tips = ", ".join(printable(tip) for tip in error.candidates)
+        return None, f"none: {len(error.candidates)} chain tips ({tips}); pass --frame"
 
 
 def info_dict(robot: Robot) -> dict:
@@ -102,23 +104,23 @@ def info_text(robot: Robot) -> str:
     """A readable description of a robot: joints with types and limits, link masses."""
     end_effector, reason = end_effector_text(robot)
     lines = [
-        f"robot {robot.name}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
+        f"robot {printable(robot.name)}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
         f"{'floating' if robot.floating_base else 'fixed'} base, gravity {_vector(robot.gravity_vector, 4)} m/s²",
-        f"end effector (default task frame): {end_effector or reason}",
+        f"end effector (default task frame): {printable(end_effector) if end_effector else reason}",
         "",
         f"{'joint':30s} {'type':11s} {'lower':>10s} {'upper':>10s} {'effort':>10s} {'velocity':>10s}",
     ]
     for joint in robot.joints:
         position_unit, effort_unit, speed_unit = ("m", "N", "m/s") if joint.type == "prismatic" else ("rad", "N m", "rad/s")
         if joint.type == "floating":
-            lines.append(f"{joint.name:30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
+            lines.append(f"{printable(joint.name):30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
             continue
         lines.append(
-            f"{joint.name:30s} {joint.type:11s} {_limit(joint.lower, position_unit):>10s} {_limit(joint.upper, position_unit):>10s} "
+            f"{printable(joint.name):30s} {joint.type:11s} {_limit(joint.lower, position_unit):>10s} {_limit(joint.upper, position_unit):>10s} "
             f"{_limit(joint.effort, effort_unit):>10s} {_limit(joint.velocity, speed_unit):>10s}"
         )
     lines += ["", f"{'link':30s} {'mass':>12s}"]
-    lines += [f"{name:30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
+    lines += [f"{printable(name):30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
     lines.append(f"{'total':30s} {robot.total_mass:>9.4g} kg")
     return "\n".join(lines)
 
@@ -195,16 +197,16 @@ def simulation_text(summary: dict) -> str:
     from robodyn.sim.limits import LimitViolation
 
     units = summary.get("torque_units", [])
-    names = summary.get("dof_names", summary.get("joint_names", []))
+    names = [printable(name) for name in summary.get("dof_names", summary.get("joint_names", []))]
     lines = [
-        f"robot: {summary['robot']}",
+        f"robot: {printable(summary['robot'])}",
         f"controller: {summary['controller']} (integrator {summary['integrator']}, limits {summary['limits']})",
         f"simulated: {_number(summary['duration_s'])} s in {summary['steps']} steps of {_number(summary['dt_s'])} s"
         + (f", {_number(summary['real_time_factor'], 3)}× real time" if summary.get("real_time_factor") else ""),
     ]
     if "frame" in summary:
         lines += [
-            f"frame: {summary['frame']}",
+            f"frame: {printable(summary['frame'])}",
             f"target: {_vector(np.array(summary['target_m']), 6)} m",
             f"final position: {_vector(np.array(summary['final_position_m']), 6)} m",
             f"final error: {_number(summary['final_error_m'], 3)} m ({'reached' if summary['target_reached'] else 'NOT reached'})",

@@ -5,8 +5,9 @@
 
 Limits a URDF leaves open: an infinite limit, or a *placeholder* of magnitude at least
 :data:`PLACEHOLDER_LIMIT` (1e3 m or rad: URDFs write ±999 999 where the format demands a
-number), counts as no limit wherever robodyn needs a physical range (sampling, the default
-configuration, simulation's limit checks).
+number), or an empty range (``lower == upper`` on a moving joint), counts as no limit
+wherever robodyn needs a physical range (sampling, the default configuration,
+simulation's limit checks).
 """
 
 from __future__ import annotations
@@ -63,7 +64,9 @@ class ConfigurationSpace:
         """Position limits of the joints (floating base excluded), placeholders as ±inf.
 
         A limit of magnitude at least :data:`PLACEHOLDER_LIMIT` (1e3 m or rad, e.g.
-        ridgeback's ±999 999 m) stands for "unlimited" and becomes ±inf.
+        ridgeback's ±999 999 m) stands for "unlimited" and becomes ±inf, and so does an
+        empty range ``lower == upper`` of a joint that is not fixed (example-robot-data's
+        double pendulums write ``lower="0" upper="0"`` on joints that swing freely).
 
         Returns:
             ``(lower, upper)``, each of shape (nv,), or (nv − 6,) with a floating base.
@@ -71,8 +74,9 @@ class ConfigurationSpace:
         lower, upper = self.lower_limits, self.upper_limits
         if self.floating_base:
             lower, upper = lower[6:], upper[6:]
-        lower = np.where(np.abs(lower) >= PLACEHOLDER_LIMIT, -np.inf, lower)
-        upper = np.where(np.abs(upper) >= PLACEHOLDER_LIMIT, np.inf, upper)
+        empty = lower == upper
+        lower = np.where((np.abs(lower) >= PLACEHOLDER_LIMIT) | empty, -np.inf, lower)
+        upper = np.where((np.abs(upper) >= PLACEHOLDER_LIMIT) | empty, np.inf, upper)
         return lower, upper
 
     def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
@@ -101,8 +105,8 @@ class ConfigurationSpace:
         """Configurations drawn uniformly within the joint limits, in a physical range.
 
         The rule: a joint with both limits draws between them. A limit that is missing,
-        infinite or a placeholder (magnitude ≥ 1e3 m or rad, :data:`PLACEHOLDER_LIMIT`)
-        counts as absent: a joint with no limit draws from [-π, π] (in [rad] or [m]), a
+        infinite or a placeholder (magnitude ≥ 1e3 m or rad, :data:`PLACEHOLDER_LIMIT`;
+        an empty range ``lower == upper``) counts as absent: a joint with no limit draws from [-π, π] (in [rad] or [m]), a
         joint with one limit from the 2π-wide interval on its side of it. A floating base
         draws its position from [-1, 1] m and a uniform random orientation.
 

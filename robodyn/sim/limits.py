@@ -15,8 +15,9 @@ Three modes (``simulate(..., limits=...)``, ``robodyn simulate --limits``):
 - ``"ignore"``: neither enforced nor reported.
 
 Limits that a URDF leaves unspecified do not count: infinite ones, placeholder position
-limits (magnitude ≥ 1e3, :data:`robodyn.dynamics.robot.PLACEHOLDER_LIMIT`), and effort or
-velocity limits of zero (the URDF's "unknown"). A floating base has no limits.
+limits (magnitude ≥ 1e3, :data:`robodyn.dynamics.robot.PLACEHOLDER_LIMIT`), empty position
+ranges (``lower == upper`` on a moving joint), and effort or velocity limits of zero (the
+URDF's "unknown"). A floating base has no limits.
 """
 
 from __future__ import annotations

@@ -22,6 +22,7 @@ from robodyn.dynamics.payload import attach_payload
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.control import quintic_reference
+from robodyn.sim.limits import printable
 from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
 
 DEFAULT_MATERIALS = ("abs", "aluminium", "steel")
@@ -181,7 +182,7 @@ def _effort_limits(robot: Robot) -> np.ndarray:
 def table_text(rows: list[Variant], joint_names: list[str], units: list[str]) -> str:
     """The sweep as a readable table; a peak above the joint's effort limit ends in ``!``."""
     header = f"{'material':10s} {'payload':>8s} {'force [N]':>16s} {'mass':>8s}"
-    for name, unit in zip(joint_names, units, strict=True):
+    for name, unit in zip((printable(n) for n in joint_names), units, strict=True):
         header += f" {'peak ' + name + ' [' + unit + ']':>22s} {'rms ' + name:>14s}"
     lines = [header]
     for row in rows:
@@ -191,7 +192,7 @@ def table_text(rows: list[Variant], joint_names: list[str], units: list[str]) ->
             line += f" {peak:>21.3f}{'!' if over else ' '} {rms:>14.3f}"
         lines.append(line)
     over = [
-        f"{name} ({rows[0].effort[index]:g} {units[index]})"
+        f"{printable(name)} ({rows[0].effort[index]:g} {units[index]})"
         for index, name in enumerate(joint_names)
         if any(row.over_limit[index] for row in rows)
     ]

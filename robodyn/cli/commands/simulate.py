@@ -43,7 +43,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.cli.report import simulation_text
     from robodyn.sim.experiment import run_simulation
-    from robodyn.sim.limits import LimitViolation, warning_text
+    from robodyn.sim.limits import LimitViolation, printable, warning_text
 
     robot = load_robot(arguments)
     trajectory, summary = run_simulation(
@@ -76,7 +76,7 @@ def run(arguments: argparse.Namespace) -> int:
         print(f"robodyn: warning: {warning_text(robot.name, violations)}", file=sys.stderr)
     if summary.get("target_reached") is False:
         print(
-            f"robodyn: warning: {robot.name}: the target was not reached: final error {summary['final_error_m']:.3g} m "
+            f"robodyn: warning: {printable(robot.name)}: the target was not reached: final error {summary['final_error_m']:.3g} m "
             "(a longer --duration, another --q0 or --target?)",
             file=sys.stderr,
         )

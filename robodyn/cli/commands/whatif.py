@@ -7,6 +7,7 @@ import argparse
 import robodyn
 from robodyn.cli.common import RANGES, json_text, vector
 from robodyn.exceptions import InputError
+from robodyn.sim.limits import printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -51,7 +52,7 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.json:
         print(json_text(table_dict(rows, robot.joint_names, units)))
     else:
-        print(f"{robot.name}: one rest-to-rest motion of {arguments.duration:g} s; torques of each joint\n")
+        print(f"{printable(robot.name)}: one rest-to-rest motion of {arguments.duration:g} s; torques of each joint\n")
         print(table_text(rows, robot.joint_names, units))
         if arguments.plot:
             print(f"\nplot: {arguments.plot}")
