@@ -76,6 +76,9 @@ def info_dict(robot: Robot) -> dict:
     def finite(value: float) -> float | None:
         return float(value) if np.isfinite(value) else None
 
+    lower, upper = robot.physical_limits()
+    offset = 1 if robot.floating_base else 0
+    limited = [False] * offset + [bool(np.isfinite(lo) or np.isfinite(up)) for lo, up in zip(lower, upper, strict=True)]
     return {
         "name": robot.name,
         "nq": robot.nq,
@@ -92,8 +95,9 @@ def info_dict(robot: Robot) -> dict:
                 "upper": finite(j.upper),
                 "effort": finite(j.effort),
                 "velocity": finite(j.velocity),
+                "position_limited": limited[index],
             }
-            for j in robot.joints
+            for index, j in enumerate(robot.joints)
         ],
         "link_masses_kg": robot.link_masses,
         "total_mass_kg": robot.total_mass,
@@ -110,15 +114,25 @@ def info_text(robot: Robot) -> str:
         "",
         f"{'joint':30s} {'type':11s} {'lower':>10s} {'upper':>10s} {'effort':>10s} {'velocity':>10s}",
     ]
-    for joint in robot.joints:
+    if robot.floating_base:
+        lines.append(f"{printable(robot.joints[0].name):30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
+    lower, upper = robot.physical_limits()
+    open_limits = 0
+    for index, joint in enumerate(robot.joints[1:] if robot.floating_base else robot.joints):
         position_unit, effort_unit, speed_unit = ("m", "N", "m/s") if joint.type == "prismatic" else ("rad", "N m", "rad/s")
-        if joint.type == "floating":
-            lines.append(f"{printable(joint.name):30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
-            continue
+        marks = [
+            "*" if np.isfinite(given) and not np.isfinite(used) else ""
+            for given, used in ((joint.lower, lower[index]), (joint.upper, upper[index]))
+        ]
+        marks += ["*" if given == 0 else "" for given in (joint.effort, joint.velocity)]
+        open_limits += sum(bool(mark) for mark in marks)
         lines.append(
-            f"{printable(joint.name):30s} {joint.type:11s} {_limit(joint.lower, position_unit):>10s} {_limit(joint.upper, position_unit):>10s} "
-            f"{_limit(joint.effort, effort_unit):>10s} {_limit(joint.velocity, speed_unit):>10s}"
+            f"{printable(joint.name):30s} {joint.type:11s} {_limit(joint.lower, position_unit) + marks[0]:>10s} "
+            f"{_limit(joint.upper, position_unit) + marks[1]:>10s} {_limit(joint.effort, effort_unit) + marks[2]:>10s} "
+            f"{_limit(joint.velocity, speed_unit) + marks[3]:>10s}"
         )
+    if open_limits:
+        lines.append("* a placeholder (|limit| ≥ 1e3, lower = upper, or 0 effort / velocity): treated as no limit")
     lines += ["", f"{'link':30s} {'mass':>12s}"]
     lines += [f"{printable(name):30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
     lines.append(f"{'total':30s} {robot.total_mass:>9.4g} kg")
