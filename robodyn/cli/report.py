@@ -12,7 +12,7 @@ import numpy as np
 
 from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
-from robodyn.sim.limits import printable
+from robodyn.exceptions import printable
 
 
 @dataclass(frozen=True)

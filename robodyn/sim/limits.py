@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, printable
 from robodyn.sim.trajectory import Trajectory
 
 LIMIT_MODES = ("warn", "enforce", "ignore")
@@ -162,11 +162,6 @@ def _beyond(times, values, limit, side, joint, quantity, unit, signed=None) -> l
     worst = float(values[worst_index] if signed is None else signed[worst_index])
     bound = float(limit if signed is None else np.copysign(limit, worst))
     return [LimitViolation(joint, quantity, side, float(times[first]), worst, bound, unit)]
-
-
-def printable(name: str) -> str:
-    """A name from a URDF with control and other unprintable characters escaped."""
-    return "".join(c if c.isprintable() else f"\\x{ord(c):02x}" if ord(c) < 256 else f"\\u{ord(c):04x}" for c in str(name))
 
 
 def limit_violations(robot: Robot, trajectory: Trajectory) -> list[LimitViolation]:

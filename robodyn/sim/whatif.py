@@ -20,9 +20,8 @@ import numpy as np
 from robodyn.dynamics.loading import load
 from robodyn.dynamics.payload import attach_payload
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, printable
 from robodyn.sim.control import quintic_reference
-from robodyn.sim.limits import printable
 from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
 
 DEFAULT_MATERIALS = ("abs", "aluminium", "steel")

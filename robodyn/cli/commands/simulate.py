@@ -42,8 +42,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.cli.report import simulation_text
+    from robodyn.exceptions import printable
     from robodyn.sim.experiment import run_simulation
-    from robodyn.sim.limits import LimitViolation, printable, warning_text
+    from robodyn.sim.limits import LimitViolation, warning_text
 
     robot = load_robot(arguments)
     trajectory, summary = run_simulation(

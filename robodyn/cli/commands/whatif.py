@@ -6,8 +6,7 @@ import argparse
 
 import robodyn
 from robodyn.cli.common import RANGES, json_text, vector
-from robodyn.exceptions import InputError
-from robodyn.sim.limits import printable
+from robodyn.exceptions import InputError, printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
