@@ -348,3 +348,27 @@ class JointLimitWarning(RobodynWarning):
     def __init__(self, message: str, violations: list | None = None):
         self.violations = list(violations or [])
         super().__init__(message)
+
+
+class ControllerFailedError(SimulationError):
+    """A controller raised a numerical error (a singular solve) during a simulation.
+
+    Attributes:
+        time: Simulation time of the step, in [s].
+        step: Index of the step.
+        joint: The joint with the largest speed at that state.
+        speed: Its speed, in [rad/s] or [m/s].
+        reason: The numerical error, e.g. ``"Singular matrix"``.
+    """
+
+    def __init__(self, time: float, step: int, joint: str, speed: float, reason: str):
+        self.time = time
+        self.step = step
+        self.joint = joint
+        self.speed = speed
+        self.reason = reason
+        RobodynError.__init__(
+            self,
+            f"simulation stopped at t = {time:.6g} s (step {step}): the controller failed ({reason}) "
+            f"with joint {joint!r} at speed {speed:.3g}; try a smaller dt or gentler gains.",
+        )

@@ -35,7 +35,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, JointLimitWarning, SimulationError, SingularMassMatrixError
+from robodyn.exceptions import (
+    ControllerFailedError,
+    InputError,
+    JointLimitWarning,
+    SimulationError,
+    SingularMassMatrixError,
+)
 from robodyn.sim.limits import JointLimits, check_mode, warning_text
 from robodyn.sim.trajectory import Trajectory
 
@@ -107,7 +113,8 @@ def simulate(
             duration that is not a whole number of steps (to 1e-9 relative).
         FrameError: An external wrench on a frame that is unknown or that no joint moves.
         SingularMassMatrixError: If the mass matrix is singular (no motion is defined).
-        SimulationError: If the state stops being finite.
+        SimulationError: If the state stops being finite (``ControllerFailedError``: if
+            the controller's own numerics fail, e.g. a singular solve on a blown-up state).
 
     Warns:
         JointLimitWarning: With ``limits="warn"``, when a limit was broken.
@@ -181,6 +188,11 @@ def simulate(
         except InputError:  # a non-finite state reached a controller's checked call
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
+        except (np.linalg.LinAlgError, FloatingPointError) as error:  # a controller's solve failed
+            _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
+            fastest = int(np.argmax(np.abs(vs[-1])))
+            joint = robot.joint_names[max(0, min(fastest - (robot.nv - len(robot.joint_names)), len(robot.joint_names) - 1))]
+            raise ControllerFailedError(t, step, joint, float(vs[-1][fastest]), str(error)) from None
         if step % _CHECK_EVERY == 0 or step == steps - 1:
             _check_finite(robot, qs, vs, q, v, dt)
     qs.append(q)
