@@ -78,7 +78,7 @@ class LimitViolation:
             "joint": self.joint,
             "quantity": self.quantity,
             "side": self.side,
-            "first_time_s": self.first_time,
+            "first_time_s": float(f"{self.first_time:.12g}"),  # t = step × dt, without its rounding noise
             "worst": self.worst,
             "limit": self.limit,
             "unit": self.unit,
