@@ -47,7 +47,7 @@ def run(arguments: argparse.Namespace) -> int:
     robot = robodyn.load(arguments.model)
     units = dof_units(robot)["tau"]
     if arguments.plot:
-        plot_whatif(rows, robot.joint_names, units, arguments.plot)
+        plot_whatif(rows, robot.joint_names, units, arguments.plot, effort_limits=[float(e) for e in rows[0].effort])
     if arguments.json:
         print(json_text(table_dict(rows, robot.joint_names, units)))
     else:
