@@ -160,7 +160,8 @@ class Range:
         return f"{'an integer' if self.integer else 'a number'} in {interval}{unit}"
 
 
-#: The accepted range of every numeric option of every command, by its ``dest``.
+#: The accepted range of every numeric option of every command, by its ``dest``
+#: (``equations --precision`` is checked by the equations command itself: 1 to 17).
 RANGES: dict[str, Range] = {
     "dt": Range(1e-6, 1.0, "s"),
     "duration": Range(0.0, 3600.0, "s", low_open=True),
@@ -168,7 +169,6 @@ RANGES: dict[str, Range] = {
     "seed": Range(0, 2**63 - 1, integer=True),
     "tolerance": Range(0.0, 1.0, low_open=True, high_open=True),
     "fps": Range(0.0, 240.0, "fps", low_open=True),
-    "precision": Range(1, 17, "digits", integer=True),
     "seconds": Range(0.0, 86_400.0, "s", low_open=True),
 }
 #: Per-entry ranges of list options.
