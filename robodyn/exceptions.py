@@ -317,3 +317,82 @@ class TrajectoryError(RobodynError, ValueError):
 
     def __reduce__(self) -> tuple:  # crosses process boundaries (Dask workers) intact
         return (self.__class__, (self.source, self.reason, self.rows))
+
+
+class StaticFrameError(FrameError):
+    """A task (target, payload, force) on a frame that no joint moves: it would do nothing.
+
+    Attributes:
+        robot: The robot's name.
+        frame: The frame asked for.
+        purpose: What the frame was for, e.g. ``"a payload"``.
+        moving: Some frames that do move (hints).
+    """
+
+    def __init__(self, robot: str, frame: str, purpose: str, moving: list[str] | None = None):
+        self.robot = robot
+        self.frame = frame
+        self.purpose = purpose
+        self.moving = list(moving or [])
+        self.close = self.moving
+        hint = f" (moving frames: {', '.join(repr(name) for name in self.moving)})" if self.moving else ""
+        Exception.__init__(
+            self,
+            f"robot {robot!r}: frame {frame!r} is fixed to the world (no joint moves it), so {purpose} on it would have no effect{hint}.",
+        )
+
+
+class AmbiguousEndEffectorError(FrameError):
+    """A robot whose moving joints form several chains (legs, fingers): no default end effector.
+
+    Attributes:
+        robot: The robot's name.
+        candidates: The tip of every chain.
+    """
+
+    def __init__(self, robot: str, candidates: list[str]):
+        self.robot = robot
+        self.frame = None
+        self.candidates = list(candidates)
+        self.close = self.candidates
+        Exception.__init__(
+            self,
+            f"robot {robot!r} has {len(self.candidates)} chain tips and no default end effector: "
+            f"name one (frame=... / --frame) of {', '.join(repr(name) for name in self.candidates)}.",
+        )
+
+
+class JointLimitWarning(RobodynWarning):
+    """A simulation or motion left a joint's position, velocity or effort limits.
+
+    Attributes:
+        violations: The violations (joint, quantity, first time, worst value, limit).
+    """
+
+    def __init__(self, message: str, violations: list | None = None):
+        self.violations = list(violations or [])
+        super().__init__(message)
+
+
+class ControllerFailedError(SimulationError):
+    """A controller raised a numerical error (a singular solve) during a simulation.
+
+    Attributes:
+        time: Simulation time of the step, in [s].
+        step: Index of the step.
+        joint: The joint with the largest speed at that state.
+        speed: Its speed, in [rad/s] or [m/s].
+        reason: The numerical error, e.g. ``"Singular matrix"``.
+    """
+
+    def __init__(self, time: float, step: int, joint: str, speed: float, reason: str):
+        self.time = time
+        self.step = step
+        self.joint = joint
+        self.speed = speed
+        self.reason = reason
+        RobodynError.__init__(
+            self,
+            f"simulation stopped at t = {time:.6g} s (step {step}): the controller failed ({reason}) "
+            f"with joint {joint!r} at speed {speed:.3g}; try a smaller dt or gentler gains.",
+        )

@@ -20,3 +20,12 @@ def test_unknown_attribute_is_an_attribute_error():
         assert "no_such_thing" in str(error)
     else:
         raise AssertionError("expected AttributeError")
+
+
+def test_new_refusals_belong_to_the_family():
+    from robodyn.exceptions import AmbiguousEndEffectorError, JointLimitWarning, StaticFrameError
+
+    assert issubclass(StaticFrameError, robodyn.FrameError) and issubclass(AmbiguousEndEffectorError, robodyn.FrameError)
+    assert issubclass(JointLimitWarning, UserWarning)
+    error = AmbiguousEndEffectorError("r", ["a", "b"])
+    assert str(error).count("\n") == 0 and error.candidates == ["a", "b"]

@@ -160,13 +160,6 @@ def test_task_space_with_the_wrong_bias_sign_fails_the_law(path, frame, speed):
     assert _task_space_deviation(path, frame, speed, flip_bias=True) > 1e-2
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: a task-space loop that diverges (here through a near-singular Jacobian) ends simulate with numpy's "
-    "LinAlgError from TaskSpace.__call__ instead of a SimulationError; fix: in simulate, catch "
-    "np.linalg.LinAlgError (and FloatingPointError) around the step like InputError, run _check_finite, and re-raise "
-    "as SimulationError naming the time",
-)
 def test_a_diverging_task_space_loop_ends_with_a_robodyn_error():
     from robodyn.exceptions import RobodynError
 
@@ -175,7 +168,7 @@ def test_a_diverging_task_space_loop_ends_with_a_robodyn_error():
     q0 = robot.random_configuration(rng) * 0.4
     v0 = rng.normal(size=robot.nv) * 1.0
     target = robot.frame_position(q0, "right") + np.array([0.03, -0.02, 0.025])
-    with np.errstate(all="ignore"), pytest.raises(RobodynError):
+    with np.errstate(all="ignore"), pytest.raises(RobodynError, match=r"stopped at t = .* the controller failed"):
         robodyn.simulate(robot, q0, v0, 1.0, DT, controller=TaskSpace(robot, "right", target, 60.0, 12.0))
 
 

@@ -1,8 +1,11 @@
 """The ``robodyn`` command: parses arguments, calls the library, prints the result.
 
 Each command lives in :mod:`robodyn.cli.commands` (its arguments and a ``run`` handler).
-Every robodyn error becomes one line on stderr and exit status 2 (``--debug`` shows the
-traceback instead). Output files are written only after the work succeeded.
+Every robodyn error becomes one line on stderr and exit status 2 (``--debug``, before or
+after the command's name, shows the traceback too). Output files are written only after
+the work succeeded. Negative numbers follow options as written (``--q -0.5,0.1``), and
+every numeric option is checked against its range
+(:data:`robodyn.cli.common.RANGES`) before any work.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from collections.abc import Sequence
 
 import robodyn
 from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, torques, view, whatif
+from robodyn.cli.common import attach_negative_values, check_ranges
 from robodyn.common.text import one_line_warnings, printable
 from robodyn.exceptions import RobodynError
 
@@ -31,6 +35,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     for command in COMMANDS:
         command.add_parser(commands)
+    for subparser in commands.choices.values():  # --debug after the command's name, too
+        subparser.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks of errors")
     return parser
 
 
@@ -44,11 +50,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         Exit status: 0 on success, 1 when a check fails, 2 on an error.
     """
     parser = build_parser()
+    argv = attach_negative_values(parser, sys.argv[1:] if argv is None else list(argv))
     try:
         arguments = parser.parse_args(argv)
     except SystemExit as exit_:
         return int(exit_.code or 0)
     try:
+        check_ranges(arguments)
         with one_line_warnings():
             return arguments.run(arguments)
     except RobodynError as error:

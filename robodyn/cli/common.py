@@ -1,10 +1,17 @@
-"""What every command shares: number lists, the model arguments, loading, progress."""
+"""What every command shares: number lists, the model arguments, loading, progress,
+numeric ranges and strict JSON."""
 
 from __future__ import annotations
 
 import argparse
+import json
+import math
+import re
 import sys
 import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -86,3 +93,129 @@ class Progress:
     def close(self) -> None:
         if self._shown:
             sys.stderr.write("\n")
+
+
+# --------------------------------------------------------------------------------------
+# Numbers as people write them: negative values after an option, ranges, valid JSON
+# --------------------------------------------------------------------------------------
+_NUMBER_LIST = re.compile(r"^[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)
+
+
+def attach_negative_values(parser: argparse.ArgumentParser, argv: Sequence[str]) -> list[str]:
+    """``["--q", "-0.5,0.1"]`` → ``["--q=-0.5,0.1"]`` for every option that takes a value.
+
+    argparse reads a token starting with ``-`` as an option unless it is a single plain
+    number; a list like ``-0.5,0.1`` (or ``-9.81,0,0``) must be attached to its option
+    with ``=``, which this does for every option of any command that takes one value.
+    """
+    takes_value = _value_options(parser)
+    result: list[str] = []
+    index = 0
+    while index < len(argv):
+        token = argv[index]
+        following = argv[index + 1] if index + 1 < len(argv) else None
+        if token in takes_value and following is not None and following.startswith("-") and _NUMBER_LIST.match(following):
+            result.append(f"{token}={following}")
+            index += 2
+            continue
+        result.append(token)
+        index += 1
+    return result
+
+
+def _value_options(parser: argparse.ArgumentParser) -> set[str]:
+    options: set[str] = set()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for subparser in action.choices.values():
+                options |= _value_options(subparser)
+        elif action.option_strings and action.nargs is None and isinstance(action, argparse._StoreAction):
+            options.update(name for name in action.option_strings if name.startswith("--"))
+    return options
+
+
+@dataclass(frozen=True)
+class Range:
+    """The values a numeric option accepts: ``low`` to ``high``, each end open or closed."""
+
+    low: float
+    high: float
+    unit: str = ""
+    low_open: bool = False
+    high_open: bool = False
+    integer: bool = False
+
+    def __contains__(self, value: float) -> bool:
+        if not math.isfinite(value):
+            return False
+        above = value > self.low if self.low_open else value >= self.low
+        below = value < self.high if self.high_open else value <= self.high
+        return above and below
+
+    def text(self) -> str:
+        """E.g. ``"in (0, 240] fps"`` or ``"an integer in [1, 100000]"``."""
+        unit = f" {self.unit}" if self.unit else ""
+        low, high = (f"{int(x)}" if self.integer else f"{x:g}" for x in (self.low, self.high))
+        interval = f"{'(' if self.low_open else '['}{low}, {high}{')' if self.high_open else ']'}"
+        return f"{'an integer' if self.integer else 'a number'} in {interval}{unit}"
+
+
+#: The accepted range of every numeric option of every command, by its ``dest``
+#: (``equations --precision`` is checked by the equations command itself: 1 to 17).
+RANGES: dict[str, Range] = {
+    "dt": Range(1e-6, 1.0, "s"),
+    "duration": Range(0.0, 3600.0, "s", low_open=True),
+    "samples": Range(1, 100_000, integer=True),
+    "seed": Range(0, 2**63 - 1, integer=True),
+    "tolerance": Range(0.0, 1.0, low_open=True, high_open=True),
+    "fps": Range(0.0, 240.0, "fps", low_open=True),
+    "seconds": Range(0.0, 86_400.0, "s", low_open=True),
+}
+#: Per-entry ranges of list options.
+LIST_RANGES: dict[str, Range] = {
+    "payloads": Range(0.0, 1e4, "kg"),
+    "force": Range(-1e6, 1e6, "N"),
+    "gravity": Range(-1e3, 1e3, "m/s²"),
+    "target": Range(-1e3, 1e3),
+}
+
+
+def check_ranges(arguments: argparse.Namespace) -> None:
+    """Refuse any numeric option outside its range (:data:`RANGES`), one line.
+
+    Also ``--dt`` ≤ ``--duration`` where a command has both.
+
+    Raises:
+        InputError: Naming the option, its range and the value given.
+    """
+    for dest, accepted in RANGES.items():
+        value = getattr(arguments, dest, None)
+        if value is not None and not isinstance(value, bool) and value not in accepted:
+            raise InputError(f"--{dest.replace('_', '-')}", accepted.text(), f"{value:g}")
+    for dest, accepted in LIST_RANGES.items():
+        values = getattr(arguments, dest, None)
+        if values is not None and not all(value in accepted for value in values):
+            bad = next(value for value in values if value not in accepted)
+            raise InputError(f"--{dest}", f"values each {accepted.text()}", f"{bad:g}")
+    dt, duration = getattr(arguments, "dt", None), getattr(arguments, "duration", None)
+    if dt is not None and duration is not None and dt > duration:
+        raise InputError("--dt", f"at most --duration ({duration:g} s)", f"{dt:g} s")
+
+
+def _finite_or_none(value: Any) -> Any:
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: _finite_or_none(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_or_none(item) for item in value]
+    if isinstance(value, np.ndarray):
+        return _finite_or_none(value.tolist())
+    if isinstance(value, np.floating):
+        return _finite_or_none(float(value))
+    return value
+
+
+def json_text(data: Any) -> str:
+    """Strict JSON (RFC 8259): a non-finite number (an unlimited limit) becomes ``null``."""
+    return json.dumps(_finite_or_none(data), indent=2, allow_nan=False)

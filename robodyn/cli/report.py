@@ -10,7 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import printable
 
 
 @dataclass(frozen=True)
@@ -56,18 +58,35 @@ def dof_units(robot: Robot) -> dict[str, list[str]]:
     }
 
 
+def end_effector_text(robot: Robot) -> tuple[str | None, str]:
+    """The default end effector, or ``None`` and why there is none."""
+    from robodyn.exceptions import AmbiguousEndEffectorError
+
+    try:
+        return robot.end_effector, ""
+    except AmbiguousEndEffectorError as error:
+        tips = ", ".join(printable(tip) for tip in error.candidates)
+        return None, f"none: {len(error.candidates)} chain tips ({tips}); pass --frame"
+
+
 def info_dict(robot: Robot) -> dict:
-    """A JSON-ready description of a robot: joints, limits, masses."""
+    """A JSON-ready description of a robot: joints, limits, masses, default end effector
+    (``null`` with ``end_effector_candidates`` when it has several chains)."""
 
     def finite(value: float) -> float | None:
         return float(value) if np.isfinite(value) else None
 
+    lower, upper = robot.physical_limits()
+    offset = 1 if robot.floating_base else 0
+    limited = [False] * offset + [bool(np.isfinite(lo) or np.isfinite(up)) for lo, up in zip(lower, upper, strict=True)]
     return {
         "name": robot.name,
         "nq": robot.nq,
         "nv": robot.nv,
         "floating_base": robot.floating_base,
         "gravity_m_s2": robot.gravity_vector.tolist(),
+        "end_effector": end_effector_text(robot)[0],
+        "end_effector_candidates": frames.end_effector_candidates(robot.model),
         "joints": [
             {
                 "name": j.name,
@@ -76,8 +95,9 @@ def info_dict(robot: Robot) -> dict:
                 "upper": finite(j.upper),
                 "effort": finite(j.effort),
                 "velocity": finite(j.velocity),
+                "position_limited": limited[index],
             }
-            for j in robot.joints
+            for index, j in enumerate(robot.joints)
         ],
         "link_masses_kg": robot.link_masses,
         "total_mass_kg": robot.total_mass,
@@ -86,23 +106,35 @@ def info_dict(robot: Robot) -> dict:
 
 def info_text(robot: Robot) -> str:
     """A readable description of a robot: joints with types and limits, link masses."""
+    end_effector, reason = end_effector_text(robot)
     lines = [
-        f"robot {robot.name}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
+        f"robot {printable(robot.name)}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
         f"{'floating' if robot.floating_base else 'fixed'} base, gravity {_vector(robot.gravity_vector, 4)} m/s²",
+        f"end effector (default task frame): {printable(end_effector) if end_effector else reason}",
         "",
         f"{'joint':30s} {'type':11s} {'lower':>10s} {'upper':>10s} {'effort':>10s} {'velocity':>10s}",
     ]
-    for joint in robot.joints:
+    if robot.floating_base:
+        lines.append(f"{printable(robot.joints[0].name):30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
+    lower, upper = robot.physical_limits()
+    open_limits = 0
+    for index, joint in enumerate(robot.joints[1:] if robot.floating_base else robot.joints):
         position_unit, effort_unit, speed_unit = ("m", "N", "m/s") if joint.type == "prismatic" else ("rad", "N m", "rad/s")
-        if joint.type == "floating":
-            lines.append(f"{joint.name:30s} {'floating':11s} {'(base pose: x y z, quaternion x y z w)':>43s}")
-            continue
+        marks = [
+            "*" if np.isfinite(given) and not np.isfinite(used) else ""
+            for given, used in ((joint.lower, lower[index]), (joint.upper, upper[index]))
+        ]
+        marks += ["*" if given == 0 else "" for given in (joint.effort, joint.velocity)]
+        open_limits += sum(bool(mark) for mark in marks)
         lines.append(
-            f"{joint.name:30s} {joint.type:11s} {_limit(joint.lower, position_unit):>10s} {_limit(joint.upper, position_unit):>10s} "
-            f"{_limit(joint.effort, effort_unit):>10s} {_limit(joint.velocity, speed_unit):>10s}"
+            f"{printable(joint.name):30s} {joint.type:11s} {_limit(joint.lower, position_unit) + marks[0]:>10s} "
+            f"{_limit(joint.upper, position_unit) + marks[1]:>10s} {_limit(joint.effort, effort_unit) + marks[2]:>10s} "
+            f"{_limit(joint.velocity, speed_unit) + marks[3]:>10s}"
         )
+    if open_limits:
+        lines.append("* a placeholder (|limit| ≥ 1e3, lower = upper, or 0 effort / velocity): treated as no limit")
     lines += ["", f"{'link':30s} {'mass':>12s}"]
-    lines += [f"{name:30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
+    lines += [f"{printable(name):30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
     lines.append(f"{'total':30s} {robot.total_mass:>9.4g} kg")
     return "\n".join(lines)
 
@@ -163,3 +195,56 @@ def equations_text(robot: Robot, terms: DynamicsTerms, *, precision: int = 6) ->
 def _dof_labels(robot: Robot) -> list[str]:
     base = [f"base {axis}" for axis in ("vx", "vy", "vz", "wx", "wy", "wz")]
     return base + robot.joint_names[1:]
+
+
+def _number(value: object, digits: int = 6) -> str:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return str(value)
+    return "unlimited" if not np.isfinite(value) else f"{value:.{digits}g}"
+
+
+def simulation_text(summary: dict) -> str:
+    """A simulation summary (from :func:`robodyn.sim.experiment.run_simulation`) as text.
+
+    Numbers with six significant digits and their units; one line a limit violation.
+    """
+    from robodyn.sim.limits import LimitViolation
+
+    units = summary.get("torque_units", [])
+    names = [printable(name) for name in summary.get("dof_names", summary.get("joint_names", []))]
+    lines = [
+        f"robot: {printable(summary['robot'])}",
+        f"controller: {summary['controller']} (integrator {summary['integrator']}, limits {summary['limits']})",
+        f"simulated: {_number(summary['duration_s'])} s in {summary['steps']} steps of {_number(summary['dt_s'])} s"
+        + (f", {_number(summary['real_time_factor'], 3)}× real time" if summary.get("real_time_factor") else ""),
+    ]
+    if "frame" in summary:
+        lines += [
+            f"frame: {printable(summary['frame'])}",
+            f"target: {_vector(np.array(summary['target_m']), 6)} m",
+            f"final position: {_vector(np.array(summary['final_position_m']), 6)} m",
+            f"final error: {_number(summary['final_error_m'], 3)} m ({'reached' if summary['target_reached'] else 'NOT reached'})",
+        ]
+    if "final_joint_error" in summary:
+        lines.append(f"final joint error: {_number(summary['final_joint_error'], 3)} (largest |q - target|, rad or m)")
+    floating = any(name.startswith("base ") for name in names)
+    q_units = "base position in m, quaternion x y z w, then joints in rad / m" if floating else "rad / m"
+    lines.append(f"final q: {_vector(np.array(summary['final_q']), 6)} ({q_units})")
+    peaks = [
+        f"{name} {_number(peak, 4)} {unit}" for name, peak, unit in zip(names, summary["peak_abs_torque"], units, strict=False)
+    ]
+    lines.append(f"peak |torque|: {', '.join(peaks)}")
+    lines.append(f"energy change: {_number(summary['energy_change_J'], 4)} J")
+    violations = summary.get("limit_violations", [])
+    if summary["limits"] == "ignore":
+        lines.append("limits: not checked (--limits ignore)")
+    elif not violations:
+        lines.append("limits: every position, velocity and effort limit kept")
+    for item in violations:
+        fields = {**item, "first_time": item["first_time_s"]}
+        del fields["first_time_s"]
+        lines.append(f"limit violation: {LimitViolation(**fields).text()}")
+    for key in ("trajectory", "plot", "recording", "poster"):
+        if key in summary:
+            lines.append(f"{key}: {summary[key]}")
+    return "\n".join(lines)

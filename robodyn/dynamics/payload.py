@@ -39,11 +39,13 @@ def attach_payload(
         name: Name of the payload link (unique in the robot).
 
     Raises:
-        FrameError: If the robot has no such link.
+        FrameError: If the robot has no such link; ``StaticFrameError`` (a FrameError) if
+            no joint moves it (the payload would change no torque).
         InputError: For a non-positive mass or a bad inertia.
     """
     if link not in robot.spec.links:
         raise FrameError(link, robot.name)
+    robot.task_frame(link, "a payload")
     if not (np.isfinite(mass) and mass > 0):
         raise InputError("mass", "a positive number of kg", repr(mass))
     centre = np.asarray(com, dtype=float)

@@ -24,12 +24,13 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from robodyn.common.inputs import as_states
+from robodyn.dynamics import frames
 from robodyn.dynamics.batch import ParallelRunner
+from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT, ConfigurationSpace
 from robodyn.dynamics.handle import per_state
 from robodyn.dynamics.kinematics import Kinematics
 from robodyn.dynamics.mimic import MimicExpansion
-from robodyn.exceptions import InputError, NonFiniteResultError, SingularMassMatrixError
+from robodyn.exceptions import NonFiniteResultError, SingularMassMatrixError
 from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
 
@@ -71,12 +72,13 @@ class LoadOptions:
     threads: int | None = None
 
 
-class Robot(Kinematics):
+class Robot(Kinematics, ConfigurationSpace):
     """A rigid-body robot and its dynamics (RNEA, CRBA, ABA through Pinocchio).
 
     Build one with :func:`robodyn.load`. The Pinocchio model is available as
     :attr:`model` for anything robodyn does not wrap. Kinematics (frames, Jacobians) come
-    from :class:`~robodyn.dynamics.kinematics.Kinematics`.
+    from :class:`~robodyn.dynamics.kinematics.Kinematics`, limits and configurations
+    (neutral, default, random) from :class:`~robodyn.dynamics.configurations.ConfigurationSpace`.
 
     A robot may be used from several threads at once: each thread gets its own Pinocchio
     data (see :mod:`robodyn.dynamics.handle`).
@@ -169,9 +171,31 @@ class Robot(Kinematics):
 
     @property
     def end_effector(self) -> str:
-        """The frame tasks refer to by default: ``end_effector`` if the URDF has that link,
-        else the URDF's last link."""
-        return "end_effector" if "end_effector" in self.spec.links else list(self.spec.links)[-1]
+        """The frame tasks refer to by default: the tip of the chain the last moving joint
+        drives (see :mod:`robodyn.dynamics.frames` for the rule; a link named
+        ``end_effector`` that moves is taken as given).
+
+        Raises:
+            AmbiguousEndEffectorError: For robots with several chains (legs, fingers, two
+                arms): the message lists the tips to choose from.
+        """
+        return frames.default_end_effector(self.model, self.name)
+
+    def task_frame(self, frame: str | None, purpose: str) -> str:
+        """A frame for a task, checked: ``frame`` (default :attr:`end_effector`) must exist
+        and some joint must move it.
+
+        Args:
+            frame: Link or joint name; ``None`` for the default end effector.
+            purpose: What the frame is for, for the message (e.g. ``"a payload"``).
+
+        Raises:
+            FrameError: Unknown frame. StaticFrameError: no joint moves it.
+            AmbiguousEndEffectorError: No ``frame`` and no default end effector.
+        """
+        name = self.end_effector if frame is None else frame
+        frames.require_moving(self.model, self.name, name, self.frame_id(name), purpose)
+        return name
 
     @cached_property
     def link_masses(self) -> dict[str, float]:
@@ -190,70 +214,6 @@ class Robot(Kinematics):
     def total_mass(self) -> float:
         """Total mass of the robot in [kg]."""
         return float(sum(self.link_masses.values()))
-
-    @property
-    def lower_limits(self) -> np.ndarray:
-        """Lower position limits per degree of freedom, shape (nv,), in [rad] or [m].
-
-        The six base coordinates of a floating base are unlimited (-inf).
-        """
-        return np.array([joint.lower for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
-
-    @property
-    def upper_limits(self) -> np.ndarray:
-        """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m]."""
-        return np.array([joint.upper for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
-
-    def neutral_configuration(self) -> np.ndarray:
-        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
-        return pin.neutral(self.model)
-
-    def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
-        """A floating-base configuration from the base pose and the joint positions.
-
-        Args:
-            position: Base origin in the world frame, in [m], shape (3,).
-            rpy: Base orientation as roll, pitch, yaw in [rad] (rotations about the fixed
-                x, y, z axes, as in URDF), shape (3,).
-            joints: Joint positions, shape (nv - 6,); default zeros.
-
-        Returns:
-            ``q`` of shape (nq,): position, quaternion (x, y, z, w), joints.
-
-        Raises:
-            InputError: For a fixed-base robot or wrong sizes.
-        """
-        if not self.floating_base:
-            raise InputError("robot", "a floating-base robot (load it with floating_base=True)", f"fixed-base {self.name!r}")
-        position, rpy = as_states({"position": (position, 3), "rpy": (rpy, 3)})[0]
-        joints = np.zeros(self.nv - 6) if joints is None else as_states({"joints": (joints, self.nv - 6)})[0][0]
-        quaternion = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs()
-        return np.concatenate([position, quaternion, joints])
-
-    def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
-        """Configurations drawn uniformly within the joint limits.
-
-        Unlimited joints draw from [-π, π]; a floating base draws its position from
-        [-1, 1] m and a uniform random orientation.
-
-        Args:
-            rng: Random generator (for reproducible draws).
-            count: Number of configurations; ``None`` for a single one.
-
-        Returns:
-            Shape (nq,) or (count, nq).
-        """
-        rows = 1 if count is None else count
-        lower = np.where(np.isfinite(self.lower_limits), self.lower_limits, -np.pi)
-        upper = np.where(np.isfinite(self.upper_limits), self.upper_limits, np.pi)
-        if self.floating_base:
-            lower, upper = lower[6:], upper[6:]
-        joints = rng.uniform(lower, upper, size=(rows, lower.size))
-        if self.floating_base:
-            quaternion = rng.normal(size=(rows, 4))
-            quaternion /= np.linalg.norm(quaternion, axis=1, keepdims=True)
-            joints = np.hstack([rng.uniform(-1, 1, size=(rows, 3)), quaternion, joints])
-        return joints[0] if count is None else joints
 
     # ----------------------------------------------------------------------------------
     # Dynamics. Each method hands ModelHandle._evaluate a one-state function and, where
@@ -454,3 +414,6 @@ class Robot(Kinematics):
         from robodyn.dynamics.display import robot_html
 
         return robot_html(self)
+
+
+__all__ = ["PLACEHOLDER_LIMIT", "JointInfo", "LoadOptions", "Robot"]

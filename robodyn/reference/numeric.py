@@ -291,13 +291,13 @@ class ReferenceRobot:
         return self._call("Cv", q=q, v=v) + self.gravity(q)
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """``a = M⁻¹ (tau − C v − G)``, shape (n,) or (N, n)."""
-        (q, v, tau), _ = as_states({"q": (q, self.nv), "v": (v, self.nv), "tau": (tau, self.nv)})
+        """``a = M⁻¹ (tau − C v − G)``, shape (nv,) or (N, nv); ``q`` has nq entries a state."""
+        (q, v, tau), _ = as_states({"q": (q, self.nq), "v": (v, self.nv), "tau": (tau, self.nv)})
         return np.linalg.solve(self.mass_matrix(q), (tau - self.nonlinear_effects(q, v))[..., None])[..., 0]
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
-        """``T = ½ vᵀ M v`` in [J]: a float or shape (N,)."""
-        (q, v), batch = as_states({"q": (q, self.nv), "v": (v, self.nv)})
+        """``T = ½ vᵀ M v`` in [J]: a float or shape (N,); ``q`` has nq entries a state."""
+        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
         energy = 0.5 * np.einsum("...i,...ij,...j->...", v, self.mass_matrix(q), v)
         return energy if batch else float(energy)
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
 
 #: A joint reference: time in [s] -> (q_d, v_d, a_d).
 JointReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -76,9 +77,13 @@ class ComputedTorque:
 class TaskSpace:
     """Drive a frame's origin to a target position through the robot's dynamics.
 
+    The frame must be one some joint moves (:class:`~robodyn.exceptions.StaticFrameError`
+    otherwise: a target for a frame fixed to the world can never be reached).
+
     Attributes:
         model: The controller's model of the robot.
-        frame: The controlled frame (e.g. ``"end_effector"``).
+        frame: The controlled frame (e.g. ``"end_effector"``); ``None`` for the model's
+            default end effector.
         target: Desired position of its origin, world frame, in [m], shape (3,).
         kp: Task stiffness in [1/s²].
         kd: Task damping in [1/s].
@@ -89,12 +94,18 @@ class TaskSpace:
     """
 
     model: Robot
-    frame: str
+    frame: str | None
     target: np.ndarray
     kp: float = 100.0
     kd: float = 20.0
     damping: float = 1e-6
     joint_damping: float = 5.0
+
+    def __post_init__(self) -> None:
+        self.frame = self.model.task_frame(self.frame, "task-space control")
+        self.target = np.asarray(self.target, dtype=float)
+        if self.target.shape != (3,) or not np.isfinite(self.target).all():
+            raise InputError("target", "3 finite values X, Y, Z in [m]", f"shape {self.target.shape}")
 
     def task_error(self, q: np.ndarray) -> np.ndarray:
         """Target minus the frame's position, shape (3,), in [m]."""

@@ -1,24 +1,30 @@
 """A simulation experiment: a robot, a controller aiming at a target, and what came of it.
 
 :func:`run_simulation` builds the chosen controller (on its own copy of the model),
-simulates, and returns the trajectory with a summary with units: final error, peak torque, energy drift, real-time factor,
-and the joints that left their limits (the simulation has no joint stops or contacts).
-Used by ``robodyn simulate``.
+simulates, and returns the trajectory with a summary with units in its keys: final error,
+peak torque, energy change, real-time factor, and every joint limit the run broke (joint,
+first time, worst value, limit; ``limits="enforce"`` saturates torques and stops joints,
+see :mod:`robodyn.sim.limits`). Used by ``robodyn simulate``.
 """
 
 from __future__ import annotations
 
 import time
+import warnings
 
 import numpy as np
 
+from robodyn.dynamics import frames
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
+from robodyn.sim.limits import check_mode, limit_violations
 from robodyn.sim.simulation import Trajectory, simulate
 
 CONTROLLERS = ("passive", "pd", "computed-torque", "task-space")
+#: Final task error below which a target counts as reached, in [m].
+REACHED = 1e-3
 
 
 def controller_model(robot: Robot) -> Robot:
@@ -46,6 +52,7 @@ def run_simulation(
     duration: float = 3.0,
     dt: float = 1e-3,
     integrator: str = "rk4",
+    limits: str = "warn",
 ) -> tuple[Trajectory, dict]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -55,18 +62,26 @@ def run_simulation(
             ``"computed-torque"`` (quintic from ``q0`` to a joint target in half the
             duration) or ``"task-space"`` (drive ``frame`` to a position target).
         target: Joint target (nq values) or task target (X,Z or X,Y,Z in [m]).
-        frame: Controlled frame for task-space control.
-        q0: Initial configuration; default neutral.
-        duration, dt, integrator: As for :func:`robodyn.simulate`.
+        frame: Controlled frame for task-space control (default the robot's end effector;
+            it must be a frame some joint moves).
+        q0: Initial configuration; default :meth:`Robot.default_configuration` (the
+            neutral one clipped into the joint limits).
+        duration, dt, integrator, limits: As for :func:`robodyn.simulate`.
 
     Returns:
         The trajectory and a JSON-ready summary with units in the keys.
+        ``limit_violations`` lists every broken limit (empty with ``limits="ignore"``).
     """
     if controller not in CONTROLLERS:
         raise InputError("controller", f"one of {', '.join(CONTROLLERS)}", repr(controller))
+    check_mode(limits)
     if controller != "passive" and target is None:
         raise InputError("--target", f"given for the {controller} controller", "nothing")
-    start = robot.neutral_configuration() if q0 is None else np.asarray(q0, dtype=float)
+    if controller == "passive" and target is not None:
+        raise InputError("--target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
+    if controller != "task-space" and frame is not None:
+        raise InputError("--frame", "given only with the task-space controller", repr(frame))
+    start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
     task = None
     law = None
     if controller == "pd":
@@ -75,22 +90,33 @@ def run_simulation(
         law = ComputedTorque(controller_model(robot), quintic_reference(start, np.asarray(target, float), duration / 2))
     elif controller == "task-space":
         task = task_target(target)
+        frame = robot.task_frame(frame, "task-space control")
+        _check_reach(robot, frame, task)
         law = TaskSpace(controller_model(robot), frame, task)
     if law is not None and controller != "task-space" and np.size(target) != robot.nq:
         raise InputError("--target", f"{robot.nq} joint values for the {controller} controller", f"{np.size(target)} values")
     began = time.perf_counter()
-    trajectory = simulate(robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator)
+    with warnings.catch_warnings():  # the summary reports the violations; the caller warns
+        warnings.simplefilter("ignore", JointLimitWarning)
+        trajectory = simulate(
+            robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits
+        )
     elapsed = time.perf_counter() - began
     energy = robot.kinetic_energy(trajectory.q, trajectory.v) + robot.potential_energy(trajectory.q)
     summary: dict = {
         "robot": robot.name,
         "controller": controller,
         "integrator": integrator,
+        "limits": limits,
         "duration_s": duration,
         "dt_s": dt,
-        "real_time_factor": duration / elapsed if elapsed > 0 else float("inf"),
+        "steps": len(trajectory) - 1,
+        "real_time_factor": duration / elapsed if elapsed > 0 else None,
+        "joint_names": list(robot.joint_names),
+        "dof_names": _dof_names(robot),
         "final_q": trajectory.q[-1].tolist(),
         "peak_abs_torque": np.abs(trajectory.tau).max(axis=0).tolist(),
+        "torque_units": ["N" if kind == "prismatic" else "N m" for kind in _dof_kinds(robot)],
         "energy_change_J": float(energy[-1] - energy[0]),
     }
     if task is not None:
@@ -99,13 +125,41 @@ def run_simulation(
         summary["target_m"] = task.tolist()
         summary["final_position_m"] = position.tolist()
         summary["final_error_m"] = float(np.linalg.norm(position - task))
+        summary["target_reached"] = summary["final_error_m"] < REACHED
     elif controller != "passive":
         summary["final_joint_error"] = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
-    joints = robot.joints[1:] if robot.floating_base else robot.joints
-    positions = trajectory.q[:, robot.nq - len(joints) :]
-    summary["joint_limit_violations"] = [
-        joint.name
-        for index, joint in enumerate(joints)
-        if positions[:, index].min() < joint.lower - 1e-9 or positions[:, index].max() > joint.upper + 1e-9
-    ]
+    violations = [] if limits == "ignore" else limit_violations(robot, trajectory)
+    summary["limit_violations"] = [violation.as_dict() for violation in violations]
     return trajectory, summary
+
+
+def _check_reach(robot: Robot, frame: str, target: np.ndarray) -> None:
+    """Refuse a task target no configuration can reach (outside the chain's reach ball)."""
+    lower, upper = robot.physical_limits()
+    ball = frames.reach(robot.model, robot.frame_id(frame), lower, upper)
+    if ball is None:
+        return
+    centre, radius = ball
+    distance = float(np.linalg.norm(target - np.asarray(centre)))
+    if distance > radius:
+        where = ", ".join(f"{c:.3g}" for c in centre)
+        raise InputError(
+            "--target",
+            f"within the reach of {frame!r} ({radius:.3f} m of its first joint at ({where}) m)",
+            f"a point {distance:.3f} m away",
+        )
+
+
+def _dof_names(robot: Robot) -> list[str]:
+    """A name for each velocity coordinate (a floating base: base vx ... base wz)."""
+    if not robot.floating_base:
+        return list(robot.joint_names)
+    return [f"base {axis}" for axis in ("vx", "vy", "vz", "wx", "wy", "wz")] + list(robot.joint_names[1:])
+
+
+def _dof_kinds(robot: Robot) -> list[str]:
+    """Joint type of each velocity coordinate (a floating base: 3 linear, 3 angular)."""
+    kinds = []
+    for joint in robot.joints:
+        kinds += ["prismatic"] * 3 + ["revolute"] * 3 if joint.type == "floating" else [joint.type]
+    return kinds

@@ -15,20 +15,34 @@ torque held during the step (zero-order hold, as on a digital controller). Exter
 wrenches are evaluated at every stage. The
 result is a :class:`Trajectory` (one row a sample) that saves to and loads from CSV and NPZ.
 
+Joint limits (``limits=``, see :mod:`robodyn.sim.limits`): ``"warn"`` (default) reports
+every position, velocity and effort limit the run broke in one
+:class:`~robodyn.exceptions.JointLimitWarning`; ``"enforce"`` saturates the torques at
+the effort limits and stops joints at their position limits; ``"ignore"`` does neither.
+
 A state that stops being finite ends the run with a :class:`SimulationError` saying when
-and which joint.
+and which joint, or a :class:`SingularMassMatrixError` when the mass matrix is singular
+there (massless moving bodies: no step size helps).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, SimulationError
+from robodyn.exceptions import (
+    ControllerFailedError,
+    InputError,
+    JointLimitWarning,
+    SimulationError,
+    SingularMassMatrixError,
+)
+from robodyn.sim.limits import JointLimits, check_mode, warning_text
 from robodyn.sim.trajectory import Trajectory
 
 #: A controller maps time in [s], q and v to joint torques, shape (nv,).
@@ -73,6 +87,7 @@ def simulate(
     integrator: str = "rk4",
     external: Sequence[ExternalWrench] = (),
     hold: bool = False,
+    limits: str = "warn",
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
 
@@ -87,22 +102,45 @@ def simulate(
         external: Wrenches the environment applies (constant or functions of time).
         hold: Sample the controller once per step and hold its torque (zero-order hold)
             instead of evaluating it at every integration stage.
+        limits: ``"warn"``, ``"enforce"`` or ``"ignore"`` (see :mod:`robodyn.sim.limits`).
 
     Returns:
-        The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0``.
+        The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0`` (``tau`` is
+        the applied torque: saturated with ``limits="enforce"``).
 
     Raises:
-        InputError: For bad initial states, step or integrator.
-        SimulationError: If the state stops being finite.
+        InputError: For bad initial states, step, integrator or limits mode, or a
+            duration that is not a whole number of steps (to 1e-9 relative).
+        FrameError: An external wrench on a frame that is unknown or that no joint moves.
+        SingularMassMatrixError: If the mass matrix is singular (no motion is defined).
+        SimulationError: If the state stops being finite (``ControllerFailedError``: if
+            the controller's own numerics fail, e.g. a singular solve on a blown-up state).
+
+    Warns:
+        JointLimitWarning: With ``limits="warn"``, when a limit was broken.
     """
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
+    check_mode(limits)
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
+    steps = round(duration / dt)
+    if abs(steps * dt - duration) > 1e-9 * max(duration, dt):
+        raise InputError("duration", f"a whole number of steps of dt = {dt:g} s", f"{duration:g} s ({duration / dt:.6g} steps)")
+    if steps > MAX_STEPS:
+        raise InputError("duration / dt", f"at most {MAX_STEPS:,} steps", f"{steps:,} steps")
     (q, v), _ = robot.validate(q=q0, v=v0)
     if q.ndim != 1:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
-    steps = round(duration / dt)
+    for item in external:
+        robot.task_frame(item.frame, "an external wrench")
+    if robot.massless_joints or _singular(robot, q):
+        raise SingularMassMatrixError(robot.name, robot.massless_joints)
+    joint_limits = JointLimits(robot)
+    enforce = limits == "enforce"
+    if enforce and controller is not None:
+        commanded = controller
+        controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
     times = np.arange(steps + 1) * dt
     qs, vs, accelerations, torques = [], [], [], []
     zero = np.zeros(robot.nv)
@@ -145,18 +183,34 @@ def simulate(
             else:
                 v = v + dt * a
                 q = q + dt * v if integrate is None else integrate(q, dt * v)
+            if enforce:
+                q, v = joint_limits.stop(q, v)
         except InputError:  # a non-finite state reached a controller's checked call
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
+        except (np.linalg.LinAlgError, FloatingPointError) as error:  # a controller's solve failed
+            _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
+            fastest = int(np.argmax(np.abs(vs[-1])))
+            joint = robot.joint_names[max(0, min(fastest - (robot.nv - len(robot.joint_names)), len(robot.joint_names) - 1))]
+            raise ControllerFailedError(t, step, joint, float(vs[-1][fastest]), str(error)) from None
         if step % _CHECK_EVERY == 0 or step == steps - 1:
             _check_finite(robot, qs, vs, q, v, dt)
     qs.append(q)
     vs.append(v)
     torques.append(torques[-1] if steps else zero)
     accelerations.append(accelerations[-1] if steps else forward(0.0, q, v, zero))
-    return Trajectory(
+    trajectory = Trajectory(
         times, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques), list(robot.joint_names), robot.name
     )
+    if limits != "ignore":
+        violations = joint_limits.violations(trajectory)
+        if violations:
+            warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
+    return trajectory
+
+
+#: Most steps one run may take (a guard against durations like 1e9 s at 1 ms).
+MAX_STEPS = 10_000_000
 
 
 #: Steps between two finiteness checks of the state (a divergence is located exactly).
@@ -178,7 +232,20 @@ def _check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: n
             )
             joint = robot.joint_names[min(int(bad[0]) if bad.size else 0, len(robot.joint_names) - 1)]
             step = first + offset - 1
+            if offset > 0 and _moderate(*states[offset - 1]) and _singular(robot, states[offset - 1][0]):
+                raise SingularMassMatrixError(robot.name, robot.massless_joints)
             raise SimulationError(step * dt, step, joint)
+
+
+def _moderate(q: np.ndarray, v: np.ndarray) -> bool:
+    """A state that did not blow up (where a singular ``M`` is the reason, not overflow)."""
+    return bool(np.abs(q).max(initial=0.0) < 1e6 and np.abs(v).max(initial=0.0) < 1e6)
+
+
+def _singular(robot: Robot, q: np.ndarray) -> bool:
+    """Whether ``M(q)`` is singular to working precision (no finite acceleration)."""
+    eigenvalues = np.linalg.eigvalsh(robot.mass_matrix(q))
+    return bool(eigenvalues[0] <= 1e-12 * max(abs(eigenvalues[-1]), np.finfo(float).tiny))
 
 
 def _accelerator(

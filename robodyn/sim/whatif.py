@@ -3,7 +3,12 @@
 What changes if the links are plastic, aluminium or steel? If the robot carries a load at
 its end effector? If an external force acts on it? :func:`sweep` drives one motion (a
 rest-to-rest quintic between two configurations) through the inverse dynamics of each
-variant of the arm and reports the peak and RMS torque of every joint.
+variant of the arm and reports the peak and RMS torque of every joint, marking peaks above
+the joint's effort limit.
+
+The payload and the force act on one frame (default the robot's end effector,
+:attr:`robodyn.Robot.end_effector`), which must be a frame some joint moves: a load on a
+frame fixed to the world changes no torque, and is refused rather than reported as such.
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ import numpy as np
 from robodyn.dynamics.loading import load
 from robodyn.dynamics.payload import attach_payload
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError, printable
 from robodyn.sim.control import quintic_reference
 from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
 
@@ -33,6 +39,7 @@ class Variant:
         robot_mass: Total mass of the arm with its payload in [kg].
         peak: Peak absolute torque per joint in [N m] / [N], shape (nv,).
         rms: RMS torque per joint over the motion, shape (nv,).
+        effort: Effort limit per joint (inf where none), shape (nv,).
     """
 
     material: str
@@ -41,6 +48,12 @@ class Variant:
     robot_mass: float
     peak: np.ndarray
     rms: np.ndarray
+    effort: np.ndarray
+
+    @property
+    def over_limit(self) -> np.ndarray:
+        """Which joints' peak torque exceeds their effort limit, shape (nv,)."""
+        return self.peak > self.effort
 
 
 def motion_torques(
@@ -87,25 +100,45 @@ def sweep(
         payloads: Payload masses at the end effector, in [kg].
         forces: External forces at the end effector, in [N], world axes.
         q_start, q_end: The motion; default: the RP arm from hanging 45° down and retracted
-            to 45° up and extended; other robots from neutral to 0.5 rad on every joint.
-        duration: Motion time in [s].
-        frame: The end-effector link; default ``end_effector`` or the last link.
+            to 45° up and extended; other robots from
+            :meth:`~robodyn.Robot.default_configuration` (neutral, clipped into the
+            limits) by 0.5 rad (or m) on every joint, towards the side with room.
+        duration: Motion time in [s], > 0.
+        frame: The frame carrying the payload and the force; default the end effector.
+
+    Raises:
+        InputError: Negative payloads, non-finite forces, a duration ≤ 0.
+        FrameError: An unknown frame, one no joint moves, or no default end effector.
     """
+    payloads = tuple(float(p) for p in payloads)
+    if not all(np.isfinite(p) and p >= 0 for p in payloads):
+        raise InputError("payloads", "masses ≥ 0 in [kg]", ", ".join(f"{p:g}" for p in payloads))
+    if not all(np.isfinite(np.asarray(f, float)).all() and np.shape(f) == (3,) for f in forces):
+        raise InputError("forces", "3 finite values FX, FY, FZ in [N] each", repr(forces))
+    if not (np.isfinite(duration) and duration > 0):
+        raise InputError("duration", "finite and > 0 s", f"{duration:g}")
     generated = model == "rp_arm"
     if generated:
         variants = [(name, load(rp_arm_urdf(RPArmParameters.from_material(name)))) for name in (materials or DEFAULT_MATERIALS)]
     else:
         if materials:
-            from robodyn.exceptions import InputError
-
             raise InputError("materials", "given only for the generated rp_arm", f"{len(materials)} materials for {model!r}")
         variants = [("as loaded", load(model))]
     base_robot = variants[0][1]
-    frame = frame or base_robot.end_effector
+    if base_robot.floating_base:
+        raise InputError(
+            "model",
+            "a fixed-base robot (a floating base's motion needs contacts; the sweep would report the "
+            "wrench of a hook holding the base)",
+            f"floating-base {base_robot.name!r}",
+        )
+    if any(payloads) or any(np.any(f) for f in forces):
+        frame = base_robot.task_frame(frame, "a payload or force")
     if q_start is None:
-        q_start = np.array([-np.pi / 4, 0.0]) if generated else base_robot.neutral_configuration()
+        q_start = np.array([-np.pi / 4, 0.0]) if generated else base_robot.default_configuration()
     if q_end is None:
-        q_end = np.array([np.pi / 4, 0.25]) if generated else base_robot.neutral_configuration() + 0.5
+        q_end = np.array([np.pi / 4, 0.25]) if generated else _half_radian_away(base_robot, q_start)
+    effort = _effort_limits(base_robot)
     rows = []
     for material, robot in variants:
         for payload in payloads:
@@ -121,23 +154,49 @@ def sweep(
                         loaded.total_mass,
                         np.abs(torques).max(axis=0),
                         np.sqrt((torques**2).mean(axis=0)),
+                        effort,
                     )
                 )
     return rows
 
 
+def _half_radian_away(robot: Robot, q_start: np.ndarray) -> np.ndarray:
+    """``q_start`` moved by 0.5 on every joint, downwards where upwards leaves the limits."""
+    lower, upper = robot.physical_limits()
+    start = robot.nq - lower.size
+    q_end = np.array(q_start, dtype=float)
+    joints = q_end[start:]
+    up = joints + 0.5
+    q_end[start:] = np.clip(np.where(up <= upper, up, joints - 0.5), lower, upper)
+    return q_end
+
+
+def _effort_limits(robot: Robot) -> np.ndarray:
+    """Effort limit per velocity coordinate, inf where none (zero in a URDF means none)."""
+    joints = robot.joints[1:] if robot.floating_base else robot.joints
+    effort = np.array([np.inf] * (robot.nv - len(joints)) + [joint.effort for joint in joints], dtype=float)
+    return np.where(effort > 0, effort, np.inf)
+
+
 def table_text(rows: list[Variant], joint_names: list[str], units: list[str]) -> str:
-    """The sweep as a readable table."""
+    """The sweep as a readable table; a peak above the joint's effort limit ends in ``!``."""
     header = f"{'material':10s} {'payload':>8s} {'force [N]':>16s} {'mass':>8s}"
-    for name, unit in zip(joint_names, units, strict=True):
+    for name, unit in zip((printable(n) for n in joint_names), units, strict=True):
         header += f" {'peak ' + name + ' [' + unit + ']':>22s} {'rms ' + name:>14s}"
     lines = [header]
     for row in rows:
         force = ",".join(f"{f:g}" for f in row.force)
         line = f"{row.material:10s} {row.payload:>6.2f}kg {force:>16s} {row.robot_mass:>6.2f}kg"
-        for peak, rms in zip(row.peak, row.rms, strict=True):
-            line += f" {peak:>22.3f} {rms:>14.3f}"
+        for peak, rms, over in zip(row.peak, row.rms, row.over_limit, strict=True):
+            line += f" {peak:>21.3f}{'!' if over else ' '} {rms:>14.3f}"
         lines.append(line)
+    over = [
+        f"{printable(name)} ({rows[0].effort[index]:g} {units[index]})"
+        for index, name in enumerate(joint_names)
+        if any(row.over_limit[index] for row in rows)
+    ]
+    if over:
+        lines += ["", f"! peak above the effort limit of {', '.join(over)}"]
     return "\n".join(lines)
 
 
@@ -146,6 +205,7 @@ def table_dict(rows: list[Variant], joint_names: list[str], units: list[str]) ->
     return {
         "joint_names": joint_names,
         "torque_units": units,
+        "effort_limits": [float(e) if np.isfinite(e) else None for e in (rows[0].effort if rows else [])],
         "rows": [
             {
                 "material": r.material,
@@ -154,6 +214,7 @@ def table_dict(rows: list[Variant], joint_names: list[str], units: list[str]) ->
                 "robot_mass_kg": r.robot_mass,
                 "peak_torque": r.peak.tolist(),
                 "rms_torque": r.rms.tolist(),
+                "over_effort_limit": r.over_limit.tolist(),
             }
             for r in rows
         ],

@@ -3,18 +3,27 @@
 from __future__ import annotations
 
 import argparse
-import json
 
-from robodyn.cli.common import add_model_arguments, load_robot
+from robodyn.cli.common import RANGES, add_model_arguments, json_text, load_robot
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("check", help="compare Pinocchio with the independent Lagrangian reference")
     add_model_arguments(parser)
-    parser.add_argument("--samples", type=int, default=100, help="random states within the joint limits (default 100)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the random states (default 0)")
-    parser.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error accepted (default 1e-9)")
+    parser.add_argument(
+        "--samples",
+        type=int,
+        default=100,
+        help=f"random states within the joint limits, {RANGES['samples'].text()} (default 100)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help=f"seed of the random states, {RANGES['seed'].text()} (default 0)")
+    parser.add_argument(
+        "--tolerance",
+        type=float,
+        default=1e-9,
+        help=f"largest relative error accepted, {RANGES['tolerance'].text()} (default 1e-9)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.set_defaults(run=run)
 
@@ -30,5 +39,5 @@ def run(arguments: argparse.Namespace) -> int:
         tolerance=arguments.tolerance,
         check_inertia=arguments.check_inertia,
     )
-    print(json.dumps(report_dict(report), indent=2) if arguments.json else report_text(report))
+    print(json_text(report_dict(report)) if arguments.json else report_text(report))
     return 0 if report.passed else 1

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from robodyn.cli import report
-from robodyn.cli.common import add_model_arguments, load_robot
+from robodyn.cli.common import add_model_arguments, json_text, load_robot
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -20,7 +19,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 def run(arguments: argparse.Namespace) -> int:
     robot = load_robot(arguments)
     if arguments.json:
-        print(json.dumps(report.info_dict(robot), indent=2))
+        print(json_text(report.info_dict(robot)))
     else:
         print(report.info_text(robot))
     return 0

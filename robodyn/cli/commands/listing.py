@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 import robodyn
+from robodyn.cli.common import json_text
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -22,7 +22,7 @@ def run(arguments: argparse.Namespace) -> int:
     names = robodyn.robot_names()
     if arguments.json:
         print(
-            json.dumps(
+            json_text(
                 [
                     {
                         "name": name,
@@ -30,8 +30,7 @@ def run(arguments: argparse.Namespace) -> int:
                         "floating_base": name in ZOO and ZOO[name].floating_base,
                     }
                     for name in names
-                ],
-                indent=2,
+                ]
             )
         )
         return 0

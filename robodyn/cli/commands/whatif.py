@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 import robodyn
-from robodyn.cli.common import vector
-from robodyn.exceptions import InputError
+from robodyn.cli.common import RANGES, json_text, vector
+from robodyn.exceptions import InputError, printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -15,9 +14,14 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser("whatif", help="peak and RMS torques of one motion across materials, payloads, forces")
     parser.add_argument("model", nargs="?", default="rp_arm", help="robot (default rp_arm; materials apply to rp_arm only)")
     parser.add_argument("--materials", help="comma-separated: abs (plastic), aluminium, steel or densities in kg/m³")
-    parser.add_argument("--payloads", type=vector, default=[0.0, 0.5, 2.0], help="payload masses in [kg] at the end effector")
+    parser.add_argument(
+        "--payloads", type=vector, default=[0.0, 0.5, 2.0], help="payload masses in [kg] (each ≥ 0) at the end effector"
+    )
     parser.add_argument("--force", type=vector, help="also an external force FX,FY,FZ in [N] on the end effector")
-    parser.add_argument("--duration", type=float, default=1.5, help="motion time in [s]")
+    parser.add_argument(
+        "--frame", help="the frame carrying payload and force (default: the end effector 'robodyn info' shows; it must move)"
+    )
+    parser.add_argument("--duration", type=float, default=1.5, help=f"motion time, {RANGES['duration'].text()} (default 1.5)")
     parser.add_argument("--plot", help="PNG bar chart of the table")
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.set_defaults(run=run)
@@ -33,16 +37,21 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.force and len(arguments.force) != 3:
         raise InputError("--force", "3 values FX,FY,FZ in [N]", f"{len(arguments.force)} values")
     rows = sweep(
-        arguments.model, materials=materials, payloads=tuple(arguments.payloads), forces=forces, duration=arguments.duration
+        arguments.model,
+        materials=materials,
+        payloads=tuple(arguments.payloads),
+        forces=forces,
+        duration=arguments.duration,
+        frame=arguments.frame,
     )
     robot = robodyn.load(arguments.model)
     units = dof_units(robot)["tau"]
     if arguments.plot:
-        plot_whatif(rows, robot.joint_names, units, arguments.plot)
+        plot_whatif(rows, robot.joint_names, units, arguments.plot, effort_limits=[float(e) for e in rows[0].effort])
     if arguments.json:
-        print(json.dumps(table_dict(rows, robot.joint_names, units), indent=2))
+        print(json_text(table_dict(rows, robot.joint_names, units)))
     else:
-        print(f"{robot.name}: one rest-to-rest motion of {arguments.duration:g} s; torques of each joint\n")
+        print(f"{printable(robot.name)}: one rest-to-rest motion of {arguments.duration:g} s; torques of each joint\n")
         print(table_text(rows, robot.joint_names, units))
         if arguments.plot:
             print(f"\nplot: {arguments.plot}")

@@ -1,0 +1,136 @@
+"""Configurations of a robot: its joint limits, and the neutral, default and random ``q``.
+
+:class:`ConfigurationSpace` is a base of :class:`robodyn.Robot` (it uses the robot's
+``joints``, ``model``, ``nq``, ``nv``, ``floating_base`` and ``name``).
+
+Limits a URDF leaves open: an infinite limit, or a *placeholder* of magnitude at least
+:data:`PLACEHOLDER_LIMIT` (1e3 m or rad: URDFs write ±999 999 where the format demands a
+number), or an empty range (``lower == upper`` on a moving joint), counts as no limit
+wherever robodyn needs a physical range (sampling, the default configuration,
+simulation's limit checks).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from robodyn.common.inputs import as_states
+from robodyn.exceptions import InputError
+
+#: Position limits at least this large in magnitude (1e3 m or rad) are placeholders for
+#: "unlimited" (URDFs write ±999 999 where the format demands a number).
+PLACEHOLDER_LIMIT = 1e3
+
+
+class ConfigurationSpace:
+    """Joint limits and configurations of a robot (a base of :class:`robodyn.Robot`)."""
+
+    @property
+    def lower_limits(self) -> np.ndarray:
+        """Lower position limits per degree of freedom, shape (nv,), in [rad] or [m].
+
+        The six base coordinates of a floating base are unlimited (-inf).
+        """
+        return np.array([joint.lower for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m]."""
+        return np.array([joint.upper for joint in self.joints for _ in range(6 if joint.type == "floating" else 1)])
+
+    def neutral_configuration(self) -> np.ndarray:
+        """The neutral configuration (zero joint positions, identity base), shape (nq,).
+
+        It may lie outside the joint limits (panda's joint 4 lives in [-3.07, -0.07] rad);
+        :meth:`default_configuration` does not.
+        """
+        return pin.neutral(self.model)
+
+    def default_configuration(self) -> np.ndarray:
+        """The neutral configuration clipped into the joint position limits, shape (nq,).
+
+        The initial state of simulations and motions when none is given: every joint at
+        zero, or at its nearest limit when zero is outside them (placeholder limits, see
+        :meth:`random_configuration`, are ignored).
+        """
+        q = self.neutral_configuration()
+        lower, upper = self.physical_limits()
+        start = self.nq - lower.size
+        q[start:] = np.clip(q[start:], lower, upper)
+        return q
+
+    def physical_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Position limits of the joints (floating base excluded), placeholders as ±inf.
+
+        A limit of magnitude at least :data:`PLACEHOLDER_LIMIT` (1e3 m or rad, e.g.
+        ridgeback's ±999 999 m) stands for "unlimited" and becomes ±inf, and so does an
+        empty range ``lower == upper`` of a joint that is not fixed (example-robot-data's
+        double pendulums write ``lower="0" upper="0"`` on joints that swing freely).
+
+        Returns:
+            ``(lower, upper)``, each of shape (nv,), or (nv − 6,) with a floating base.
+        """
+        lower, upper = self.lower_limits, self.upper_limits
+        if self.floating_base:
+            lower, upper = lower[6:], upper[6:]
+        empty = lower == upper
+        lower = np.where((np.abs(lower) >= PLACEHOLDER_LIMIT) | empty, -np.inf, lower)
+        upper = np.where((np.abs(upper) >= PLACEHOLDER_LIMIT) | empty, np.inf, upper)
+        return lower, upper
+
+    def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
+        """A floating-base configuration from the base pose and the joint positions.
+
+        Args:
+            position: Base origin in the world frame, in [m], shape (3,).
+            rpy: Base orientation as roll, pitch, yaw in [rad] (rotations about the fixed
+                x, y, z axes, as in URDF), shape (3,).
+            joints: Joint positions, shape (nv - 6,); default zeros.
+
+        Returns:
+            ``q`` of shape (nq,): position, quaternion (x, y, z, w), joints.
+
+        Raises:
+            InputError: For a fixed-base robot or wrong sizes.
+        """
+        if not self.floating_base:
+            raise InputError("robot", "a floating-base robot (load it with floating_base=True)", f"fixed-base {self.name!r}")
+        position, rpy = as_states({"position": (position, 3), "rpy": (rpy, 3)})[0]
+        joints = np.zeros(self.nv - 6) if joints is None else as_states({"joints": (joints, self.nv - 6)})[0][0]
+        quaternion = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs()
+        return np.concatenate([position, quaternion, joints])
+
+    def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
+        """Configurations drawn uniformly within the joint limits, in a physical range.
+
+        The rule: a joint with both limits draws between them. A limit that is missing,
+        infinite or a placeholder (magnitude ≥ 1e3 m or rad, :data:`PLACEHOLDER_LIMIT`;
+        an empty range ``lower == upper``) counts as absent: a joint with no limit draws from [-π, π] (in [rad] or [m]), a
+        joint with one limit from the 2π-wide interval on its side of it. A floating base
+        draws its position from [-1, 1] m and a uniform random orientation.
+
+        Args:
+            rng: Random generator (for reproducible draws).
+            count: Number of configurations (≥ 0); ``None`` for a single one.
+
+        Returns:
+            Shape (nq,) or (count, nq).
+
+        Raises:
+            InputError: If ``count`` is not a non-negative integer.
+        """
+        if count is not None and (isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0):
+            raise InputError("count", "a non-negative integer or None", repr(count))
+        rows = 1 if count is None else int(count)
+        lower, upper = self.physical_limits()
+        lower, upper = (
+            np.where(np.isfinite(lower), lower, np.where(np.isfinite(upper), upper - 2 * np.pi, -np.pi)),
+            np.where(np.isfinite(upper), upper, np.where(np.isfinite(lower), lower + 2 * np.pi, np.pi)),
+        )
+        joints = rng.uniform(lower, upper, size=(rows, lower.size))
+        if self.floating_base:
+            quaternion = rng.normal(size=(rows, 4))
+            quaternion /= np.linalg.norm(quaternion, axis=1, keepdims=True)
+            joints = np.hstack([rng.uniform(-1, 1, size=(rows, 3)), quaternion, joints])
+        return joints[0] if count is None else joints

@@ -1,0 +1,179 @@
+"""Joint limits in simulation: what a run did to them, and how ``enforce`` keeps them.
+
+Three modes (``simulate(..., limits=...)``, ``robodyn simulate --limits``):
+
+- ``"warn"`` (default): the dynamics are unconstrained; every position, velocity and
+  effort limit that the run broke is reported (:func:`limit_violations`: joint, first
+  time, worst value, limit) and :func:`robodyn.simulate` emits one
+  :class:`~robodyn.exceptions.JointLimitWarning`.
+- ``"enforce"``: the model of a joint with stops and current-limited motors —
+  the applied torque is saturated at the effort limit, ``tau = clip(tau_c, −effort,
+  effort)`` (at every evaluation of the controller, so RK4's stages see it too), and
+  after every step a joint beyond a position limit is put back on it and its velocity
+  into the limit is set to zero (a perfectly plastic stop: no bounce, no penetration;
+  the velocity away from the limit is kept). Velocity limits are reported, not enforced.
+- ``"ignore"``: neither enforced nor reported.
+
+Limits that a URDF leaves unspecified do not count: infinite ones, placeholder position
+limits (magnitude ≥ 1e3, :data:`robodyn.dynamics.robot.PLACEHOLDER_LIMIT`), empty position
+ranges (``lower == upper`` on a moving joint), and effort or velocity limits of zero (the
+URDF's "unknown"). A floating base has no limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError, printable
+from robodyn.sim.trajectory import Trajectory
+
+LIMIT_MODES = ("warn", "enforce", "ignore")
+#: Slack before a value counts as beyond its limit: absolute, plus relative to the limit.
+TOLERANCE = 1e-9
+
+
+def check_mode(limits: str) -> str:
+    """Refuse an unknown limits mode."""
+    if limits not in LIMIT_MODES:
+        raise InputError("limits", f"one of {', '.join(LIMIT_MODES)}", repr(limits))
+    return limits
+
+
+@dataclass(frozen=True)
+class LimitViolation:
+    """One limit a run broke.
+
+    Attributes:
+        joint: Joint name.
+        quantity: ``"position"``, ``"velocity"`` or ``"effort"``.
+        side: ``"lower"`` or ``"upper"`` for positions; ``"magnitude"`` otherwise.
+        first_time: When the value first went beyond the limit, in [s].
+        worst: The value furthest beyond the limit (signed), in ``unit``.
+        limit: The limit it broke (signed like ``worst``), in ``unit``.
+        unit: ``"rad"``, ``"m"``, ``"rad/s"``, ``"m/s"``, ``"N m"`` or ``"N"``.
+    """
+
+    joint: str
+    quantity: str
+    side: str
+    first_time: float
+    worst: float
+    limit: float
+    unit: str
+
+    def text(self) -> str:
+        """E.g. ``"panda_joint2 effort 474 N m beyond ±87 N m from t = 0 s"``."""
+        bound = f"{self.limit:.4g}" if self.side != "magnitude" else f"±{abs(self.limit):.4g}"
+        return (
+            f"{printable(self.joint)} {self.quantity} {self.worst:.4g} {self.unit} beyond {bound} {self.unit} "
+            f"from t = {self.first_time:.4g} s"
+        )
+
+    def as_dict(self) -> dict:
+        """JSON-ready, units in the keys' companion ``unit``."""
+        return {
+            "joint": self.joint,
+            "quantity": self.quantity,
+            "side": self.side,
+            "first_time_s": float(f"{self.first_time:.12g}"),  # t = step × dt, without its rounding noise
+            "worst": self.worst,
+            "limit": self.limit,
+            "unit": self.unit,
+        }
+
+
+class JointLimits:
+    """The limits of a robot's joints as arrays over the coordinates they apply to.
+
+    Attributes:
+        lower, upper: Position limits of the joint coordinates of ``q`` (the floating
+            base's seven excluded), ±inf where unlimited; shape (nj,).
+        velocity, effort: Limits per velocity coordinate (inf where unlimited), (nv,).
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        self.lower, self.upper = robot.physical_limits()
+        self.joints = robot.joints[1:] if robot.floating_base else robot.joints
+        base = [float("inf")] * (6 if robot.floating_base else 0)
+        velocity = np.array(base + [joint.velocity for joint in self.joints], dtype=float)
+        effort = np.array(base + [joint.effort for joint in self.joints], dtype=float)
+        self.velocity = np.where(velocity > 0, velocity, np.inf)
+        self.effort = np.where(effort > 0, effort, np.inf)
+        self._q_start = robot.nq - len(self.joints)
+        self._v_start = robot.nv - len(self.joints)
+        self._has_stops = bool(np.isfinite(self.lower).any() or np.isfinite(self.upper).any())
+        self._has_efforts = bool(np.isfinite(self.effort).any())
+
+    def saturate(self, tau: np.ndarray) -> np.ndarray:
+        """Torques clipped at the effort limits, shape (nv,)."""
+        return np.clip(tau, -self.effort, self.effort) if self._has_efforts else tau
+
+    def stop(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Put joints beyond a position limit back on it, with no velocity into it."""
+        if not self._has_stops:
+            return q, v
+        joints = q[self._q_start :]
+        below, above = joints < self.lower, joints > self.upper
+        if not (below.any() or above.any()):
+            return q, v
+        q, v = q.copy(), v.copy()
+        q[self._q_start :] = np.clip(joints, self.lower, self.upper)
+        speeds = v[self._v_start :]
+        speeds[(below & (speeds < 0)) | (above & (speeds > 0))] = 0.0
+        return q, v
+
+    def violations(self, trajectory: Trajectory) -> list[LimitViolation]:
+        """Every limit the trajectory broke, by joint then quantity."""
+        units = _units(self.joints)
+        found = []
+        positions = trajectory.q[:, self._q_start :]
+        velocities = trajectory.v[:, self._v_start :]
+        torques = trajectory.tau[:, self._v_start :]
+        for index, joint in enumerate(self.joints):
+            unit = units[index]
+            for side, limit in (("lower", self.lower[index]), ("upper", self.upper[index])):
+                found += _beyond(trajectory.t, positions[:, index], limit, side, joint.name, "position", unit)
+            for quantity, values, limit, per_second in (
+                ("velocity", velocities[:, index], self.velocity[self._v_start + index], "/s"),
+                ("effort", torques[:, index], self.effort[self._v_start + index], ""),
+            ):
+                unit_q = unit + per_second if quantity == "velocity" else ("N" if unit == "m" else "N m")
+                found += _beyond(trajectory.t, np.abs(values), limit, "magnitude", joint.name, quantity, unit_q, values)
+        return found
+
+
+def _units(joints) -> list[str]:
+    return ["m" if joint.type == "prismatic" else "rad" for joint in joints]
+
+
+def _beyond(times, values, limit, side, joint, quantity, unit, signed=None) -> list[LimitViolation]:
+    if not np.isfinite(limit):
+        return []
+    slack = TOLERANCE * (1.0 + abs(limit))
+    outside = values < limit - slack if side == "lower" else values > limit + slack
+    if not outside.any():
+        return []
+    first = int(np.argmax(outside))
+    worst_index = int(np.argmin(values) if side == "lower" else np.argmax(values))
+    worst = float(values[worst_index] if signed is None else signed[worst_index])
+    bound = float(limit if signed is None else np.copysign(limit, worst))
+    return [LimitViolation(joint, quantity, side, float(times[first]), worst, bound, unit)]
+
+
+def limit_violations(robot: Robot, trajectory: Trajectory) -> list[LimitViolation]:
+    """Every position, velocity and effort limit a trajectory of ``robot`` broke.
+
+    Each violation names the joint, the first time in [s], the worst value and the limit.
+    """
+    return JointLimits(robot).violations(trajectory)
+
+
+def warning_text(robot: str, violations: list[LimitViolation], *, shown: int = 4) -> str:
+    """One line summarising the violations (the first ``shown`` in full)."""
+    listed = "; ".join(violation.text() for violation in violations[:shown])
+    more = f"; and {len(violations) - shown} more" if len(violations) > shown else ""
+    return f"{printable(robot)}: {len(violations)} joint limit violation{'s' if len(violations) != 1 else ''}: {listed}{more}"
