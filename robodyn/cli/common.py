@@ -41,6 +41,15 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--gravity", type=vector, metavar="GX,GY,GZ", help="gravity in the world frame, in [m/s²] (default 0,0,-9.81)"
     )
+    parser.add_argument(
+        "--strict", action="store_true", help="refuse what robodyn otherwise loads with a warning (e.g. the triangle inequality)"
+    )
+    parser.add_argument(
+        "--max-dof",
+        type=int,
+        dest="max_dof",
+        help="largest number of degrees of freedom to build (Pinocchio's memory grows as nv²; default 300)",
+    )
 
 
 def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
@@ -49,6 +58,8 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
         floating_base=arguments.floating_base,
         gravity=arguments.gravity,
         check_inertia=arguments.check_inertia,
+        strict=arguments.strict,
+        max_dof=arguments.max_dof,
     )
 
 
@@ -170,6 +181,7 @@ RANGES: dict[str, Range] = {
     "tolerance": Range(0.0, 1.0, low_open=True, high_open=True),
     "fps": Range(0.0, 240.0, "fps", low_open=True),
     "seconds": Range(0.0, 86_400.0, "s", low_open=True),
+    "max_dof": Range(1, 100_000, integer=True),
 }
 #: Per-entry ranges of list options.
 LIST_RANGES: dict[str, Range] = {

@@ -175,6 +175,9 @@ def simulate_compiled(
             q, v = out[0][start + count].copy(), out[1][start + count].copy()
     else:
         raise InputError("controller", "None, a compiled controller or a callable (t, q, v) -> tau", repr(controller))
+    q_out, v_out, a_out, tau_out = out
+    if steps:  # the last sample's own acceleration, under the torque held at the end (as robodyn.simulate)
+        a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], tau_out[-1])
     return SimulationArrays(np.arange(steps + 1) * dt, *out)
 
 

@@ -132,6 +132,7 @@ def rebuild(robot: Robot, *, urdf: str | None = None, label: str | None = None) 
         gravity=options.gravity,
         check_inertia=options.check_inertia,
         threads=options.threads,
+        strict=options.strict,
         max_dof=max(robot.nv, MAX_DOF),
     )
 
@@ -195,7 +196,8 @@ def build_robot(
             resolved.label, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)"
         )
     name = spec.name if resolved.name == "robot" else resolved.name
-    options = LoadOptions(floating, tuple(float(g) for g in model.gravity.linear), check_inertia, threads)  # type: ignore[arg-type]
+    gravity_vector = (float(model.gravity.linear[0]), float(model.gravity.linear[1]), float(model.gravity.linear[2]))
+    options = LoadOptions(floating, gravity_vector, check_inertia, threads, strict)
     return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
 
 

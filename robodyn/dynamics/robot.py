@@ -64,12 +64,14 @@ class LoadOptions:
         gravity: Gravity in the world frame, in [m/s²].
         check_inertia: Whether impossible inertias on moving links were refused.
         threads: Native threads for batches (``None``: every available core).
+        strict: Whether warnings of the validator were treated as errors.
     """
 
     floating_base: bool
     gravity: tuple[float, float, float]
     check_inertia: bool = True
     threads: int | None = None
+    strict: bool = False
 
 
 class Robot(Kinematics, ConfigurationSpace):

@@ -122,24 +122,31 @@ class TaskSpace:
         return self.model.inverse_dynamics(q, v, command)
 
 
-def quintic_reference(q_start: np.ndarray, q_end: np.ndarray, duration: float) -> JointReference:
+@dataclass(frozen=True)
+class QuinticReference:
     """A rest-to-rest joint motion with zero velocity and acceleration at both ends.
 
-    Args:
+    ``reference(t) -> (q_d, v_d, a_d)``; after ``duration`` it holds ``q_end``. Plain data,
+    so the compiled engine can run the same formulas in C.
+
+    Attributes:
         q_start, q_end: Start and end configurations, shape (n,).
-        duration: Motion time in [s]; after it the reference holds ``q_end``.
-
-    Returns:
-        ``reference(t) -> (q_d, v_d, a_d)``.
+        duration: Motion time in [s].
     """
-    q_start, q_end = np.asarray(q_start, float), np.asarray(q_end, float)
-    delta = q_end - q_start
 
-    def reference(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    q_start: np.ndarray
+    q_end: np.ndarray
+    duration: float
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        duration, delta = self.duration, self.q_end - self.q_start
         s = min(max(t / duration, 0.0), 1.0)
         position = 10 * s**3 - 15 * s**4 + 6 * s**5
         speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / duration if 0 < t < duration else 0.0
         acceleration = (60 * s - 180 * s**2 + 120 * s**3) / duration**2 if 0 < t < duration else 0.0
-        return q_start + position * delta, speed * delta, acceleration * delta
+        return self.q_start + position * delta, speed * delta, acceleration * delta
 
-    return reference
+
+def quintic_reference(q_start: np.ndarray, q_end: np.ndarray, duration: float) -> QuinticReference:
+    """A rest-to-rest joint motion from ``q_start`` to ``q_end`` in ``duration`` [s] (:class:`QuinticReference`)."""
+    return QuinticReference(np.asarray(q_start, float), np.asarray(q_end, float), float(duration))

@@ -53,6 +53,7 @@ def run_simulation(
     dt: float = 1e-3,
     integrator: str = "rk4",
     limits: str = "warn",
+    engine: str = "pinocchio",
 ) -> tuple[Trajectory, dict]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -66,7 +67,8 @@ def run_simulation(
             it must be a frame some joint moves).
         q0: Initial configuration; default :meth:`Robot.default_configuration` (the
             neutral one clipped into the joint limits).
-        duration, dt, integrator, limits: As for :func:`robodyn.simulate`.
+        duration, dt, integrator, limits, engine: As for :func:`robodyn.simulate` (with
+            ``engine="compiled"`` the task-space controller is sampled every step).
 
     Returns:
         The trajectory and a JSON-ready summary with units in the keys.
@@ -99,7 +101,7 @@ def run_simulation(
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
         trajectory = simulate(
-            robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits
+            robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits, engine=engine
         )
     elapsed = time.perf_counter() - began
     energy = robot.kinetic_energy(trajectory.q, trajectory.v) + robot.potential_energy(trajectory.q)
@@ -108,6 +110,7 @@ def run_simulation(
         "controller": controller,
         "integrator": integrator,
         "limits": limits,
+        "engine": engine,
         "duration_s": duration,
         "dt_s": dt,
         "steps": len(trajectory) - 1,

@@ -88,6 +88,8 @@ def simulate(
     external: Sequence[ExternalWrench] = (),
     hold: bool = False,
     limits: str = "warn",
+    engine: str = "pinocchio",
+    control_period: float | None = None,
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
 
@@ -103,6 +105,13 @@ def simulate(
         hold: Sample the controller once per step and hold its torque (zero-order hold)
             instead of evaluating it at every integration stage.
         limits: ``"warn"``, ``"enforce"`` or ``"ignore"`` (see :mod:`robodyn.sim.limits`).
+        engine: ``"pinocchio"`` (this loop in Python, ABA per stage) or ``"compiled"`` (the
+            whole loop in C, :mod:`robodyn.compiled`; fixed-base robots, no external
+            wrenches, limits warned or ignored). PD + gravity and computed torque along a
+            quintic run in C on their own compiled models; any other controller is called
+            every ``control_period`` [s] and its torque held in between.
+        control_period: With ``engine="compiled"`` and a Python controller, in [s] (a whole
+            number of steps; default ``dt``).
 
     Returns:
         The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0`` (``tau`` is
@@ -122,6 +131,13 @@ def simulate(
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
     check_mode(limits)
+    if engine not in ENGINES:
+        raise InputError("engine", f"one of {', '.join(ENGINES)}", repr(engine))
+    if engine == "compiled":
+        return _simulate_compiled(
+            robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
+            limits=limits, control_period=control_period,
+        )  # fmt: skip
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
     steps = round(duration / dt)
@@ -198,7 +214,7 @@ def simulate(
     qs.append(q)
     vs.append(v)
     torques.append(torques[-1] if steps else zero)
-    accelerations.append(accelerations[-1] if steps else forward(0.0, q, v, zero))
+    accelerations.append(forward(steps * dt, q, v, torques[-1]))  # the last sample's own acceleration
     trajectory = Trajectory(
         times, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques), list(robot.joint_names), robot.name
     )
@@ -206,6 +222,61 @@ def simulate(
         violations = joint_limits.violations(trajectory)
         if violations:
             warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
+    return trajectory
+
+
+ENGINES = ("pinocchio", "compiled")
+
+
+def _simulate_compiled(
+    robot: Robot,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    duration: float,
+    dt: float,
+    *,
+    controller: Controller | None,
+    integrator: str,
+    external: Sequence[ExternalWrench],
+    hold: bool,
+    limits: str,
+    control_period: float | None,
+) -> Trajectory:
+    """:func:`simulate` with ``engine="compiled"``: the same trajectory, integrated in C."""
+    from robodyn.compiled import CompiledComputedTorque, CompiledPDGravity, compile, simulate_compiled
+    from robodyn.sim.control import ComputedTorque, PDGravity, QuinticReference
+
+    if external:
+        raise InputError("external", "no wrenches with engine='compiled' (use the Pinocchio engine)", f"{len(external)} wrenches")
+    if limits == "enforce":
+        raise InputError(
+            "limits", "'warn' or 'ignore' with engine='compiled' (enforce runs on the Pinocchio engine)", "'enforce'"
+        )
+    plant = compile(robot)
+    law: object = controller
+    if isinstance(controller, PDGravity):
+        law = CompiledPDGravity(compile(controller.model), controller.target, controller.kp, controller.kd)
+    elif isinstance(controller, ComputedTorque) and isinstance(controller.reference, QuinticReference):
+        reference = controller.reference
+        law = CompiledComputedTorque(
+            compile(controller.model), reference.q_start, reference.q_end, reference.duration, controller.kp, controller.kd
+        )
+    run = simulate_compiled(
+        plant,
+        q0,
+        v0,
+        duration,
+        dt,
+        integrator=integrator,
+        controller=law,
+        control_period=control_period,
+        hold=hold,  # type: ignore[arg-type]
+    )
+    trajectory = Trajectory(run.t, run.q, run.v, run.a, run.tau, list(robot.joint_names), robot.name)
+    if limits != "ignore":
+        violations = JointLimits(robot).violations(trajectory)
+        if violations:
+            warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=3)
     return trajectory
 
 

@@ -8,6 +8,7 @@ import sys
 import numpy as np
 
 from robodyn.cli.common import RANGES, add_model_arguments, json_text, load_robot, vector
+from robodyn.common.files import outputs_together
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -31,6 +32,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default="warn",
         help="joint limits: warn (report every violation, default), enforce (saturate torques at the effort "
         "limits, stop joints at the position limits), ignore",
+    )
+    parser.add_argument(
+        "--compiled",
+        action="store_true",
+        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too",
     )
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
@@ -57,21 +63,25 @@ def run(arguments: argparse.Namespace) -> int:
         dt=arguments.dt,
         integrator=arguments.integrator,
         limits=arguments.limits,
+        engine="compiled" if arguments.compiled else "pinocchio",
     )
     frame = summary.get("frame")
-    if arguments.out:
-        summary["trajectory"] = str(trajectory.save(arguments.out))
-    if arguments.plot:
-        from robodyn.viz.plots import plot_simulation
+    task = np.asarray(summary["target_m"]) if "target_m" in summary else None
+    with outputs_together():  # every file of the run, or none of them
+        if arguments.out:
+            summary["trajectory"] = str(trajectory.save(arguments.out))
+        if arguments.plot:
+            from robodyn.viz.plots import plot_simulation
 
-        task = np.asarray(summary["target_m"]) if "target_m" in summary else None
-        summary["plot"] = str(plot_simulation(robot, trajectory, arguments.plot, frame=frame, target=task))
-    if arguments.record:
-        from robodyn.viz.viewer import record
+            summary["plot"] = str(plot_simulation(robot, trajectory, arguments.plot, frame=frame, target=task))
+        if arguments.record:
+            from robodyn.viz.viewer import record
 
-        summary["recording"] = str(record(robot, trajectory, arguments.record, png=arguments.png))
-        if arguments.png:
-            summary["poster"] = str(arguments.png)
+            summary["recording"] = str(
+                record(robot, trajectory, arguments.record, png=arguments.png, target=task, frame=frame or robot.end_effector)
+            )
+            if arguments.png:
+                summary["poster"] = str(arguments.png)
     violations = [LimitViolation(**_violation_fields(item)) for item in summary["limit_violations"]]
     if violations:
         print(f"robodyn: warning: {warning_text(robot.name, violations)}", file=sys.stderr)

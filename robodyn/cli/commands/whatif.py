@@ -23,6 +23,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--duration", type=float, default=1.5, help=f"motion time, {RANGES['duration'].text()} (default 1.5)")
     parser.add_argument("--plot", help="PNG bar chart of the table")
+    parser.add_argument(
+        "--scheduler", metavar="ADDRESS|local:N", help="compute the variants on Dask (a scheduler address, or N local workers)"
+    )
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.set_defaults(run=run)
 
@@ -36,14 +39,16 @@ def run(arguments: argparse.Namespace) -> int:
     forces = ((0.0, 0.0, 0.0),) + ((tuple(arguments.force),) if arguments.force else ())
     if arguments.force and len(arguments.force) != 3:
         raise InputError("--force", "3 values FX,FY,FZ in [N]", f"{len(arguments.force)} values")
-    rows = sweep(
-        arguments.model,
-        materials=materials,
-        payloads=tuple(arguments.payloads),
-        forces=forces,
-        duration=arguments.duration,
-        frame=arguments.frame,
-    )
+    options = {"materials": materials, "payloads": tuple(arguments.payloads), "forces": forces}
+    options |= {"duration": arguments.duration, "frame": arguments.frame}
+    if arguments.scheduler:
+        from robodyn.scale.cluster import connect
+        from robodyn.scale.sweeps import sweep as distributed_sweep
+
+        with connect(arguments.scheduler) as client:
+            rows = distributed_sweep(arguments.model, client=client, **options)
+    else:
+        rows = sweep(arguments.model, **options)
     robot = robodyn.load(arguments.model)
     units = dof_units(robot)["tau"]
     if arguments.plot:
