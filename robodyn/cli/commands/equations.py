@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 import numpy as np
 
 from robodyn.cli import report
-from robodyn.cli.common import Progress, add_model_arguments, load_robot, lock_values, state, vector
+from robodyn.cli.common import Progress, add_model_arguments, json_text, load_robot, lock_values, state, vector
 from robodyn.exceptions import InputError
 
 
@@ -49,6 +48,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--christoffel", action="store_true", help="with --symbolic: the Christoffel symbols of M (closed form; text or json)"
+    )
+    parser.add_argument(
+        "--base-parameters",
+        action="store_true",
+        help="the identifiable combinations of the inertial parameters (robodyn.base_parameters; text, latex or json)",
     )
     parser.add_argument(
         "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
@@ -128,19 +132,32 @@ def _emit(arguments: argparse.Namespace, output: str | bytes, what: str) -> int:
     return 0
 
 
+def _base_parameters(arguments: argparse.Namespace) -> int:
+    from robodyn.ident import base_parameters
+    from robodyn.ident.render import render_base_parameters
+
+    if arguments.format not in ("text", "latex", "json"):
+        raise InputError("--format", "text, latex or json with --base-parameters", repr(arguments.format))
+    robot = load_robot(arguments)
+    print(render_base_parameters(base_parameters(robot), arguments.format), end="")
+    return 0
+
+
 def run(arguments: argparse.Namespace) -> int:
+    if arguments.base_parameters:
+        return _base_parameters(arguments)
     if arguments.symbolic or arguments.lecture:
         return _symbolic(arguments)
     from robodyn.equations.output import check_precision
 
     check_precision(arguments.precision)
     robot = load_robot(arguments)
-    q = state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
+    q = state(robot, arguments.q, "q", robot.nq, robot.default_configuration())
     v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
     a = state(robot, arguments.a, "a", robot.nv, np.zeros(robot.nv))
     terms = report.equations_at(robot, q, v, a)
     if arguments.json:
-        print(json.dumps(report.equations_dict(robot, terms), indent=2))
+        print(json_text(report.equations_dict(robot, terms)))
     else:
         print(report.equations_text(robot, terms, precision=arguments.precision))
     return 0
