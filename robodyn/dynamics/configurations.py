@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.common.inputs import as_states
+from robodyn.dynamics.joints import JointInfo
 from robodyn.exceptions import InputError
 
 #: Position limits at least this large in magnitude (1e3 m or rad) are placeholders for
@@ -25,6 +26,14 @@ PLACEHOLDER_LIMIT = 1e3
 
 class ConfigurationSpace:
     """Joint limits and configurations of a robot (a base of :class:`robodyn.Robot`)."""
+
+    # Provided by the robot this is a base of.
+    model: pin.Model
+    name: str
+    nq: int
+    nv: int
+    floating_base: bool
+    joints: list[JointInfo]
 
     @property
     def lower_limits(self) -> np.ndarray:

@@ -28,31 +28,12 @@ from robodyn.dynamics import frames
 from robodyn.dynamics.batch import ParallelRunner
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT, ConfigurationSpace
 from robodyn.dynamics.handle import per_state
+from robodyn.dynamics.joints import JointInfo
 from robodyn.dynamics.kinematics import Kinematics
 from robodyn.dynamics.mimic import MimicExpansion
 from robodyn.exceptions import NonFiniteResultError, SingularMassMatrixError
 from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
-
-
-@dataclass(frozen=True)
-class JointInfo:
-    """One degree of freedom of a robot.
-
-    Attributes:
-        name: Joint name in the URDF.
-        type: ``"revolute"``, ``"continuous"``, ``"prismatic"`` or ``"floating"``.
-        lower, upper: Position limits in [rad] or [m] (±inf when unlimited).
-        effort: Effort limit in [N m] or [N] (inf when not given).
-        velocity: Velocity limit in [rad/s] or [m/s] (inf when not given).
-    """
-
-    name: str
-    type: str
-    lower: float
-    upper: float
-    effort: float
-    velocity: float
 
 
 @dataclass(frozen=True)

@@ -256,6 +256,7 @@ class ReferenceRobot:
         arrays, batch = as_states({name: (value, self.nq if name == "q" else self.nv) for name, value in named.items()})
         stacked = [array if batch else array[None] for array in arrays]
         q, v, a = [*stacked, None, None][:3]
+        assert q is not None  # every quantity takes q first
         result = self._evaluate(q, v, a)[key]
         return result if batch else result[0]
 

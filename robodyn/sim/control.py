@@ -102,19 +102,19 @@ class TaskSpace:
     joint_damping: float = 5.0
 
     def __post_init__(self) -> None:
-        self.frame = self.model.task_frame(self.frame, "task-space control")
+        self.frame = self._frame = self.model.task_frame(self.frame, "task-space control")
         self.target = np.asarray(self.target, dtype=float)
         if self.target.shape != (3,) or not np.isfinite(self.target).all():
             raise InputError("target", "3 finite values X, Y, Z in [m]", f"shape {self.target.shape}")
 
     def task_error(self, q: np.ndarray) -> np.ndarray:
         """Target minus the frame's position, shape (3,), in [m]."""
-        return np.asarray(self.target, float) - self.model.frame_position(q, self.frame)
+        return np.asarray(self.target, float) - self.model.frame_position(q, self._frame)
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        jacobian = self.model.frame_jacobian(q, self.frame)[:3]
+        jacobian = self.model.frame_jacobian(q, self._frame)[:3]
         velocity = jacobian @ v
-        desired = self.kp * self.task_error(q) - self.kd * velocity - self.model.frame_bias_acceleration(q, v, self.frame)
+        desired = self.kp * self.task_error(q) - self.kd * velocity - self.model.frame_bias_acceleration(q, v, self._frame)
         gram = jacobian @ jacobian.T + self.damping * np.eye(3)
         pseudo_inverse = jacobian.T @ np.linalg.solve(gram, np.eye(3))
         null_space = np.eye(self.model.nv) - pseudo_inverse @ jacobian

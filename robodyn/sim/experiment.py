@@ -85,18 +85,20 @@ def run_simulation(
         raise InputError("--frame", "given only with the task-space controller", repr(frame))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
     task = None
-    law = None
+    law: PDGravity | ComputedTorque | TaskSpace | None = None
     if controller == "pd":
         law = PDGravity(controller_model(robot), np.asarray(target, float))
     elif controller == "computed-torque":
         law = ComputedTorque(controller_model(robot), quintic_reference(start, np.asarray(target, float), duration / 2))
     elif controller == "task-space":
+        assert target is not None  # checked above
         task = task_target(target)
-        frame = robot.task_frame(frame, "task-space control")
-        _check_reach(robot, frame, task)
-        law = TaskSpace(controller_model(robot), frame, task)
-    if law is not None and controller != "task-space" and np.size(target) != robot.nq:
-        raise InputError("--target", f"{robot.nq} joint values for the {controller} controller", f"{np.size(target)} values")
+        controlled = robot.task_frame(frame, "task-space control")
+        _check_reach(robot, controlled, task)
+        law = TaskSpace(controller_model(robot), controlled, task)
+    given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
+    if controller in ("pd", "computed-torque") and given != robot.nq:
+        raise InputError("--target", f"{robot.nq} joint values for the {controller} controller", f"{given} values")
     began = time.perf_counter()
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
@@ -104,7 +106,9 @@ def run_simulation(
             robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits, engine=engine
         )
     elapsed = time.perf_counter() - began
-    energy = robot.kinetic_energy(trajectory.q, trajectory.v) + robot.potential_energy(trajectory.q)
+    torques = trajectory.tau
+    assert torques is not None  # simulate records the applied torques
+    energy = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v)) + np.atleast_1d(robot.potential_energy(trajectory.q))
     summary: dict = {
         "robot": robot.name,
         "controller": controller,
@@ -118,13 +122,13 @@ def run_simulation(
         "joint_names": list(robot.joint_names),
         "dof_names": _dof_names(robot),
         "final_q": trajectory.q[-1].tolist(),
-        "peak_abs_torque": np.abs(trajectory.tau).max(axis=0).tolist(),
+        "peak_abs_torque": np.abs(torques).max(axis=0).tolist(),
         "torque_units": ["N" if kind == "prismatic" else "N m" for kind in _dof_kinds(robot)],
         "energy_change_J": float(energy[-1] - energy[0]),
     }
     if task is not None:
-        position = robot.frame_position(trajectory.q[-1], frame)
-        summary["frame"] = frame
+        position = robot.frame_position(trajectory.q[-1], controlled)
+        summary["frame"] = controlled
         summary["target_m"] = task.tolist()
         summary["final_position_m"] = position.tolist()
         summary["final_error_m"] = float(np.linalg.norm(position - task))

@@ -132,7 +132,7 @@ class JointLimits:
         found = []
         positions = trajectory.q[:, self._q_start :]
         velocities = trajectory.v[:, self._v_start :]
-        torques = trajectory.tau[:, self._v_start :]
+        torques = np.zeros_like(trajectory.v) if trajectory.tau is None else trajectory.tau[:, self._v_start :]
         for index, joint in enumerate(self.joints):
             unit = units[index]
             for side, limit in (("lower", self.lower[index]), ("upper", self.upper[index])):

@@ -253,7 +253,7 @@ def _simulate_compiled(
             "limits", "'warn' or 'ignore' with engine='compiled' (enforce runs on the Pinocchio engine)", "'enforce'"
         )
     plant = compile(robot)
-    law: object = controller
+    law: CompiledPDGravity | CompiledComputedTorque | Controller | None = controller
     if isinstance(controller, PDGravity):
         law = CompiledPDGravity(compile(controller.model), controller.target, controller.kp, controller.kd)
     elif isinstance(controller, ComputedTorque) and isinstance(controller.reference, QuinticReference):
@@ -270,7 +270,7 @@ def _simulate_compiled(
         integrator=integrator,
         controller=law,
         control_period=control_period,
-        hold=hold,  # type: ignore[arg-type]
+        hold=hold,
     )
     trajectory = Trajectory(run.t, run.q, run.v, run.a, run.tau, list(robot.joint_names), robot.name)
     if limits != "ignore":

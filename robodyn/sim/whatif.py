@@ -76,6 +76,8 @@ def motion_torques(
     q, v, a = (np.array(column) for column in zip(*(reference(t) for t in times), strict=True))
     torques = robot.inverse_dynamics(q, v, a)
     if force is not None and np.any(force):
+        if frame is None:
+            raise InputError("frame", "a frame the force acts on", "None")
         torques = torques - np.array([robot.wrench_torques(qi, frame, force) for qi in q])
     return times, torques
 
@@ -142,15 +144,15 @@ def sweep(
     rows = []
     for material, robot in variants:
         for payload in payloads:
-            loaded = attach_payload(robot, frame, payload) if payload > 0 else robot
+            loaded = attach_payload(robot, frame, payload) if payload > 0 and frame is not None else robot
             for force in forces:
-                force = np.asarray(force, dtype=float)
-                _, torques = motion_torques(loaded, q_start, q_end, duration, frame=frame, force=force)
+                force_vector = np.asarray(force, dtype=float)
+                _, torques = motion_torques(loaded, q_start, q_end, duration, frame=frame, force=force_vector)
                 rows.append(
                     Variant(
                         material,
                         float(payload),
-                        force,
+                        force_vector,
                         loaded.total_mass,
                         np.abs(torques).max(axis=0),
                         np.sqrt((torques**2).mean(axis=0)),

@@ -178,7 +178,7 @@ def check_robot(
     robot = source if isinstance(source, Robot) else load(source, check_inertia=check_inertia)
     model = reference.load(
         robot.urdf if reference_source is None else reference_source,
-        gravity=robot.gravity_vector,
+        gravity=tuple(robot.gravity_vector),
         check_inertia=check_inertia,
         floating_base=robot.floating_base,
     )

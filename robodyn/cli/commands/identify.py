@@ -6,6 +6,7 @@ import argparse
 import json
 
 from robodyn.cli.common import add_model_arguments, lock_values
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -26,7 +27,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 def run(arguments: argparse.Namespace) -> int:
     import robodyn
     from robodyn.common.files import atomic_write_text
-    from robodyn.exceptions import InputError
     from robodyn.ident import base_parameters, identified_urdf, identify
     from robodyn.ident.render import printable, render_base_parameters
     from robodyn.sim.trajectory import Trajectory
@@ -49,7 +49,9 @@ def run(arguments: argparse.Namespace) -> int:
         print(render_base_parameters(base, arguments.format), end="")
         return 0
     data = Trajectory.load(arguments.data).for_robot(robot)
-    result = identify(robot, data, method=arguments.method, base=base)
+    if data.tau is None:
+        raise InputError("DATA", "a trajectory file with tau[<joint>] columns (the measured torques)", repr(arguments.data))
+    result = identify(robot, data, method=arguments.method, base=base)  # type: ignore[arg-type]  # tau checked above
     urdf = identified_urdf(robot, result.standard, base.columns) if arguments.urdf_out and result.standard is not None else None
     width = max(len(printable(name)) for name in base.names)
     print(

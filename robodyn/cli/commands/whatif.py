@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 import robodyn
 from robodyn.cli.common import RANGES, json_text, vector
@@ -39,7 +40,7 @@ def run(arguments: argparse.Namespace) -> int:
     forces = ((0.0, 0.0, 0.0),) + ((tuple(arguments.force),) if arguments.force else ())
     if arguments.force and len(arguments.force) != 3:
         raise InputError("--force", "3 values FX,FY,FZ in [N]", f"{len(arguments.force)} values")
-    options = {"materials": materials, "payloads": tuple(arguments.payloads), "forces": forces}
+    options: dict[str, Any] = {"materials": materials, "payloads": tuple(arguments.payloads), "forces": forces}
     options |= {"duration": arguments.duration, "frame": arguments.frame}
     if arguments.scheduler:
         from robodyn.scale.cluster import connect
