@@ -81,7 +81,10 @@ def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> Newton
     program = _Program()
     zero = sp.zeros(3, 1)
     base_acc = exact_matrix(-robot.gravity_vector[:, None], 0.0)
-    R, t, axis = [None] * count, [None] * count, [None] * count
+    # Every entry is set (parents first) before it is read.
+    R: list[sp.Matrix] = [zero] * count
+    t: list[sp.Matrix] = [zero] * count
+    axis: list[sp.Matrix] = [zero] * count
     w, dw, acc = [zero] * count, [zero] * count, [zero] * count
     for b, body in enumerate(bodies):
         axis[b] = exact_matrix(body.axis[:, None], snap)

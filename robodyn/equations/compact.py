@@ -55,9 +55,9 @@ class CompactDynamics:
     qd: list[sp.Symbol]
     qdd: list[sp.Symbol]
     assignments: list[tuple[sp.Symbol, sp.Expr]] = field(default_factory=list)
-    M: sp.Matrix | None = None
-    Cv: sp.Matrix | None = None
-    G: sp.Matrix | None = None
+    M: sp.Matrix = field(default_factory=sp.Matrix)
+    Cv: sp.Matrix = field(default_factory=sp.Matrix)
+    G: sp.Matrix = field(default_factory=sp.Matrix)
     parameters: dict = field(default_factory=dict)
     labels: dict = field(default_factory=dict)
 
@@ -245,9 +245,10 @@ def derive_compact(
     bodies = tree.bodies
     count = len(bodies)
     zero = sp.zeros(3, 1)
-    R = [None] * count  # parent frame <- body frame
-    t = [None] * count  # body origin in the parent frame
-    axis = [None] * count  # joint axis in the body frame
+    # Every entry is set (parents first) before it is read.
+    R: list[sp.Matrix] = [zero] * count  # parent frame <- body frame
+    t: list[sp.Matrix] = [zero] * count  # body origin in the parent frame
+    axis: list[sp.Matrix] = [zero] * count  # joint axis in the body frame
     w, dw, acc = ([zero] * count for _ in range(3))  # angular velocity, its bias rate, origin's bias acceleration
     gacc = [zero] * count  # the acceleration gravity amounts to, in the body frame
     gravity = -params.gravity(robot.gravity_vector)  # the base "accelerates upwards"

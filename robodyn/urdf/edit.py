@@ -15,6 +15,7 @@ import copy
 import difflib
 import math
 import xml.etree.ElementTree as ET
+from typing import cast
 
 import numpy as np
 
@@ -77,16 +78,16 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
             values[joint.name] = joint.mimic.multiplier * values[joint.mimic.joint] + joint.mimic.offset
     root = copy.deepcopy(spec.xml)
     for node in root.findall("joint"):
-        name = node.get("name")
-        if name not in values:
+        joint_name = node.get("name")
+        if joint_name is None or joint_name not in values:
             continue
-        joint = spec.joints[name]
+        joint = spec.joints[joint_name]
         rotation = rpy_matrix(joint.origin_rpy)
         translation = joint.origin_xyz.copy()
         if joint.type == "prismatic":
-            translation = translation + rotation @ joint.axis * values[name]
+            translation = translation + rotation @ joint.axis * values[joint_name]
         else:
-            rotation = rotation @ _axis_rotation(joint.axis, values[name])
+            rotation = rotation @ _axis_rotation(joint.axis, values[joint_name])
         for child in list(node):
             if child.tag in ("origin", "axis", "limit", "mimic", "dynamics", "safety_controller", "calibration"):
                 node.remove(child)
@@ -106,6 +107,6 @@ def weld_link(spec: URDFSpec, parent: str, link: ET.Element, xyz: str = "0 0 0",
     root.append(link)
     joint = ET.SubElement(root, "joint", name=f"{link.get('name')}_joint", type="fixed")
     ET.SubElement(joint, "parent", link=parent)
-    ET.SubElement(joint, "child", link=link.get("name"))
+    ET.SubElement(joint, "child", link=cast(str, link.get("name")))  # callers build the link with a name
     ET.SubElement(joint, "origin", xyz=xyz, rpy=rpy)
     return ET.tostring(root, encoding="unicode")
