@@ -28,10 +28,10 @@ from __future__ import annotations
 import math
 import warnings
 import xml.etree.ElementTree as ET
-from typing import overload
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import overload
 
 import numpy as np
 
@@ -86,9 +86,7 @@ class _Reader:
         return np.array(values, dtype=float)
 
     @overload
-    def number(
-        self, where: str, node: ET.Element | None, attribute: str, default: float, *, bounded: bool = True
-    ) -> float: ...
+    def number(self, where: str, node: ET.Element | None, attribute: str, default: float, *, bounded: bool = True) -> float: ...
     @overload
     def number(
         self, where: str, node: ET.Element | None, attribute: str, default: None, *, bounded: bool = True
