@@ -20,7 +20,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.symbolic import exact_matrix
+from robodyn.reference.symbolic import axis_rotation, exact_matrix
 
 
 @dataclass
@@ -60,12 +60,6 @@ class _Program:
         return sp.Matrix([self.let(value) for value in values])
 
 
-def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
-    x, y, z = axis
-    skew = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return sp.eye(3) + s * skew + (1 - c) * skew * skew
-
-
 def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> NewtonEuler:
     """``tau(q, q̇, q̈)`` of every body of a reference robot (mimic joints as bodies of their own).
 
@@ -92,7 +86,7 @@ def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> Newton
         translation = exact_matrix(body.origin[:3, 3:], 0.0)
         if body.revolute:
             c, s = program.let(sp.cos(q[b])), program.let(sp.sin(q[b]))
-            R[b] = (rotation * _rotation(axis[b], c, s)).applyfunc(program.let)
+            R[b] = (rotation * axis_rotation(axis[b], c, s)).applyfunc(program.let)
             t[b] = translation
         else:
             R[b] = rotation

@@ -19,31 +19,9 @@ from typing import cast
 
 import numpy as np
 
+from robodyn.common.rotations import axis_rotation, matrix_rpy, rpy_matrix
 from robodyn.exceptions import InputError, quoted
 from robodyn.urdf.validation import URDFSpec
-
-
-def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
-    """Rotation matrix of URDF roll-pitch-yaw angles in [rad] (fixed axes X, Y, Z)."""
-    roll, pitch, yaw = rpy
-    rx = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
-    ry = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]])
-    rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]])
-    return rz @ ry @ rx
-
-
-def _matrix_rpy(rotation: np.ndarray) -> np.ndarray:
-    """Roll, pitch, yaw of a rotation matrix (URDF's fixed-axis X-Y-Z convention)."""
-    pitch = math.atan2(-rotation[2, 0], math.hypot(rotation[0, 0], rotation[1, 0]))
-    if abs(math.cos(pitch)) < 1e-12:  # gimbal lock: put everything in yaw
-        return np.array([0.0, pitch, math.atan2(-rotation[0, 1], rotation[1, 1])])
-    return np.array([math.atan2(rotation[2, 1], rotation[2, 2]), pitch, math.atan2(rotation[1, 0], rotation[0, 0])])
-
-
-def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z = axis
-    skew = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return np.eye(3) + math.sin(angle) * skew + (1 - math.cos(angle)) * skew @ skew
 
 
 def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<string>") -> str:
@@ -87,7 +65,7 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
         if joint.type == "prismatic":
             translation = translation + rotation @ joint.axis * values[joint_name]
         else:
-            rotation = rotation @ _axis_rotation(joint.axis, values[joint_name])
+            rotation = rotation @ axis_rotation(joint.axis, values[joint_name])
         for child in list(node):
             if child.tag in ("origin", "axis", "limit", "mimic", "dynamics", "safety_controller", "calibration"):
                 node.remove(child)
@@ -96,7 +74,7 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
             node,
             "origin",
             xyz=" ".join(repr(float(x)) for x in translation),
-            rpy=" ".join(repr(float(x)) for x in _matrix_rpy(rotation)),
+            rpy=" ".join(repr(float(x)) for x in matrix_rpy(rotation)),
         )
     return ET.tostring(root, encoding="unicode")
 

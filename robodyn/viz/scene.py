@@ -23,10 +23,10 @@ from meshcat.animation import AnimationClip
 from meshcat.commands import SetAnimation, SetObject, SetProperty, SetTransform
 from meshcat.path import Path as MeshcatPath
 
+from robodyn.common.rotations import rpy_matrix
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
-from robodyn.urdf.edit import rpy_matrix
 from robodyn.urdf.meshes import MeshPathError, resolve_mesh
 from robodyn.viz.mesh_files import MAX_MESH_BYTES, MeshFileError, MeshWarning, read_mesh
 
