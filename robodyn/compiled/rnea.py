@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from robodyn.equations.compact import trivial
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import axis_rotation, exact_matrix
 
@@ -46,11 +47,7 @@ class _Program:
 
     def let(self, expr: sp.Expr) -> sp.Expr:
         expr = sp.expand(expr)
-        if (
-            expr.is_Number
-            or expr.is_Symbol
-            or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
-        ):
+        if trivial(expr):
             return expr
         symbol = sp.Symbol(f"r{len(self.assignments)}", real=True)
         self.assignments.append((symbol, expr))

@@ -62,6 +62,15 @@ class CompactDynamics:
     labels: dict = field(default_factory=dict)
 
 
+def trivial(expr: sp.Expr) -> bool:
+    """Whether an expression is not worth a variable: a number, a symbol, or number × symbol."""
+    return bool(
+        expr.is_Number
+        or expr.is_Symbol
+        or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
+    )
+
+
 class _Program:
     """Collects assignments; a variable is made only for a non-trivial expression."""
 
@@ -82,11 +91,7 @@ class _Program:
 
     def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
         expr = self.pythagoras(expr)
-        if (
-            expr.is_Number
-            or expr.is_Symbol
-            or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
-        ):
+        if trivial(expr):
             return expr
         self._counter += 1
         symbol = sp.Symbol(f"{prefix}{self._counter}", real=True)

@@ -79,6 +79,26 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
     return ET.tostring(root, encoding="unicode")
 
 
+def inertial_element(mass: float, com: np.ndarray, inertia: np.ndarray) -> ET.Element:
+    """An ``<inertial>`` element (numbers written to round-trip exactly).
+
+    Args:
+        mass: In [kg].
+        com: Centre of mass in the link frame, shape (3,), in [m].
+        inertia: About the centre of mass, link-frame axes, shape (3, 3), in [kg m²].
+    """
+    element = ET.Element("inertial")
+    ET.SubElement(element, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
+    ET.SubElement(element, "mass", value=repr(float(mass)))
+    ET.SubElement(
+        element,
+        "inertia",
+        ixx=repr(float(inertia[0, 0])), ixy=repr(float(inertia[0, 1])), ixz=repr(float(inertia[0, 2])),
+        iyy=repr(float(inertia[1, 1])), iyz=repr(float(inertia[1, 2])), izz=repr(float(inertia[2, 2])),
+    )  # fmt: skip
+    return element
+
+
 def weld_link(spec: URDFSpec, parent: str, link: ET.Element, xyz: str = "0 0 0", rpy: str = "0 0 0") -> str:
     """URDF text with ``link`` (a ``<link>`` element) welded to ``parent`` by a fixed joint."""
     root = copy.deepcopy(spec.xml)
