@@ -352,7 +352,7 @@ class AmbiguousEndEffectorError(FrameError):
 
     def __init__(self, robot: str, candidates: list[str]):
         self.robot = robot
-        self.frame = None
+        self.frame = ""  # no frame was asked for
         self.candidates = list(candidates)
         self.close = self.candidates
         Exception.__init__(

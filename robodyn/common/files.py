@@ -297,7 +297,8 @@ def _reason(error: OSError) -> str:
         errno.ENOTDIR: "a folder on the path is not a folder",
         errno.EDQUOT: "the disk quota is exceeded",
     }
-    return reasons.get(error.errno, error.strerror or str(error))
+    fallback = error.strerror or str(error)
+    return reasons.get(error.errno, fallback) if error.errno is not None else fallback
 
 
 def _umask() -> int:

@@ -200,6 +200,7 @@ def _import(name: str, path: Path) -> ModuleType:
         return sys.modules[name]
     loader = importlib.machinery.ExtensionFileLoader(name, str(path))
     spec = importlib.util.spec_from_file_location(name, str(path), loader=loader)
+    assert spec is not None  # an explicit loader always yields a spec
     module = importlib.util.module_from_spec(spec)
     loader.exec_module(module)
     sys.modules[name] = module

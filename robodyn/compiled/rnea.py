@@ -19,8 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from robodyn.equations.compact import trivial
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.symbolic import exact_matrix
+from robodyn.reference.symbolic import axis_rotation, exact_matrix
 
 
 @dataclass
@@ -46,11 +47,7 @@ class _Program:
 
     def let(self, expr: sp.Expr) -> sp.Expr:
         expr = sp.expand(expr)
-        if (
-            expr.is_Number
-            or expr.is_Symbol
-            or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
-        ):
+        if trivial(expr):
             return expr
         symbol = sp.Symbol(f"r{len(self.assignments)}", real=True)
         self.assignments.append((symbol, expr))
@@ -58,12 +55,6 @@ class _Program:
 
     def vector(self, values: sp.Matrix) -> sp.Matrix:
         return sp.Matrix([self.let(value) for value in values])
-
-
-def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
-    x, y, z = axis
-    skew = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return sp.eye(3) + s * skew + (1 - c) * skew * skew
 
 
 def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> NewtonEuler:
@@ -81,7 +72,10 @@ def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> Newton
     program = _Program()
     zero = sp.zeros(3, 1)
     base_acc = exact_matrix(-robot.gravity_vector[:, None], 0.0)
-    R, t, axis = [None] * count, [None] * count, [None] * count
+    # Every entry is set (parents first) before it is read.
+    R: list[sp.Matrix] = [zero] * count
+    t: list[sp.Matrix] = [zero] * count
+    axis: list[sp.Matrix] = [zero] * count
     w, dw, acc = [zero] * count, [zero] * count, [zero] * count
     for b, body in enumerate(bodies):
         axis[b] = exact_matrix(body.axis[:, None], snap)
@@ -89,7 +83,7 @@ def derive_newton_euler(robot: ReferenceRobot, *, snap: float = 1e-15) -> Newton
         translation = exact_matrix(body.origin[:3, 3:], 0.0)
         if body.revolute:
             c, s = program.let(sp.cos(q[b])), program.let(sp.sin(q[b]))
-            R[b] = (rotation * _rotation(axis[b], c, s)).applyfunc(program.let)
+            R[b] = (rotation * axis_rotation(axis[b], c, s)).applyfunc(program.let)
             t[b] = translation
         else:
             R[b] = rotation

@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 from types import ModuleType
+from typing import cast
 
 import numpy as np
 
@@ -49,7 +50,8 @@ def _generator_source() -> str:
     """The code that turns a URDF into kernels (part of the key: a change there, by anyone,
     must not reuse kernels generated before it)."""
     modules = (codegen, rnea, compact, reference_tree, reference_symbolic)
-    return "".join(Path(module.__file__).read_text(encoding="utf-8") for module in modules)
+    # cast: these modules are loaded from source files, so __file__ is set
+    return "".join(Path(cast(str, module.__file__)).read_text(encoding="utf-8") for module in modules)
 
 
 def robot_key(robot: Robot) -> str:

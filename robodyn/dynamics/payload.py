@@ -15,7 +15,7 @@ import numpy as np
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import FrameError, InputError
-from robodyn.urdf.edit import weld_link
+from robodyn.urdf.edit import inertial_element, weld_link
 
 
 def attach_payload(
@@ -55,15 +55,7 @@ def attach_payload(
             "com and inertia", "3 finite values and a finite 3×3 matrix", f"shapes {centre.shape} and {inertia.shape}"
         )
     payload_link = ET.Element("link", name=name)
-    inertial = ET.SubElement(payload_link, "inertial")
-    ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(x)) for x in centre), rpy="0 0 0")
-    ET.SubElement(inertial, "mass", value=repr(float(mass)))
-    ET.SubElement(
-        inertial,
-        "inertia",
-        ixx=repr(float(inertia[0, 0])), ixy=repr(float(inertia[0, 1])), ixz=repr(float(inertia[0, 2])),
-        iyy=repr(float(inertia[1, 1])), iyz=repr(float(inertia[1, 2])), izz=repr(float(inertia[2, 2])),
-    )  # fmt: skip
+    payload_link.append(inertial_element(mass, centre, inertia))
     visual = ET.SubElement(payload_link, "visual")
     ET.SubElement(visual, "origin", xyz=" ".join(repr(float(x)) for x in centre), rpy="0 0 0")
     ET.SubElement(ET.SubElement(visual, "geometry"), "sphere", radius="0.03")

@@ -55,11 +55,20 @@ class CompactDynamics:
     qd: list[sp.Symbol]
     qdd: list[sp.Symbol]
     assignments: list[tuple[sp.Symbol, sp.Expr]] = field(default_factory=list)
-    M: sp.Matrix | None = None
-    Cv: sp.Matrix | None = None
-    G: sp.Matrix | None = None
+    M: sp.Matrix = field(default_factory=sp.Matrix)
+    Cv: sp.Matrix = field(default_factory=sp.Matrix)
+    G: sp.Matrix = field(default_factory=sp.Matrix)
     parameters: dict = field(default_factory=dict)
     labels: dict = field(default_factory=dict)
+
+
+def trivial(expr: sp.Expr) -> bool:
+    """Whether an expression is not worth a variable: a number, a symbol, or number × symbol."""
+    return bool(
+        expr.is_Number
+        or expr.is_Symbol
+        or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
+    )
 
 
 class _Program:
@@ -82,11 +91,7 @@ class _Program:
 
     def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
         expr = self.pythagoras(expr)
-        if (
-            expr.is_Number
-            or expr.is_Symbol
-            or (expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol)
-        ):
+        if trivial(expr):
             return expr
         self._counter += 1
         symbol = sp.Symbol(f"{prefix}{self._counter}", real=True)
@@ -245,9 +250,10 @@ def derive_compact(
     bodies = tree.bodies
     count = len(bodies)
     zero = sp.zeros(3, 1)
-    R = [None] * count  # parent frame <- body frame
-    t = [None] * count  # body origin in the parent frame
-    axis = [None] * count  # joint axis in the body frame
+    # Every entry is set (parents first) before it is read.
+    R: list[sp.Matrix] = [zero] * count  # parent frame <- body frame
+    t: list[sp.Matrix] = [zero] * count  # body origin in the parent frame
+    axis: list[sp.Matrix] = [zero] * count  # joint axis in the body frame
     w, dw, acc = ([zero] * count for _ in range(3))  # angular velocity, its bias rate, origin's bias acceleration
     gacc = [zero] * count  # the acceleration gravity amounts to, in the body frame
     gravity = -params.gravity(robot.gravity_vector)  # the base "accelerates upwards"

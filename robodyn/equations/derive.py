@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import sympy as sp
 
@@ -125,7 +126,7 @@ def derive_equations(
             raise DerivationTooExpensiveError(model.name, model.nv, estimate, CLOSED_FORM_LIMIT_S)
     taken: set[str] = set()
     q, qd, qdd = _symbols(model.joint_names, taken)
-    common = {
+    common: dict[str, Any] = {
         "robot": model.name,
         "joint_names": list(model.joint_names),
         "gravity": tuple(float(g) for g in model.gravity_vector),
@@ -183,7 +184,7 @@ def substitute_parameters(equations: EquationsData) -> EquationsData:
     from robodyn.reference.symbolic import exact_number
 
     values = {s: exact_number(v) for s, v in equations.parameters.items()}
-    matrices = {
+    matrices: dict[str, Any] = {
         name: getattr(equations, name).xreplace(values) if getattr(equations, name) is not None else None
         for name in ("M", "Cv", "G", "C")
     }

@@ -18,6 +18,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn import reference
+from robodyn.common.rotations import rpy_matrix
 from robodyn.equations import simplify
 from robodyn.equations.model import numeric
 from robodyn.equations.naming import comment_text, identifier, json_text, latex_text, terminal_text
@@ -46,14 +47,6 @@ class Kinematics:
     position: sp.Matrix
     rotation: sp.Matrix
     jacobian: sp.Matrix
-
-
-def _rpy(rpy: np.ndarray) -> np.ndarray:
-    r, p, y = rpy
-    rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
-    ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
-    rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
-    return rz @ ry @ rx
 
 
 def derive_kinematics(
@@ -85,7 +78,7 @@ def derive_kinematics(
     while link not in carried and link in by_child:
         joint = by_child[link]
         step = np.eye(4)
-        step[:3, :3], step[:3, 3] = _rpy(joint.origin_rpy), joint.origin_xyz
+        step[:3, :3], step[:3, 3] = rpy_matrix(joint.origin_rpy), joint.origin_xyz
         transform = step @ transform
         link = joint.parent
     taken: set[str] = set()

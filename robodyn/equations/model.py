@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from robodyn.common.constants import STANDARD_GRAVITY
+
 
 @dataclass
 class EquationsData:
@@ -45,7 +47,7 @@ class EquationsData:
     C: sp.Matrix | None = None
     parameters: dict[sp.Symbol, float] = field(default_factory=dict)
     labels: dict[sp.Symbol, tuple[str, str, str]] = field(default_factory=dict)
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    gravity: tuple[float, float, float] = STANDARD_GRAVITY
 
     def operation_count(self) -> int:
         """See :func:`operation_count`."""

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from robodyn.equations import render_c, render_json, render_latex, render_python, render_text
 from robodyn.equations.model import EquationsData
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
@@ -24,7 +26,7 @@ def render(equations: EquationsData, format: str = "text", *, precision: int = D
         MissingToolError: For ``"pdf"`` without a TeX engine.
     """
     check_precision(precision)
-    renderers = {
+    renderers: dict[str, Callable[[EquationsData], str | bytes]] = {
         "text": lambda e: render_text.to_text(e, precision=precision),
         "latex": lambda e: render_latex.to_latex(e, precision=precision),
         "pdf": lambda e: render_latex.to_pdf(e, precision=precision),

@@ -97,11 +97,11 @@ def _lines(printer: _Printer, expr: sp.Expr, width: float) -> list[str]:
             inner = max(sums, key=lambda f: len(printer.doprint(f)))
             rest = sp.Mul(*(f for f in expr.args if f is not inner))
             head = "" if rest == 1 else ("-" if rest == -1 else printer.doprint(rest))
-            body = _lines(printer, inner, width - 4)
+            inner_lines = _lines(printer, inner, width - 4)
             return (
-                [rf"{head}\bigl({body[0]}", *body[1:-1], rf"{body[-1]}\bigr)"]
-                if len(body) > 1
-                else [rf"{head}\left({body[0]}\right)"]
+                [rf"{head}\bigl({inner_lines[0]}", *inner_lines[1:-1], rf"{inner_lines[-1]}\bigr)"]
+                if len(inner_lines) > 1
+                else [rf"{head}\left({inner_lines[0]}\right)"]
             )
     return [tex]
 

@@ -20,6 +20,7 @@ from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.regressor import body_links, inertial_parameters
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import IdentificationError
+from robodyn.urdf.edit import inertial_element
 
 #: Masses below this, in [kg], are written as a massless link (no centre of mass).
 MASSLESS = 1e-12
@@ -42,16 +43,7 @@ def _inertial(parameters: np.ndarray) -> ET.Element:
     about_origin = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     com = first / mass if mass > MASSLESS else np.zeros(3)
     about_com = about_origin - mass * (com @ com * np.eye(3) - np.outer(com, com))
-    element = ET.Element("inertial")
-    ET.SubElement(element, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
-    ET.SubElement(element, "mass", value=repr(max(mass, 0.0)))
-    ET.SubElement(
-        element,
-        "inertia",
-        ixx=repr(float(about_com[0, 0])), ixy=repr(float(about_com[0, 1])), ixz=repr(float(about_com[0, 2])),
-        iyy=repr(float(about_com[1, 1])), iyz=repr(float(about_com[1, 2])), izz=repr(float(about_com[2, 2])),
-    )  # fmt: skip
-    return element
+    return inertial_element(max(mass, 0.0), com, about_com)
 
 
 def identified_urdf(robot: Robot, standard: np.ndarray, columns: np.ndarray) -> str:

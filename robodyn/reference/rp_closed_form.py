@@ -17,9 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn.common.constants import STANDARD_GRAVITY_MAGNITUDE
 from robodyn.urdf.models.rp_arm import RPArmParameters
-
-STANDARD_GRAVITY = 9.81
 
 
 def _r2(p: RPArmParameters, q: np.ndarray) -> np.ndarray:
@@ -54,13 +53,15 @@ def coriolis_forces(p: RPArmParameters, q: np.ndarray, v: np.ndarray) -> np.ndar
     return np.stack([2 * h * v[..., 0] * v[..., 1], -h * v[..., 0] ** 2], axis=-1)
 
 
-def gravity(p: RPArmParameters, q: np.ndarray, g: float = STANDARD_GRAVITY) -> np.ndarray:
+def gravity(p: RPArmParameters, q: np.ndarray, g: float = STANDARD_GRAVITY_MAGNITUDE) -> np.ndarray:
     """``G(q)``, shape (2,) or (N, 2)."""
     q = np.asarray(q, float)
     return np.stack([(p.m1 * p.l1 / 2 + p.m2 * _r2(p, q)) * g * np.cos(q[..., 0]), p.m2 * g * np.sin(q[..., 0])], axis=-1)
 
 
-def inverse_dynamics(p: RPArmParameters, q: np.ndarray, v: np.ndarray, a: np.ndarray, g: float = STANDARD_GRAVITY) -> np.ndarray:
+def inverse_dynamics(
+    p: RPArmParameters, q: np.ndarray, v: np.ndarray, a: np.ndarray, g: float = STANDARD_GRAVITY_MAGNITUDE
+) -> np.ndarray:
     """``tau = M(q) a + C(q, v) v + G(q)``, shape (2,) or (N, 2)."""
     a = np.asarray(a, float)
     return np.einsum("...ij,...j->...i", mass_matrix(p, q), a) + coriolis_forces(p, q, v) + gravity(p, q, g)
@@ -72,7 +73,7 @@ def kinetic_energy(p: RPArmParameters, q: np.ndarray, v: np.ndarray) -> np.ndarr
     return 0.5 * np.einsum("...i,...ij,...j->...", v, mass_matrix(p, q), v)
 
 
-def potential_energy(p: RPArmParameters, q: np.ndarray, g: float = STANDARD_GRAVITY) -> np.ndarray:
+def potential_energy(p: RPArmParameters, q: np.ndarray, g: float = STANDARD_GRAVITY_MAGNITUDE) -> np.ndarray:
     """``m1 g (l1/2) sin q1 + m2 g r2 sin q1`` in [J] (zero at the shoulder's height)."""
     q = np.asarray(q, float)
     return (p.m1 * p.l1 / 2 + p.m2 * _r2(p, q)) * g * np.sin(q[..., 0])

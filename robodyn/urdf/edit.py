@@ -15,34 +15,13 @@ import copy
 import difflib
 import math
 import xml.etree.ElementTree as ET
+from typing import cast
 
 import numpy as np
 
+from robodyn.common.rotations import axis_rotation, matrix_rpy, rpy_matrix
 from robodyn.exceptions import InputError, quoted
 from robodyn.urdf.validation import URDFSpec
-
-
-def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
-    """Rotation matrix of URDF roll-pitch-yaw angles in [rad] (fixed axes X, Y, Z)."""
-    roll, pitch, yaw = rpy
-    rx = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
-    ry = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]])
-    rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]])
-    return rz @ ry @ rx
-
-
-def _matrix_rpy(rotation: np.ndarray) -> np.ndarray:
-    """Roll, pitch, yaw of a rotation matrix (URDF's fixed-axis X-Y-Z convention)."""
-    pitch = math.atan2(-rotation[2, 0], math.hypot(rotation[0, 0], rotation[1, 0]))
-    if abs(math.cos(pitch)) < 1e-12:  # gimbal lock: put everything in yaw
-        return np.array([0.0, pitch, math.atan2(-rotation[0, 1], rotation[1, 1])])
-    return np.array([math.atan2(rotation[2, 1], rotation[2, 2]), pitch, math.atan2(rotation[1, 0], rotation[0, 0])])
-
-
-def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z = axis
-    skew = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return np.eye(3) + math.sin(angle) * skew + (1 - math.cos(angle)) * skew @ skew
 
 
 def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<string>") -> str:
@@ -77,16 +56,16 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
             values[joint.name] = joint.mimic.multiplier * values[joint.mimic.joint] + joint.mimic.offset
     root = copy.deepcopy(spec.xml)
     for node in root.findall("joint"):
-        name = node.get("name")
-        if name not in values:
+        joint_name = node.get("name")
+        if joint_name is None or joint_name not in values:
             continue
-        joint = spec.joints[name]
+        joint = spec.joints[joint_name]
         rotation = rpy_matrix(joint.origin_rpy)
         translation = joint.origin_xyz.copy()
         if joint.type == "prismatic":
-            translation = translation + rotation @ joint.axis * values[name]
+            translation = translation + rotation @ joint.axis * values[joint_name]
         else:
-            rotation = rotation @ _axis_rotation(joint.axis, values[name])
+            rotation = rotation @ axis_rotation(joint.axis, values[joint_name])
         for child in list(node):
             if child.tag in ("origin", "axis", "limit", "mimic", "dynamics", "safety_controller", "calibration"):
                 node.remove(child)
@@ -95,9 +74,29 @@ def lock_joints(spec: URDFSpec, positions: dict[str, float], source: str = "<str
             node,
             "origin",
             xyz=" ".join(repr(float(x)) for x in translation),
-            rpy=" ".join(repr(float(x)) for x in _matrix_rpy(rotation)),
+            rpy=" ".join(repr(float(x)) for x in matrix_rpy(rotation)),
         )
     return ET.tostring(root, encoding="unicode")
+
+
+def inertial_element(mass: float, com: np.ndarray, inertia: np.ndarray) -> ET.Element:
+    """An ``<inertial>`` element (numbers written to round-trip exactly).
+
+    Args:
+        mass: In [kg].
+        com: Centre of mass in the link frame, shape (3,), in [m].
+        inertia: About the centre of mass, link-frame axes, shape (3, 3), in [kg m²].
+    """
+    element = ET.Element("inertial")
+    ET.SubElement(element, "origin", xyz=" ".join(repr(float(x)) for x in com), rpy="0 0 0")
+    ET.SubElement(element, "mass", value=repr(float(mass)))
+    ET.SubElement(
+        element,
+        "inertia",
+        ixx=repr(float(inertia[0, 0])), ixy=repr(float(inertia[0, 1])), ixz=repr(float(inertia[0, 2])),
+        iyy=repr(float(inertia[1, 1])), iyz=repr(float(inertia[1, 2])), izz=repr(float(inertia[2, 2])),
+    )  # fmt: skip
+    return element
 
 
 def weld_link(spec: URDFSpec, parent: str, link: ET.Element, xyz: str = "0 0 0", rpy: str = "0 0 0") -> str:
@@ -106,6 +105,6 @@ def weld_link(spec: URDFSpec, parent: str, link: ET.Element, xyz: str = "0 0 0",
     root.append(link)
     joint = ET.SubElement(root, "joint", name=f"{link.get('name')}_joint", type="fixed")
     ET.SubElement(joint, "parent", link=parent)
-    ET.SubElement(joint, "child", link=link.get("name"))
+    ET.SubElement(joint, "child", link=cast(str, link.get("name")))  # callers build the link with a name
     ET.SubElement(joint, "origin", xyz=xyz, rpy=rpy)
     return ET.tostring(root, encoding="unicode")

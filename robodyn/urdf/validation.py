@@ -31,6 +31,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import overload
 
 import numpy as np
 
@@ -68,9 +69,10 @@ class _Reader:
     def floats(self, where: str, node: ET.Element | None, attribute: str, default: str) -> np.ndarray:
         text = default if node is None else node.get(attribute, default)
         fallback = _DEFAULTS.setdefault(default, tuple(float(token) for token in default.split()))
-        values = [parse_number(token) for token in split_numbers(text)]
+        parsed = [parse_number(token) for token in split_numbers(text)]
+        values = [value for value in parsed if value is not None]
         problem = None
-        if any(value is None for value in values):
+        if len(values) != len(parsed):
             problem = "is not a list of numbers"
         elif len(values) != len(fallback):
             problem = f"must have {len(fallback)} numbers"
@@ -83,12 +85,18 @@ class _Reader:
             values = list(fallback)
         return np.array(values, dtype=float)
 
+    @overload
+    def number(self, where: str, node: ET.Element | None, attribute: str, default: float, *, bounded: bool = True) -> float: ...
+    @overload
+    def number(
+        self, where: str, node: ET.Element | None, attribute: str, default: None, *, bounded: bool = True
+    ) -> float | None: ...
     def number(
         self, where: str, node: ET.Element | None, attribute: str, default: float | None, *, bounded: bool = True
     ) -> float | None:
-        if node is None or node.get(attribute) is None:
+        text = None if node is None else node.get(attribute)
+        if text is None:
             return default
-        text = node.get(attribute)
         value = parse_number(text)
         if value is None or math.isnan(value):
             self.error(where, f"{attribute}={quoted(text)} is not a number")
@@ -148,7 +156,9 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
         reader.error(where, f"{joint_type} joints inside a URDF are not supported (use floating_base=True for a free root)")
         return None
     parent, child = node.find("parent"), node.find("child")
-    if parent is None or parent.get("link") is None or child is None or child.get("link") is None:
+    parent_link = None if parent is None else parent.get("link")
+    child_link = None if child is None else child.get("link")
+    if parent_link is None or child_link is None:
         reader.error(where, "needs <parent link=...> and <child link=...>")
         return None
     origin = node.find("origin")
@@ -197,7 +207,7 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
             reader.error(where, "mimic multiplier and offset must be finite")
             return None
     return JointSpec(
-        name, joint_type, parent.get("link"), child.get("link"), xyz, rpy, axis,
+        name, joint_type, parent_link, child_link, xyz, rpy, axis,
         lower, upper, effort, velocity, mimic,
     )  # fmt: skip
 
@@ -337,7 +347,7 @@ def lint_urdf(
     if strict:
         reader.problems = [Problem(problem.element, problem.rule) if problem.loud else problem for problem in reader.problems]
     errors = [problem for problem in reader.problems if problem.severity == "error"]
-    spec = None if errors else URDFSpec(root.get("name", "robot"), tree_root, links, joints, root)
+    spec = None if errors or tree_root is None else URDFSpec(root.get("name", "robot"), tree_root, links, joints, root)
     return spec, reader.problems
 
 

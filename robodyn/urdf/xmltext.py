@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from typing import cast
 
 from robodyn.exceptions import URDFError
 
@@ -30,12 +31,15 @@ def parse_xml(text: str, source: str) -> ET.Element:
     if _FORBIDDEN_XML.search(text):
         raise URDFError(source, "DOCTYPE and entity declarations are not allowed in a URDF")
     text = text.lstrip(" \t\r\n\ufeff")
-    parser = ET.XMLPullParser(events=("start", "end"))
-    depth, root = 0, None
+    parser: ET.XMLPullParser[ET.Element] = ET.XMLPullParser(events=("start", "end"))
+    depth = 0
+    root: ET.Element | None = None
     try:
         for start in range(0, max(len(text), 1), 1 << 16):
             parser.feed(text[start : start + (1 << 16)])
-            for event, element in parser.read_events():
+            for item in parser.read_events():
+                # only "start"/"end" events were asked for: each is an (event, Element) pair
+                event, element = cast("tuple[str, ET.Element]", item)
                 depth += 1 if event == "start" else -1
                 root = element if root is None else root
                 if depth > MAX_XML_DEPTH:
@@ -43,6 +47,7 @@ def parse_xml(text: str, source: str) -> ET.Element:
         parser.close()
     except ET.ParseError as error:
         raise URDFError(source, f"not well-formed XML ({error})") from None
+    assert root is not None  # parser.close() refuses a document without an element
     if root.tag != "robot":
         raise URDFError(source, f"the root element must be <robot>, not <{root.tag}>")
     return root

@@ -16,6 +16,9 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Callable
+from types import FrameType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import umsgpack
@@ -23,6 +26,12 @@ import umsgpack
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
+
+if TYPE_CHECKING:
+    import zmq
+
+#: What ``signal.signal`` takes and returns.
+_Handler = Callable[[int, FrameType | None], Any] | int | signal.Handlers | None
 
 #: Signals that end a live session normally (the server is stopped, exit status 0).
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
@@ -47,9 +56,9 @@ class LiveViewer:
 
     def __init__(self) -> None:
         self._process: subprocess.Popen | None = None
-        self._socket = None
-        self._context = None
-        self._previous: dict[int, object] = {}
+        self._socket: zmq.Socket | None = None
+        self._context: zmq.Context | None = None
+        self._previous: dict[int, _Handler] = {}
         self.url = ""
 
     def __enter__(self) -> LiveViewer:
@@ -57,22 +66,23 @@ class LiveViewer:
 
         web_port, zmq_port = _free_port(), _free_port()
         zmq_url = f"tcp://127.0.0.1:{zmq_port}"
-        self._process = subprocess.Popen(
+        self._process = process = subprocess.Popen(
             [sys.executable, "-m", "robodyn.viz.server", zmq_url, str(web_port), str(os.getpid())],
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             stdin=subprocess.DEVNULL,
             start_new_session=True,  # its own process group: a terminal's signals reach robodyn only
         )
-        line = self._process.stdout.readline().decode().strip()
+        assert process.stdout is not None  # stdout=PIPE
+        line = process.stdout.readline().decode().strip()
         if not line.startswith("web_url="):
             self.close()
             raise RobodynError("the meshcat server did not start.")
         self.url = line.removeprefix("web_url=")
-        self._context = zmq.Context()
-        self._socket = self._context.socket(zmq.REQ)
-        self._socket.setsockopt(zmq.LINGER, 0)
-        self._socket.connect(zmq_url)
+        self._context = context = zmq.Context()
+        self._socket = requests = context.socket(zmq.REQ)
+        requests.setsockopt(zmq.LINGER, 0)
+        requests.connect(zmq_url)
         for number in STOP_SIGNALS:
             self._previous[number] = signal.signal(number, _raise_interrupt)
         return self
@@ -85,7 +95,7 @@ class LiveViewer:
         for number, handler in self._previous.items():
             signal.signal(number, handler)
         self._previous = {}
-        if self._socket is not None:
+        if self._socket is not None and self._context is not None:  # set together
             self._socket.close()
             self._context.term()
             self._socket = self._context = None

@@ -22,6 +22,7 @@ import io
 import os
 import stat
 from pathlib import Path
+from typing import cast
 
 import meshcat.geometry as mg
 import numpy as np
@@ -108,7 +109,8 @@ def _bounds(data: bytes, kind: str, path: Path) -> np.ndarray:
 
     logging.getLogger("trimesh").setLevel(logging.ERROR)
     try:
-        mesh = trimesh.load(io.BytesIO(data), file_type=kind, force="mesh")
+        # force="mesh" makes the Geometry trimesh.load is typed to return a Trimesh
+        mesh = cast("trimesh.Trimesh", trimesh.load(io.BytesIO(data), file_type=kind, force="mesh"))
         vertices = np.asarray(mesh.vertices, dtype=float)
     except Exception as error:  # trimesh and its parsers raise many kinds
         raise MeshFileError(path, f"is not a valid {kind.upper()} file ({type(error).__name__})") from None

@@ -23,9 +23,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 from matplotlib.transforms import Bbox
 
 from robodyn.common.files import atomic_write_bytes
@@ -49,8 +51,8 @@ def new_figure(width: float, height: float) -> Figure:
     return figure
 
 
-def save_png(figure: Figure, path: str | Path) -> Path:
-    """Write a figure as PNG, atomically."""
+def save_png(figure: Figure, path: str | Path) -> Path | None:
+    """Write a figure as PNG, atomically; the file written, ``None`` for standard output (``-``)."""
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     return atomic_write_bytes(path, buffer.getvalue())
@@ -181,7 +183,8 @@ def simulation_figure(
         effort = ylabel.startswith(("torque", "force"))
         data, limits = [], []
         for dof in group:
-            column = trajectory.tau[:, dof.v_column] if effort else trajectory.q[:, dof.q_column]
+            torques = trajectory.tau if trajectory.tau is not None else np.zeros_like(trajectory.v)
+            column = torques[:, dof.v_column] if effort else trajectory.q[:, dof.q_column]
             axis.plot(t, column, color=colors[dof.name], label=text_label(dof.name), linewidth=1.3)
             low, high = (-dof.effort, dof.effort) if effort else (dof.lower, dof.upper)
             _band(axis, low, high, colors[dof.name], min(0.07, 0.2 / len(group)))
@@ -196,7 +199,7 @@ def simulation_figure(
         axis.set_ylabel(ylabel)
         axis.grid(alpha=0.3)
     row = len(panels)
-    if task:
+    if frame is not None and target is not None:  # the task panel
         error = np.linalg.norm(robot.frame_position(trajectory.q, frame) - np.asarray(target, dtype=float), axis=1)
         axes[row].semilogy(t, np.maximum(error, 1e-16), color="tab:red", label=f"|{text_label(frame)} − target|")
         axes[row].set_ylabel("distance [m]")
@@ -224,8 +227,8 @@ def simulation_figure(
 
 def plot_simulation(
     robot: Robot, trajectory: Trajectory, path: str | Path, *, frame: str | None = None, target: np.ndarray | None = None
-) -> Path:
-    """Write :func:`simulation_figure` as a PNG (atomically) and return its path."""
+) -> Path | None:
+    """Write :func:`simulation_figure` as a PNG (atomically) and return its path (``None`` for ``-``)."""
     return save_png(simulation_figure(robot, trajectory, frame=frame, target=target), path)
 
 
@@ -281,8 +284,8 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
     return figure
 
 
-def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path, **options) -> Path:
-    """Write :func:`whatif_figure` as a PNG (atomically) and return its path."""
+def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path, **options) -> Path | None:
+    """Write :func:`whatif_figure` as a PNG (atomically) and return its path (``None`` for ``-``)."""
     return save_png(whatif_figure(rows, joint_names, units, **options), path)
 
 
@@ -302,11 +305,10 @@ def _visible_ticks(axis) -> list:
 
 def text_boxes(figure: Figure) -> list[tuple[str, Bbox]]:
     """Every visible text and legend of a figure with its box in display pixels (draws it)."""
-    if not isinstance(figure.canvas, FigureCanvasAgg):
-        FigureCanvasAgg(figure)
-    figure.canvas.draw()
-    renderer = figure.canvas.get_renderer()
-    boxes: list[tuple[str, object]] = []
+    canvas = figure.canvas if isinstance(figure.canvas, FigureCanvasAgg) else FigureCanvasAgg(figure)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    boxes: list[tuple[str, Artist]] = []
     for number, axis in enumerate(figure.axes):
         if not axis.get_visible():
             continue
@@ -321,12 +323,15 @@ def text_boxes(figure: Figure) -> list[tuple[str, Bbox]]:
         texts += [("x tick", label) for label in _visible_ticks(axis.xaxis)]
         texts += [("y tick", label) for label in _visible_ticks(axis.yaxis)]
         boxes += [(f"axes {number} {kind} {artist.get_text()!r}", artist) for kind, artist in texts]
-        if axis.get_legend() is not None:
-            boxes.append((f"axes {number} legend", axis.get_legend()))
+        legend = axis.get_legend()
+        if legend is not None:
+            boxes.append((f"axes {number} legend", legend))
     boxes += [(f"figure legend {i}", legend) for i, legend in enumerate(figure.legends)]
-    boxes += [(f"figure text {text.get_text()!r}", text) for text in figure.texts if text is not figure._suptitle]
-    if figure._suptitle is not None:
-        boxes.append((f"suptitle {figure._suptitle.get_text()!r}", figure._suptitle))
+    # Figure._suptitle (private, not in the stubs) is the Text that suptitle() made
+    suptitle: Text | None = getattr(figure, "_suptitle", None)
+    boxes += [(f"figure text {text.get_text()!r}", text) for text in figure.texts if text is not suptitle]
+    if suptitle is not None:
+        boxes.append((f"suptitle {suptitle.get_text()!r}", suptitle))
     found = []
     for name, artist in boxes:
         if artist.get_visible() and (not hasattr(artist, "get_text") or artist.get_text()):

@@ -102,8 +102,8 @@ class Recording:
     robot: str
     placeholders: list[str]
 
-    def save(self, path: str | os.PathLike) -> Path:
-        """Write the page (atomically) and return its path."""
+    def save(self, path: str | os.PathLike) -> Path | None:
+        """Write the page (atomically) and return its path (``None`` for standard output, ``-``)."""
         return atomic_write_text(path, self.html)
 
     def _repr_html_(self) -> str:
@@ -113,14 +113,14 @@ class Recording:
             'style="width: 100%; height: 480px; border: 0;" sandbox="allow-scripts"></iframe>'
         )
 
-    def still(self, png: str | os.PathLike, *, at: float = 0.0, size: tuple[int, int] = (800, 600)) -> Path:
-        """A PNG of the frame at ``at`` seconds (headless Chromium)."""
+    def still(self, png: str | os.PathLike, *, at: float = 0.0, size: tuple[int, int] = (800, 600)) -> Path | None:
+        """A PNG of the frame at ``at`` seconds (headless Chromium); ``None`` for ``-``."""
         from robodyn.viz.stills import still_of_page
 
         return still_of_page(self.html, png, at=self._time(at), size=size)
 
-    def filmstrip(self, png: str | os.PathLike, count: int, *, size: tuple[int, int] = (480, 360)) -> Path:
-        """``count`` frames evenly spread over the motion, side by side in one PNG."""
+    def filmstrip(self, png: str | os.PathLike, count: int, *, size: tuple[int, int] = (480, 360)) -> Path | None:
+        """``count`` frames evenly spread over the motion, side by side in one PNG; ``None`` for ``-``."""
         from robodyn.viz.stills import filmstrip_of_page
 
         return filmstrip_of_page(self.html, png, self.duration, count, size=size)
@@ -246,7 +246,7 @@ def record(
     frame: str | None = None,
     axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
-) -> Path:
+) -> Path | None:
     """Write a self-contained HTML animation of a trajectory (plays on open).
 
     Args:
@@ -262,7 +262,7 @@ def record(
         max_mesh_bytes: Largest mesh file drawn (see :mod:`robodyn.viz.mesh_files`).
 
     Returns:
-        The HTML path.
+        The HTML path (``None`` for standard output, ``-``).
 
     Raises:
         RobodynError: If the trajectory is empty or does not fit the robot, or the still

@@ -14,6 +14,7 @@ from __future__ import annotations
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
+from typing import cast
 
 import meshcat.geometry as mg
 import numpy as np
@@ -22,10 +23,10 @@ from meshcat.animation import AnimationClip
 from meshcat.commands import SetAnimation, SetObject, SetProperty, SetTransform
 from meshcat.path import Path as MeshcatPath
 
+from robodyn.common.rotations import rpy_matrix
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import RobodynError
 from robodyn.sim.simulation import Trajectory
-from robodyn.urdf.edit import rpy_matrix
 from robodyn.urdf.meshes import MeshPathError, resolve_mesh
 from robodyn.viz.mesh_files import MAX_MESH_BYTES, MeshFileError, MeshWarning, read_mesh
 
@@ -63,8 +64,9 @@ def _color(visual: ET.Element, materials: dict[str, int]) -> int:
     if material is None:
         return DEFAULT_COLOR
     color = material.find("color")
-    if color is not None and color.get("rgba"):
-        return _rgb(color.get("rgba"))
+    rgba = None if color is None else color.get("rgba")
+    if rgba:
+        return _rgb(rgba)
     return materials.get(material.get("name", ""), DEFAULT_COLOR)
 
 
@@ -138,11 +140,12 @@ def build_scene(robot: Robot, *, max_mesh_bytes: int = MAX_MESH_BYTES) -> Scene:
     materials = {}
     for material in root.findall("material"):
         color = material.find("color")
-        if color is not None and color.get("rgba"):
-            materials[material.get("name", "")] = _rgb(color.get("rgba"))
+        rgba = None if color is None else color.get("rgba")
+        if rgba:
+            materials[material.get("name", "")] = _rgb(rgba)
     scene = Scene()
     for link in root.findall("link"):
-        name = link.get("name")
+        name = cast(str, link.get("name"))  # the strict reader refused nameless links
         corners = []
         for index, visual in enumerate(link.findall("visual")):
             result = _geometry(visual, robot, scene, name, max_mesh_bytes)
@@ -152,10 +155,10 @@ def build_scene(robot: Robot, *, max_mesh_bytes: int = MAX_MESH_BYTES) -> Scene:
             placeholder = len(result) == 4
             origin = visual.find("origin")
             offset = _transform(_floats(origin, "xyz", "0 0 0"), _floats(origin, "rpy", "0 0 0"))
-            color = PLACEHOLDER_COLOR if placeholder else _color(visual, materials)
-            material = mg.MeshLambertMaterial(color=color, wireframe=placeholder)
+            rgb = PLACEHOLDER_COLOR if placeholder else _color(visual, materials)
+            lambert = mg.MeshLambertMaterial(color=rgb, wireframe=placeholder)
             path = _path(name, f"visual{index}")
-            scene.commands.append(SetObject(geometry, material, path=path).lower())
+            scene.commands.append(SetObject(geometry, lambert, path=path).lower())
             scene.commands.append(SetTransform(offset @ extra, path=path).lower())
             local = _box_corners(*box) @ offset[:3, :3].T + offset[:3, 3]
             corners.append(local)

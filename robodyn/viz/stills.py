@@ -24,6 +24,7 @@ import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -152,15 +153,16 @@ def _png(image: np.ndarray) -> bytes:
     return buffer.getvalue()
 
 
-def still_of_page(page: str | os.PathLike, png: str | os.PathLike, *, at: float = 0.0, size=(800, 600)) -> Path:
-    """A PNG of the recording's frame at ``at`` seconds (written atomically)."""
+def still_of_page(page: str | os.PathLike, png: str | os.PathLike, *, at: float = 0.0, size=(800, 600)) -> Path | None:
+    """A PNG of the recording's frame at ``at`` seconds (written atomically; ``None`` for ``-``)."""
     return atomic_write_bytes(png, _png(capture(page, [at], size=size)[0]))
 
 
 def screenshot(
     html: str | os.PathLike, png: str | os.PathLike, *, at_seconds: float = 0.0, size: tuple[int, int] = (800, 600)
-) -> Path:
-    """A PNG of an HTML recording ``at_seconds`` into its animation (headless Chromium)."""
+) -> Path | None:
+    """A PNG of an HTML recording ``at_seconds`` into its animation (headless Chromium);
+    the file written, ``None`` for standard output (``-``)."""
     return still_of_page(Path(html), png, at=at_seconds, size=size)
 
 
@@ -173,9 +175,9 @@ def evenly(duration: float, count: int) -> list[float]:
 
 def filmstrip_of_page(
     page: str | os.PathLike, png: str | os.PathLike, duration: float, count: int, *, size=(480, 360), columns: int = 6
-) -> Path:
+) -> Path | None:
     """``count`` frames evenly over the motion, side by side (rows of ``columns``), each
-    labelled with its time."""
+    labelled with its time; the file written, ``None`` for standard output (``-``)."""
     from PIL import Image, ImageDraw
 
     times = evenly(duration, count)
@@ -240,5 +242,7 @@ def video_of_page(
                 for frame in frames:
                     writer.append_data(frame)
         else:
-            imageio.mimsave(scratch, frames, duration=1000.0 / fps, loop=0)
-        return atomic_write_bytes(path, scratch.read_bytes())
+            # the stub asks for an (invariant) list of ArrayLike; a list of arrays is one
+            imageio.mimsave(scratch, frames, duration=1000.0 / fps, loop=0)  # type: ignore[arg-type]
+        written = atomic_write_bytes(path, scratch.read_bytes())
+    return cast(Path, written)  # never None: the extension check refused "-"

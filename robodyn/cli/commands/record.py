@@ -67,9 +67,11 @@ def run(arguments: argparse.Namespace) -> int:
     for path in videos:
         made.video(path, fps=arguments.video_fps)
     path = made.save(arguments.out)
+    size = f"{len(made.html.encode()) / 1e6:.2f} MB"
     print(
-        f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB, {made.duration:.3g} s at {arguments.fps:g} fps, "
-        f"{time.perf_counter() - started:.2f} s)"
+        f"wrote {path or 'standard output'} ({size}, {made.duration:.3g} s at {arguments.fps:g} fps, "
+        f"{time.perf_counter() - started:.2f} s)",
+        file=sys.stderr if path is None else sys.stdout,
     )
     for extra in ([arguments.png] if arguments.png else []) + videos:
         print(f"wrote {extra}")

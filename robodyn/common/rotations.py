@@ -1,0 +1,62 @@
+"""Rotation helpers in plain numpy (URDF roll-pitch-yaw, cross-product matrices, Rodrigues).
+
+The one copy for the code that does not use Pinocchio: the URDF edits, the viewer, the
+equations and the reference. Angles in [rad].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
+    """Rotation matrix of URDF roll-pitch-yaw angles in [rad] (fixed axes X, Y, Z).
+
+    Args:
+        rpy: Roll, pitch, yaw, shape (3,), in [rad].
+
+    Returns:
+        ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``, shape (3, 3).
+    """
+    roll, pitch, yaw = rpy
+    rx = np.array([[1, 0, 0], [0, math.cos(roll), -math.sin(roll)], [0, math.sin(roll), math.cos(roll)]])
+    ry = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]])
+    rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def matrix_rpy(rotation: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw in [rad] of a rotation matrix (URDF's fixed-axis X-Y-Z convention).
+
+    Args:
+        rotation: A rotation matrix, shape (3, 3).
+
+    Returns:
+        Shape (3,); at gimbal lock (pitch ±90°) the roll is 0 and everything is in yaw.
+    """
+    pitch = math.atan2(-rotation[2, 0], math.hypot(rotation[0, 0], rotation[1, 0]))
+    if abs(math.cos(pitch)) < 1e-12:  # gimbal lock: put everything in yaw
+        return np.array([0.0, pitch, math.atan2(-rotation[0, 1], rotation[1, 1])])
+    return np.array([math.atan2(rotation[2, 1], rotation[2, 2]), pitch, math.atan2(rotation[1, 0], rotation[0, 0])])
+
+
+def skew(vectors: np.ndarray) -> np.ndarray:
+    """Cross-product matrices: ``skew(v) @ w == cross(v, w)``.
+
+    Args:
+        vectors: Shape (..., 3).
+
+    Returns:
+        Shape (..., 3, 3).
+    """
+    x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
+    zero = np.zeros_like(x)
+    return np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)], -2)
+
+
+def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues' rotation by ``angle`` in [rad] about a unit ``axis`` (shape (3,)); shape (3, 3)."""
+    cross = skew(np.asarray(axis, dtype=float))
+    return np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
