@@ -45,6 +45,7 @@ demo: $(STAMP) chromium
 test: $(STAMP) chromium tex
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/lint-imports
+	$(BIN)/mypy
 	$(BIN)/python -m pytest -m "not slow"
 	$(BIN)/python -m pytest -m slow
 
@@ -55,6 +56,7 @@ lint: $(STAMP)
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/ruff format --check robodyn tests scripts
 	$(BIN)/lint-imports
+	$(BIN)/mypy
 
 # MuJoCo is the simulation reference of the benchmarks only (requirements-bench.lock).
 bench: $(STAMP)

@@ -18,13 +18,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.tree import KinematicTree, build_tree
 from robodyn.urdf.sources import locked_source, resolve_source
 from robodyn.urdf.validation import parse_urdf
-
-STANDARD_GRAVITY = (0.0, 0.0, -9.81)
 
 
 def load(

@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from robodyn.common.inputs import as_states
+from robodyn.common.rotations import skew
 from robodyn.reference.tree import KinematicTree
 from robodyn.urdf.validation import URDFSpec
 
@@ -37,13 +38,6 @@ CHUNK = 256
 #: Bound on the entries of the largest intermediate array (the derivative of the body
 #: Jacobians: bodies × joints² × 3 a state), which sets the chunk for large robots.
 MAX_CHUNK_ENTRIES = 4_000_000
-
-
-def _skew(vectors: np.ndarray) -> np.ndarray:
-    """Cross-product matrices of vectors, shape (..., 3) -> (..., 3, 3)."""
-    x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
-    zero = np.zeros_like(x)
-    return np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)], -2)
 
 
 def _quaternion_matrix(quaternion: np.ndarray) -> np.ndarray:
@@ -111,7 +105,7 @@ class ReferenceRobot:
         self._masses = np.array([body.mass for body in bodies])
         self._coms = np.array([body.com for body in bodies]).reshape(-1, 3)
         self._inertias = np.array([body.inertia for body in bodies]).reshape(-1, 3, 3)
-        self._axis_skews = _skew(self._axes)
+        self._axis_skews = skew(self._axes)
         ancestors = tree.ancestors
         # dJ[b, i]/dθ_k = z_k × J[b, i] where k is i or an ancestor of i, and revolute.
         self._mask_rotating = ancestors & self._revolute[None, :]
@@ -208,7 +202,7 @@ class ReferenceRobot:
             axes[:, None, :, None, :], linear[:, :, None, :, :]
         )
         d_angular = rotating * np.cross(z_k, angular[:, :, :, None, :])
-        spin = _skew(axes)  # (N, K, 3, 3)
+        spin = skew(axes)  # (N, K, 3, 3)
         moving = (self.tree.ancestors & self._revolute[None, :])[None, :, :, None, None]  # (1, B, K, 1, 1)
         d_inertia = moving * (spin[:, None] @ world_inertia[:, :, None] - world_inertia[:, :, None] @ spin[:, None])
         inertia_angular = world_inertia @ np.swapaxes(angular, -1, -2)  # (N, B, 3, n)
