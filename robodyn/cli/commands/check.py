@@ -29,6 +29,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    from robodyn.common.text import printable_lines
     from robodyn.verify.check import check_robot, report_dict, report_text
 
     robot = load_robot(arguments)
@@ -39,5 +40,5 @@ def run(arguments: argparse.Namespace) -> int:
         tolerance=arguments.tolerance,
         check_inertia=arguments.check_inertia,
     )
-    print(json_text(report_dict(report)) if arguments.json else report_text(report))
+    print(json_text(report_dict(report)) if arguments.json else printable_lines(report_text(report)))
     return 0 if report.passed else 1

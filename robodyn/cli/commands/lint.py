@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from robodyn.exceptions import printable
+
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
@@ -37,6 +39,7 @@ def run(arguments: argparse.Namespace) -> int:
         for problem in problems:
             print(f"{problem.severity}: {problem}")
         print(
-            f"{arguments.model if len(arguments.model) < 80 else '<URDF text>'}: {errors} errors, {len(problems) - errors} warnings"
+            f"{printable(arguments.model) if len(arguments.model) < 80 else '<URDF text>'}: {errors} errors, "
+            f"{len(problems) - errors} warnings"
         )
     return 1 if errors else 0
