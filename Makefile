@@ -27,9 +27,9 @@ chromium:
 # pdflatex compiles the equations' LaTeX (--format pdf, and the slow tier's typesetting
 # test). Debian's TeX Live, installed when missing and we may (root with apt).
 tex:
-	@command -v pdflatex >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
+	@command -v pdflatex >/dev/null 2>&1 && command -v pdftoppm >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
 		(apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-			texlive-latex-base texlive-latex-extra >/dev/null) || \
+			texlive-latex-base texlive-latex-extra poppler-utils >/dev/null) || \
 		echo "note: no pdflatex (install Debian's texlive-latex-base for --format pdf and the typesetting test)"; }
 
 # The main job on the built-in robot: the RP arm's equations, then the lecture's control
