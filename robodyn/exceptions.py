@@ -396,3 +396,73 @@ class ControllerFailedError(SimulationError):
             f"simulation stopped at t = {time:.6g} s (step {step}): the controller failed ({reason}) "
             f"with joint {joint!r} at speed {speed:.3g}; try a smaller dt or gentler gains.",
         )
+
+
+class MeshPathError(RobodynError, ValueError):
+    """A mesh path that leaves the model's folders, or is not a regular file.
+
+    Attributes:
+        filename: The mesh path as the URDF writes it.
+        reason: Why it is refused.
+    """
+
+    def __init__(self, filename: str, reason: str):
+        self.filename = filename
+        self.reason = reason
+        super().__init__(f"mesh {quoted(filename)} {reason}")
+
+
+class MeshFileError(RobodynError):
+    """A mesh file that cannot be drawn (not a regular file, too large, corrupt).
+
+    Attributes:
+        path: The mesh file.
+        reason: Why it cannot be drawn.
+    """
+
+    def __init__(self, path: object, reason: str):
+        self.path = path
+        self.reason = reason
+        super().__init__(f"mesh {quoted(str(path))} {reason}")
+
+
+class MeshWarning(RobodynWarning):
+    """A mesh replaced by a placeholder in a drawing."""
+
+
+class ViewerError(RobodynError):
+    """Viewing failed or was refused: a recording, a still or video, the browser, the live viewer.
+
+    Attributes:
+        reason: What went wrong, with the offending values.
+    """
+
+    def __init__(self, reason: str):
+        self.reason = reason
+        super().__init__(reason)
+
+
+class SchedulerError(RobodynError):
+    """A Dask scheduler that cannot be used (Dask missing, address unreachable).
+
+    Attributes:
+        scheduler: The address or ``local:N`` given.
+        reason: Why.
+    """
+
+    def __init__(self, scheduler: str, reason: str):
+        self.scheduler = scheduler
+        self.reason = reason
+        super().__init__(f"--scheduler {quoted(scheduler)}: {reason}.")
+
+
+class TypesettingError(RobodynError):
+    """The TeX engine refused a document robodyn wrote.
+
+    Attributes:
+        reason: The engine's first error line.
+    """
+
+    def __init__(self, reason: str):
+        self.reason = reason
+        super().__init__(f"pdflatex failed on the equations: {reason}")

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn.exceptions import MeshFileError, MeshWarning
 from robodyn.sim.simulation import Trajectory
-from robodyn.viz.mesh_files import MeshFileError, MeshWarning, read_mesh
+from robodyn.viz.mesh_files import read_mesh
 from robodyn.viz.recording import recording
 from tests.conftest import ROOT
 from tests.test_viewer import commands_of

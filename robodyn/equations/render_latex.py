@@ -22,7 +22,7 @@ from sympy.printing.latex import LatexPrinter
 from robodyn.equations.model import EquationsData, numeric
 from robodyn.equations.naming import latex_text
 from robodyn.equations.printing import format_float
-from robodyn.exceptions import MissingToolError, RobodynError
+from robodyn.exceptions import MissingToolError, TypesettingError
 
 #: Width of a display line, in characters of typeset math (A4, 2 cm margins, 10 pt).
 LINE_WIDTH = 72
@@ -193,7 +193,7 @@ def compile_latex(tex: str, folder: Path) -> tuple[Path, str]:
     log = (folder / "equations.log").read_text(errors="replace") if (folder / "equations.log").exists() else result.stdout
     if result.returncode != 0 or not (folder / "equations.pdf").exists():
         first = next((line for line in log.splitlines() if line.startswith("!")), "unknown error")
-        raise RobodynError(f"pdflatex failed on the equations: {first[:200]}")
+        raise TypesettingError(first[:200])
     return folder / "equations.pdf", log
 
 

@@ -8,7 +8,7 @@ import contextlib
 import re
 from collections.abc import Iterator
 
-from robodyn.exceptions import InputError, RobodynError
+from robodyn.exceptions import InputError, MissingExtraError, SchedulerError
 
 _LOCAL = re.compile(r"^local:(\d+)$")
 #: Largest N of ``local:N`` (each worker is a process).
@@ -42,7 +42,7 @@ def connect(scheduler: str, *, timeout: float = 20.0) -> Iterator:
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:
-        raise RobodynError("--scheduler needs Dask: pip install 'robodyn[scale]'.") from None
+        raise MissingExtraError("dask.distributed", "scale", "--scheduler") from None
     match = _LOCAL.match(scheduler)
     if match:
         cluster = LocalCluster(
@@ -59,7 +59,7 @@ def connect(scheduler: str, *, timeout: float = 20.0) -> Iterator:
     try:
         client = Client(scheduler, timeout=timeout)
     except (OSError, TimeoutError) as error:
-        raise RobodynError(f"cannot reach the Dask scheduler {scheduler} ({error.__class__.__name__}: {error}).") from None
+        raise SchedulerError(scheduler, f"cannot reach it ({error.__class__.__name__}: {error})") from None
     with client:
         yield client
 

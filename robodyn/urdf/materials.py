@@ -50,9 +50,3 @@ def box_inertia(mass: float, size: tuple[float, float, float]) -> np.ndarray:
     """Inertia in [kg m²] about the centre of a solid box, box axes, shape (3, 3)."""
     x, y, z = size
     return mass / 12 * np.diag([y**2 + z**2, x**2 + z**2, x**2 + y**2])
-
-
-def cylinder_inertia(mass: float, radius: float, length: float) -> np.ndarray:
-    """Inertia in [kg m²] about the centre of a solid cylinder along z, shape (3, 3)."""
-    transverse = mass * (3 * radius**2 + length**2) / 12
-    return np.diag([transverse, transverse, mass * radius**2 / 2])

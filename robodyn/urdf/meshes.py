@@ -17,9 +17,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
-
-class MeshPathError(ValueError):
-    """A mesh path that leaves the model's folders (raised by :func:`resolve_mesh`)."""
+from robodyn.exceptions import MeshPathError
 
 
 def _inside(path: Path, folder: Path) -> bool:
@@ -49,7 +47,7 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
         for folder in package_dirs:
             candidate = Path(folder) / relative
             if not _inside(candidate, Path(folder) / package):
-                raise MeshPathError(f"mesh {filename!r} leaves its package {package!r}")
+                raise MeshPathError(filename, f"leaves its package {package!r}")
             if _regular(candidate, filename):
                 return candidate
         return None
@@ -62,9 +60,9 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
     else:
         candidate = Path(base_dir) / filename
         if not _inside(candidate, Path(base_dir)):
-            raise MeshPathError(f"mesh {filename!r} leaves the URDF's folder")
+            raise MeshPathError(filename, "leaves the URDF's folder")
     if not any(_inside(candidate, root) for root in roots):
-        raise MeshPathError(f"mesh {filename!r} is outside the URDF's folder and package folders")
+        raise MeshPathError(filename, "is outside the URDF's folder and package folders")
     return candidate if _regular(candidate, filename) else None
 
 
@@ -76,7 +74,7 @@ def _regular(candidate: Path, filename: str) -> bool:
     except (OSError, ValueError):  # missing, a name too long, a NUL byte
         return False
     if not stat.S_ISREG(mode):
-        raise MeshPathError(f"mesh {filename!r} is not a regular file (a FIFO, device or directory)")
+        raise MeshPathError(filename, "is not a regular file (a FIFO, device or directory)")
     return True
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from robodyn.exceptions import MissingExtraError, RobodynError, UnknownRobotError
+from robodyn.exceptions import MissingExtraError, UnknownRobotError, URDFError
 
 
 @dataclass(frozen=True)
@@ -152,7 +152,7 @@ def zoo_urdf_path(name: str) -> Path:
     """Absolute path of a zoo robot's URDF file."""
     path = robots_dir() / zoo_robot(name).relative_path
     if not path.is_file():
-        raise RobodynError(f"zoo robot {name!r}: its URDF {path} is not installed.")
+        raise URDFError(name, f"the zoo robot's URDF {path} is not installed")
     return path
 
 

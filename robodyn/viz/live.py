@@ -24,7 +24,7 @@ import numpy as np
 import umsgpack
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import ViewerError
 from robodyn.sim.simulation import Trajectory
 
 if TYPE_CHECKING:
@@ -77,7 +77,7 @@ class LiveViewer:
         line = process.stdout.readline().decode().strip()
         if not line.startswith("web_url="):
             self.close()
-            raise RobodynError("the meshcat server did not start.")
+            raise ViewerError("the meshcat server did not start.")
         self.url = line.removeprefix("web_url=")
         self._context = context = zmq.Context()
         self._socket = requests = context.socket(zmq.REQ)
@@ -110,15 +110,10 @@ class LiveViewer:
             self._process.stdout.close()
         self._process = None
 
-    @property
-    def server_pid(self) -> int | None:
-        """Process id of the server, while it runs."""
-        return self._process.pid if self._process is not None else None
-
     def send(self, commands: list[dict]) -> None:
         """Send lowered meshcat commands to the viewer."""
         if self._socket is None:
-            raise RobodynError("the live viewer is not running.")
+            raise ViewerError("the live viewer is not running.")
         for command in commands:
             self._socket.send_multipart([command["type"].encode(), command.get("path", "").encode(), umsgpack.packb(command)])
             self._socket.recv()

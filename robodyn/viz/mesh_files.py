@@ -28,24 +28,11 @@ import meshcat.geometry as mg
 import numpy as np
 import umsgpack
 
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import MeshFileError
 
 #: Largest mesh file drawn, in bytes (``ROBODYN_MAX_MESH_MB`` overrides, in MB).
 MAX_MESH_BYTES = int(float(os.environ.get("ROBODYN_MAX_MESH_MB", "64")) * 1_000_000)
 FORMATS = {".stl": "stl", ".obj": "obj", ".dae": "dae"}
-
-
-class MeshFileError(RobodynError):
-    """A mesh file that cannot be drawn (not a regular file, too large, corrupt)."""
-
-    def __init__(self, path: Path, reason: str):
-        self.path = path
-        self.reason = reason
-        super().__init__(f"mesh {str(path)!r} {reason}")
-
-
-class MeshWarning(UserWarning):
-    """A mesh replaced by a placeholder in a drawing."""
 
 
 def read_mesh(path: str | os.PathLike, *, max_bytes: int = MAX_MESH_BYTES) -> tuple[mg.MeshGeometry, np.ndarray]:

@@ -32,7 +32,7 @@ from matplotlib.transforms import Bbox
 
 from robodyn.common.files import atomic_write_bytes
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import ViewerError
 from robodyn.sim.simulation import Trajectory
 
 DPI = 110
@@ -245,7 +245,7 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         effort_limits: Effort limit a column (drawn as a dashed line when finite).
     """
     if len(joint_names) != len(units) or any(len(r.peak) != len(units) for r in rows):
-        raise RobodynError(
+        raise ViewerError(
             f"the what-if plot needs one joint name a unit and a column: {len(joint_names)} names, {len(units)} units."
         )
     labels = [

@@ -27,7 +27,7 @@ import umsgpack
 
 from robodyn.common.files import atomic_write_text
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import RobodynError, ViewerError
 from robodyn.sim.simulation import Trajectory
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
 from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands
@@ -133,7 +133,7 @@ class Recording:
 
     def _time(self, at: float) -> float:
         if not (np.isfinite(at) and 0.0 <= at <= self.duration + 1e-9):
-            raise RobodynError(f"--at must lie within the motion, 0 to {self.duration:g} s; got {at:g}.")
+            raise ViewerError(f"--at must lie within the motion, 0 to {self.duration:g} s; got {at:g}.")
         return float(at)
 
 
@@ -172,12 +172,12 @@ def motion_commands(
         The commands, the animation's length in [s], and the placeholder reasons.
     """
     if trajectory.q.ndim != 2 or trajectory.q.shape[1] != robot.nq:
-        raise RobodynError(f"the trajectory has {trajectory.q.shape[-1]} coordinates a sample; {robot.name} needs {robot.nq}.")
+        raise ViewerError(f"the trajectory has {trajectory.q.shape[-1]} coordinates a sample; {robot.name} needs {robot.nq}.")
     if not (np.isfinite(fps) and 0 < fps <= 240):
-        raise RobodynError(f"fps must lie in (0, 240], got {fps}.")
+        raise ViewerError(f"fps must lie in (0, 240], got {fps}.")
     scene = build_scene(robot, max_mesh_bytes=max_mesh_bytes)
     if not scene.commands:
-        raise RobodynError(f"robot {robot.name!r} has no visual geometry robodyn can draw: the recording would be empty.")
+        raise ViewerError(f"robot {robot.name!r} has no visual geometry robodyn can draw: the recording would be empty.")
     moved, clips = motion(robot, trajectory, fps)
     target_m = _target(target)
     if frame is None:

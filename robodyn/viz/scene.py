@@ -25,10 +25,10 @@ from meshcat.path import Path as MeshcatPath
 
 from robodyn.common.rotations import rpy_matrix
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import MeshFileError, MeshWarning, ViewerError
 from robodyn.sim.simulation import Trajectory
 from robodyn.urdf.meshes import MeshPathError, resolve_mesh
-from robodyn.viz.mesh_files import MAX_MESH_BYTES, MeshFileError, MeshWarning, read_mesh
+from robodyn.viz.mesh_files import MAX_MESH_BYTES, read_mesh
 
 ROOT_PATH = ("robodyn",)
 DEFAULT_COLOR = 0xB0B8C0
@@ -115,7 +115,7 @@ def _geometry(visual: ET.Element, robot: Robot, scene: Scene, link: str, max_mes
     try:
         found = resolve_mesh(filename, base_dir=base_dir, package_dirs=robot.package_dirs)
         if found is None:
-            raise MeshFileError(filename, "was not found or is not a regular file")  # type: ignore[arg-type]
+            raise MeshFileError(filename, "was not found or is not a regular file")
         mesh, bounds = read_mesh(found, max_bytes=max_mesh_bytes)
     except (MeshPathError, MeshFileError) as error:
         reason = f"link {link!r}: {error}"
@@ -187,7 +187,7 @@ def resample(trajectory: Trajectory, fps: float) -> tuple[np.ndarray, np.ndarray
     """Times and configurations at ``fps`` frames per second (linear interpolation;
     a floating base's quaternion renormalised)."""
     if len(trajectory) == 0:
-        raise RobodynError("the trajectory is empty: nothing to record.")
+        raise ViewerError("the trajectory is empty: nothing to record.")
     duration = float(trajectory.t[-1] - trajectory.t[0])
     times = trajectory.t[0] + np.arange(int(np.floor(duration * fps + 1e-9)) + 1) / fps
     q = np.column_stack([np.interp(times, trajectory.t, trajectory.q[:, i]) for i in range(trajectory.q.shape[1])])

@@ -29,7 +29,7 @@ from typing import cast
 import numpy as np
 
 from robodyn.common.files import atomic_write_bytes
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import ViewerError
 
 #: Headless Chromium flags for rendering recordings (WebGL on the CPU, nothing networked).
 CHROMIUM_FLAGS = [
@@ -66,7 +66,7 @@ def chromium() -> str | None:
 def _browser() -> str:
     browser = chromium()
     if browser is None:
-        raise RobodynError(
+        raise ViewerError(
             "no Chromium found for stills and videos: install Debian's 'chromium' package (make chromium) or set ROBODYN_CHROMIUM."
         )
     return browser
@@ -77,7 +77,7 @@ def _decode(url: str, mode: str = "RGB") -> np.ndarray:
 
     prefix = "data:image/png;base64,"
     if not url.startswith(prefix):
-        raise RobodynError("Chromium returned no image: the page could not render (no WebGL?).")
+        raise ViewerError("Chromium returned no image: the page could not render (no WebGL?).")
     with Image.open(io.BytesIO(base64.b64decode(url[len(prefix) :]))) as image:
         return np.asarray(image.convert(mode))
 
@@ -124,19 +124,19 @@ def capture(
             try:
                 result = subprocess.run(command, capture_output=True, timeout=300, check=False)
             except (OSError, subprocess.TimeoutExpired) as error:
-                raise RobodynError(f"Chromium ({browser}) could not run: {error}.") from None
+                raise ViewerError(f"Chromium ({browser}) could not run: {error}.") from None
             dom = result.stdout.decode("utf-8", "replace")
             begin, end = dom.find('<pre id="frames">'), dom.find("</pre>")
             urls = dom[begin + len('<pre id="frames">') : end].split() if begin >= 0 and end > begin else []
             if result.returncode != 0 or len(urls) != len(batch):
                 detail = result.stderr.decode("utf-8", "replace").strip().splitlines()
                 reason = detail[-1][:160] if detail else f"exit {result.returncode}"
-                raise RobodynError(
+                raise ViewerError(
                     f"Chromium ({browser}) did not render the recording ({reason}); see CHROMIUM_FLAGS in robodyn.viz.stills."
                 )
             decoded = [_decode(u, "RGBA" if "Background" in hide else "RGB") for u in urls]
             if any(frame.shape[:2] != (size[1], size[0]) for frame in decoded):
-                raise RobodynError(
+                raise ViewerError(
                     f"Chromium rendered {decoded[0].shape[1]}x{decoded[0].shape[0]} frames, not {size[0]}x{size[1]}."
                 )
             frames += decoded
@@ -169,7 +169,7 @@ def screenshot(
 def evenly(duration: float, count: int) -> list[float]:
     """``count`` times from the start to the end of a motion, in [s]."""
     if not (isinstance(count, int) and 1 <= count <= 60):
-        raise RobodynError(f"a filmstrip has 1 to 60 frames, got {count}.")
+        raise ViewerError(f"a filmstrip has 1 to 60 frames, got {count}.")
     return [float(t) for t in np.linspace(0.0, duration, count)] if count > 1 else [0.0]
 
 
@@ -216,18 +216,18 @@ def video_of_page(
     """
     suffix = Path(path).suffix.lower()
     if suffix not in (".mp4", ".gif"):
-        raise RobodynError(f"a video is .mp4 or .gif, got {str(path)!r}.")
+        raise ViewerError(f"a video is .mp4 or .gif, got {str(path)!r}.")
     if not (np.isfinite(fps) and 1 <= fps <= 60):
-        raise RobodynError(f"video fps must lie in [1, 60], got {fps:g}.")
+        raise ViewerError(f"video fps must lie in [1, 60], got {fps:g}.")
     if size[0] % 16 or size[1] % 16:
-        raise RobodynError(f"video sizes are multiples of 16 pixels (H.264), got {size[0]}x{size[1]}.")
+        raise ViewerError(f"video sizes are multiples of 16 pixels (H.264), got {size[0]}x{size[1]}.")
     try:
         import imageio.v2 as imageio
     except ImportError:
-        raise RobodynError("videos need imageio: pip install 'robodyn[viewer]'.") from None
+        raise ViewerError("videos need imageio: pip install 'robodyn[viewer]'.") from None
     count = int(np.floor(duration * fps + 1e-9)) + 1
     if count > 3600:
-        raise RobodynError(f"the video would have {count} frames (over 3600): lower --video-fps or shorten the motion.")
+        raise ViewerError(f"the video would have {count} frames (over 3600): lower --video-fps or shorten the motion.")
     frames = capture(page, [k / fps for k in range(count)], size=size, progress=progress)
     with tempfile.TemporaryDirectory(prefix="robodyn-video-") as folder:
         scratch = Path(folder) / f"video{suffix}"
@@ -237,7 +237,7 @@ def video_of_page(
                     scratch, fps=fps, codec="libx264", quality=8, pixelformat="yuv420p", macro_block_size=16
                 )
             except (ImportError, ValueError, RuntimeError) as error:
-                raise RobodynError(f"no MP4 writer ({error}): pip install 'robodyn[viewer]' (imageio-ffmpeg).") from None
+                raise ViewerError(f"no MP4 writer ({error}): pip install 'robodyn[viewer]' (imageio-ffmpeg).") from None
             with writer:
                 for frame in frames:
                     writer.append_data(frame)
