@@ -126,5 +126,3 @@ def test_trajectory_save_interrupted_keeps_the_previous_file(tmp_path, monkeypat
     assert path.read_bytes() == previous
     assert _leftovers(tmp_path, path.name) == []
     np.testing.assert_array_equal(Trajectory.load(path).t, old.t)
-
-

@@ -278,7 +278,7 @@ def test_mimic_before_its_source_is_refused_cleanly_or_right():
 # ------------------------------------------------------------------------------------
 EQUATION_CASES = {
     "oblique": pytest.param("oblique", marks=pytest.mark.slow),
-    "oblique_locked": "oblique_locked",
+    "oblique_locked": pytest.param("oblique_locked", marks=pytest.mark.slow),
     "oblique_locked_negative": "oblique_locked_negative",
     "gripper_locked_sources": "gripper_locked_sources",
     "mimic_tree_locked": "mimic_tree_locked",
