@@ -251,3 +251,32 @@ def test_without_hold_the_controller_is_continuous():
     exact = solve_ivp(rhs, (0, steps * dt), np.concatenate([q0, v0]), rtol=1e-11, atol=1e-13, t_eval=continuous.t).y
     np.testing.assert_allclose(continuous.q, exact[:2].T, atol=1e-6)
     assert np.max(np.abs(held.v - continuous.v)) > 1e-2
+
+
+def test_task_space_damps_the_motion_the_task_leaves_free():
+    """The oblique arm's last joint turns its frame about the frame's origin: that motion is
+    the null space, where the law is a_tool = −joint_damping v_tool, so v_tool(t) decays as
+    exp(−joint_damping t) exactly (perfect model), however the task moves."""
+    robot = robodyn.load(OBLIQUE)
+    q0 = np.array([0.3, -0.4, 0.1, 0.5])
+    assert np.allclose(robot.frame_jacobian(q0, "end_effector")[:3, 3], 0.0)
+    v0 = np.array([0.5, -0.3, 0.2, 2.0])
+    target = robot.frame_position(q0, "end_effector") + np.array([0.02, 0.01, -0.02])
+    controller = TaskSpace(robot, "end_effector", target, 60.0, 12.0, joint_damping=4.0)
+    trajectory = robodyn.simulate(robot, q0, v0, 0.5, 2 * DT, controller=controller)
+    np.testing.assert_allclose(trajectory.v[:, 3], 2.0 * np.exp(-4.0 * trajectory.t), atol=1e-6)
+
+
+def test_quintic_reference_is_a_rest_to_rest_motion_with_consistent_derivatives():
+    start, end, duration = np.array([0.2, -1.0]), np.array([1.4, 0.5]), 0.8
+    reference = quintic_reference(start, end, duration)
+    h = 1e-5
+    for t in np.linspace(0.01, duration - 0.01, 9):
+        q_d, v_d, a_d = reference(t)
+        np.testing.assert_allclose(v_d, (reference(t + h)[0] - reference(t - h)[0]) / (2 * h), atol=1e-7)
+        np.testing.assert_allclose(a_d, (reference(t + h)[1] - reference(t - h)[1]) / (2 * h), atol=1e-5)
+    for t, position in ((0.0, start), (-1.0, start), (duration, end), (2 * duration, end)):
+        q_d, v_d, a_d = reference(t)
+        np.testing.assert_allclose(q_d, position, atol=1e-15)
+        assert not v_d.any() and not a_d.any()
+    np.testing.assert_allclose(reference(duration / 2)[0], (start + end) / 2, atol=1e-15)  # symmetric in time
