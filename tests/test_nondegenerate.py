@@ -359,3 +359,53 @@ def test_a_quaternion_of_norm_1_5_is_refused(robot_name, method):
     if method not in ("frame_bias_acceleration", "wrench_torques", "simulate"):  # single-state methods
         with pytest.raises(InputError, match="quaternion"):
             call(bad, v)
+
+
+# ------------------------------------------------------------------------------------
+# Lock edits at the awkward angles (gimbal lock of the rpy written back)
+# ------------------------------------------------------------------------------------
+def test_rpy_round_trip_including_gimbal_lock():
+    from robodyn.urdf.edit import _matrix_rpy, rpy_matrix
+
+    rng = np.random.default_rng(9)
+    angles = [rng.uniform(-3, 3, 3) for _ in range(20)]
+    angles += [np.array([0.3, np.pi / 2, -0.7]), np.array([-1.2, -np.pi / 2, 0.4]), np.zeros(3), np.array([np.pi, 0.2, -np.pi])]
+    for rpy in angles:
+        rotation = rpy_matrix(rpy)
+        np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-14)
+        assert np.linalg.det(rotation) == pytest.approx(1.0)
+        np.testing.assert_allclose(rpy_matrix(_matrix_rpy(rotation)), rotation, atol=1e-12)
+    roll, pitch, yaw = 0.3, -0.5, 0.8  # rz(yaw) @ ry(pitch) @ rx(roll), column by column
+    expected_x = [np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), -np.sin(pitch)]
+    np.testing.assert_allclose(rpy_matrix(np.array([roll, pitch, yaw]))[:, 0], expected_x, atol=1e-15)
+    np.testing.assert_allclose(_matrix_rpy(rpy_matrix(np.array([roll, pitch, yaw]))), [roll, pitch, yaw], atol=1e-14)
+
+
+GIMBAL = """<robot name="gimbal">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <joint name="tilt" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="0.1 0.2 0.3" rpy="0 0 0.4"/><axis xyz="0 2 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><origin xyz="0.2 0.05 -0.1" rpy="0.2 0.1 0"/><mass value="1.3"/>
+    <inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.025"/></inertial></link>
+  <joint name="spin" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0.3 -0.1 0.05" rpy="0.2 -0.3 0.1"/><axis xyz="1 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="b"><inertial><origin xyz="0.1 0.02 0.03" rpy="0 0.3 0.2"/><mass value="0.7"/>
+    <inertia ixx="0.01" ixy="0" ixz="0.001" iyy="0.012" iyz="0" izz="0.011"/></inertial></link>
+</robot>"""
+
+
+@pytest.mark.parametrize("angle", [np.pi / 2, -np.pi / 2, 1.0])
+def test_lock_at_a_gimbal_lock_angle(angle):
+    """Locking ``tilt`` at ±π/2 makes the fixed joint's rotation a gimbal lock of rpy."""
+    locked, full = robodyn.load(GIMBAL, lock={"tilt": angle}), robodyn.load(GIMBAL)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        q, v, a = rng.uniform(-2, 2, 1), rng.normal(size=1), rng.normal(size=1)
+        q_full, v_full, a_full = np.array([angle, q[0]]), np.array([0.0, v[0]]), np.array([0.0, a[0]])
+        np.testing.assert_allclose(locked.mass_matrix(q), full.mass_matrix(q_full)[1:, 1:], atol=1e-12)
+        np.testing.assert_allclose(locked.gravity(q), full.gravity(q_full)[1:], atol=1e-12)
+        np.testing.assert_allclose(
+            locked.inverse_dynamics(q, v, a), full.inverse_dynamics(q_full, v_full, a_full)[1:], atol=1e-12
+        )
+        np.testing.assert_allclose(locked.frame_position(q, "b"), full.frame_position(q_full, "b"), atol=1e-12)
+        np.testing.assert_allclose(locked.frame_rotation(q, "b"), full.frame_rotation(q_full, "b"), atol=1e-12)
