@@ -84,19 +84,40 @@ def test_the_target_is_never_opened_for_writing(target, monkeypatch):
 
     def spy(path, flags, *args, **kwargs):
         if flags & (os.O_WRONLY | os.O_RDWR):
-            opened.append(Path(path).name)
+            opened.append(Path(path))
         return real_open(path, flags, *args, **kwargs)
 
     replaced = []
     real_replace = os.replace
     monkeypatch.setattr(os, "open", spy)
-    monkeypatch.setattr(os, "replace", lambda src, dst: (replaced.append((Path(src).name, Path(dst))), real_replace(src, dst)))
+    monkeypatch.setattr(os, "replace", lambda src, dst: (replaced.append((Path(src), Path(dst))), real_replace(src, dst)))
     before = target.stat().st_ino
     atomic_write_bytes(target, NEW)
     assert target.read_bytes() == NEW
-    assert target.name not in opened and opened  # a temporary file was written instead
-    assert replaced == [(opened[0], target)]
+    assert target not in opened and len(opened) == 1  # a temporary file was written instead
+    temporary = opened[0]
+    assert replaced == [(temporary, target)]
+    # In the same folder (a rename within one file system is atomic), hidden and not matching
+    # the target's pattern (a reader globbing *.bin never sees a half-written file).
+    assert temporary.parent == target.parent
+    assert temporary.name.startswith(f".{target.name}.") and temporary.name.endswith(".part")
     assert target.stat().st_ino != before  # a new file took the old one's place
+    assert _leftovers(target.parent, target.name) == []
+
+
+def test_interrupt_just_after_the_rename_propagates_and_leaves_nothing(target, monkeypatch):
+    """Ctrl-C between the rename and the return: the new file is in place, the interrupt
+    (not a FileNotFoundError from cleaning up the renamed temporary file) reaches the caller."""
+    real_replace = os.replace
+
+    def replace_then_interrupt(src, dst):
+        real_replace(src, dst)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "replace", replace_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        atomic_write_bytes(target, NEW)
+    assert target.read_bytes() == NEW
     assert _leftovers(target.parent, target.name) == []
 
 
