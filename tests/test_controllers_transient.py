@@ -280,3 +280,20 @@ def test_quintic_reference_is_a_rest_to_rest_motion_with_consistent_derivatives(
         np.testing.assert_allclose(q_d, position, atol=1e-15)
         assert not v_d.any() and not a_d.any()
     np.testing.assert_allclose(reference(duration / 2)[0], (start + end) / 2, atol=1e-15)  # symmetric in time
+
+
+def test_task_space_damped_least_squares_bounds_the_command():
+    """Damped least squares: ‖J⁺ x‖ ≤ ‖x‖ / (2 √damping) for every Jacobian, so the command
+    stays bounded however close to singular the arm is (here damping = σ_min²: the bound is
+    reached, and a Gram matrix J Jᵀ − damping I would be singular)."""
+    robot = robodyn.load(OBLIQUE)
+    q = np.array([0.3, -0.4, 0.1, 0.5])
+    jacobian = robot.frame_jacobian(q, "end_effector")[:3]
+    u, sigma, _ = np.linalg.svd(jacobian)
+    damping = sigma[-1] ** 2
+    target = robot.frame_position(q, "end_effector") + 0.01 * u[:, -1]  # along the weakest direction
+    controller = TaskSpace(robot, "end_effector", target, 50.0, 10.0, damping=damping)
+    zero = np.zeros(robot.nv)
+    command = robot.forward_dynamics(q, zero, controller(0.0, q, zero))
+    desired = 50.0 * 0.01
+    assert np.linalg.norm(command) == pytest.approx(desired / (2 * np.sqrt(damping)), rel=1e-6)
