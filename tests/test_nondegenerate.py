@@ -409,3 +409,48 @@ def test_lock_at_a_gimbal_lock_angle(angle):
         )
         np.testing.assert_allclose(locked.frame_position(q, "b"), full.frame_position(q_full, "b"), atol=1e-12)
         np.testing.assert_allclose(locked.frame_rotation(q, "b"), full.frame_rotation(q_full, "b"), atol=1e-12)
+
+
+def test_lock_refuses_fixed_and_unknown_joints_naming_them():
+    for name in ("bracket", "nonexistent"):
+        with pytest.raises(InputError, match=rf"^lock must be moving joints of .*, got '{name}'\.$"):
+            robodyn.load(OBLIQUE, lock={name: 0.0})
+    with pytest.raises(InputError, match=r"^lock must be a position of 'j_extend' within \[-0\.1, 0\.25\], got 0\.3\.$"):
+        robodyn.load(OBLIQUE, lock={"j_extend": 0.3})
+    with pytest.raises(InputError, match="j_yaw"):
+        robodyn.load(OBLIQUE, lock={"j_yaw": float("nan")})
+
+
+PAYLOAD = (
+    '<link name="payload"><inertial><origin xyz="0.02 -0.01 0.03" rpy="0.3 0.1 -0.2"/><mass value="0.9"/>'
+    '<inertia ixx="0.004" ixy="0.0003" ixz="0" iyy="0.006" iyz="0.0002" izz="0.005"/></inertial></link>'
+)
+
+
+def test_weld_link_is_the_same_robot_as_the_link_written_by_hand():
+    """weld_link against the URDF with the link and its fixed joint written into the text."""
+    import xml.etree.ElementTree as ET
+
+    from robodyn.urdf.edit import weld_link
+    from robodyn.urdf.validation import parse_urdf
+
+    text = OBLIQUE.read_text()
+    spec = parse_urdf(text)
+    before = ET.tostring(spec.xml, encoding="unicode")
+    welded = weld_link(spec, "ram", ET.fromstring(PAYLOAD), xyz="0.05 0.02 -0.04", rpy="0.4 -0.2 0.3")
+    assert ET.tostring(spec.xml, encoding="unicode") == before  # the spec is not changed
+    joint = ET.fromstring(welded).find("joint[@name='payload_joint']")
+    assert joint is not None and joint.get("type") == "fixed"
+    by_hand = text.replace(
+        "</robot>",
+        PAYLOAD + '<joint name="payload_joint" type="fixed"><parent link="ram"/><child link="payload"/>'
+        '<origin xyz="0.05 0.02 -0.04" rpy="0.4 -0.2 0.3"/></joint></robot>',
+    )
+    robot, expected, plain = robodyn.load(welded), robodyn.load(by_hand), robodyn.load(OBLIQUE)
+    q, v, a = states(robot)
+    np.testing.assert_allclose(robot.mass_matrix(q), expected.mass_matrix(q), atol=1e-12)
+    np.testing.assert_allclose(robot.inverse_dynamics(q, v, a), expected.inverse_dynamics(q, v, a), atol=1e-12)
+    assert np.max(np.abs(robot.gravity(q) - plain.gravity(q))) > 1e-3  # the payload matters
+    for xyz, rpy in (("0 0 0", "0.4 -0.2 0.3"), ("0.05 0.02 -0.04", "0 0 0")):  # each part of the origin matters
+        other = robodyn.load(weld_link(spec, "ram", ET.fromstring(PAYLOAD), xyz=xyz, rpy=rpy))
+        assert np.max(np.abs(other.mass_matrix(q) - robot.mass_matrix(q))) > 1e-6
