@@ -454,3 +454,22 @@ def test_weld_link_is_the_same_robot_as_the_link_written_by_hand():
     for xyz, rpy in (("0 0 0", "0.4 -0.2 0.3"), ("0.05 0.02 -0.04", "0 0 0")):  # each part of the origin matters
         other = robodyn.load(weld_link(spec, "ram", ET.fromstring(PAYLOAD), xyz=xyz, rpy=rpy))
         assert np.max(np.abs(other.mass_matrix(q) - robot.mass_matrix(q))) > 1e-6
+
+
+def test_lock_joints_edits_a_copy_and_accepts_the_limits_themselves():
+    import xml.etree.ElementTree as ET
+
+    from robodyn.urdf.edit import lock_joints
+    from robodyn.urdf.validation import parse_urdf
+
+    spec = parse_urdf(OBLIQUE.read_text())
+    before = ET.tostring(spec.xml, encoding="unicode")
+    for value in (0.25, -0.1):  # exactly at the upper and lower limits
+        locked = ET.fromstring(lock_joints(spec, {"j_extend": value}))
+        assert locked.find("joint[@name='j_extend']").get("type") == "fixed"
+    assert ET.tostring(spec.xml, encoding="unicode") == before  # the spec is not changed
+    for value in (-0.6, 0.25 + 1e-9, -0.1 - 1e-9):
+        with pytest.raises(InputError, match="within"):
+            lock_joints(spec, {"j_extend": value})
+    with pytest.raises(InputError, match=r"^lock must be moving joints of <string>, got 'bracket'\.$"):
+        lock_joints(spec, {"bracket": 0.0})
