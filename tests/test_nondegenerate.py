@@ -473,3 +473,21 @@ def test_lock_joints_edits_a_copy_and_accepts_the_limits_themselves():
             lock_joints(spec, {"j_extend": value})
     with pytest.raises(InputError, match=r"^lock must be moving joints of <string>, got 'bracket'\.$"):
         lock_joints(spec, {"bracket": 0.0})
+
+
+@pytest.mark.parametrize(("path", "lock"), [(OBLIQUE, {"j_twist": 0.7}), (GRIPPER, {"j_rotate": 0.6, "j_left": 0.03})])
+def test_locked_joints_keep_nothing_of_their_motion(path, lock):
+    """A locked joint is a plain fixed joint: no axis, limit, mimic, dynamics, safety
+    controller or calibration left (nothing for lint to warn about)."""
+    import xml.etree.ElementTree as ET
+
+    from robodyn.urdf.edit import lock_joints
+    from robodyn.urdf.validation import lint_urdf, parse_urdf
+
+    text = lock_joints(parse_urdf(path.read_text()), lock)
+    spec, problems = lint_urdf(text)
+    assert spec is not None and problems == []
+    fixed = {node.get("name"): node for node in ET.fromstring(text).findall("joint") if node.get("type") == "fixed"}
+    locked = set(lock) | {j.name for j in parse_urdf(path.read_text()).joints.values() if j.mimic and j.mimic.joint in lock}
+    for name in locked:
+        assert sorted(child.tag for child in fixed[name]) == ["child", "origin", "parent"]
