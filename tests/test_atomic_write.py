@@ -119,3 +119,20 @@ def test_trajectory_save_interrupted_keeps_the_previous_file(tmp_path, monkeypat
     assert path.read_bytes() == previous
     assert _leftovers(tmp_path, path.name) == []
     np.testing.assert_array_equal(Trajectory.load(path).t, old.t)
+
+
+def test_interrupt_just_after_the_rename_propagates_and_leaves_nothing(target, monkeypatch):
+    """Ctrl-C between the rename and the return: the new file is in place, the interrupt
+    (not a FileNotFoundError from cleaning up the renamed temporary file) reaches the caller."""
+    real_replace = os.replace
+
+    def replace_then_interrupt(src, dst):
+        real_replace(src, dst)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "replace", replace_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        atomic_write_bytes(target, NEW)
+    monkeypatch.undo()
+    assert target.read_bytes() == NEW
+    assert _leftovers(target.parent, target.name) == []

@@ -9,7 +9,6 @@ the ``Ṁ − 2C`` skew test must fail on a matrix that is not skew.
 
 from __future__ import annotations
 
-import functools
 import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -19,7 +18,6 @@ import pytest
 
 import robodyn
 from robodyn.cli import main
-from robodyn.verify import check
 from robodyn.verify.check import check_robot, report_text, skewness
 
 ROBOTS = Path(__file__).parent / "data" / "robots"
@@ -154,11 +152,11 @@ def test_mimic_model_passes_the_quantities_the_perturbations_fail():
 def test_cli_check_exits_1_naming_quantity_and_joint(tmp_path, monkeypatch, capsys):
     wrong = tmp_path / "wrong.urdf"
     wrong.write_text(perturbed(OBLIQUE, flip_prismatic_axis))
-    monkeypatch.setattr(check, "check_robot", functools.partial(check_robot, reference_source=OBLIQUE))
-    assert main(["check", str(wrong), "--samples", str(SAMPLES)]) == 1
+    reference = ["--reference", str(OBLIQUE)]
+    assert main(["check", str(wrong), "--samples", str(SAMPLES), *reference]) == 1
     out = capsys.readouterr().out
     assert "FAILED" in out and "G: relative error" in out and "joint 'j_extend'" in out
-    assert main(["check", str(wrong), "--samples", str(SAMPLES), "--json"]) == 1
+    assert main(["check", str(wrong), "--samples", str(SAMPLES), "--json", *reference]) == 1
     data = json.loads(capsys.readouterr().out)
     assert data["passed"] is False and data["comparisons"]["G"]["where"] == "joint 'j_extend'"
 

@@ -284,7 +284,7 @@ def test_mimic_before_its_source_is_refused_cleanly_or_right():
 # ------------------------------------------------------------------------------------
 EQUATION_CASES = {
     "oblique": pytest.param("oblique", marks=pytest.mark.slow),
-    "oblique_locked": "oblique_locked",
+    "oblique_locked": pytest.param("oblique_locked", marks=pytest.mark.slow),
     "oblique_locked_negative": "oblique_locked_negative",
     "gripper_locked_sources": "gripper_locked_sources",
     "mimic_tree_locked": "mimic_tree_locked",
@@ -357,3 +357,145 @@ def test_a_quaternion_of_norm_1_5_is_refused(robot_name, method):
     if method not in ("frame_bias_acceleration", "wrench_torques", "simulate"):  # single-state methods
         with pytest.raises(InputError, match="quaternion"):
             call(bad, v)
+
+
+# ------------------------------------------------------------------------------------
+# Lock edits at the awkward angles (gimbal lock of the rpy written back)
+# ------------------------------------------------------------------------------------
+def test_rpy_round_trip_including_gimbal_lock():
+    from robodyn.common.rotations import matrix_rpy as _matrix_rpy
+    from robodyn.common.rotations import rpy_matrix
+
+    rng = np.random.default_rng(9)
+    angles = [rng.uniform(-3, 3, 3) for _ in range(20)]
+    angles += [np.array([0.3, np.pi / 2, -0.7]), np.array([-1.2, -np.pi / 2, 0.4]), np.zeros(3), np.array([np.pi, 0.2, -np.pi])]
+    for rpy in angles:
+        rotation = rpy_matrix(rpy)
+        np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-14)
+        assert np.linalg.det(rotation) == pytest.approx(1.0)
+        np.testing.assert_allclose(rpy_matrix(_matrix_rpy(rotation)), rotation, atol=1e-12)
+    roll, pitch, yaw = 0.3, -0.5, 0.8  # rz(yaw) @ ry(pitch) @ rx(roll), column by column
+    expected_x = [np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), -np.sin(pitch)]
+    np.testing.assert_allclose(rpy_matrix(np.array([roll, pitch, yaw]))[:, 0], expected_x, atol=1e-15)
+    np.testing.assert_allclose(_matrix_rpy(rpy_matrix(np.array([roll, pitch, yaw]))), [roll, pitch, yaw], atol=1e-14)
+
+
+GIMBAL = """<robot name="gimbal">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <joint name="tilt" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="0.1 0.2 0.3" rpy="0 0 0.4"/><axis xyz="0 2 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><origin xyz="0.2 0.05 -0.1" rpy="0.2 0.1 0"/><mass value="1.3"/>
+    <inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.025"/></inertial></link>
+  <joint name="spin" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0.3 -0.1 0.05" rpy="0.2 -0.3 0.1"/><axis xyz="1 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="b"><inertial><origin xyz="0.1 0.02 0.03" rpy="0 0.3 0.2"/><mass value="0.7"/>
+    <inertia ixx="0.01" ixy="0" ixz="0.001" iyy="0.012" iyz="0" izz="0.011"/></inertial></link>
+</robot>"""
+
+
+@pytest.mark.parametrize("angle", [np.pi / 2, -np.pi / 2, 1.0])
+def test_lock_at_a_gimbal_lock_angle(angle):
+    """Locking ``tilt`` at ±π/2 makes the fixed joint's rotation a gimbal lock of rpy."""
+    locked, full = robodyn.load(GIMBAL, lock={"tilt": angle}), robodyn.load(GIMBAL)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        q, v, a = rng.uniform(-2, 2, 1), rng.normal(size=1), rng.normal(size=1)
+        q_full, v_full, a_full = np.array([angle, q[0]]), np.array([0.0, v[0]]), np.array([0.0, a[0]])
+        np.testing.assert_allclose(locked.mass_matrix(q), full.mass_matrix(q_full)[1:, 1:], atol=1e-12)
+        np.testing.assert_allclose(locked.gravity(q), full.gravity(q_full)[1:], atol=1e-12)
+        np.testing.assert_allclose(
+            locked.inverse_dynamics(q, v, a), full.inverse_dynamics(q_full, v_full, a_full)[1:], atol=1e-12
+        )
+        np.testing.assert_allclose(locked.frame_position(q, "b"), full.frame_position(q_full, "b"), atol=1e-12)
+        np.testing.assert_allclose(_rotation(locked, q, "b"), _rotation(full, q_full, "b"), atol=1e-12)
+
+
+def test_lock_refuses_fixed_and_unknown_joints_naming_them():
+    for name in ("bracket", "nonexistent"):
+        with pytest.raises(InputError, match=rf"^lock must be moving joints of .*, got '{name}'\.$"):
+            robodyn.load(OBLIQUE, lock={name: 0.0})
+    with pytest.raises(InputError, match=r"^lock must be a position of 'j_extend' within \[-0\.1, 0\.25\], got 0\.3\.$"):
+        robodyn.load(OBLIQUE, lock={"j_extend": 0.3})
+    with pytest.raises(InputError, match="j_yaw"):
+        robodyn.load(OBLIQUE, lock={"j_yaw": float("nan")})
+
+
+PAYLOAD = (
+    '<link name="payload"><inertial><origin xyz="0.02 -0.01 0.03" rpy="0.3 0.1 -0.2"/><mass value="0.9"/>'
+    '<inertia ixx="0.004" ixy="0.0003" ixz="0" iyy="0.006" iyz="0.0002" izz="0.005"/></inertial></link>'
+)
+
+
+def test_weld_link_is_the_same_robot_as_the_link_written_by_hand():
+    """weld_link against the URDF with the link and its fixed joint written into the text."""
+    import xml.etree.ElementTree as ET
+
+    from robodyn.urdf.edit import weld_link
+    from robodyn.urdf.validation import parse_urdf
+
+    text = OBLIQUE.read_text()
+    spec = parse_urdf(text)
+    before = ET.tostring(spec.xml, encoding="unicode")
+    welded = weld_link(spec, "ram", ET.fromstring(PAYLOAD), xyz="0.05 0.02 -0.04", rpy="0.4 -0.2 0.3")
+    assert ET.tostring(spec.xml, encoding="unicode") == before  # the spec is not changed
+    joint = ET.fromstring(welded).find("joint[@name='payload_joint']")
+    assert joint is not None and joint.get("type") == "fixed"
+    by_hand = text.replace(
+        "</robot>",
+        PAYLOAD + '<joint name="payload_joint" type="fixed"><parent link="ram"/><child link="payload"/>'
+        '<origin xyz="0.05 0.02 -0.04" rpy="0.4 -0.2 0.3"/></joint></robot>',
+    )
+    robot, expected, plain = robodyn.load(welded), robodyn.load(by_hand), robodyn.load(OBLIQUE)
+    q, v, a = states(robot)
+    np.testing.assert_allclose(robot.mass_matrix(q), expected.mass_matrix(q), atol=1e-12)
+    np.testing.assert_allclose(robot.inverse_dynamics(q, v, a), expected.inverse_dynamics(q, v, a), atol=1e-12)
+    assert np.max(np.abs(robot.gravity(q) - plain.gravity(q))) > 1e-3  # the payload matters
+    for xyz, rpy in (("0 0 0", "0.4 -0.2 0.3"), ("0.05 0.02 -0.04", "0 0 0")):  # each part of the origin matters
+        other = robodyn.load(weld_link(spec, "ram", ET.fromstring(PAYLOAD), xyz=xyz, rpy=rpy))
+        assert np.max(np.abs(other.mass_matrix(q) - robot.mass_matrix(q))) > 1e-6
+
+
+def test_lock_joints_edits_a_copy_and_accepts_the_limits_themselves():
+    import xml.etree.ElementTree as ET
+
+    from robodyn.urdf.edit import lock_joints
+    from robodyn.urdf.validation import parse_urdf
+
+    spec = parse_urdf(OBLIQUE.read_text())
+    before = ET.tostring(spec.xml, encoding="unicode")
+    for value in (0.25, -0.1):  # exactly at the upper and lower limits
+        locked = ET.fromstring(lock_joints(spec, {"j_extend": value}))
+        assert locked.find("joint[@name='j_extend']").get("type") == "fixed"
+    assert ET.tostring(spec.xml, encoding="unicode") == before  # the spec is not changed
+    for value in (-0.6, 0.25 + 1e-9, -0.1 - 1e-9):
+        with pytest.raises(InputError, match="within"):
+            lock_joints(spec, {"j_extend": value})
+    with pytest.raises(InputError, match=r"^lock must be moving joints of <string>, got 'bracket'\.$"):
+        lock_joints(spec, {"bracket": 0.0})
+
+
+@pytest.mark.parametrize(("path", "lock"), [(OBLIQUE, {"j_twist": 0.7}), (GRIPPER, {"j_rotate": 0.6, "j_left": 0.03})])
+def test_locked_joints_keep_nothing_of_their_motion(path, lock):
+    """A locked joint is a plain fixed joint: no axis, limit, mimic, dynamics, safety
+    controller or calibration left (nothing for lint to warn about)."""
+    import xml.etree.ElementTree as ET
+
+    from robodyn.urdf.edit import lock_joints
+    from robodyn.urdf.validation import lint_urdf, parse_urdf
+
+    text = lock_joints(parse_urdf(path.read_text()), lock)
+    spec, problems = lint_urdf(text)
+    assert spec is not None and problems == []
+    fixed = {node.get("name"): node for node in ET.fromstring(text).findall("joint") if node.get("type") == "fixed"}
+    locked = set(lock) | {j.name for j in parse_urdf(path.read_text()).joints.values() if j.mimic and j.mimic.joint in lock}
+    for name in locked:
+        assert sorted(child.tag for child in fixed[name]) == ["child", "origin", "parent"]
+
+
+def _rotation(robot, q, frame):
+    """Orientation of a frame in the world frame (through Pinocchio: Robot has no such method)."""
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return data.oMf[robot.frame_id(frame)].rotation.copy()

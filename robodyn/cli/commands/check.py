@@ -24,6 +24,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default=1e-9,
         help=f"largest relative error accepted, {RANGES['tolerance'].text()} (default 1e-9)",
     )
+    parser.add_argument(
+        "--reference",
+        metavar="URDF",
+        help="build the reference from this URDF instead of the model's own (e.g. the true model of a suspect file)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.set_defaults(run=run)
 
@@ -39,6 +44,7 @@ def run(arguments: argparse.Namespace) -> int:
         seed=arguments.seed,
         tolerance=arguments.tolerance,
         check_inertia=arguments.check_inertia,
+        reference_source=arguments.reference,
     )
     print(json_text(report_dict(report)) if arguments.json else printable_lines(report_text(report)))
     return 0 if report.passed else 1
