@@ -1,6 +1,6 @@
 """The lecture's RP arm derivation, as printed, as derived, and as a rigid body.
 
-``shared/lecture/rp-arm.md`` restates the lecture's revolute–prismatic arm: link 1 with
+docs/rp-arm.md restates the lecture's revolute–prismatic arm: link 1 with
 centre of mass at ``l1/2``, link 2 with its centre of mass at ``l1 + q2/2`` (half the joint
 speed: not a rigid body), gravity ``(0, −g, 0)`` in the lecture's plane. This module gives,
 in the lecture's symbols ``l1, m1, m2, Iz1, Iz2, g``:

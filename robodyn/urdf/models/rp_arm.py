@@ -1,6 +1,6 @@
 """The lecture's revolute–prismatic (RP) arm, generated as URDF from its parameters.
 
-The arm of ``shared/lecture/rp-arm.md``, as a rigid-body model:
+The lecture's revolute–prismatic arm (docs/rp-arm.md), as a rigid-body model:
 
 - ``joint1`` (revolute) turns link 1 in a vertical plane. The lecture's frame is rotated by
   +90° about X so that its Y axis points up (URDF gravity is ``(0, 0, -9.81)``): the joint
