@@ -37,10 +37,11 @@ class PerThreadData:
 
     def get(self) -> pin.Data:
         """This thread's data."""
-        data = getattr(self._local, "data", None)
-        if data is None:
+        try:
+            return self._local.data
+        except AttributeError:
             data = self._local.data = self._model.createData()
-        return data
+            return data
 
 
 class ModelHandle:
@@ -60,6 +61,9 @@ class ModelHandle:
         self.nq: int = model.nq
         self.nv: int = model.nv
         self._data = PerThreadData(model)
+        #: What :meth:`_evaluate` computes, by quantity: ``(one state, batch or None)``,
+        #: set up once by the subclass (so a call builds no closures).
+        self._kernels: dict[str, tuple[Callable[..., np.ndarray], Callable[..., np.ndarray] | None]] = {}
 
     @property
     def data(self) -> pin.Data:
@@ -95,8 +99,7 @@ class ModelHandle:
         floating base needs a unit quaternion. Anything else is re-done through
         :meth:`validate`, which names the offending argument.
         """
-        flat = result.ravel()
-        if not (_isfinite(flat.dot(flat)) and _isfinite(q.dot(q))):
+        if not (_all_finite(result) and _all_finite(q)):
             return False
         if self.floating_base:
             quaternion = q[3:7]
@@ -109,30 +112,43 @@ class ModelHandle:
             raise NonFiniteResultError(self.name, what)
         return result
 
-    def _evaluate(
-        self,
-        what: str,
-        single: Callable[..., np.ndarray],
-        batch: Callable[..., np.ndarray] | None,
-        **named: np.ndarray,
-    ) -> np.ndarray:
-        """Fast path, then checked path: ``single`` on the raw arguments if Pinocchio takes
-        them and the result passes :meth:`_accept`; else the arguments go through
-        :meth:`validate` and one state goes to ``single``, a batch to ``batch`` (or to
-        ``single`` row by row when ``batch`` is ``None``)."""
-        values = tuple(named.values())
+    def _evaluate(self, what: str, names: tuple[str, ...], *values: np.ndarray) -> np.ndarray:
+        """Fast path, then checked path, for the quantity ``what`` of :attr:`_kernels`.
+
+        Its one-state function runs on the raw arguments if Pinocchio takes them and the
+        result passes :meth:`_accept`; else the arguments (named ``names``, for messages)
+        go through :meth:`validate` and one state goes to the one-state function, a batch
+        to the batch function (or to the one-state function row by row when there is none).
+        """
+        single, batch = self._kernels[what]
         try:
             result = single(*values)
-            if self._accept(result, values[0]):
+            q = values[0]
+            # _accept, written out on the hot path: finite result and q, unit quaternion.
+            if (
+                (_isfinite(sum(result.tolist())) if result.ndim == 1 else _all_finite(result))
+                and _isfinite(sum(q.tolist()))
+                and (not self.floating_base or self._accept(result, q))
+            ):
                 return result
         except PINOCCHIO_ERRORS:
             pass
-        arrays, is_batch = self.validate(**named)
+        arrays, is_batch = self.validate(**dict(zip(names, values, strict=True)))
         if not is_batch:
             return self._finite(single(*arrays), what)
         if batch is not None:
             return self._finite(batch(*arrays), what)
         return self._finite(per_state(single, *arrays), what)
+
+
+def _all_finite(array: np.ndarray) -> bool:
+    """Whether an array holds no NaN or inf, by the cheapest exact test for its size: a NaN
+    or inf anywhere makes the sum (a vector) or the sum of squares (a matrix) non-finite; a
+    finite sum that overflows only sends the caller to the exact check."""
+    if array.ndim == 1:
+        return _isfinite(sum(array.tolist()))
+    flat = array.ravel()
+    return _isfinite(flat.dot(flat))
 
 
 def per_state(function: Callable[..., np.ndarray], *states: np.ndarray) -> np.ndarray:

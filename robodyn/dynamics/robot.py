@@ -17,6 +17,7 @@ Conventions, stated once:
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -96,6 +97,7 @@ class Robot(Kinematics, ConfigurationSpace):
         self.joints: list[JointInfo] = self._joint_infos()
         self.joint_names: list[str] = [joint.name for joint in self.joints]
         self._parallel = ParallelRunner(model, threads=options.threads)
+        self._kernels.update(self._dynamics_kernels())
         self._lower_triangle = np.tri(self.nv, self.nv, -1, dtype=bool)
 
     @property
@@ -199,9 +201,10 @@ class Robot(Kinematics, ConfigurationSpace):
         return float(sum(self.link_masses.values()))
 
     # ----------------------------------------------------------------------------------
-    # Dynamics. Each method hands ModelHandle._evaluate a one-state function and, where
-    # Pinocchio has one, a parallel batch function: the fast path tries Pinocchio on the
-    # raw arguments first, anything doubtful goes through the full boundary check.
+    # Dynamics. Each method asks ModelHandle._evaluate for its quantity, whose one-state
+    # and (where Pinocchio has one) parallel batch function _dynamics_kernels set up once:
+    # the fast path tries Pinocchio on the raw arguments first, anything doubtful goes
+    # through the full boundary check.
     # ----------------------------------------------------------------------------------
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA).
@@ -214,14 +217,7 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
-        return self._evaluate(
-            "tau",
-            lambda q, v, a: pin.rnea(self.model, self.data, q, v, a),
-            lambda q, v, a: self._parallel.run(pin.rneaInParallel, q, v, a),
-            q=q,
-            v=v,
-            a=a,
-        )
+        return self._evaluate("tau", ("q", "v", "a"), q, v, a)
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).
@@ -237,13 +233,8 @@ class Robot(Kinematics, ConfigurationSpace):
         Raises:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
-        if self.mimic is None:
-            single = self.forward_dynamics_unchecked
-            batch = lambda q, v, tau: self._parallel.run(pin.abaInParallel, q, v, tau)  # noqa: E731
-        else:  # Pinocchio's ABA does not support mimic joints (and abaInParallel crashes on them)
-            single, batch = self._solve_dynamics, None
         try:
-            return self._evaluate("a", single, batch, q=q, v=v, tau=tau)
+            return self._evaluate("a", ("q", "v", "tau"), q, v, tau)
         except NonFiniteResultError:  # finite inputs, non-finite accelerations: only a singular M does that
             raise SingularMassMatrixError(self.name, self.massless_joints) from None
 
@@ -276,7 +267,7 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
         """
-        return self._evaluate("M", self._mass_matrix, None, q=q)
+        return self._evaluate("M", ("q",), q)
 
     def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
         # Upper triangle only. With a mimic joint between two free joints, Pinocchio 4.1's
@@ -299,7 +290,7 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv, nv) or (N, nv, nv).
         """
-        return self._evaluate("C", self._coriolis, None, q=q, v=v)
+        return self._evaluate("C", ("q", "v"), q, v)
 
     def _coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self.mimic is not None:  # computeCoriolisMatrix mishandles mimic joints
@@ -318,12 +309,7 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-
-        def batch(q: np.ndarray) -> np.ndarray:
-            zeros = np.zeros((q.shape[0], self.nv))
-            return self._parallel.run(pin.rneaInParallel, q, zeros, zeros)
-
-        return self._evaluate("G", lambda q: pin.computeGeneralizedGravity(self.model, self.data, q), batch, q=q)
+        return self._evaluate("G", ("q",), q)
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``C(q, v) v + G(q)``: the torques at zero acceleration.
@@ -335,13 +321,32 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        return self._evaluate(
-            "C v + G",
-            lambda q, v: pin.nonLinearEffects(self.model, self.data, q, v),
-            lambda q, v: self._parallel.run(pin.rneaInParallel, q, v, np.zeros_like(v)),
-            q=q,
-            v=v,
+        return self._evaluate("C v + G", ("q", "v"), q, v)
+
+    def _dynamics_kernels(self) -> dict:
+        """One-state and batch functions of each quantity, for :meth:`_evaluate` (built once)."""
+        model, data, run = self.model, self._data.get, self._parallel.run
+
+        def gravity_batch(q: np.ndarray) -> np.ndarray:
+            zeros = np.zeros((q.shape[0], self.nv))
+            return run(pin.rneaInParallel, q, zeros, zeros)
+
+        forward: tuple[Callable[..., np.ndarray], Callable[..., np.ndarray] | None] = (
+            (lambda q, v, tau: pin.aba(model, data(), q, v, tau), lambda q, v, tau: run(pin.abaInParallel, q, v, tau))
+            if self.mimic is None
+            else (self._solve_dynamics, None)  # Pinocchio's ABA refuses mimic joints (abaInParallel crashes on them)
         )
+        return {
+            "tau": (lambda q, v, a: pin.rnea(model, data(), q, v, a), lambda q, v, a: run(pin.rneaInParallel, q, v, a)),
+            "a": forward,
+            "M": (self._mass_matrix, None),
+            "C": (self._coriolis, None),
+            "G": (lambda q: pin.computeGeneralizedGravity(model, data(), q), gravity_batch),
+            "C v + G": (
+                lambda q, v: pin.nonLinearEffects(model, data(), q, v),
+                lambda q, v: run(pin.rneaInParallel, q, v, np.zeros_like(v)),
+            ),
+        }
 
     # ----------------------------------------------------------------------------------
     # Energies
