@@ -61,13 +61,13 @@ def paired(ours: Callable[[], object], raw: Callable[[], object], repeats: int =
     return statistics.median(ours_times), statistics.median(raw_times), statistics.median(ratios)
 
 
-def median_once(function: Callable[[], object], repeats: int = 3) -> float:
-    """Median wall time of ``repeats`` whole runs of a long function."""
+def median_once(function: Callable[[], object], repeats: int = 3, clock: Callable[[], float] = time.perf_counter) -> float:
+    """Median time of ``repeats`` whole runs of a long function (wall time by default)."""
     times = []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start = clock()
         function()
-        times.append(time.perf_counter() - start)
+        times.append(clock() - start)
     return statistics.median(times)
 
 
@@ -498,12 +498,7 @@ def _mujoco_model(robot):
 def median_cpu(function: Callable[[], object], repeats: int = 3) -> float:
     """Median CPU time of this process over whole runs (on a loaded machine, less noisy than
     wall time for single-threaded loops)."""
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
-        function()
-        times.append(time.process_time() - start)
-    return statistics.median(times)
+    return median_once(function, repeats, clock=time.process_time)
 
 
 def bench_compiled_simulation(quick: bool) -> list[dict]:

@@ -53,6 +53,7 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
+    """The robot of a command's model arguments (and its ``--lock``, where it has one)."""
     return robodyn.load(
         arguments.model,
         floating_base=arguments.floating_base,
@@ -60,6 +61,7 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
         check_inertia=arguments.check_inertia,
         strict=arguments.strict,
         max_dof=arguments.max_dof,
+        lock=lock_values(getattr(arguments, "lock", None)),
     )
 
 

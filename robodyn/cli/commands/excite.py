@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import add_model_arguments, lock_values, vector
+from robodyn.cli.common import add_model_arguments, load_robot, vector
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -30,18 +30,11 @@ def _limit(values: list[float] | None):
 
 
 def run(arguments: argparse.Namespace) -> int:
-    import robodyn
     from robodyn.ident import base_parameters, excite
     from robodyn.ident.render import printable
     from robodyn.sim.trajectory import Trajectory
 
-    robot = robodyn.load(
-        arguments.model,
-        floating_base=arguments.floating_base,
-        gravity=arguments.gravity,
-        check_inertia=arguments.check_inertia,
-        lock=lock_values(arguments.lock),
-    )
+    robot = load_robot(arguments)
     base = base_parameters(robot)
     excitation = excite(
         robot,

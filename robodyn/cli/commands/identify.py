@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from robodyn.cli.common import add_model_arguments, lock_values
+from robodyn.cli.common import add_model_arguments, load_robot
 from robodyn.exceptions import InputError
 
 
@@ -25,7 +25,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    import robodyn
     from robodyn.common.files import atomic_write_text
     from robodyn.ident import base_parameters, identified_urdf, identify
     from robodyn.ident.render import printable, render_base_parameters
@@ -37,13 +36,7 @@ def run(arguments: argparse.Namespace) -> int:
         )
     if arguments.data is None and not arguments.base_parameters:
         raise InputError("DATA", "a trajectory file (or --base-parameters)", "nothing")
-    robot = robodyn.load(
-        arguments.model,
-        floating_base=arguments.floating_base,
-        gravity=arguments.gravity,
-        check_inertia=arguments.check_inertia,
-        lock=lock_values(arguments.lock),
-    )
+    robot = load_robot(arguments)
     base = base_parameters(robot, friction=arguments.friction)
     if arguments.base_parameters:
         print(render_base_parameters(base, arguments.format), end="")
