@@ -28,6 +28,7 @@ import pinocchio as pin
 from robodyn.dynamics import frames
 from robodyn.dynamics.batch import ParallelRunner
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT, ConfigurationSpace
+from robodyn.dynamics.dofs import Dof, configuration_names, robot_dofs
 from robodyn.dynamics.handle import per_state
 from robodyn.dynamics.joints import JointInfo
 from robodyn.dynamics.kinematics import Kinematics
@@ -96,6 +97,10 @@ class Robot(Kinematics, ConfigurationSpace):
         self.mimic = mimic
         self.joints: list[JointInfo] = self._joint_infos()
         self.joint_names: list[str] = [joint.name for joint in self.joints]
+        #: One record per degree of freedom (name, joint, kind, units, limits), length nv.
+        self.dofs: tuple[Dof, ...] = robot_dofs(self.joints)
+        #: A name for each entry of ``q`` (length nq; a floating base's are ``base.x`` … ``base.qw``).
+        self.configuration_names: list[str] = configuration_names(self.joints)
         self._parallel = ParallelRunner(model, threads=options.threads)
         self._kernels.update(self._dynamics_kernels())
         self._lower_triangle = np.tri(self.nv, self.nv, -1, dtype=bool)
@@ -404,4 +409,4 @@ class Robot(Kinematics, ConfigurationSpace):
         return robot_html(self)
 
 
-__all__ = ["PLACEHOLDER_LIMIT", "JointInfo", "LoadOptions", "Robot"]
+__all__ = ["PLACEHOLDER_LIMIT", "Dof", "JointInfo", "LoadOptions", "Robot"]
