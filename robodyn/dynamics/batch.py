@@ -1,8 +1,11 @@
-"""Batches of states on native threads: Pinocchio's ``rneaInParallel`` / ``abaInParallel``.
+"""Pinocchio on several threads: one ``Data`` a thread, and batches of states on native threads.
 
-A :class:`ParallelRunner` keeps the ``ModelPool`` those functions need (built on first use)
-and the number of threads. States come one a row (robodyn's shape rule); Pinocchio wants
-one a column, so the runner passes transposed views and transposes the result back.
+A :class:`PerThreadData` gives each thread its own Pinocchio ``Data`` (scratch memory that
+every algorithm overwrites), so one model can be used from several threads at once.
+A :class:`ParallelRunner` runs Pinocchio's ``rneaInParallel`` / ``abaInParallel``: it keeps
+the ``ModelPool`` those functions need (built on first use) and the number of threads.
+States come one a row (robodyn's shape rule); Pinocchio wants one a column, so the runner
+passes transposed views and transposes the result back.
 """
 
 from __future__ import annotations
@@ -35,6 +38,22 @@ def check_threads(threads: int | None) -> int:
     if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
         raise InputError("threads", "a whole number ≥ 1 (or None for every core)", repr(threads))
     return int(threads)
+
+
+class PerThreadData:
+    """One Pinocchio ``Data`` for ``model`` per thread, created on first use in that thread."""
+
+    def __init__(self, model: pin.Model) -> None:
+        self._model = model
+        self._local = threading.local()
+
+    def get(self) -> pin.Data:
+        """This thread's data."""
+        try:
+            return self._local.data
+        except AttributeError:
+            data = self._local.data = self._model.createData()
+            return data
 
 
 class ParallelRunner:

@@ -1,6 +1,7 @@
 """A robot as an HTML table, for notebooks (``Robot._repr_html_``).
 
-Pure: reads the robot, returns text. Every name from the URDF is HTML-escaped.
+Pure: reads the robot, returns text. Every name from the URDF is HTML-escaped; units come
+from the robot's degrees of freedom (:mod:`robodyn.dynamics.dofs`).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import math
 from robodyn.exceptions import RobodynError
 
 
-def _number(value: float, unit: str) -> str:
+def _number(value: float | None, unit: str) -> str:
     if value is None or not math.isfinite(value):
         return "—"
     return f"{value:.4g} {unit}"
@@ -33,17 +34,14 @@ def robot_html(robot) -> str:
     except RobodynError as error:  # no default end effector (several tips)
         effector = f"none ({escape(str(error))})"
     masses = robot.link_masses
+    units = {dof.joint: dof for dof in robot.dofs if not dof.is_base}  # a joint's one degree of freedom
     rows = []
     for joint in robot.joints:
-        linear = joint.type == "prismatic"
         spec = robot.spec.joints.get(joint.name)
         child = spec.child if spec is not None else robot.spec.root
-        limit = (
-            f"{_number(joint.lower, 'm' if linear else 'rad')} … {_number(joint.upper, 'm' if linear else 'rad')}"
-            if joint.type != "floating"
-            else "—"
-        )
-        effort = _number(joint.effort, "N" if linear else "N m") if joint.type != "floating" else "—"
+        dof = units.get(joint.name)
+        limit = f"{_number(dof.lower, dof.position_unit)} … {_number(dof.upper, dof.position_unit)}" if dof else "—"
+        effort = _number(dof.effort_limit, dof.effort_unit) if dof else "—"
         rows.append(
             f"<tr><td>{escape(joint.name)}</td><td>{escape(joint.type)}</td><td>{limit}</td><td>{effort}</td>"
             f"<td>{escape(child)}</td><td>{_number(masses.get(child), 'kg')}</td></tr>"

@@ -1,8 +1,11 @@
 """What every computation on a Pinocchio model shares: the model, per-thread data, and the input boundary.
 
-:class:`ModelHandle` is the base of :class:`robodyn.Robot`. It owns the one rule by which
+A :class:`ModelHandle` is what the functions of :mod:`robodyn.dynamics.kinematics`,
+:mod:`robodyn.dynamics.configurations` and :mod:`robodyn.dynamics.regressor` take, Pinocchio
+style (``frame_position(handle, q, frame)``); a :class:`robodyn.Robot` holds one
+(:attr:`robodyn.Robot.handle`) and delegates to them. The handle owns the one rule by which
 robodyn accepts numbers (:meth:`ModelHandle.validate`) and the fast path that tries
-Pinocchio directly first (:meth:`ModelHandle._evaluate`).
+Pinocchio directly first (:meth:`ModelHandle.evaluate`).
 
 Thread safety: Pinocchio's ``Data`` is scratch memory that every algorithm overwrites. A
 handle keeps one ``Data`` per thread (:attr:`ModelHandle.data`), so one robot may be used
@@ -12,13 +15,15 @@ from several threads at once; the model itself is only read.
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
 
 from robodyn.common.inputs import as_states
+from robodyn.dynamics.batch import ParallelRunner, PerThreadData
+from robodyn.dynamics.kernels import Kernel, dynamics_kernels
+from robodyn.dynamics.mimic import MimicExpansion
 from robodyn.exceptions import InputError, NonFiniteResultError
 
 #: Largest accepted deviation of a floating base's quaternion norm from 1.
@@ -28,42 +33,46 @@ PINOCCHIO_ERRORS = (TypeError, ValueError, RuntimeError, AttributeError)
 _isfinite = math.isfinite
 
 
-class PerThreadData:
-    """One Pinocchio ``Data`` for ``model`` per thread, created on first use in that thread."""
-
-    def __init__(self, model: pin.Model) -> None:
-        self._model = model
-        self._local = threading.local()
-
-    def get(self) -> pin.Data:
-        """This thread's data."""
-        try:
-            return self._local.data
-        except AttributeError:
-            data = self._local.data = self._model.createData()
-            return data
-
-
 class ModelHandle:
-    """A Pinocchio model with per-thread data and robodyn's input checks.
+    """A Pinocchio model with per-thread data, its dynamics kernels and robodyn's input checks.
+
+    Args:
+        model: The Pinocchio model.
+        name: Robot name, for messages.
+        floating_base: Whether the root is a free-flyer joint.
+        mimic: For a model with mimic joints, its expansion (:mod:`robodyn.dynamics.mimic`).
+        threads: Native threads for batches (``None``: every available core).
 
     Attributes:
         model: The Pinocchio model (read only).
         name: Robot name, for messages.
         nq, nv: Sizes of a configuration and of a velocity.
         floating_base: Whether the root is a free-flyer joint (``q[3:7]`` a quaternion).
+        mimic: The expansion of a model with mimic joints, or ``None``.
+        frames: Pinocchio index of every frame, by name.
+        parallel: Runs Pinocchio's parallel algorithms on batches.
+        kernels: The equations of motion as Pinocchio calls (:mod:`robodyn.dynamics.kernels`).
     """
 
-    def __init__(self, model: pin.Model, *, name: str, floating_base: bool) -> None:
+    def __init__(
+        self,
+        model: pin.Model,
+        *,
+        name: str,
+        floating_base: bool,
+        mimic: MimicExpansion | None = None,
+        threads: int | None = None,
+    ) -> None:
         self.model = model
         self.name = name
         self.floating_base = floating_base
+        self.mimic = mimic
         self.nq: int = model.nq
         self.nv: int = model.nv
+        self.frames: dict[str, int] = {frame.name: index for index, frame in enumerate(model.frames)}
         self._data = PerThreadData(model)
-        #: What :meth:`_evaluate` computes, by quantity: ``(one state, batch or None)``,
-        #: set up once by the subclass (so a call builds no closures).
-        self._kernels: dict[str, tuple[Callable[..., np.ndarray], Callable[..., np.ndarray] | None]] = {}
+        self.parallel = ParallelRunner(model, threads=threads)
+        self.kernels = dynamics_kernels(model, self._data.get, self.parallel.run, mimic, name=name)
 
     @property
     def data(self) -> pin.Data:
@@ -91,7 +100,7 @@ class ModelHandle:
                 raise InputError("q[3:7]", "a unit quaternion (x, y, z, w) for the floating base", f"norm {norms[worst]:.9g}")
         return arrays, batch
 
-    def _accept(self, result: np.ndarray, q: np.ndarray) -> bool:
+    def accept(self, result: np.ndarray, q: np.ndarray) -> bool:
         """Whether a fast-path result can be returned as it is.
 
         A NaN or inf anywhere in the inputs makes a result non-finite (detected by one dot
@@ -106,39 +115,44 @@ class ModelHandle:
             return abs(quaternion.dot(quaternion) - 1.0) < QUATERNION_TOLERANCE
         return True
 
-    def _finite(self, result: np.ndarray, what: str) -> np.ndarray:
+    def finite(self, result: np.ndarray, what: str) -> np.ndarray:
         """Refuse a non-finite result of finite inputs (an overflow), never return it."""
         if not np.isfinite(result).all():
             raise NonFiniteResultError(self.name, what)
         return result
 
-    def _evaluate(self, what: str, names: tuple[str, ...], *values: np.ndarray) -> np.ndarray:
-        """Fast path, then checked path, for the quantity ``what`` of :attr:`_kernels`.
+    def evaluate(self, kernel: Kernel, *values: np.ndarray) -> np.ndarray:
+        """Fast path, then checked path, for one quantity (a :class:`~robodyn.dynamics.kernels.Kernel`).
 
         Its one-state function runs on the raw arguments if Pinocchio takes them and the
-        result passes :meth:`_accept`; else the arguments (named ``names``, for messages)
-        go through :meth:`validate` and one state goes to the one-state function, a batch
-        to the batch function (or to the one-state function row by row when there is none).
+        result passes :meth:`accept`; else the arguments (named ``kernel.names``, for
+        messages) go through :meth:`validate` and one state goes to the one-state function,
+        a batch to the batch function (or to the one-state function row by row when there
+        is none).
+
+        Raises:
+            InputError: For arguments :meth:`validate` refuses.
+            NonFiniteResultError: For a non-finite result of finite inputs (an overflow).
         """
-        single, batch = self._kernels[what]
+        what, names, single, batch = kernel
         try:
             result = single(*values)
             q = values[0]
-            # _accept, written out on the hot path: finite result and q, unit quaternion.
+            # accept, written out on the hot path: finite result and q, unit quaternion.
             if (
                 (_isfinite(sum(result.tolist())) if result.ndim == 1 else _all_finite(result))
                 and _isfinite(sum(q.tolist()))
-                and (not self.floating_base or self._accept(result, q))
+                and (not self.floating_base or self.accept(result, q))
             ):
                 return result
         except PINOCCHIO_ERRORS:
             pass
         arrays, is_batch = self.validate(**dict(zip(names, values, strict=True)))
         if not is_batch:
-            return self._finite(single(*arrays), what)
+            return self.finite(single(*arrays), what)
         if batch is not None:
-            return self._finite(batch(*arrays), what)
-        return self._finite(per_state(single, *arrays), what)
+            return self.finite(batch(*arrays), what)
+        return self.finite(per_state(single, *arrays), what)
 
 
 def _all_finite(array: np.ndarray) -> bool:

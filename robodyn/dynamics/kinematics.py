@@ -1,7 +1,10 @@
 """Kinematics of a loaded robot: frame positions, Jacobians, bias accelerations, wrenches.
 
-:class:`Kinematics` is a base of :class:`robodyn.Robot`; its methods follow the same
-conventions (1-D state → one result, 2-D → stacked; world axes; [m], [rad]).
+Functions of a :class:`~robodyn.dynamics.handle.ModelHandle`, Pinocchio style
+(``frame_position(handle, q, frame)``); :class:`robodyn.Robot` has them as methods
+(``robot.frame_position(q, frame)``). They follow the Robot's conventions (1-D state → one
+result, 2-D → stacked; world axes; [m], [rad]) and its fast path: Pinocchio is tried on the
+arguments as they are, and anything doubtful goes through the boundary check.
 """
 
 from __future__ import annotations
@@ -11,131 +14,132 @@ import difflib
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics.handle import ModelHandle, per_state
+from robodyn.dynamics.handle import ModelHandle
+from robodyn.dynamics.kernels import Kernel
 from robodyn.exceptions import FrameError, InputError
 
 
-class Kinematics(ModelHandle):
-    """Frames of a robot and how they move (through Pinocchio)."""
+def frame_id(handle: ModelHandle, frame: str) -> int:
+    """Pinocchio index of a frame (link, joint or fixed frame) by name.
 
-    def __init__(self, model: pin.Model, *, name: str, floating_base: bool) -> None:
-        super().__init__(model, name=name, floating_base=floating_base)
-        self._frame_ids = {frame.name: index for index, frame in enumerate(model.frames)}
+    Raises:
+        FrameError: If the robot has no such frame (with the closest names).
+    """
+    try:
+        return handle.frames[frame]
+    except (KeyError, TypeError):
+        close = difflib.get_close_matches(str(frame), list(handle.frames), n=3)
+        raise FrameError(frame, handle.name, close) from None
 
-    @property
-    def frame_names(self) -> list[str]:
-        """Names of every frame: links, joints and fixed frames of the URDF."""
-        return list(self._frame_ids)
 
-    @property
-    def frame_ids(self) -> dict[str, int]:
-        """Pinocchio index of every frame, by name (a copy)."""
-        return dict(self._frame_ids)
+def frame_position(handle: ModelHandle, q: np.ndarray, frame: str) -> np.ndarray:
+    """Position of a frame's origin in the world frame.
 
-    def frame_id(self, frame: str) -> int:
-        """Pinocchio index of a frame (link, joint or fixed frame) by name.
+    Args:
+        handle: The robot's model handle.
+        q: Configuration, shape (nq,) or (N, nq).
+        frame: Link or joint name, e.g. ``"end_effector"``.
 
-        Raises:
-            FrameError: If the robot has no such frame (with the closest names).
-        """
-        try:
-            return self._frame_ids[frame]
-        except (KeyError, TypeError):
-            close = difflib.get_close_matches(str(frame), list(self._frame_ids), n=3)
-            raise FrameError(frame, self.name, close) from None
+    Returns:
+        Shape (3,) or (N, 3), in [m].
+    """
+    index = frame_id(handle, frame)
+    model, data = handle.model, handle.data
 
-    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Position of a frame's origin in the world frame.
+    def position(qi: np.ndarray) -> np.ndarray:
+        pin.framesForwardKinematics(model, data, qi)
+        return data.oMf[index].translation.copy()
 
-        Args:
-            q: Configuration, shape (nq,) or (N, nq).
-            frame: Link or joint name, e.g. ``"end_effector"``.
+    return handle.evaluate(Kernel("frame position", ("q",), position), q)
 
-        Returns:
-            Shape (3,) or (N, 3), in [m].
-        """
-        frame_id = self.frame_id(frame)
-        (q,), _ = self.validate(q=q)
-        return per_state(lambda qi: self._placement(qi, frame_id).translation.copy(), q)
 
-    def _placement(self, q: np.ndarray, frame_id: int) -> pin.SE3:
-        data = self.data
-        pin.framesForwardKinematics(self.model, data, q)
-        return data.oMf[frame_id]
+def frame_jacobian(handle: ModelHandle, q: np.ndarray, frame: str) -> np.ndarray:
+    """Jacobian of a frame: its velocity is ``J v`` (linear first, then angular).
 
-    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Jacobian of a frame: its velocity is ``J v`` (linear first, then angular).
+    Both parts are expressed in world-aligned axes at the frame's origin (Pinocchio's
+    ``LOCAL_WORLD_ALIGNED``): rows 0-2 give the origin's velocity in [m/s], rows 3-5
+    the angular velocity in [rad/s].
 
-        Both parts are expressed in world-aligned axes at the frame's origin (Pinocchio's
-        ``LOCAL_WORLD_ALIGNED``): rows 0-2 give the origin's velocity in [m/s], rows 3-5
-        the angular velocity in [rad/s].
+    Args:
+        handle: The robot's model handle.
+        q: Configuration, shape (nq,) or (N, nq).
+        frame: Link or joint name.
 
-        Args:
-            q: Configuration, shape (nq,) or (N, nq).
-            frame: Link or joint name.
+    Returns:
+        Shape (6, nv) or (N, 6, nv).
+    """
+    index = frame_id(handle, frame)
+    model, data = handle.model, handle.data
 
-        Returns:
-            Shape (6, nv) or (N, 6, nv).
-        """
-        frame_id = self.frame_id(frame)
-        (q,), _ = self.validate(q=q)
-        return per_state(
-            lambda qi: pin.computeFrameJacobian(self.model, self.data, qi, frame_id, pin.LOCAL_WORLD_ALIGNED).copy(), q
-        )
+    def jacobian(qi: np.ndarray) -> np.ndarray:
+        return pin.computeFrameJacobian(model, data, qi, index, pin.LOCAL_WORLD_ALIGNED).copy()
 
-    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str) -> np.ndarray:
-        """``J̇(q, v) v``: the acceleration of a frame's origin at zero joint acceleration.
+    return handle.evaluate(Kernel("frame Jacobian", ("q",), jacobian), q)
 
-        The classical (not spatial) acceleration of the origin, in world axes, in [m/s²];
-        the frame's acceleration is ``J a + J̇ v`` with ``J`` from :meth:`frame_jacobian`.
 
-        Args:
-            q: Configuration, shape (nq,).
-            v: Velocity, shape (nv,).
-            frame: Link or joint name.
+def frame_bias_acceleration(handle: ModelHandle, q: np.ndarray, v: np.ndarray, frame: str) -> np.ndarray:
+    """``J̇(q, v) v``: the acceleration of a frame's origin at zero joint acceleration.
 
-        Returns:
-            Shape (3,).
-        """
-        frame_id = self.frame_id(frame)
-        (q, v), _ = self.validate(q=q, v=v)
-        data = self.data
-        pin.forwardKinematics(self.model, data, q, v, np.zeros(self.nv))
-        return pin.getFrameClassicalAcceleration(self.model, data, frame_id, pin.LOCAL_WORLD_ALIGNED).linear.copy()
+    The classical (not spatial) acceleration of the origin, in world axes, in [m/s²];
+    the frame's acceleration is ``J a + J̇ v`` with ``J`` from :func:`frame_jacobian`.
 
-    def wrench_torques(self, q: np.ndarray, frame: str, wrench: np.ndarray) -> np.ndarray:
-        """Joint torques ``J(q)ᵀ w`` that an external wrench on a frame exerts on the joints.
+    Args:
+        handle: The robot's model handle.
+        q: Configuration, shape (nq,).
+        v: Velocity, shape (nv,).
+        frame: Link or joint name.
 
-        Args:
-            q: Configuration, shape (nq,).
-            frame: Link or joint name; the wrench acts at its origin.
-            wrench: Force in [N] then torque in [N m], world axes, shape (6,) (or a force
-                alone, shape (3,)).
+    Returns:
+        Shape (3,).
+    """
+    index = frame_id(handle, frame)
+    model, data, zeros = handle.model, handle.data, np.zeros(handle.nv)
 
-        Returns:
-            Shape (nv,): add to the motor torques in forward dynamics, subtract from the
-            inverse dynamics' torques.
-        """
-        wrench = np.asarray(wrench, dtype=float)
-        if wrench.shape == (3,):
-            wrench = np.concatenate([wrench, np.zeros(3)])
-        if wrench.shape != (6,) or not np.isfinite(wrench).all():
-            raise InputError("wrench", "6 finite values (force in [N], torque in [N m])", f"shape {wrench.shape}")
-        return self.frame_jacobian(q, frame).T @ wrench
+    def bias(qi: np.ndarray, vi: np.ndarray) -> np.ndarray:
+        pin.forwardKinematics(model, data, qi, vi, zeros)
+        return pin.getFrameClassicalAcceleration(model, data, index, pin.LOCAL_WORLD_ALIGNED).linear.copy()
 
-    def integrate(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
-        """The configuration reached from ``q`` along the velocity ``dq`` in unit time.
+    return handle.evaluate(Kernel("frame bias acceleration", ("q", "v"), bias), q, v)
 
-        ``q + dq`` for joints; the floating base's pose moves on SE(3) (Pinocchio's
-        ``integrate``), keeping its quaternion unit.
 
-        Raises:
-            InputError: For states of the wrong size, non-finite values or a base
-                quaternion that is not unit (an all-zero one included).
-        """
-        (q, dq), _ = self.validate(q=q, v=dq)  # refuses a base quaternion that is not unit
-        if self.floating_base:
-            if q.ndim == 2:
-                return np.array([pin.integrate(self.model, qi, dqi) for qi, dqi in zip(q, dq, strict=True)])
-            return pin.integrate(self.model, q, dq)
-        return q + dq
+def wrench_torques(handle: ModelHandle, q: np.ndarray, frame: str, wrench: np.ndarray) -> np.ndarray:
+    """Joint torques ``J(q)ᵀ w`` that an external wrench on a frame exerts on the joints.
+
+    Args:
+        handle: The robot's model handle.
+        q: Configuration, shape (nq,).
+        frame: Link or joint name; the wrench acts at its origin.
+        wrench: Force in [N] then torque in [N m], world axes, shape (6,) (or a force
+            alone, shape (3,)).
+
+    Returns:
+        Shape (nv,): add to the motor torques in forward dynamics, subtract from the
+        inverse dynamics' torques.
+    """
+    wrench = np.asarray(wrench, dtype=float)
+    if wrench.shape == (3,):
+        wrench = np.concatenate([wrench, np.zeros(3)])
+    if wrench.shape != (6,) or not np.isfinite(wrench).all():
+        raise InputError("wrench", "6 finite values (force in [N], torque in [N m])", f"shape {wrench.shape}")
+    return frame_jacobian(handle, q, frame).T @ wrench
+
+
+def integrate(handle: ModelHandle, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+    """The configuration reached from ``q`` along the velocity ``dq`` in unit time.
+
+    ``q + dq`` for joints; the floating base's pose moves on SE(3) (Pinocchio's
+    ``integrate``), keeping its quaternion unit.
+
+    Raises:
+        InputError: For states of the wrong size, non-finite values or a base
+            quaternion that is not unit (an all-zero one included).
+    """
+    (q, dq), _ = handle.validate(q=q, v=dq)  # refuses a base quaternion that is not unit
+    if handle.floating_base:
+        if q.ndim == 2:
+            return np.array([pin.integrate(handle.model, qi, dqi) for qi, dqi in zip(q, dq, strict=True)])
+        return pin.integrate(handle.model, q, dq)
+    return q + dq
+
+
+__all__ = ["frame_bias_acceleration", "frame_id", "frame_jacobian", "frame_position", "integrate", "wrench_torques"]

@@ -10,33 +10,36 @@ that a mimic's source comes first), with ``<mimic>`` honoured (Pinocchio's
 Before Pinocchio allocates its data, the memory it needs is estimated
 (:func:`data_memory_estimate`); a model above ``max_dof`` degrees of freedom is refused
 instead of exhausting the machine.
+
+Every option of :func:`load` is kept in the robot's :class:`~robodyn.dynamics.options.LoadOptions`,
+and every later build from the robot's source takes them all: :func:`rebuild` and
+unpickling. A robot pickles by its source and options (registered with :mod:`copyreg`
+here, beside the loader), never by Pinocchio pointers; :func:`restore` builds it again
+once per process (:mod:`robodyn.dynamics.pickling`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import copyreg
 import os
 import sys
 import tempfile
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any
 
+import numpy as np
 import pinocchio as pin
 
-from robodyn.common.inputs import as_state
+from robodyn.dynamics import pickling
 from robodyn.dynamics.mimic import has_mimic, mimic_expansion
-from robodyn.dynamics.robot import LoadOptions, Robot
+from robodyn.dynamics.options import MAX_DOF, LoadOptions, load_options
+from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import URDFError
 from robodyn.urdf.normalised import normalised_urdf
 from robodyn.urdf.sources import URDFSource, locked_source, resolve_source
 from robodyn.urdf.validation import URDFSpec, parse_urdf
-
-#: Most degrees of freedom loaded by default. Pinocchio's data grows with njoints × nv²
-#: (:func:`data_memory_estimate`): about 1.8 GB a thread at 300, so the few copies a
-#: program holds (one a thread, the mimic expansion) fit on a 24 GB machine, where a
-#: 400-joint star needs 4 GB a copy and a 999-joint chain exhausted 24 GB. ``max_dof=``
-#: overrides it.
-MAX_DOF = 300
 
 
 def pinocchio_xml(spec: URDFSpec) -> str:
@@ -104,17 +107,20 @@ def load(
         RobodynWarning: For what ``strict=True`` refuses.
     """
     resolved = resolve_source(source, max_bytes=max_bytes)
+    floating = resolved.floating_base if floating_base is None else bool(floating_base)
     if lock:
-        resolved = locked_source(resolved, lock, floating_base=floating_base, check_inertia=check_inertia, strict=strict)
-    return build_robot(
-        resolved,
-        floating_base=floating_base,
+        resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
+    options = load_options(
+        floating_base=floating,
         gravity=gravity,
         check_inertia=check_inertia,
         strict=strict,
+        lock=lock,
         threads=threads,
         max_dof=max_dof,
+        max_bytes=max_bytes,
     )
+    return build_robot(resolved, options)
 
 
 def rebuild(robot: Robot, *, urdf: str | None = None, label: str | None = None) -> Robot:
@@ -125,16 +131,29 @@ def rebuild(robot: Robot, *, urdf: str | None = None, label: str | None = None) 
         if urdf is None
         else replace(robot.source, text=urdf, label=label or robot.source.label, name=label or robot.name)
     )
-    options = robot.options
-    return build_robot(
-        source,
-        floating_base=options.floating_base,
-        gravity=options.gravity,
-        check_inertia=options.check_inertia,
-        threads=options.threads,
-        strict=options.strict,
-        max_dof=max(robot.nv, MAX_DOF),
-    )
+    return build_robot(source, robot.options)
+
+
+def restore(source: URDFSource, options: LoadOptions) -> Robot:
+    """The robot built from ``source`` with ``options``, built once per process: what
+    unpickling a robot calls (see :mod:`robodyn.dynamics.pickling`).
+
+    Args:
+        source: Where the URDF came from (:attr:`Robot.source`).
+        options: How it was built (:attr:`Robot.options`).
+
+    Returns:
+        The (shared) robot.
+    """
+    return pickling.shared(source, options, build_robot)
+
+
+def _reduce(robot: Robot) -> tuple[Any, ...]:
+    """Pickle a robot by its source and options (:func:`restore` rebuilds it)."""
+    return restore, (robot.source, robot.options)
+
+
+copyreg.pickle(Robot, _reduce)
 
 
 def build_model(spec: URDFSpec, label: str, *, floating: bool, mimic: bool) -> pin.Model:
@@ -164,31 +183,32 @@ def build_model(spec: URDFSpec, label: str, *, floating: bool, mimic: bool) -> p
     return model
 
 
-def build_robot(
-    resolved: URDFSource,
-    *,
-    floating_base: bool | None = None,
-    gravity: Sequence[float] | None = None,
-    check_inertia: bool = True,
-    strict: bool = False,
-    threads: int | None = None,
-    max_dof: int | None = None,
-) -> Robot:
+def build_robot(resolved: URDFSource, options: LoadOptions) -> Robot:
     """Build a robot from a resolved URDF source (what :func:`load` does after resolving).
 
-    Arguments as for :func:`load`.
+    Args:
+        resolved: The URDF and where it came from (its joints already locked).
+        options: Every option of :func:`load` (``lock`` and ``max_bytes`` were applied
+            when the source was resolved).
+
+    Raises:
+        URDFError: If the URDF describes an impossible robot or one above ``max_dof``.
     """
-    floating = resolved.floating_base if floating_base is None else bool(floating_base)
+    floating = options.floating_base
     spec = parse_urdf(
-        resolved.text, resolved.label, floating_base=floating, check_inertia=check_inertia, strict=strict, **resolved.mesh_context
+        resolved.text,
+        resolved.label,
+        floating_base=floating,
+        check_inertia=options.check_inertia,
+        strict=options.strict,
+        **resolved.mesh_context,
     )
-    _check_size(spec, resolved.label, floating, MAX_DOF if max_dof is None else max_dof)
+    _check_size(spec, resolved.label, floating, options.max_dof)
     model = build_model(spec, resolved.label, floating=floating, mimic=True)
     mimic = None
     if has_mimic(model, spec, floating):
         mimic = mimic_expansion(model, spec, build_model(spec, resolved.label, floating=floating, mimic=False))
-    if gravity is not None:
-        model.gravity.linear = as_state(gravity, "gravity", 3)
+    model.gravity.linear = np.array(options.gravity)
     if mimic is not None:
         mimic.model.gravity.linear = model.gravity.linear
     if model.nv == 0:
@@ -196,8 +216,6 @@ def build_robot(
             resolved.label, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)"
         )
     name = spec.name if resolved.name == "robot" else resolved.name
-    gravity_vector = (float(model.gravity.linear[0]), float(model.gravity.linear[1]), float(model.gravity.linear[2]))
-    options = LoadOptions(floating, gravity_vector, check_inertia, threads, strict)
     return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
 
 
@@ -245,4 +263,4 @@ def _captured_stderr():
             captured.content = stream.read(4000).decode("utf-8", "replace")
 
 
-__all__ = ["MAX_DOF", "build_model", "build_robot", "data_memory_estimate", "load", "pinocchio_xml", "rebuild"]
+__all__ = ["MAX_DOF", "build_model", "build_robot", "data_memory_estimate", "load", "pinocchio_xml", "rebuild", "restore"]

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics.handle import PerThreadData
+from robodyn.dynamics.batch import PerThreadData
 from robodyn.urdf.validation import URDFSpec
 
 

@@ -12,26 +12,33 @@ Conventions, stated once (they are Pinocchio's, ``pin.Inertia.toDynamicParameter
   ``m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz`` — the mass in [kg], the first
   moment ``m·c`` in [kg m] (``c`` the centre of mass), and the inertia **about the body
   frame's origin** (not about the centre of mass) in [kg m²], lower triangle row by row.
-- Optional **friction** columns come after all bodies: one viscous coefficient a joint
-  (``fv``, torque ``fv·v`` in [N m s/rad] or [N s/m]), then one Coulomb coefficient a
-  joint (``fc``, torque ``fc·sign(v)`` in [N m] or [N]), in the order of ``joint_names``.
+- Optional **friction** columns come after all bodies: one viscous coefficient a degree
+  of freedom (``fv``, torque ``fv·v`` in [N m s/rad] or [N s/m]), then one Coulomb
+  coefficient a degree of freedom (``fc``, torque ``fc·sign(v)`` in [N m] or [N]), in the
+  order of ``robot.dofs`` (named by them: ``fv[joint1]``, a floating base's ``fv[base.x]``).
   The robot's own dynamics have no friction, so its friction parameters are zero.
 
 The columns for a body are exactly those of Pinocchio's ``computeJointTorqueRegressor``
 (``Y = Sᵀ Y_full`` through the mimic map for robots with mimic joints, where Pinocchio's
 regressor is evaluated on the expanded model; locked joints are fixed joints, so their
 links are welded). ``Y π = robot.inverse_dynamics`` to rounding.
+
+:func:`regressor` and :func:`inertial_parameters` are functions of the robot's
+:class:`~robodyn.dynamics.handle.ModelHandle` (a :class:`robodyn.Robot` is taken too, for
+its handle); the names (:func:`body_links`, :func:`parameter_names`) need the robot's
+URDF and degrees of freedom.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 import pinocchio as pin
 
-if TYPE_CHECKING:  # Robot calls into this module (Robot.regressor): no import at run time
-    from robodyn.dynamics.robot import Robot
+from robodyn.dynamics.dofs import Dof
+from robodyn.dynamics.handle import ModelHandle
+from robodyn.urdf.validation import URDFSpec
 
 #: Names of a body's 10 standard parameters, in order.
 PARAMETER_KINDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
@@ -39,53 +46,72 @@ PARAMETER_KINDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Iz
 FRICTION_KINDS = ("fv", "fc")
 
 
-def body_links(robot: Robot) -> list[str]:
+class DescribedModel(Protocol):
+    """A model handle with the description it was built from (a :class:`robodyn.Robot`)."""
+
+    @property
+    def handle(self) -> ModelHandle: ...
+    @property
+    def spec(self) -> URDFSpec: ...
+    @property
+    def dofs(self) -> tuple[Dof, ...]: ...
+
+
+def _handle(model: ModelHandle | DescribedModel) -> ModelHandle:
+    """The handle itself, or a robot's handle."""
+    return model if isinstance(model, ModelHandle) else model.handle
+
+
+def body_links(robot: DescribedModel) -> list[str]:
     """The URDF link that names each body (the moving joint's child link), in order."""
-    model = robot.model if robot.mimic is None else robot.mimic.model
+    handle, spec = robot.handle, robot.spec
+    model = handle.model if handle.mimic is None else handle.mimic.model
     links = []
     for joint_id in range(1, model.njoints):
         name = model.names[joint_id]
-        links.append(robot.spec.joints[name].child if name in robot.spec.joints else robot.spec.root)
+        links.append(spec.joints[name].child if name in spec.joints else spec.root)
     return links
 
 
-def parameter_names(robot: Robot, *, friction: bool = False) -> list[str]:
+def parameter_names(robot: DescribedModel, *, friction: bool = False) -> list[str]:
     """Names of the standard parameters, ``"kind[link]"`` (e.g. ``"Izz[link1]"``), in the
-    order of :func:`regressor`'s columns (friction: ``"fv[joint]"``, ``"fc[joint]"``)."""
+    order of :func:`regressor`'s columns (friction: ``"fv[dof]"``, ``"fc[dof]"`` with the
+    degrees of freedom's names, :attr:`robodyn.Robot.dofs`: a floating base's six are
+    ``base.x`` … ``base.rz``)."""
     names = [f"{kind}[{link}]" for link in body_links(robot) for kind in PARAMETER_KINDS]
     if friction:
-        names += [f"{kind}[{joint}]" for kind in FRICTION_KINDS for joint in _friction_joints(robot)]
+        names += [f"{kind}[{dof.name}]" for kind in FRICTION_KINDS for dof in robot.dofs]
     return names
 
 
-def _friction_joints(robot: Robot) -> list[str]:
-    """One name per velocity coordinate (a floating base's six get ``root_joint.k``)."""
-    names = []
-    for joint in robot.joints:
-        names += [f"{joint.name}.{k}" for k in range(6)] if joint.type == "floating" else [joint.name]
-    return names
+def _bodies(handle: ModelHandle) -> pin.Model:
+    """The model whose joints are the bodies (the expanded one for mimic joints)."""
+    return handle.model if handle.mimic is None else handle.mimic.model
 
 
-def inertial_parameters(robot: Robot, *, friction: bool = False) -> np.ndarray:
+def inertial_parameters(model: ModelHandle | DescribedModel, *, friction: bool = False) -> np.ndarray:
     """The standard parameters π of the robot's model (its URDF), so that ``Y π = tau``.
 
     Args:
-        robot: The robot.
+        model: The robot's model handle (or the robot).
         friction: Append the friction parameters (zeros: the model has no friction).
 
     Returns:
         Shape (10·n_bodies,) (``+ 2·nv`` with friction), units as in the module docstring.
     """
-    model = robot.model if robot.mimic is None else robot.mimic.model
-    values = np.concatenate([model.inertias[i].toDynamicParameters() for i in range(1, model.njoints)])
-    return np.concatenate([values, np.zeros(2 * robot.nv)]) if friction else values
+    handle = _handle(model)
+    bodies = _bodies(handle)
+    values = np.concatenate([bodies.inertias[i].toDynamicParameters() for i in range(1, bodies.njoints)])
+    return np.concatenate([values, np.zeros(2 * handle.nv)]) if friction else values
 
 
-def regressor(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, friction: bool = False) -> np.ndarray:
+def regressor(
+    model: ModelHandle | DescribedModel, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, friction: bool = False
+) -> np.ndarray:
     """The regressor ``Y(q, v, a)`` with ``tau = Y π`` (π from :func:`inertial_parameters`).
 
     Args:
-        robot: The robot.
+        model: The robot's model handle (or the robot).
         q: Configuration, shape (nq,) or (N, nq).
         v: Velocity, shape (nv,) or (N, nv).
         a: Acceleration, shape (nv,) or (N, nv).
@@ -97,24 +123,34 @@ def regressor(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, fric
     Raises:
         InputError: For states of the wrong shape or with non-finite values.
     """
-    (q, v, a), batch = robot.validate(q=q, v=v, a=a)
-    rows = [_one(robot, *state) for state in zip(np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a), strict=True)]
-    result = np.stack(rows) if rows else np.zeros((0, robot.nv, 10 * len(body_links(robot))))
+    handle = _handle(model)
+    nv = handle.nv
+    (q, v, a), batch = handle.validate(q=q, v=v, a=a)
+    rows = [_one(handle, *state) for state in zip(np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a), strict=True)]
+    result = np.stack(rows) if rows else np.zeros((0, nv, 10 * (_bodies(handle).njoints - 1)))
     if friction:
         v2 = np.atleast_2d(v)
-        eye = np.eye(robot.nv)
+        eye = np.eye(nv)
         columns = np.concatenate([eye[None] * v2[:, None, :], eye[None] * np.sign(v2)[:, None, :]], axis=2)
         result = np.concatenate([result, columns], axis=2)
     return result if batch else result[0]
 
 
-def _one(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+def _one(handle: ModelHandle, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
     # (the Python binding returns a 1-D array when nv = 1: reshape)
-    if robot.mimic is None:
-        return np.array(pin.computeJointTorqueRegressor(robot.model, robot.data, q, v, a)).reshape(robot.nv, -1)
-    mimic = robot.mimic
+    mimic = handle.mimic
+    if mimic is None:
+        return np.array(pin.computeJointTorqueRegressor(handle.model, handle.data, q, v, a)).reshape(handle.nv, -1)
     full = pin.computeJointTorqueRegressor(mimic.model, mimic.data, mimic.q(q), mimic.selection @ v, mimic.selection @ a)
     return mimic.selection.T @ np.reshape(full, (mimic.model.nv, -1))
 
 
-__all__ = ["FRICTION_KINDS", "PARAMETER_KINDS", "body_links", "inertial_parameters", "parameter_names", "regressor"]
+__all__ = [
+    "FRICTION_KINDS",
+    "PARAMETER_KINDS",
+    "DescribedModel",
+    "body_links",
+    "inertial_parameters",
+    "parameter_names",
+    "regressor",
+]

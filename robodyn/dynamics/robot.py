@@ -13,71 +13,75 @@ Conventions, stated once:
       length N accordingly.
     - The equations of motion are ``tau = M(q) a + C(q, v) v + G(q)``; ``C`` is
       Pinocchio's Coriolis matrix, which satisfies ``dM/dt = C + C^T``.
+
+A Robot is made by composition: a :class:`~robodyn.dynamics.handle.ModelHandle` (the model,
+per-thread data, the input boundary and the fast path) inside, and methods that delegate to
+the functions of the handle in :mod:`~robodyn.dynamics.kinematics`,
+:mod:`~robodyn.dynamics.configurations`, :mod:`~robodyn.dynamics.energies` and
+:mod:`~robodyn.dynamics.regressor`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics import frames
-from robodyn.dynamics.batch import ParallelRunner
-from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT, ConfigurationSpace
+from robodyn.dynamics import configurations, energies, frames, kinematics
+from robodyn.dynamics import regressor as identification
+from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
+from robodyn.dynamics.display import robot_html
 from robodyn.dynamics.dofs import Dof, configuration_names, robot_dofs
-from robodyn.dynamics.handle import per_state
+from robodyn.dynamics.handle import ModelHandle
 from robodyn.dynamics.joints import JointInfo
-from robodyn.dynamics.kinematics import Kinematics
+from robodyn.dynamics.kernels import massless_joints
 from robodyn.dynamics.mimic import MimicExpansion
+from robodyn.dynamics.options import LoadOptions
 from robodyn.exceptions import NonFiniteResultError, SingularMassMatrixError
 from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
 
 
-@dataclass(frozen=True)
-class LoadOptions:
-    """How a robot was built from its source (what :func:`robodyn.load` was given).
-
-    Attributes:
-        floating_base: Whether the root got a free-flyer joint.
-        gravity: Gravity in the world frame, in [m/s²].
-        check_inertia: Whether impossible inertias on moving links were refused.
-        threads: Native threads for batches (``None``: every available core).
-        strict: Whether warnings of the validator were treated as errors.
-    """
-
-    floating_base: bool
-    gravity: tuple[float, float, float]
-    check_inertia: bool = True
-    threads: int | None = None
-    strict: bool = False
-
-
-class Robot(Kinematics, ConfigurationSpace):
+class Robot:
     """A rigid-body robot and its dynamics (RNEA, CRBA, ABA through Pinocchio).
 
     Build one with :func:`robodyn.load`. The Pinocchio model is available as
-    :attr:`model` for anything robodyn does not wrap. Kinematics (frames, Jacobians) come
-    from :class:`~robodyn.dynamics.kinematics.Kinematics`, limits and configurations
-    (neutral, default, random) from :class:`~robodyn.dynamics.configurations.ConfigurationSpace`.
+    :attr:`model` for anything robodyn does not wrap. Kinematics (frames, Jacobians) are
+    the functions of :mod:`robodyn.dynamics.kinematics`, limits and configurations
+    (neutral, default, random) those of :mod:`robodyn.dynamics.configurations`, all
+    applied to the robot's :attr:`handle`.
 
     A robot may be used from several threads at once: each thread gets its own Pinocchio
     data (see :mod:`robodyn.dynamics.handle`).
 
+    Pickling and copies: a robot pickles by its source and its complete load options
+    (:attr:`options`), never by Pinocchio pointers, and unpickling builds it again once
+    per process (:func:`robodyn.dynamics.loading.restore`). A robot is not changed by
+    anything robodyn does, so ``copy.copy(robot)`` and ``copy.deepcopy(robot)`` return the
+    robot itself (objects holding a robot copy cheaply and share it); for an independent
+    robot, e.g. to edit its Pinocchio model by hand, use
+    :func:`robodyn.dynamics.loading.rebuild`.
+
     Attributes:
         name: Robot name.
+        handle: The model handle the methods delegate to (model, per-thread data, input
+            checks, fast path); pass it to the functions of the modules above.
         model: The Pinocchio model.
         spec: The validated URDF (links, joints, inertials).
         source: Where the URDF came from (:attr:`urdf` is its text); copies and edits of
             the robot are built from it (:func:`robodyn.dynamics.loading.rebuild`).
-        options: How it was built (floating base, gravity, inertia check, threads).
+        options: How it was built: every option of :func:`robodyn.load`.
         floating_base: Whether the root is a free-flyer joint.
+        nq, nv: Sizes of a configuration and of a velocity.
         mimic: For robots with mimic joints, the model with every joint independent and the
             map to it (Pinocchio supports mimic joints in RNEA and CRBA but not everywhere).
+        joints: The joints with coordinates (root joint first), with their limits.
+        joint_names: Their names: the order of ``q``, ``v``, ``a``, ``tau``.
+        dofs: One record per degree of freedom (name, joint, kind, units, limits), length nv.
+        configuration_names: A name for each entry of ``q`` (length nq; a floating base's
+            are ``base.x`` … ``base.qw``).
     """
 
     def __init__(
@@ -90,20 +94,37 @@ class Robot(Kinematics, ConfigurationSpace):
         name: str,
         mimic: MimicExpansion | None = None,
     ):
-        super().__init__(model, name=name, floating_base=options.floating_base)
+        self.handle = ModelHandle(model, name=name, floating_base=options.floating_base, mimic=mimic, threads=options.threads)
+        self.name = name
+        self.model = model
         self.spec = spec
         self.source = source
         self.options = options
+        self.floating_base = options.floating_base
         self.mimic = mimic
-        self.joints: list[JointInfo] = self._joint_infos()
+        self.nq: int = model.nq
+        self.nv: int = model.nv
+        self.joints: list[JointInfo] = joint_infos(model, spec)
         self.joint_names: list[str] = [joint.name for joint in self.joints]
-        #: One record per degree of freedom (name, joint, kind, units, limits), length nv.
         self.dofs: tuple[Dof, ...] = robot_dofs(self.joints)
-        #: A name for each entry of ``q`` (length nq; a floating base's are ``base.x`` … ``base.qw``).
         self.configuration_names: list[str] = configuration_names(self.joints)
-        self._parallel = ParallelRunner(model, threads=options.threads)
-        self._kernels.update(self._dynamics_kernels())
-        self._lower_triangle = np.tri(self.nv, self.nv, -1, dtype=bool)
+
+    @property
+    def data(self) -> pin.Data:
+        """This thread's Pinocchio data for :attr:`model` (created on first use)."""
+        return self.handle.data
+
+    def validate(self, **named: object) -> tuple[list[np.ndarray], bool]:
+        """Check state arguments by name (``q`` has nq entries, the others nv); see
+        :meth:`robodyn.dynamics.handle.ModelHandle.validate`.
+
+        Returns:
+            The arguments as float64 arrays, and whether they are a batch (2-D).
+
+        Raises:
+            InputError: Naming the argument.
+        """
+        return self.handle.validate(**named)
 
     @property
     def urdf(self) -> str:
@@ -123,33 +144,22 @@ class Robot(Kinematics, ConfigurationSpace):
     @property
     def threads(self) -> int:
         """Native threads used for batches of states."""
-        return self._parallel.threads
+        return self.handle.parallel.threads
 
     def __repr__(self) -> str:
         return f"<Robot {self.name!r}: nq={self.nq}, nv={self.nv}, joints={self.joint_names}>"
 
-    def __reduce__(self) -> tuple:
-        """Pickle by source and options; unpickling rebuilds the robot once per process
-        (:func:`robodyn.dynamics.pickling.restore`)."""
-        from robodyn.dynamics.pickling import restore
+    def __copy__(self) -> Robot:
+        """The robot itself (see the class docstring)."""
+        return self
 
-        return restore, (self.source, self.options)
+    def __deepcopy__(self, memo: dict) -> Robot:
+        """The robot itself (see the class docstring; ``rebuild`` makes an independent one)."""
+        return self
 
-    def _joint_infos(self) -> list[JointInfo]:
-        infos = []
-        for joint_id in range(1, self.model.njoints):
-            joint = self.model.joints[joint_id]
-            if joint.nv == 0:  # mimic joints follow another joint
-                continue
-            name = self.model.names[joint_id]
-            if name in self.spec.joints:
-                urdf_joint = self.spec.joints[name]
-                infos.append(
-                    JointInfo(name, urdf_joint.type, urdf_joint.lower, urdf_joint.upper, urdf_joint.effort, urdf_joint.velocity)
-                )
-            else:
-                infos.append(JointInfo(name, "floating", -np.inf, np.inf, np.inf, np.inf))
-        return infos
+    def _repr_html_(self) -> str:
+        """The robot as an HTML table in notebooks (:func:`robodyn.dynamics.display.robot_html`)."""
+        return robot_html(self)
 
     # ----------------------------------------------------------------------------------
     # Properties of the model
@@ -195,10 +205,7 @@ class Robot(Kinematics, ConfigurationSpace):
     @cached_property
     def massless_joints(self) -> list[str]:
         """Joints whose whole subtree has no mass: they make ``M(q)`` singular."""
-        subtree_mass = [self.model.inertias[i].mass for i in range(self.model.njoints)]
-        for joint_id in range(self.model.njoints - 1, 0, -1):
-            subtree_mass[self.model.parents[joint_id]] += subtree_mass[joint_id]
-        return [self.model.names[i] for i in range(1, self.model.njoints) if subtree_mass[i] <= 0 and self.model.joints[i].nv > 0]
+        return massless_joints(self.model)
 
     @property
     def total_mass(self) -> float:
@@ -206,10 +213,9 @@ class Robot(Kinematics, ConfigurationSpace):
         return float(sum(self.link_masses.values()))
 
     # ----------------------------------------------------------------------------------
-    # Dynamics. Each method asks ModelHandle._evaluate for its quantity, whose one-state
-    # and (where Pinocchio has one) parallel batch function _dynamics_kernels set up once:
-    # the fast path tries Pinocchio on the raw arguments first, anything doubtful goes
-    # through the full boundary check.
+    # Dynamics: each quantity is a kernel of the handle (robodyn.dynamics.kernels), which
+    # ModelHandle.evaluate runs on the raw arguments first; anything doubtful goes through
+    # the full boundary check.
     # ----------------------------------------------------------------------------------
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA).
@@ -222,7 +228,8 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
-        return self._evaluate("tau", ("q", "v", "a"), q, v, a)
+        handle = self.handle
+        return handle.evaluate(handle.kernels.tau, q, v, a)
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).
@@ -238,8 +245,9 @@ class Robot(Kinematics, ConfigurationSpace):
         Raises:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
+        handle = self.handle
         try:
-            return self._evaluate("a", ("q", "v", "tau"), q, v, tau)
+            return handle.evaluate(handle.kernels.a, q, v, tau)
         except NonFiniteResultError:  # finite inputs, non-finite accelerations: only a singular M does that
             raise SingularMassMatrixError(self.name, self.massless_joints) from None
 
@@ -250,18 +258,7 @@ class Robot(Kinematics, ConfigurationSpace):
         the right sizes. A singular mass matrix gives non-finite values here (ABA), or a
         :class:`SingularMassMatrixError` for robots with mimic joints.
         """
-        if self.mimic is not None:
-            return self._solve_dynamics(q, v, tau)
-        return pin.aba(self.model, self.data, q, v, tau)
-
-    def _solve_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """``M⁻¹ (tau − C v − G)`` by a linear solve (for models ABA cannot take)."""
-        mass = self._mass_matrix(q)
-        rhs = tau - pin.nonLinearEffects(self.model, self.data, q, v)
-        try:
-            return np.linalg.solve(mass, rhs)
-        except np.linalg.LinAlgError:
-            raise SingularMassMatrixError(self.name, self.massless_joints) from None
+        return self.handle.kernels.a.single(q, v, tau)
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """Joint-space inertia matrix ``M(q)`` (CRBA), symmetric.
@@ -272,18 +269,8 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
         """
-        return self._evaluate("M", ("q",), q)
-
-    def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        # Upper triangle only. With a mimic joint between two free joints, Pinocchio 4.1's
-        # crba in its default LOCAL convention accumulates into data from call to call;
-        # the WORLD convention does not (tests/test_nondegenerate.py, mimic_tree).
-        if self.mimic is None:
-            mass = pin.crba(self.model, self.data, q)
-        else:
-            mass = pin.crba(self.model, self.data, q, pin.Convention.WORLD)
-        np.copyto(mass, mass.T, where=self._lower_triangle)
-        return mass
+        handle = self.handle
+        return handle.evaluate(handle.kernels.M, q)
 
     def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Coriolis and centrifugal matrix ``C(q, v)``, with ``dM/dt = C + Cᵀ``.
@@ -295,15 +282,8 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv, nv) or (N, nv, nv).
         """
-        return self._evaluate("C", ("q", "v"), q, v)
-
-    def _coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        if self.mimic is not None:  # computeCoriolisMatrix mishandles mimic joints
-            expansion = self.mimic
-            with np.errstate(invalid="ignore"):  # inf inputs: the checks after report them
-                full = pin.computeCoriolisMatrix(expansion.model, expansion.data, expansion.q(q), expansion.selection @ v)
-                return expansion.selection.T @ full @ expansion.selection
-        return pin.computeCoriolisMatrix(self.model, self.data, q, v)
+        handle = self.handle
+        return handle.evaluate(handle.kernels.C, q, v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
         """Generalised gravity ``G(q)``: the torques that hold the robot still.
@@ -314,7 +294,8 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        return self._evaluate("G", ("q",), q)
+        handle = self.handle
+        return handle.evaluate(handle.kernels.G, q)
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``C(q, v) v + G(q)``: the torques at zero acceleration.
@@ -326,58 +307,118 @@ class Robot(Kinematics, ConfigurationSpace):
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        return self._evaluate("C v + G", ("q", "v"), q, v)
-
-    def _dynamics_kernels(self) -> dict:
-        """One-state and batch functions of each quantity, for :meth:`_evaluate` (built once)."""
-        model, data, run = self.model, self._data.get, self._parallel.run
-
-        def gravity_batch(q: np.ndarray) -> np.ndarray:
-            zeros = np.zeros((q.shape[0], self.nv))
-            return run(pin.rneaInParallel, q, zeros, zeros)
-
-        forward: tuple[Callable[..., np.ndarray], Callable[..., np.ndarray] | None] = (
-            (lambda q, v, tau: pin.aba(model, data(), q, v, tau), lambda q, v, tau: run(pin.abaInParallel, q, v, tau))
-            if self.mimic is None
-            else (self._solve_dynamics, None)  # Pinocchio's ABA refuses mimic joints (abaInParallel crashes on them)
-        )
-        return {
-            "tau": (lambda q, v, a: pin.rnea(model, data(), q, v, a), lambda q, v, a: run(pin.rneaInParallel, q, v, a)),
-            "a": forward,
-            "M": (self._mass_matrix, None),
-            "C": (self._coriolis, None),
-            "G": (lambda q: pin.computeGeneralizedGravity(model, data(), q), gravity_batch),
-            "C v + G": (
-                lambda q, v: pin.nonLinearEffects(model, data(), q, v),
-                lambda q, v: run(pin.rneaInParallel, q, v, np.zeros_like(v)),
-            ),
-        }
+        handle = self.handle
+        return handle.evaluate(handle.kernels.nle, q, v)
 
     # ----------------------------------------------------------------------------------
-    # Energies
+    # Energies (robodyn.dynamics.energies)
     # ----------------------------------------------------------------------------------
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
         """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch."""
-        (q, v), batch = self.validate(q=q, v=v)
-        # From the mass matrix rather than computeKineticEnergy, which refuses mimic joints.
-        energy = per_state(lambda qi, vi: np.array(0.5 * vi @ self._mass_matrix(qi) @ vi), q, v)
-        energy = self._finite(np.asarray(energy), "kinetic energy")
-        return energy if batch else float(energy)
+        return energies.kinetic_energy(self.handle, q, v)
 
     def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
         """Gravitational potential energy ``−Σ m_i gᵀ p_i`` in [J]: a float, or shape (N,).
 
         Zero when every centre of mass is at height zero (for the default gravity).
         """
-        (q,), batch = self.validate(q=q)
-        # computePotentialEnergy refuses mimic joints: use the expanded model for those.
-        if self.mimic is None:
-            energy = per_state(lambda qi: np.array(pin.computePotentialEnergy(self.model, self.data, qi)), q)
-        else:
-            mimic = self.mimic
-            energy = per_state(lambda qi: np.array(pin.computePotentialEnergy(mimic.model, mimic.data, mimic.q(qi))), q)
-        energy = self._finite(np.asarray(energy), "potential energy")
-        return energy if batch else float(energy)
+        return energies.potential_energy(self.handle, q)
+
+    # ----------------------------------------------------------------------------------
+    # Kinematics (robodyn.dynamics.kinematics)
+    # ----------------------------------------------------------------------------------
+    @property
+    def frame_names(self) -> list[str]:
+        """Names of every frame: links, joints and fixed frames of the URDF."""
+        return list(self.handle.frames)
+
+    @property
+    def frame_ids(self) -> dict[str, int]:
+        """Pinocchio index of every frame, by name (a copy)."""
+        return dict(self.handle.frames)
+
+    def frame_id(self, frame: str) -> int:
+        """Pinocchio index of a frame (link, joint or fixed frame) by name.
+
+        Raises:
+            FrameError: If the robot has no such frame (with the closest names).
+        """
+        return kinematics.frame_id(self.handle, frame)
+
+    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Position of a frame's origin in the world frame, shape (3,) or (N, 3), in [m]
+        (:func:`robodyn.dynamics.kinematics.frame_position`)."""
+        return kinematics.frame_position(self.handle, q, frame)
+
+    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Jacobian of a frame, shape (6, nv) or (N, 6, nv): linear rows then angular, in
+        world-aligned axes at the frame's origin (:func:`robodyn.dynamics.kinematics.frame_jacobian`)."""
+        return kinematics.frame_jacobian(self.handle, q, frame)
+
+    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str) -> np.ndarray:
+        """``J̇(q, v) v`` of a frame's origin, world axes, shape (3,), in [m/s²]
+        (:func:`robodyn.dynamics.kinematics.frame_bias_acceleration`)."""
+        return kinematics.frame_bias_acceleration(self.handle, q, v, frame)
+
+    def wrench_torques(self, q: np.ndarray, frame: str, wrench: np.ndarray) -> np.ndarray:
+        """Joint torques ``J(q)ᵀ w`` of a wrench (force [N], torque [N m], world axes) on a
+        frame's origin, shape (nv,) (:func:`robodyn.dynamics.kinematics.wrench_torques`)."""
+        return kinematics.wrench_torques(self.handle, q, frame, wrench)
+
+    def integrate(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        """The configuration reached from ``q`` along the velocity ``dq`` in unit time
+        (:func:`robodyn.dynamics.kinematics.integrate`: SE(3) for a floating base)."""
+        return kinematics.integrate(self.handle, q, dq)
+
+    # ----------------------------------------------------------------------------------
+    # Limits and configurations (robodyn.dynamics.configurations)
+    # ----------------------------------------------------------------------------------
+    @property
+    def lower_limits(self) -> np.ndarray:
+        """Lower position limits per degree of freedom, shape (nv,), in [rad] or [m].
+
+        The six base coordinates of a floating base are unlimited (-inf).
+        """
+        return configurations.lower_limits(self.dofs)
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m]."""
+        return configurations.upper_limits(self.dofs)
+
+    def neutral_configuration(self) -> np.ndarray:
+        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
+        return configurations.neutral_configuration(self.handle)
+
+    def default_configuration(self) -> np.ndarray:
+        """The neutral configuration clipped into the joint position limits, shape (nq,)
+        (:func:`robodyn.dynamics.configurations.default_configuration`)."""
+        return configurations.default_configuration(self.handle, self.dofs)
+
+    def physical_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Position limits of the joints (floating base excluded), placeholders and empty
+        ranges as ±inf: ``(lower, upper)``, each of shape (nv,) or (nv − 6,)
+        (:func:`robodyn.dynamics.configurations.physical_limits`)."""
+        return configurations.physical_limits(self.dofs)
+
+    def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
+        """A floating-base ``q`` (nq,) from the base position in [m], its roll, pitch, yaw
+        in [rad] and the joint positions (default zeros)
+        (:func:`robodyn.dynamics.configurations.floating_configuration`).
+
+        Raises:
+            InputError: For a fixed-base robot or wrong sizes.
+        """
+        return configurations.floating_configuration(self.handle, position, rpy, joints)
+
+    def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
+        """Configurations drawn uniformly within the joint limits, in a physical range,
+        shape (nq,) or (count, nq) (:func:`robodyn.dynamics.configurations.random_configuration`).
+
+        Raises:
+            InputError: If ``count`` is not a non-negative integer.
+        """
+        return configurations.random_configuration(self.handle, self.dofs, rng, count)
 
     # ----------------------------------------------------------------------------------
     # Identification (robodyn.dynamics.regressor)
@@ -387,26 +428,33 @@ class Robot(Kinematics, ConfigurationSpace):
 
         Per body (the links that move): m, m·c (3), inertia about the body origin in the
         body frame (Ixx, Ixy, Iyy, Ixz, Iyz, Izz); optional viscous and Coulomb friction
-        columns per joint. See :func:`robodyn.dynamics.regressor.regressor`.
+        columns per degree of freedom. See :func:`robodyn.dynamics.regressor.regressor`.
 
         Returns:
             Shape (nv, 10·n_bodies [+ 2·nv]) or (N, nv, …) for a batch.
         """
-        from robodyn.dynamics.regressor import regressor
-
-        return regressor(self, q, v, a, friction=friction)
+        return identification.regressor(self.handle, q, v, a, friction=friction)
 
     def inertial_parameters(self, *, friction: bool = False) -> np.ndarray:
         """The URDF's standard inertial parameters π, in :meth:`regressor`'s order."""
-        from robodyn.dynamics.regressor import inertial_parameters
-
-        return inertial_parameters(self, friction=friction)
-
-    def _repr_html_(self) -> str:
-        """The robot as an HTML table in notebooks (:func:`robodyn.dynamics.display.robot_html`)."""
-        from robodyn.dynamics.display import robot_html
-
-        return robot_html(self)
+        return identification.inertial_parameters(self.handle, friction=friction)
 
 
-__all__ = ["PLACEHOLDER_LIMIT", "Dof", "JointInfo", "LoadOptions", "Robot"]
+def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:
+    """The joints of ``model`` that have coordinates (mimic joints follow another joint and
+    have none), in Pinocchio's order, with their URDF limits; a floating root joint is
+    unlimited."""
+    infos = []
+    for joint_id in range(1, model.njoints):
+        if model.joints[joint_id].nv == 0:  # mimic joints follow another joint
+            continue
+        name = model.names[joint_id]
+        if name in spec.joints:
+            joint = spec.joints[name]
+            infos.append(JointInfo(name, joint.type, joint.lower, joint.upper, joint.effort, joint.velocity))
+        else:
+            infos.append(JointInfo(name, "floating", -np.inf, np.inf, np.inf, np.inf))
+    return infos
+
+
+__all__ = ["PLACEHOLDER_LIMIT", "Dof", "JointInfo", "LoadOptions", "Robot", "joint_infos"]

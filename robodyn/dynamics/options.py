@@ -1,0 +1,85 @@
+"""How a robot is built from its URDF: every option :func:`robodyn.load` takes, in one record.
+
+A :class:`LoadOptions` goes with the robot (:attr:`robodyn.Robot.options`) and is passed
+everywhere a robot is built again from its source: :func:`robodyn.dynamics.loading.rebuild`
+(copies, payloads, identified models) and unpickling, so a rebuilt robot is built exactly
+as the original was.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from robodyn.common.constants import STANDARD_GRAVITY
+from robodyn.common.inputs import as_state
+from robodyn.urdf.sources import max_urdf_bytes
+
+#: Most degrees of freedom loaded by default. Pinocchio's data grows with njoints × nv²
+#: (:func:`robodyn.dynamics.loading.data_memory_estimate`): about 1.8 GB a thread at 300,
+#: so the few copies a program holds (one a thread, the mimic expansion) fit on a 24 GB
+#: machine, where a 400-joint star needs 4 GB a copy and a 999-joint chain exhausted
+#: 24 GB. ``max_dof=`` overrides it.
+MAX_DOF = 300
+
+
+@dataclass(frozen=True)
+class LoadOptions:
+    """How a robot was built from its source (what :func:`robodyn.load` was given, resolved).
+
+    Attributes:
+        floating_base: Whether the root got a free-flyer joint.
+        gravity: Gravity in the world frame, in [m/s²].
+        check_inertia: Whether impossible inertias on moving links were refused.
+        threads: Native threads for batches (``None``: every available core).
+        strict: Whether warnings of the validator were treated as errors.
+        lock: Joints frozen, as ``(name, position in [rad] or [m])`` pairs. They are fixed
+            joints of the robot's source (:attr:`robodyn.Robot.urdf`) already, so building
+            from that source does not lock them again.
+        max_dof: Most degrees of freedom accepted (:data:`MAX_DOF` by default).
+        max_bytes: Largest URDF accepted when it was read, in bytes (the source, read
+            once, carries the text: building from it reads no file).
+    """
+
+    floating_base: bool
+    gravity: tuple[float, float, float] = STANDARD_GRAVITY
+    check_inertia: bool = True
+    threads: int | None = None
+    strict: bool = False
+    lock: tuple[tuple[str, float], ...] = ()
+    max_dof: int = MAX_DOF
+    max_bytes: int | None = None
+
+
+def load_options(
+    *,
+    floating_base: bool,
+    gravity: Sequence[float] | None = None,
+    check_inertia: bool = True,
+    strict: bool = False,
+    lock: Mapping[str, float] | None = None,
+    threads: int | None = None,
+    max_dof: int | None = None,
+    max_bytes: int | None = None,
+) -> LoadOptions:
+    """The options :func:`robodyn.load` was given, with the defaults filled in.
+
+    Arguments as for :func:`robodyn.load` (``floating_base`` already decided).
+
+    Raises:
+        InputError: If ``gravity`` is not 3 finite numbers.
+    """
+    vector = STANDARD_GRAVITY if gravity is None else tuple(float(g) for g in as_state(gravity, "gravity", 3))
+    return LoadOptions(
+        floating_base=bool(floating_base),
+        gravity=(vector[0], vector[1], vector[2]),
+        check_inertia=bool(check_inertia),
+        threads=threads,
+        strict=bool(strict),
+        lock=tuple((name, float(position)) for name, position in (lock or {}).items()),
+        max_dof=MAX_DOF if max_dof is None else max_dof,
+        max_bytes=max_urdf_bytes(max_bytes),
+    )
+
+
+__all__ = ["MAX_DOF", "LoadOptions", "load_options"]
