@@ -121,30 +121,42 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
             (see :mod:`robodyn.reference.numeric` for how they map to Pinocchio's state).
     """
     urdf = yourdfpy.URDF.load(io.BytesIO(text.encode("utf-8")), build_scene_graph=False, load_meshes=False)
+    bodies = _virtual_bodies(spec.root) if floating_base else []
+    bodies = _moving_bodies(urdf, spec.root, bodies)
+    independent, selection, offset = _mimic_map(spec, bodies)
+    ancestors = np.zeros((len(bodies), len(bodies)), dtype=bool)
+    for index, body in enumerate(bodies):
+        ancestors[index, index] = True
+        if body.parent >= 0:
+            ancestors[index] |= ancestors[body.parent]
+    return KinematicTree(spec.name, bodies, independent, selection, offset, ancestors, floating_base)
+
+
+def _massless(joint: str, link: str, parent: int, origin: np.ndarray, axis: np.ndarray, revolute: bool) -> Body:
+    """A body whose mass properties are filled in once its welded links are known."""
+    return Body(joint, link, parent, origin, axis, revolute, 0.0, np.zeros(3), np.zeros((3, 3)))
+
+
+def _virtual_bodies(root: str) -> list[Body]:
+    """The six massless bodies of a floating base's virtual joints (the last carries ``root``)."""
+    revolute = (False,) * 3 + (True,) * 3
+    return [
+        _massless(name, root if index == 5 else name, index - 1, np.eye(4), np.eye(3)[index % 3], revolute[index])
+        for index, name in enumerate(VIRTUAL_JOINTS)
+    ]
+
+
+def _moving_bodies(urdf: yourdfpy.URDF, root: str, bodies: list[Body]) -> list[Body]:
+    """``bodies`` followed by one body per moving joint of ``urdf``, depth-first from
+    ``root`` (a parent before its children), each with the links welded to it merged in."""
     links = {link.name: link for link in urdf.robot.links}
     children: dict[str, list[yourdfpy.Joint]] = {}
     for joint in urdf.robot.joints:
         children.setdefault(joint.parent, []).append(joint)
-
-    bodies: list[Body] = []
-    if floating_base:
-        for index, (name, revolute) in enumerate(zip(VIRTUAL_JOINTS, (False,) * 3 + (True,) * 3, strict=True)):
-            bodies.append(
-                Body(
-                    name,
-                    spec.root if index == 5 else name,
-                    index - 1,
-                    np.eye(4),
-                    np.eye(3)[index % 3],
-                    revolute,
-                    0.0,
-                    np.zeros(3),
-                    np.zeros((3, 3)),
-                )
-            )
-    # Depth-first from the root; each entry: (link, transform from the current body's
-    # frame to this link's frame, index of the current body).
-    stack = [(spec.root, np.eye(4), len(bodies) - 1)]
+    bodies = list(bodies)
+    # Each entry: (link, transform from the current body's frame to this link's frame,
+    # index of the current body).
+    stack = [(root, np.eye(4), len(bodies) - 1)]
     welded: dict[int, list[tuple[float, np.ndarray, np.ndarray]]] = {}
     while stack:
         link_name, to_link, body_index = stack.pop()
@@ -158,23 +170,20 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
                 continue
             axis = np.asarray(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), float)
             bodies.append(
-                Body(
-                    joint.name,
-                    joint.child,
-                    body_index,
-                    to_link @ origin,
-                    axis / np.linalg.norm(axis),
-                    joint.type != "prismatic",
-                    0.0,
-                    np.zeros(3),
-                    np.zeros((3, 3)),
+                _massless(
+                    joint.name, joint.child, body_index, to_link @ origin, axis / np.linalg.norm(axis), joint.type != "prismatic"
                 )
             )
             stack.append((joint.child, np.eye(4), len(bodies) - 1))
-    bodies = [
+    return [
         Body(b.joint, b.link, b.parent, b.origin, b.axis, b.revolute, *_combine(welded.get(index, [])))
         for index, b in enumerate(bodies)
     ]
+
+
+def _mimic_map(spec: URDFSpec, bodies: list[Body]) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The independent joints (the order of ``q``) and the map ``theta = selection @ q + offset``
+    from them to every body's coordinate (a mimic joint follows its source)."""
 
     def mimic_of(body: Body):
         return None if body.joint in VIRTUAL_JOINTS else spec.joints[body.joint].mimic
@@ -190,9 +199,4 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
         else:
             selection[index, column_of[mimic.joint]] = mimic.multiplier
             offset[index] = mimic.offset
-    ancestors = np.zeros((len(bodies), len(bodies)), dtype=bool)
-    for index, body in enumerate(bodies):
-        ancestors[index, index] = True
-        if body.parent >= 0:
-            ancestors[index] |= ancestors[body.parent]
-    return KinematicTree(spec.name, bodies, independent, selection, offset, ancestors, floating_base)
+    return independent, selection, offset

@@ -143,6 +143,7 @@ def _read_inertial(reader: _Reader, where: str, node: ET.Element) -> Inertial | 
 
 
 def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | None:
+    """One ``<joint>``, or ``None`` (with the errors reported) if it cannot be read."""
     name = node.get("name")
     where = f'joint "{name}"' if name else f"joint #{index + 1}"
     if not name:
@@ -161,6 +162,21 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
     if parent_link is None or child_link is None:
         reader.error(where, "needs <parent link=...> and <child link=...>")
         return None
+    placement = _read_placement(reader, where, node, joint_type)
+    limits = None if placement is None else _read_limits(reader, where, node, joint_type)
+    if placement is None or limits is None:
+        return None
+    readable, mimic = _read_mimic(reader, where, node)
+    if not readable:
+        return None
+    return JointSpec(name, joint_type, parent_link, child_link, *placement, *limits, mimic)
+
+
+def _read_placement(
+    reader: _Reader, where: str, node: ET.Element, joint_type: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """A joint's origin (``xyz`` in [m], ``rpy`` in [rad]) and unit axis, or ``None`` for a
+    moving joint with a zero axis."""
     origin = node.find("origin")
     xyz = reader.floats(where, origin, "xyz", "0 0 0")
     rpy = reader.floats(where, origin, "rpy", "0 0 0")
@@ -169,7 +185,12 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
     if joint_type != "fixed" and norm < 1e-12:
         reader.error(where, "axis must not be zero")
         return None
-    axis = axis / norm if norm >= 1e-12 else axis
+    return xyz, rpy, axis / norm if norm >= 1e-12 else axis
+
+
+def _read_limits(reader: _Reader, where: str, node: ET.Element, joint_type: str) -> tuple[float, float, float, float] | None:
+    """A joint's ``(lower, upper, effort, velocity)`` limits (±inf where not given), or
+    ``None`` for a revolute or prismatic joint without a finite, ordered range."""
     limit = node.find("limit")
     lower, upper = -math.inf, math.inf
     effort = reader.number(where, limit, "effort", math.inf, bounded=False)
@@ -191,25 +212,27 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
             reader.error(where, f"{label} limit {value} must not be negative")
         elif value == 0 and joint_type != "fixed":
             reader.warn(where, f"{label} limit is zero: the joint cannot move under that limit")
-    mimic = None
+    return lower, upper, effort, velocity
+
+
+def _read_mimic(reader: _Reader, where: str, node: ET.Element) -> tuple[bool, Mimic | None]:
+    """A joint's ``<mimic>``: whether it could be read, and the mimic (``None`` if none)."""
     mimic_node = node.find("mimic")
-    if mimic_node is not None:
-        source_joint = mimic_node.get("joint")
-        if not source_joint:
-            reader.error(where, "<mimic> needs a joint attribute")
-            return None
-        mimic = Mimic(
-            source_joint,
-            reader.number(where, mimic_node, "multiplier", 1.0),
-            reader.number(where, mimic_node, "offset", 0.0),
-        )
-        if not (math.isfinite(mimic.multiplier) and math.isfinite(mimic.offset)):
-            reader.error(where, "mimic multiplier and offset must be finite")
-            return None
-    return JointSpec(
-        name, joint_type, parent_link, child_link, xyz, rpy, axis,
-        lower, upper, effort, velocity, mimic,
-    )  # fmt: skip
+    if mimic_node is None:
+        return True, None
+    source_joint = mimic_node.get("joint")
+    if not source_joint:
+        reader.error(where, "<mimic> needs a joint attribute")
+        return False, None
+    mimic = Mimic(
+        source_joint,
+        reader.number(where, mimic_node, "multiplier", 1.0),
+        reader.number(where, mimic_node, "offset", 0.0),
+    )
+    if not (math.isfinite(mimic.multiplier) and math.isfinite(mimic.offset)):
+        reader.error(where, "mimic multiplier and offset must be finite")
+        return False, None
+    return True, mimic
 
 
 def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> str | None:
