@@ -48,7 +48,7 @@ __version__ = "0.1.0"
 _LAZY = {
     "load": "robodyn.dynamics.loading",
     "Robot": "robodyn.dynamics.robot",
-    "JointInfo": "robodyn.dynamics.robot",
+    "JointInfo": "robodyn.dynamics.joints",
     "simulate": "robodyn.sim.simulation",
     "Trajectory": "robodyn.sim.simulation",
     "ExternalWrench": "robodyn.sim.simulation",
