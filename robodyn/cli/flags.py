@@ -22,6 +22,9 @@ FLAGS: dict[str, str] = {
     "form": "--form",
     "max_dof": "--max-dof",
     "at": "--at",
+    "urdf_out": "--urdf-out",
+    "method": "--method",
+    "data": "DATA",
 }
 
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.
