@@ -223,7 +223,8 @@ def _accumulate(
         trajectory = chunk.trajectory
         tau = result["tau"]
         peak = np.maximum(peak, np.abs(tau).max(axis=0))
-        squares += np.square(tau).sum(axis=0)
+        with np.errstate(over="ignore"):  # an overflow is refused by the caller, naming the file
+            squares += np.square(tau).sum(axis=0)
         if writer is not None:
             parts = [trajectory.t, trajectory.q, trajectory.v, trajectory.a, tau]
             if gravity:
