@@ -11,7 +11,9 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol, cast
+
+import numpy as np
 
 from robodyn.common.files import atomic_write_text
 from robodyn.dynamics.robot import Robot
@@ -19,6 +21,16 @@ from robodyn.exceptions import InputError, printable
 from robodyn.ident.base import base_parameters
 from robodyn.ident.identify import Identification, Method, Samples, identify
 from robodyn.ident.urdf_out import identified_urdf
+
+
+class Measured(Protocol):
+    """Measured data that may lack torques (a trajectory file read without ``tau`` columns)."""
+
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray | None
+    joint_names: list[str]
 
 
 @dataclass(frozen=True)
@@ -62,7 +74,7 @@ class IdentificationRun:
 
 def identify_run(
     robot: Robot,
-    data: Samples,
+    data: Measured,
     *,
     method: Method = "ls",
     friction: bool = False,
@@ -87,7 +99,7 @@ def identify_run(
     if data.tau is None:
         raise InputError("data", "a trajectory with tau[<joint>] columns (the measured torques)", "none")
     base = base_parameters(robot, friction=friction)
-    result = identify(robot, data, method=method, base=base)
+    result = identify(robot, cast(Samples, data), method=method, base=base)  # tau checked above
     urdf = identified_urdf(robot, result.standard, base.columns) if urdf_out and result.standard is not None else None
     if out:
         atomic_write_text(out, json.dumps(result.to_dict(), indent=2) + "\n")

@@ -179,7 +179,9 @@ def torques_file(
     header, arrays = output_header(robot, gravity=gravity, mass_matrix=mass_matrix)
     writer = DatasetWriter(out, header, robot=dataset.robot or robot.name, arrays=arrays) if out else None
     try:
-        peak, rms, done, chunks = _accumulate(robot, dataset, client, writer, gravity=gravity, mass_matrix=mass_matrix, progress=progress)
+        peak, rms, done, chunks = _accumulate(
+            robot, dataset, client, writer, gravity=gravity, mass_matrix=mass_matrix, progress=progress
+        )
         if not (np.isfinite(peak).all() and np.isfinite(rms).all()):
             raise InputError("trajectory", "states whose torques are finite", "an overflow")
         written = None if writer is None else writer.close(small=_names(robot))

@@ -156,7 +156,7 @@ class SimulationSummary:
         lines.append(f"peak |torque|: {', '.join(peaks)}")
         lines.append(f"energy change: {_number(self.energy_change, 4)} J")
         if self.limits == "ignore":
-            lines.append("limits: not checked (mode \"ignore\")")
+            lines.append('limits: not checked (mode "ignore")')
         elif not self.violations:
             lines.append("limits: every position, velocity and effort limit kept")
         lines += [f"limit violation: {violation.text()}" for violation in self.violations]

@@ -326,8 +326,6 @@ def _simulate_compiled(
     return trajectory
 
 
-
-
 def _check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: np.ndarray, v: np.ndarray, dt: float) -> None:
     """Raise :class:`SimulationError` at the first non-finite state since the last check."""
     if math.isfinite(v.dot(v)) and math.isfinite(q.dot(q)):

@@ -9,8 +9,8 @@ chart (``robodyn whatif``).
 
 from __future__ import annotations
 
-import os
 from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,7 +21,7 @@ from robodyn.sim.experiment import run_simulation
 from robodyn.sim.report import SimulationSummary
 from robodyn.sim.whatif import WhatIfTable, what_if
 
-PathLike = str | os.PathLike
+PathLike = str | Path
 
 
 def run_experiment(
@@ -69,7 +69,9 @@ def run_experiment(
     return summary
 
 
-def run_whatif(model: str = "rp_arm", *, scheduler: str | None = None, plot: PathLike | None = None, **options: Any) -> WhatIfTable:
+def run_whatif(
+    model: str = "rp_arm", *, scheduler: str | None = None, plot: PathLike | None = None, **options: Any
+) -> WhatIfTable:
     """The what-if table of ``model`` (``options``: as for :func:`~robodyn.sim.whatif.what_if`).
 
     Args:

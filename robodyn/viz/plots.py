@@ -151,9 +151,7 @@ def _joint_panels(robot: Robot) -> list[tuple[str, list[Dof]]]:
     return panels
 
 
-def _joint_panel(
-    axis: Axes, robot: Robot, trajectory: Trajectory, ylabel: str, group: list[Dof], colors: dict[str, str]
-) -> None:
+def _joint_panel(axis: Axes, robot: Robot, trajectory: Trajectory, ylabel: str, group: list[Dof], colors: dict[str, str]) -> None:
     """The positions or efforts of ``group`` over time, each with its limits shaded (and, in
     the panel of lengths of a floating-base robot, the base's position)."""
     effort = ylabel.startswith(("torque", "force"))

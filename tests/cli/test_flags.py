@@ -64,7 +64,7 @@ def test_the_cli_names_the_flag_target_for_the_same_error(capsys):
 
 
 def test_a_passive_run_given_a_target_is_refused_naming_target_in_the_library_and_the_flag_in_the_cli(capsys):
-    with pytest.raises(InputError, match="^target must be given only with a controller"):
+    with pytest.raises(InputError, match=r"^target must be given only with a controller"):
         run_simulation(robodyn.load("rp_arm"), target=[0.1, 0.2], duration=0.01)
     assert main(["simulate", "rp_arm", "--target", "0.1,0.2", "--duration", "0.01"]) == 2
     assert "--target must be given only with a controller" in capsys.readouterr().err

@@ -41,7 +41,9 @@ def test_the_run_text_and_files_are_what_the_cli_prints_and_writes(data, tmp_pat
     assert run.identification.relative_error < 1e-9
 
 
-def test_a_urdf_out_without_the_physical_method_names_the_parameter_in_the_library_and_the_flag_in_the_cli(data, tmp_path, capsys):
+def test_a_urdf_out_without_the_physical_method_names_the_parameter_in_the_library_and_the_flag_in_the_cli(
+    data, tmp_path, capsys
+):
     robot, path = data
     with pytest.raises(InputError) as raised:
         identify_run(robot, Trajectory.load(path).for_robot(robot), urdf_out=tmp_path / "x.urdf")
@@ -55,7 +57,7 @@ def test_data_without_torques_is_refused_naming_data(data, tmp_path, capsys):
     robot, path = data
     loaded = Trajectory.load(path).for_robot(robot)
     bare = Trajectory(loaded.t, loaded.q, loaded.v, loaded.a, None, list(robot.joint_names), robot.name)
-    with pytest.raises(InputError, match="^data must be a trajectory with tau"):
+    with pytest.raises(InputError, match=r"^data must be a trajectory with tau"):
         identify_run(robot, bare)
     bare.save(tmp_path / "bare.csv")
     assert main(["identify", "rp_arm", str(tmp_path / "bare.csv")]) == 2

@@ -38,7 +38,12 @@ def test_the_csv_header_and_the_text_carry_the_dofs_names_and_units(slider_run, 
         header = next(row for row in csv.reader(handle) if row and not row[0].startswith("#"))
     names = ["base.x", "base.y", "base.z", "base.rx", "base.ry", "base.rz", "shoulder", "slide"]
     assert [column for column in header if column.startswith("tau[")] == [f"tau[{name}]" for name in names]
-    assert [column for column in header if column.startswith("q[")][3:7] == ["q[base.qx]", "q[base.qy]", "q[base.qz]", "q[base.qw]"]
+    assert [column for column in header if column.startswith("q[")][3:7] == [
+        "q[base.qx]",
+        "q[base.qy]",
+        "q[base.qz]",
+        "q[base.qw]",
+    ]
     lines = {line.split(":")[0].strip(): line for line in text.splitlines() if line.startswith("  ")}
     assert set(lines) == set(names)
     for dof in robot.dofs:
