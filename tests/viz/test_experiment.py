@@ -50,3 +50,19 @@ def test_whatif_loads_the_robot_once(monkeypatch, capsys):
     monkeypatch.setattr(robodyn, "load", counted)
     assert main(["whatif", "ur5", "--payloads", "0", "--duration", "0.5", "--json"]) == 0
     assert len(calls) == 1 and json.loads(capsys.readouterr().out)["torque_units"] == ["N m"] * 6
+
+
+def test_record_files_writes_the_page_and_says_what_it_wrote(tmp_path, capsys):
+    from robodyn.viz.experiment import RecordingRun, record_files
+
+    robot = robodyn.load("rp_arm")
+    summary = run_experiment(robot, duration=0.2, out=tmp_path / "m.csv")
+    run = record_files(robot, Trajectory.load(summary.files[0][1]).for_robot(robot), tmp_path / "m.html", fps=10)
+    assert isinstance(run, RecordingRun) and run.path == str(tmp_path / "m.html")
+    assert run.size == (tmp_path / "m.html").stat().st_size and run.extras == () and run.duration > 0
+    assert run.text().startswith(f"wrote {tmp_path / 'm.html'} (") and " s at 10 fps, " in run.text()
+    assert json.loads(json.dumps(run.to_dict()))["size_bytes"] == run.size
+    argv = ["record", "rp_arm", "--trajectory", str(tmp_path / "m.csv"), "--out", str(tmp_path / "c.html"), "--fps", "10"]
+    assert main(argv) == 0
+    assert capsys.readouterr().out.startswith(f"wrote {tmp_path / 'c.html'} (")
+    assert abs((tmp_path / "c.html").stat().st_size - run.size) < 0.01 * run.size  # the same page (meshcat's uuids aside)
