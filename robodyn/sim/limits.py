@@ -101,9 +101,8 @@ class JointLimits:
         self.robot = robot
         self.lower, self.upper = robot.physical_limits()
         self.joints = robot.joints[1:] if robot.floating_base else robot.joints
-        base = [float("inf")] * (6 if robot.floating_base else 0)
-        velocity = np.array(base + [joint.velocity for joint in self.joints], dtype=float)
-        effort = np.array(base + [joint.effort for joint in self.joints], dtype=float)
+        velocity = np.array([dof.velocity_limit for dof in robot.dofs], dtype=float)  # a base's: inf
+        effort = np.array([dof.effort_limit for dof in robot.dofs], dtype=float)
         self.velocity = np.where(velocity > 0, velocity, np.inf)
         self.effort = np.where(effort > 0, effort, np.inf)
         self._q_start = robot.nq - len(self.joints)

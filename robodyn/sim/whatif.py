@@ -225,8 +225,7 @@ def _half_radian_away(robot: Robot, q_start: np.ndarray) -> np.ndarray:
 
 def _effort_limits(robot: Robot) -> np.ndarray:
     """Effort limit per velocity coordinate, inf where none (zero in a URDF means none)."""
-    joints = robot.joints[1:] if robot.floating_base else robot.joints
-    effort = np.array([np.inf] * (robot.nv - len(joints)) + [joint.effort for joint in joints], dtype=float)
+    effort = np.array([dof.effort_limit for dof in robot.dofs], dtype=float)
     return np.where(effort > 0, effort, np.inf)
 
 
