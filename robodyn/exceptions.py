@@ -277,7 +277,7 @@ class DerivationTooExpensiveError(RobodynError):
         self.limit_s = limit_s
         super().__init__(
             f"the closed form of {quoted(robot)} ({joints} joints) would take about {estimate_s:.3g} s to derive "
-            f"(limit {limit_s:g} s); use --form compact (form='compact')."
+            f"(limit {limit_s:g} s); use form='compact'."
         )
 
 
@@ -358,7 +358,7 @@ class AmbiguousEndEffectorError(FrameError):
         Exception.__init__(
             self,
             f"robot {robot!r} has {len(self.candidates)} chain tips and no default end effector: "
-            f"name one (frame=... / --frame) of {', '.join(repr(name) for name in self.candidates)}.",
+            f"name one (frame=...) of {', '.join(repr(name) for name in self.candidates)}.",
         )
 
 
@@ -453,7 +453,7 @@ class SchedulerError(RobodynError):
     def __init__(self, scheduler: str, reason: str):
         self.scheduler = scheduler
         self.reason = reason
-        super().__init__(f"--scheduler {quoted(scheduler)}: {reason}.")
+        super().__init__(f"scheduler={quoted(scheduler)}: {reason}.")
 
 
 class TypesettingError(RobodynError):

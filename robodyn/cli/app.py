@@ -19,7 +19,8 @@ from collections.abc import Sequence
 import robodyn
 from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, torques, view, whatif
 from robodyn.cli.common import attach_negative_values, check_ranges
-from robodyn.common.text import one_line_warnings, printable
+from robodyn.cli.flags import error_text
+from robodyn.common.text import one_line_warnings
 from robodyn.exceptions import RobodynError
 
 #: The commands, in the order ``robodyn --help`` lists them.
@@ -62,7 +63,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except RobodynError as error:
         if arguments.debug:
             traceback.print_exc()
-        print(f"robodyn: error: {printable(error)}", file=sys.stderr)
+        print(f"robodyn: error: {error_text(error)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("robodyn: interrupted", file=sys.stderr)

@@ -87,6 +87,12 @@ def lock_values(text: str | None) -> dict[str, float] | None:
     return locked
 
 
+def warn(lines: Sequence[str]) -> None:
+    """Each line as ``robodyn: warning: <line>`` on stderr."""
+    for line in lines:
+        print(f"robodyn: warning: {line}", file=sys.stderr)
+
+
 class Progress:
     """A progress bar on stderr, shown once a derivation takes more than ``DELAY`` seconds."""
 

@@ -228,7 +228,7 @@ def _check_size(spec: URDFSpec, label: str, floating: bool, max_dof: int) -> Non
         raise URDFError(
             label,
             f"{nv} degrees of freedom need about {estimate / 1e9:.2g} GB for Pinocchio's data per thread, "
-            f"above the limit of {max_dof} degrees of freedom (max_dof= or --max-dof raises it)",
+            f"above the limit of {max_dof} degrees of freedom (max_dof= raises it)",
         )
 
 

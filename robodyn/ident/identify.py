@@ -23,7 +23,7 @@ The relative prediction error is ``|tau − tau_predicted| / |tau|`` (Frobenius 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 
@@ -43,7 +43,9 @@ class Samples(Protocol):
     joint_names: list[str]
 
 
-METHODS = ("ls", "wls", "physical")
+#: Estimators: least squares, weighted least squares, physically consistent (module docstring).
+Method = Literal["ls", "wls", "physical"]
+METHODS: tuple[Method, ...] = ("ls", "wls", "physical")
 
 
 @dataclass
@@ -128,7 +130,7 @@ def identify(
     trajectory: Samples,
     tau: np.ndarray | None = None,
     *,
-    method: str = "ls",
+    method: Method = "ls",
     base: BaseParameters | None = None,
     friction: bool = False,
 ) -> Identification:

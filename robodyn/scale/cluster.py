@@ -24,10 +24,10 @@ def check_scheduler(text: str) -> str:
     match = _LOCAL.match(text)
     if match:
         if not 1 <= int(match.group(1)) <= MAX_LOCAL_WORKERS:
-            raise InputError("--scheduler", f"local:N with 1 ≤ N ≤ {MAX_LOCAL_WORKERS}", repr(text))
+            raise InputError("scheduler", f"local:N with 1 ≤ N ≤ {MAX_LOCAL_WORKERS}", repr(text))
         return text
     if not re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s]+$|^[\w.\-]+:\d+$", text):
-        raise InputError("--scheduler", "a scheduler address (tcp://host:port) or local:N", repr(text))
+        raise InputError("scheduler", "a scheduler address (tcp://host:port) or local:N", repr(text))
     return text
 
 
@@ -42,7 +42,7 @@ def connect(scheduler: str, *, timeout: float = 20.0) -> Iterator:
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:
-        raise MissingExtraError("dask.distributed", "scale", "--scheduler") from None
+        raise MissingExtraError("dask.distributed", "scale", "a Dask scheduler (scheduler=...)") from None
     match = _LOCAL.match(scheduler)
     if match:
         cluster = LocalCluster(

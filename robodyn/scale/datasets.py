@@ -247,7 +247,7 @@ class DatasetWriter:
     ) -> None:
         self.path = Path(path)
         if self.path.suffix not in SUFFIXES:
-            raise InputError("--out", "a .csv, .npz or .parquet file", repr(str(path)))
+            raise InputError("out", "a .csv, .npz or .parquet file", repr(str(path)))
         self.header, self.length, self.robot, self.arrays = header, length, robot, arrays or {}
         self.path.parent.mkdir(parents=True, exist_ok=True)
         handle, name = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".part", dir=self.path.parent)

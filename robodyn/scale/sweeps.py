@@ -40,9 +40,20 @@ def sweep(
     return [row for rows in client.gather(futures) for row in rows]
 
 
+def what_if(model: str = "rp_arm", *, client, materials: tuple[str, ...] | None = None, **options) -> whatif.WhatIfTable:
+    """:func:`robodyn.sim.whatif.what_if` with one Dask task a row (same arguments, same table).
+
+    The robot is loaded here once more (the first material's), for the table's names and units.
+    """
+    rows = sweep(model, client=client, materials=materials, **options)
+    first = (materials or whatif.DEFAULT_MATERIALS)[:1] if model == "rp_arm" else None
+    robot = whatif.model_variants(model, first)[0][1]
+    return whatif.table_of(robot, options.get("duration", 1.5), rows)
+
+
 def zoo_statuses(client, names: list[str]) -> list[ZooStatus]:
     """:func:`robodyn.verify.zoo_status.zoo_statuses` with one Dask task a robot, in ``names`` order."""
     return client.gather(client.map(zoo_status, names, pure=False))
 
 
-__all__ = ["sweep", "zoo_statuses"]
+__all__ = ["sweep", "what_if", "zoo_statuses"]

@@ -14,15 +14,71 @@ from __future__ import annotations
 import os
 from collections import deque
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, RobodynError, TrajectoryError
+from robodyn.exceptions import InputError, RobodynError, TrajectoryError, printable
+from robodyn.scale.cluster import check_scheduler, connect
 from robodyn.scale.datasets import DEFAULT_ROWS, Dataset, DatasetWriter
-from robodyn.sim.trajectory import coordinate_names
+
+
+@dataclass(frozen=True)
+class TorquesRun:
+    """What :func:`torques_file` computed: peak and RMS effort of each degree of freedom.
+
+    Attributes:
+        robot: The robot's name.
+        trajectory: The file read.
+        samples: Rows computed; ``chunks``: in how many chunks.
+        names: One name a velocity coordinate (``robot.dofs``: ``base.x`` … for a base).
+        units: Unit of each one's effort (``"N m"`` or ``"N"``).
+        peak: Largest |tau| of each, in ``units``; ``rms``: root mean square of tau.
+        out: The file written, if any.
+    """
+
+    robot: str
+    trajectory: str
+    samples: int
+    chunks: int
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    peak: tuple[float, ...]
+    rms: tuple[float, ...]
+    out: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (the ``robodyn torques --json`` output): by name, in ``units``."""
+        data: dict[str, Any] = {
+            "robot": self.robot,
+            "trajectory": self.trajectory,
+            "samples": self.samples,
+            "chunks": self.chunks,
+            "peak_abs_torque": dict(zip(self.names, self.peak, strict=True)),
+            "rms_torque": dict(zip(self.names, self.rms, strict=True)),
+        }
+        return data if self.out is None else data | {"out": self.out}
+
+    def __getitem__(self, key: str) -> Any:
+        """A key of :meth:`to_dict` (for code that reads the run as the JSON dict)."""
+        return self.to_dict()[key]
+
+    def text(self) -> str:
+        """Readable text: peak and RMS effort of each degree of freedom, with its unit."""
+        lines = [
+            f"robot: {printable(self.robot)}",
+            f"trajectory: {printable(self.trajectory)}",
+            f"samples: {self.samples} ({self.chunks} chunks)",
+            "joint: peak |tau|, rms tau",
+        ]
+        lines += [
+            f"  {printable(name)}: {peak:.6g} {unit}, {rms:.6g} {unit}"
+            for name, unit, peak, rms in zip(self.names, self.units, self.peak, self.rms, strict=True)
+        ]
+        return "\n".join(lines + ([f"wrote {self.out}"] if self.out is not None else []))
 
 
 def chunk_dynamics(
@@ -55,7 +111,7 @@ def chunk_dynamics(
 
 def output_header(robot: Robot, *, gravity: bool, mass_matrix: bool) -> tuple[list[str], dict]:
     """Columns of the output file and, for NPZ, which columns make which array."""
-    q_names, v_names = coordinate_names(robot.joint_names, robot.floating_base)
+    q_names, v_names = list(robot.configuration_names), [dof.name for dof in robot.dofs]
     nq, nv = len(q_names), len(v_names)
     header = ["t"] + [f"q[{n}]" for n in q_names] + [f"{kind}[{n}]" for kind in ("v", "a", "tau") for n in v_names]
     start = 1 + nq + 3 * nv
@@ -89,7 +145,7 @@ def torques_file(
     rows: int = DEFAULT_ROWS,
     client=None,
     progress: Callable[[int, int], None] | None = None,
-) -> dict:
+) -> TorquesRun:
     """Inverse dynamics of every sample of a trajectory file.
 
     Args:
@@ -104,67 +160,92 @@ def torques_file(
         progress: ``progress(done_rows, total_rows)`` after each chunk.
 
     Returns:
-        Summary: samples, chunks, peak and RMS torque per joint, the output path.
+        The run: samples, chunks, peak and RMS torque per degree of freedom, the output path.
 
     Raises:
         TrajectoryError: For a file of another robot, or bad data (naming file and rows);
             no output file is left then.
+        InputError: Naming ``trajectory``, for states whose torques overflow (no output
+            file is left then either).
     """
     if out is not None and Path(out).resolve() == Path(source).resolve():
-        raise InputError("--out", "a file other than the trajectory read", repr(str(out)))
+        raise InputError("out", "a file other than the trajectory read", repr(str(out)))
     dataset = Dataset(source, rows=rows)
     names = dataset.layout.joint_names
     expected = robot.joint_names
     if sorted(names) != sorted(expected) or len(dataset.layout.q_names) != robot.nq:
         probe = _probe(dataset)
         probe.check(robot)  # raises, naming the columns
-    total = len(dataset)  # for progress (a CSV's lines, counted)
     header, arrays = output_header(robot, gravity=gravity, mass_matrix=mass_matrix)
     writer = DatasetWriter(out, header, robot=dataset.robot or robot.name, arrays=arrays) if out else None
-    nv = robot.nv
-    peak, squares, done, chunks = np.zeros(nv), np.zeros(nv), 0, 0
     try:
-        for chunk, result in _results(robot, dataset, client, gravity=gravity, mass_matrix=mass_matrix):
-            trajectory = chunk.trajectory
-            tau = result["tau"]
-            peak = np.maximum(peak, np.abs(tau).max(axis=0))
-            squares += np.square(tau).sum(axis=0)
-            if writer is not None:
-                parts = [trajectory.t, trajectory.q, trajectory.v, trajectory.a, tau]
-                if gravity:
-                    parts.append(result["G"])
-                if mass_matrix:
-                    iu = np.triu_indices(nv)
-                    parts.append(result["M"][:, iu[0], iu[1]])
-                writer.write(np.column_stack(parts))
-            done += len(tau)
-            chunks += 1
-            if progress is not None:
-                progress(done, total)
+        peak, rms, done, chunks = _accumulate(
+            robot, dataset, client, writer, gravity=gravity, mass_matrix=mass_matrix, progress=progress
+        )
+        if not (np.isfinite(peak).all() and np.isfinite(rms).all()):
+            raise InputError("trajectory", "states whose torques are finite", "an overflow")
         written = None if writer is None else writer.close(small=_names(robot))
     except BaseException:
         if writer is not None:
             writer.discard()
         raise
-    _, v_names = coordinate_names(robot.joint_names, robot.floating_base)
-    summary = {
-        "robot": robot.name,
-        "trajectory": str(source),
-        "samples": done,
-        "chunks": chunks,
-        "peak_abs_torque": dict(zip(v_names, peak.tolist(), strict=True)),
-        "rms_torque": dict(zip(v_names, np.sqrt(squares / max(done, 1)).tolist(), strict=True)),
-    }
-    if written is not None:
-        summary["out"] = str(written)
-    return summary
+    return TorquesRun(
+        robot.name, str(source), done, chunks, tuple(dof.name for dof in robot.dofs),
+        tuple(dof.effort_unit for dof in robot.dofs), tuple(peak.tolist()), tuple(rms.tolist()),
+        None if written is None else str(written),
+    )  # fmt: skip
+
+
+def torques_run(
+    robot: Robot, source: str | os.PathLike, out: str | os.PathLike | None = None, *, scheduler: str | None = None, **options: Any
+) -> TorquesRun:
+    """:func:`torques_file` here, or on the Dask scheduler ``scheduler`` (an address or
+    ``local:N``, :func:`robodyn.scale.cluster.connect`); ``options`` as for it."""
+    if not scheduler:
+        return torques_file(robot, source, out, **options)
+    check_scheduler(scheduler)
+    with connect(scheduler) as client:
+        return torques_file(robot, source, out, client=client, **options)
+
+
+def _accumulate(
+    robot: Robot,
+    dataset: Dataset,
+    client,
+    writer: DatasetWriter | None,
+    *,
+    gravity: bool,
+    mass_matrix: bool,
+    progress: Callable[[int, int], None] | None,
+) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """Compute every chunk (writing it when ``writer`` is given): peak |tau|, RMS tau, rows, chunks."""
+    nv, total = robot.nv, len(dataset)  # for progress (a CSV's lines, counted)
+    peak, squares, done, chunks = np.zeros(nv), np.zeros(nv), 0, 0
+    for chunk, result in _results(robot, dataset, client, gravity=gravity, mass_matrix=mass_matrix):
+        trajectory = chunk.trajectory
+        tau = result["tau"]
+        peak = np.maximum(peak, np.abs(tau).max(axis=0))
+        with np.errstate(over="ignore"):  # an overflow is refused by the caller, naming the file
+            squares += np.square(tau).sum(axis=0)
+        if writer is not None:
+            parts = [trajectory.t, trajectory.q, trajectory.v, trajectory.a, tau]
+            if gravity:
+                parts.append(result["G"])
+            if mass_matrix:
+                iu = np.triu_indices(nv)
+                parts.append(result["M"][:, iu[0], iu[1]])
+            writer.write(np.column_stack(parts))
+        done += len(tau)
+        chunks += 1
+        if progress is not None:
+            progress(done, total)
+    return peak, np.sqrt(squares / max(done, 1)), done, chunks
 
 
 def _names(robot: Robot) -> dict[str, np.ndarray]:
-    q_names, v_names = coordinate_names(robot.joint_names, robot.floating_base)
     return {
-        "q_names": np.array(q_names),
-        "v_names": np.array(v_names),
+        "q_names": np.array(robot.configuration_names),
+        "v_names": np.array([dof.name for dof in robot.dofs]),
         "joint_names": np.array(robot.joint_names),
         "robot": np.array(robot.name),
     }
@@ -213,4 +294,4 @@ def _results(robot: Robot, dataset: Dataset, client, *, gravity: bool, mass_matr
             future.cancel()
 
 
-__all__ = ["chunk_dynamics", "output_header", "torques_file"]
+__all__ = ["TorquesRun", "chunk_dynamics", "output_header", "torques_file", "torques_run"]

@@ -1,9 +1,9 @@
 """A simulation experiment: a robot, a controller aiming at a target, and what came of it.
 
 :func:`run_simulation` builds the chosen controller (on its own copy of the model),
-simulates, and returns the trajectory with a summary with units in its keys: final error,
-peak torque, energy change, real-time factor, and every joint limit the run broke (joint,
-first time, worst value, limit; ``limits="enforce"`` saturates torques and stops joints,
+simulates, and returns the trajectory with a :class:`~robodyn.sim.report.SimulationSummary`:
+final error, peak torque, energy change, real-time factor, and every joint limit the run
+broke (joint, first time, worst value, limit; ``limits="enforce"`` saturates torques and stops joints,
 see :mod:`robodyn.sim.limits`). Used by ``robodyn simulate``.
 """
 
@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import time
 import warnings
+from dataclasses import replace
+from typing import Literal
 
 import numpy as np
 
@@ -19,10 +21,13 @@ from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
-from robodyn.sim.limits import check_mode, limit_violations
-from robodyn.sim.simulation import Trajectory, simulate
+from robodyn.sim.limits import LimitMode, check_mode, limit_violations
+from robodyn.sim.report import SimulationSummary, TaskOutcome
+from robodyn.sim.simulation import Engine, Integrator, Trajectory, simulate
 
-CONTROLLERS = ("passive", "pd", "computed-torque", "task-space")
+#: The controllers a run can use, by name.
+ControllerName = Literal["passive", "pd", "computed-torque", "task-space"]
+CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space")
 #: Final task error below which a target counts as reached, in [m].
 REACHED = 1e-3
 
@@ -39,22 +44,22 @@ def task_target(values: list[float] | np.ndarray) -> np.ndarray:
         return np.array([values[0], 0.0, values[1]])
     if values.shape == (3,):
         return values
-    raise InputError("--target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
+    raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
 
 
 def run_simulation(
     robot: Robot,
     *,
-    controller: str = "passive",
+    controller: ControllerName = "passive",
     target: list[float] | None = None,
     frame: str | None = None,
     q0: list[float] | None = None,
     duration: float = 3.0,
     dt: float = 1e-3,
-    integrator: str = "rk4",
-    limits: str = "warn",
-    engine: str = "pinocchio",
-) -> tuple[Trajectory, dict]:
+    integrator: Integrator = "rk4",
+    limits: LimitMode = "warn",
+    engine: Engine = "pinocchio",
+) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
     Args:
@@ -71,34 +76,15 @@ def run_simulation(
             ``engine="compiled"`` the task-space controller is sampled every step).
 
     Returns:
-        The trajectory and a JSON-ready summary with units in the keys.
-        ``limit_violations`` lists every broken limit (empty with ``limits="ignore"``).
+        The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
+        (``violations``: every broken limit, none with ``limits="ignore"``).
+
+    Raises:
+        InputError: Naming the parameter (``controller``, ``target``, ``frame``, ...).
     """
-    if controller not in CONTROLLERS:
-        raise InputError("controller", f"one of {', '.join(CONTROLLERS)}", repr(controller))
-    check_mode(limits)
-    if controller != "passive" and target is None:
-        raise InputError("--target", f"given for the {controller} controller", "nothing")
-    if controller == "passive" and target is not None:
-        raise InputError("--target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
-    if controller != "task-space" and frame is not None:
-        raise InputError("--frame", "given only with the task-space controller", repr(frame))
+    _check_request(robot, controller, target, frame, limits)
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
-    task = None
-    law: PDGravity | ComputedTorque | TaskSpace | None = None
-    if controller == "pd":
-        law = PDGravity(controller_model(robot), np.asarray(target, float))
-    elif controller == "computed-torque":
-        law = ComputedTorque(controller_model(robot), quintic_reference(start, np.asarray(target, float), duration / 2))
-    elif controller == "task-space":
-        assert target is not None  # checked above
-        task = task_target(target)
-        controlled = robot.task_frame(frame, "task-space control")
-        _check_reach(robot, controlled, task)
-        law = TaskSpace(controller_model(robot), controlled, task)
-    given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
-    if controller in ("pd", "computed-torque") and given != robot.nq:
-        raise InputError("--target", f"{robot.nq} joint values for the {controller} controller", f"{given} values")
+    law, task, controlled = _control_law(robot, controller, target, frame, start, duration)
     began = time.perf_counter()
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
@@ -109,35 +95,67 @@ def run_simulation(
     torques = trajectory.tau
     assert torques is not None  # simulate records the applied torques
     energy = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v)) + np.atleast_1d(robot.potential_energy(trajectory.q))
-    summary: dict = {
-        "robot": robot.name,
-        "controller": controller,
-        "integrator": integrator,
-        "limits": limits,
-        "engine": engine,
-        "duration_s": duration,
-        "dt_s": dt,
-        "steps": len(trajectory) - 1,
-        "real_time_factor": duration / elapsed if elapsed > 0 else None,
-        "joint_names": list(robot.joint_names),
-        "dof_names": _dof_names(robot),
-        "final_q": trajectory.q[-1].tolist(),
-        "peak_abs_torque": np.abs(torques).max(axis=0).tolist(),
-        "torque_units": ["N" if kind == "prismatic" else "N m" for kind in _dof_kinds(robot)],
-        "energy_change_J": float(energy[-1] - energy[0]),
-    }
+    summary = SimulationSummary(
+        robot=robot.name, controller=controller, integrator=integrator, limits=limits, engine=engine,
+        duration=duration, dt=dt, steps=len(trajectory) - 1,
+        real_time_factor=duration / elapsed if elapsed > 0 else None,
+        joint_names=tuple(robot.joint_names),
+        dof_names=tuple(dof.name for dof in robot.dofs),
+        final_q=tuple(trajectory.q[-1].tolist()),
+        peak_abs_torque=tuple(np.abs(torques).max(axis=0).tolist()),
+        torque_units=tuple(dof.effort_unit for dof in robot.dofs),
+        energy_change=float(energy[-1] - energy[0]),
+        violations=() if limits == "ignore" else tuple(limit_violations(robot, trajectory)),
+    )  # fmt: skip
     if task is not None:
-        position = robot.frame_position(trajectory.q[-1], controlled)
-        summary["frame"] = controlled
-        summary["target_m"] = task.tolist()
-        summary["final_position_m"] = position.tolist()
-        summary["final_error_m"] = float(np.linalg.norm(position - task))
-        summary["target_reached"] = summary["final_error_m"] < REACHED
-    elif controller != "passive":
-        summary["final_joint_error"] = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
-    violations = [] if limits == "ignore" else limit_violations(robot, trajectory)
-    summary["limit_violations"] = [violation.as_dict() for violation in violations]
+        return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
+    if controller != "passive":
+        error = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
+        return trajectory, replace(summary, final_joint_error=error)
     return trajectory, summary
+
+
+def _check_request(robot: Robot, controller: str, target: list[float] | None, frame: str | None, limits: str) -> None:
+    """Refuse an unknown controller or limits mode, and a target or frame it does not take."""
+    if controller not in CONTROLLERS:
+        raise InputError("controller", f"one of {', '.join(CONTROLLERS)}", repr(controller))
+    check_mode(limits)
+    if controller != "passive" and target is None:
+        raise InputError("target", f"given for the {controller} controller", "nothing")
+    if controller == "passive" and target is not None:
+        raise InputError("target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
+    if controller != "task-space" and frame is not None:
+        raise InputError("frame", "given only with the task-space controller", repr(frame))
+
+
+def _control_law(
+    robot: Robot, controller: str, target: list[float] | None, frame: str | None, start: np.ndarray, duration: float
+) -> tuple[PDGravity | ComputedTorque | TaskSpace | None, np.ndarray | None, str]:
+    """The controller (on its own model), the task target in [m] and the controlled frame
+    (task-space control only: ``None`` and ``""`` otherwise)."""
+    law: PDGravity | ComputedTorque | TaskSpace | None = None
+    task, controlled = None, ""
+    if controller == "pd":
+        law = PDGravity(controller_model(robot), np.asarray(target, float))
+    elif controller == "computed-torque":
+        law = ComputedTorque(controller_model(robot), quintic_reference(start, np.asarray(target, float), duration / 2))
+    elif controller == "task-space":
+        assert target is not None  # checked by _check_request
+        task = task_target(target)
+        controlled = robot.task_frame(frame, "task-space control")
+        _check_reach(robot, controlled, task)
+        law = TaskSpace(controller_model(robot), controlled, task)
+    given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
+    if controller in ("pd", "computed-torque") and given != robot.nq:
+        raise InputError("target", f"{robot.nq} joint values for the {controller} controller", f"{given} values")
+    return law, task, controlled
+
+
+def _task_outcome(robot: Robot, trajectory: Trajectory, frame: str, task: np.ndarray) -> TaskOutcome:
+    """Where the run left ``frame``, against the target ``task`` in [m]."""
+    position = robot.frame_position(trajectory.q[-1], frame)
+    error = float(np.linalg.norm(position - task))
+    return TaskOutcome(frame, tuple(task.tolist()), tuple(position.tolist()), error, error < REACHED)
 
 
 def _check_reach(robot: Robot, frame: str, target: np.ndarray) -> None:
@@ -151,22 +169,7 @@ def _check_reach(robot: Robot, frame: str, target: np.ndarray) -> None:
     if distance > radius:
         where = ", ".join(f"{c:.3g}" for c in centre)
         raise InputError(
-            "--target",
+            "target",
             f"within the reach of {frame!r} ({radius:.3f} m of its first joint at ({where}) m)",
             f"a point {distance:.3f} m away",
         )
-
-
-def _dof_names(robot: Robot) -> list[str]:
-    """A name for each velocity coordinate (a floating base: base vx ... base wz)."""
-    if not robot.floating_base:
-        return list(robot.joint_names)
-    return [f"base {axis}" for axis in ("vx", "vy", "vz", "wx", "wy", "wz")] + list(robot.joint_names[1:])
-
-
-def _dof_kinds(robot: Robot) -> list[str]:
-    """Joint type of each velocity coordinate (a floating base: 3 linear, 3 angular)."""
-    kinds = []
-    for joint in robot.joints:
-        kinds += ["prismatic"] * 3 + ["revolute"] * 3 if joint.type == "floating" else [joint.type]
-    return kinds

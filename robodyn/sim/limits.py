@@ -23,6 +23,7 @@ URDF's "unknown"). A floating base has no limits.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -30,7 +31,9 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, printable
 from robodyn.sim.trajectory import Trajectory
 
-LIMIT_MODES = ("warn", "enforce", "ignore")
+#: What a run does with joint limits (see the module docstring).
+LimitMode = Literal["warn", "enforce", "ignore"]
+LIMIT_MODES: tuple[LimitMode, ...] = ("warn", "enforce", "ignore")
 #: Slack before a value counts as beyond its limit: absolute, plus relative to the limit.
 TOLERANCE = 1e-9
 
@@ -98,9 +101,8 @@ class JointLimits:
         self.robot = robot
         self.lower, self.upper = robot.physical_limits()
         self.joints = robot.joints[1:] if robot.floating_base else robot.joints
-        base = [float("inf")] * (6 if robot.floating_base else 0)
-        velocity = np.array(base + [joint.velocity for joint in self.joints], dtype=float)
-        effort = np.array(base + [joint.effort for joint in self.joints], dtype=float)
+        velocity = np.array([dof.velocity_limit for dof in robot.dofs], dtype=float)  # a base's: inf
+        effort = np.array([dof.effort_limit for dof in robot.dofs], dtype=float)
         self.velocity = np.where(velocity > 0, velocity, np.inf)
         self.effort = np.where(effort > 0, effort, np.inf)
         self._q_start = robot.nq - len(self.joints)
@@ -127,27 +129,20 @@ class JointLimits:
         return q, v
 
     def violations(self, trajectory: Trajectory) -> list[LimitViolation]:
-        """Every limit the trajectory broke, by joint then quantity."""
-        units = _units(self.joints)
+        """Every limit the trajectory broke, by joint then quantity (units from ``robot.dofs``)."""
         found = []
         positions = trajectory.q[:, self._q_start :]
         velocities = trajectory.v[:, self._v_start :]
         torques = np.zeros_like(trajectory.v) if trajectory.tau is None else trajectory.tau[:, self._v_start :]
-        for index, joint in enumerate(self.joints):
-            unit = units[index]
+        for index, dof in enumerate(self.robot.dofs[self._v_start :]):
             for side, limit in (("lower", self.lower[index]), ("upper", self.upper[index])):
-                found += _beyond(trajectory.t, positions[:, index], limit, side, joint.name, "position", unit)
-            for quantity, values, limit, per_second in (
-                ("velocity", velocities[:, index], self.velocity[self._v_start + index], "/s"),
-                ("effort", torques[:, index], self.effort[self._v_start + index], ""),
+                found += _beyond(trajectory.t, positions[:, index], limit, side, dof.joint, "position", dof.position_unit)
+            for quantity, values, limit, unit in (
+                ("velocity", velocities[:, index], self.velocity[self._v_start + index], dof.velocity_unit),
+                ("effort", torques[:, index], self.effort[self._v_start + index], dof.effort_unit),
             ):
-                unit_q = unit + per_second if quantity == "velocity" else ("N" if unit == "m" else "N m")
-                found += _beyond(trajectory.t, np.abs(values), limit, "magnitude", joint.name, quantity, unit_q, values)
+                found += _beyond(trajectory.t, np.abs(values), limit, "magnitude", dof.joint, quantity, unit, values)
         return found
-
-
-def _units(joints) -> list[str]:
-    return ["m" if joint.type == "prismatic" else "rad" for joint in joints]
 
 
 def _beyond(times, values, limit, side, joint, quantity, unit, signed=None) -> list[LimitViolation]:

@@ -31,6 +31,7 @@ import math
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -42,12 +43,21 @@ from robodyn.exceptions import (
     SimulationError,
     SingularMassMatrixError,
 )
-from robodyn.sim.limits import JointLimits, check_mode, warning_text
+from robodyn.sim.limits import JointLimits, LimitMode, check_mode, warning_text
 from robodyn.sim.trajectory import Trajectory
 
 #: A controller maps time in [s], q and v to joint torques, shape (nv,).
 Controller = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
-INTEGRATORS = ("rk4", "semi-implicit-euler")
+#: Integration schemes: classical Runge–Kutta, or semi-implicit (symplectic) Euler.
+Integrator = Literal["rk4", "semi-implicit-euler"]
+INTEGRATORS: tuple[Integrator, ...] = ("rk4", "semi-implicit-euler")
+#: Where the loop runs: Python over Pinocchio, or C (:mod:`robodyn.compiled`).
+Engine = Literal["pinocchio", "compiled"]
+ENGINES: tuple[Engine, ...] = ("pinocchio", "compiled")
+#: Most steps one run may take (a guard against durations like 1e9 s at 1 ms).
+MAX_STEPS = 10_000_000
+#: Steps between two finiteness checks of the state (a divergence is located exactly).
+_CHECK_EVERY = 64
 
 
 @dataclass(frozen=True)
@@ -84,11 +94,11 @@ def simulate(
     dt: float,
     *,
     controller: Controller | None = None,
-    integrator: str = "rk4",
+    integrator: Integrator = "rk4",
     external: Sequence[ExternalWrench] = (),
     hold: bool = False,
-    limits: str = "warn",
-    engine: str = "pinocchio",
+    limits: LimitMode = "warn",
+    engine: Engine = "pinocchio",
     control_period: float | None = None,
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
@@ -128,23 +138,13 @@ def simulate(
     Warns:
         JointLimitWarning: With ``limits="warn"``, when a limit was broken.
     """
-    if integrator not in INTEGRATORS:
-        raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
-    check_mode(limits)
-    if engine not in ENGINES:
-        raise InputError("engine", f"one of {', '.join(ENGINES)}", repr(engine))
+    _check_modes(integrator, limits, engine)
     if engine == "compiled":
         return _simulate_compiled(
             robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
             limits=limits, control_period=control_period,
         )  # fmt: skip
-    if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
-        raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
-    steps = round(duration / dt)
-    if abs(steps * dt - duration) > 1e-9 * max(duration, dt):
-        raise InputError("duration", f"a whole number of steps of dt = {dt:g} s", f"{duration:g} s ({duration / dt:.6g} steps)")
-    if steps > MAX_STEPS:
-        raise InputError("duration / dt", f"at most {MAX_STEPS:,} steps", f"{steps:,} steps")
+    steps = _step_count(duration, dt)
     (q, v), _ = robot.validate(q=q0, v=v0)
     if q.ndim != 1:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
@@ -157,50 +157,106 @@ def simulate(
     if enforce and controller is not None:
         commanded = controller
         controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
-    times = np.arange(steps + 1) * dt
+    stepper = _Stepper(robot, external, controller, hold=hold, rk4=integrator == "rk4")
+    qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, joint_limits if enforce else None)
+    trajectory = Trajectory(
+        np.arange(steps + 1) * dt, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques),
+        list(robot.joint_names), robot.name,
+    )  # fmt: skip
+    if limits != "ignore":
+        violations = joint_limits.violations(trajectory)
+        if violations:
+            warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
+    return trajectory
+
+
+def _check_modes(integrator: str, limits: str, engine: str) -> None:
+    """Refuse an unknown integrator, limits mode or engine."""
+    if integrator not in INTEGRATORS:
+        raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
+    check_mode(limits)
+    if engine not in ENGINES:
+        raise InputError("engine", f"one of {', '.join(ENGINES)}", repr(engine))
+
+
+def _step_count(duration: float, dt: float) -> int:
+    """The number of steps of ``dt`` in ``duration`` (both in [s]), refused unless whole."""
+    if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
+        raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
+    steps = round(duration / dt)
+    if abs(steps * dt - duration) > 1e-9 * max(duration, dt):
+        raise InputError("duration", f"a whole number of steps of dt = {dt:g} s", f"{duration:g} s ({duration / dt:.6g} steps)")
+    if steps > MAX_STEPS:
+        raise InputError("duration / dt", f"at most {MAX_STEPS:,} steps", f"{steps:,} steps")
+    return steps
+
+
+class _Stepper:
+    """One integration step of ``(q, v)`` under a controller: RK4 or semi-implicit Euler."""
+
+    def __init__(
+        self, robot: Robot, external: Sequence[ExternalWrench], controller: Controller | None, *, hold: bool, rk4: bool
+    ) -> None:
+        self.controller = controller
+        self.forward = _accelerator(robot, external)
+        if controller is None or hold:  # the step's torque (zero when passive) holds
+            self.accelerate = self.forward
+        else:
+            forward = self.forward
+            self.accelerate = lambda t, q, v, tau: forward(t, q, v, np.asarray(controller(t, q, v), dtype=float))
+        # Fixed base: q moves by plain addition (no call); floating base: on SE(3).
+        self.integrate = robot.integrate if robot.floating_base else None
+        self.rk4 = rk4
+        self.zero = np.zeros(robot.nv)
+
+    def torque(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The controller's torque at the step's start, shape (nv,) (zero when passive)."""
+        return self.zero if self.controller is None else np.asarray(self.controller(t, q, v), dtype=float)
+
+    def step(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
+        """``(q, v)`` after one step of ``dt`` from time ``t`` with acceleration ``a`` there."""
+        if not self.rk4:
+            v = v + dt * a
+            return (q + dt * v if self.integrate is None else self.integrate(q, dt * v)), v
+        accelerate, integrate = self.accelerate, self.integrate
+        half, sixth = 0.5 * dt, dt / 6.0
+        v2 = v + half * a
+        if integrate is None:
+            a2 = accelerate(t + half, q + half * v, v2, tau)
+            v3 = v + half * a2
+            a3 = accelerate(t + half, q + half * v2, v3, tau)
+            v4 = v + dt * a3
+            a4 = accelerate(t + dt, q + dt * v3, v4, tau)
+            q = q + sixth * (v + v4 + 2.0 * (v2 + v3))
+        else:
+            a2 = accelerate(t + half, integrate(q, half * v), v2, tau)
+            v3 = v + half * a2
+            a3 = accelerate(t + half, integrate(q, half * v2), v3, tau)
+            v4 = v + dt * a3
+            a4 = accelerate(t + dt, integrate(q, dt * v3), v4, tau)
+            q = integrate(q, sixth * (v + v4 + 2.0 * (v2 + v3)))
+        return q, v + sixth * (a + a4 + 2.0 * (a2 + a3))
+
+
+def _integrate(
+    robot: Robot, stepper: _Stepper, q: np.ndarray, v: np.ndarray, steps: int, dt: float, stops: JointLimits | None
+) -> tuple[list, list, list, list]:
+    """The samples of ``steps`` steps from ``(q, v)``: positions, velocities, accelerations,
+    torques (``stops``: joints stopped at their position limits after each step)."""
     qs, vs, accelerations, torques = [], [], [], []
-    zero = np.zeros(robot.nv)
-    forward = _accelerator(robot, external)
-    if controller is None or hold:  # the step's torque (zero when passive) holds
-        accelerate = forward
-    else:
-        accelerate = lambda t, q, v, tau: forward(t, q, v, np.asarray(controller(t, q, v), dtype=float))  # noqa: E731
-    # Fixed base: q moves by plain addition (no call); floating base: on SE(3).
-    integrate = robot.integrate if robot.floating_base else None
     q, v = q.copy(), v.copy()
-    half, sixth = 0.5 * dt, dt / 6.0
-    rk4 = integrator == "rk4"
     for step in range(steps):
         t = step * dt
         try:
             qs.append(q)
             vs.append(v)
-            tau = zero if controller is None else np.asarray(controller(t, q, v), dtype=float)
+            tau = stepper.torque(t, q, v)
             torques.append(tau)
-            a = forward(t, q, v, tau)
+            a = stepper.forward(t, q, v, tau)
             accelerations.append(a)
-            if rk4:
-                v2 = v + half * a
-                if integrate is None:
-                    a2 = accelerate(t + half, q + half * v, v2, tau)
-                    v3 = v + half * a2
-                    a3 = accelerate(t + half, q + half * v2, v3, tau)
-                    v4 = v + dt * a3
-                    a4 = accelerate(t + dt, q + dt * v3, v4, tau)
-                    q = q + sixth * (v + v4 + 2.0 * (v2 + v3))
-                else:
-                    a2 = accelerate(t + half, integrate(q, half * v), v2, tau)
-                    v3 = v + half * a2
-                    a3 = accelerate(t + half, integrate(q, half * v2), v3, tau)
-                    v4 = v + dt * a3
-                    a4 = accelerate(t + dt, integrate(q, dt * v3), v4, tau)
-                    q = integrate(q, sixth * (v + v4 + 2.0 * (v2 + v3)))
-                v = v + sixth * (a + a4 + 2.0 * (a2 + a3))
-            else:
-                v = v + dt * a
-                q = q + dt * v if integrate is None else integrate(q, dt * v)
-            if enforce:
-                q, v = joint_limits.stop(q, v)
+            q, v = stepper.step(t, dt, q, v, tau, a)
+            if stops is not None:
+                q, v = stops.stop(q, v)
         except InputError:  # a non-finite state reached a controller's checked call
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
@@ -213,19 +269,9 @@ def simulate(
             _check_finite(robot, qs, vs, q, v, dt)
     qs.append(q)
     vs.append(v)
-    torques.append(torques[-1] if steps else zero)
-    accelerations.append(forward(steps * dt, q, v, torques[-1]))  # the last sample's own acceleration
-    trajectory = Trajectory(
-        times, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques), list(robot.joint_names), robot.name
-    )
-    if limits != "ignore":
-        violations = joint_limits.violations(trajectory)
-        if violations:
-            warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
-    return trajectory
-
-
-ENGINES = ("pinocchio", "compiled")
+    torques.append(torques[-1] if steps else stepper.zero)
+    accelerations.append(stepper.forward(steps * dt, q, v, torques[-1]))  # the last sample's own acceleration
+    return qs, vs, accelerations, torques
 
 
 def _simulate_compiled(
@@ -278,14 +324,6 @@ def _simulate_compiled(
         if violations:
             warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=3)
     return trajectory
-
-
-#: Most steps one run may take (a guard against durations like 1e9 s at 1 ms).
-MAX_STEPS = 10_000_000
-
-
-#: Steps between two finiteness checks of the state (a divergence is located exactly).
-_CHECK_EVERY = 64
 
 
 def _check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: np.ndarray, v: np.ndarray, dt: float) -> None:

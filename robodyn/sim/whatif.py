@@ -82,7 +82,44 @@ def motion_torques(
     return times, torques
 
 
-def sweep(
+@dataclass(frozen=True)
+class WhatIfTable:
+    """The what-if table of one robot's motion: a row a material × payload × force.
+
+    Attributes:
+        robot: The robot's name.
+        duration: Motion time in [s].
+        joint_names: Its joints (one column pair each).
+        torque_units: Unit of each joint's torques (``robot.dofs``: N m or N).
+        rows: The variants, in sweep order.
+        plot: A bar chart written of the table, if any.
+    """
+
+    robot: str
+    duration: float
+    joint_names: tuple[str, ...]
+    torque_units: tuple[str, ...]
+    rows: tuple[Variant, ...]
+    plot: str | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready (the ``robodyn whatif --json`` output)."""
+        data = table_dict(list(self.rows), list(self.joint_names), list(self.torque_units))
+        return data if self.plot is None else data | {"plot": self.plot}
+
+    def text(self) -> str:
+        """A title line and the table (a peak above the effort limit ends in ``!``)."""
+        title = f"{printable(self.robot)}: one rest-to-rest motion of {self.duration:g} s; torques of each joint"
+        table = table_text(list(self.rows), list(self.joint_names), list(self.torque_units))
+        return f"{title}\n\n{table}" + (f"\n\nplot: {self.plot}" if self.plot is not None else "")
+
+
+def sweep(model: str = "rp_arm", **options) -> list[Variant]:
+    """The rows of :func:`what_if` (same arguments)."""
+    return list(what_if(model, **options).rows)
+
+
+def what_if(
     model: str = "rp_arm",
     *,
     materials: tuple[str, ...] | None = None,
@@ -92,7 +129,7 @@ def sweep(
     q_end: np.ndarray | None = None,
     duration: float = 1.5,
     frame: str | None = None,
-) -> list[Variant]:
+) -> WhatIfTable:
     """Peak and RMS joint torques of one motion, for each material × payload × force.
 
     Args:
@@ -112,28 +149,10 @@ def sweep(
         InputError: Negative payloads, non-finite forces, a duration ≤ 0.
         FrameError: An unknown frame, one no joint moves, or no default end effector.
     """
-    payloads = tuple(float(p) for p in payloads)
-    if not all(np.isfinite(p) and p >= 0 for p in payloads):
-        raise InputError("payloads", "masses ≥ 0 in [kg]", ", ".join(f"{p:g}" for p in payloads))
-    if not all(np.isfinite(np.asarray(f, float)).all() and np.shape(f) == (3,) for f in forces):
-        raise InputError("forces", "3 finite values FX, FY, FZ in [N] each", repr(forces))
-    if not (np.isfinite(duration) and duration > 0):
-        raise InputError("duration", "finite and > 0 s", f"{duration:g}")
+    payloads = _check_sweep(payloads, forces, duration)
     generated = model == "rp_arm"
-    if generated:
-        variants = [(name, load(rp_arm_urdf(RPArmParameters.from_material(name)))) for name in (materials or DEFAULT_MATERIALS)]
-    else:
-        if materials:
-            raise InputError("materials", "given only for the generated rp_arm", f"{len(materials)} materials for {model!r}")
-        variants = [("as loaded", load(model))]
+    variants = model_variants(model, materials)
     base_robot = variants[0][1]
-    if base_robot.floating_base:
-        raise InputError(
-            "model",
-            "a fixed-base robot (a floating base's motion needs contacts; the sweep would report the "
-            "wrench of a hook holding the base)",
-            f"floating-base {base_robot.name!r}",
-        )
     if any(payloads) or any(np.any(f) for f in forces):
         frame = base_robot.task_frame(frame, "a payload or force")
     if q_start is None:
@@ -148,18 +167,49 @@ def sweep(
             for force in forces:
                 force_vector = np.asarray(force, dtype=float)
                 _, torques = motion_torques(loaded, q_start, q_end, duration, frame=frame, force=force_vector)
-                rows.append(
-                    Variant(
-                        material,
-                        float(payload),
-                        force_vector,
-                        loaded.total_mass,
-                        np.abs(torques).max(axis=0),
-                        np.sqrt((torques**2).mean(axis=0)),
-                        effort,
-                    )
-                )
-    return rows
+                peak, rms = np.abs(torques).max(axis=0), np.sqrt((torques**2).mean(axis=0))
+                rows.append(Variant(material, float(payload), force_vector, loaded.total_mass, peak, rms, effort))
+    return table_of(base_robot, duration, rows)
+
+
+def table_of(robot: Robot, duration: float, rows: list[Variant]) -> WhatIfTable:
+    """The table of ``rows`` swept on ``robot`` (names and units from ``robot.dofs``)."""
+    units = tuple(dof.effort_unit for dof in robot.dofs)
+    return WhatIfTable(robot.name, duration, tuple(robot.joint_names), units, tuple(rows))
+
+
+def _check_sweep(payloads: tuple[float, ...], forces: tuple[tuple[float, float, float], ...], duration: float) -> tuple:
+    """The payloads as floats; refuse negative payloads, bad forces or a duration ≤ 0."""
+    payloads = tuple(float(p) for p in payloads)
+    if not all(np.isfinite(p) and p >= 0 for p in payloads):
+        raise InputError("payloads", "masses ≥ 0 in [kg]", ", ".join(f"{p:g}" for p in payloads))
+    if not all(np.isfinite(np.asarray(f, float)).all() and np.shape(f) == (3,) for f in forces):
+        raise InputError("forces", "3 finite values FX, FY, FZ in [N] each", repr(forces))
+    if not (np.isfinite(duration) and duration > 0):
+        raise InputError("duration", "finite and > 0 s", f"{duration:g}")
+    return payloads
+
+
+def model_variants(model: str, materials: tuple[str, ...] | None) -> list[tuple[str, Robot]]:
+    """The robots a sweep compares: the RP arm in each material, or ``model`` as loaded.
+
+    Raises:
+        InputError: Materials for another robot than ``rp_arm``, or a floating base.
+    """
+    if model == "rp_arm":
+        variants = [(name, load(rp_arm_urdf(RPArmParameters.from_material(name)))) for name in (materials or DEFAULT_MATERIALS)]
+    else:
+        if materials:
+            raise InputError("materials", "given only for the generated rp_arm", f"{len(materials)} materials for {model!r}")
+        variants = [("as loaded", load(model))]
+    if variants[0][1].floating_base:
+        raise InputError(
+            "model",
+            "a fixed-base robot (a floating base's motion needs contacts; the sweep would report the "
+            "wrench of a hook holding the base)",
+            f"floating-base {variants[0][1].name!r}",
+        )
+    return variants
 
 
 def _half_radian_away(robot: Robot, q_start: np.ndarray) -> np.ndarray:
@@ -175,8 +225,7 @@ def _half_radian_away(robot: Robot, q_start: np.ndarray) -> np.ndarray:
 
 def _effort_limits(robot: Robot) -> np.ndarray:
     """Effort limit per velocity coordinate, inf where none (zero in a URDF means none)."""
-    joints = robot.joints[1:] if robot.floating_base else robot.joints
-    effort = np.array([np.inf] * (robot.nv - len(joints)) + [joint.effort for joint in joints], dtype=float)
+    effort = np.array([dof.effort_limit for dof in robot.dofs], dtype=float)
     return np.where(effort > 0, effort, np.inf)
 
 

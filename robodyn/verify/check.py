@@ -94,6 +94,14 @@ class CheckReport:
             if not comparison.passed
         ]
 
+    def to_dict(self) -> dict:
+        """JSON-ready (the ``robodyn check --json`` output)."""
+        return report_dict(self)
+
+    def text(self) -> str:
+        """A readable table: one line a quantity, then PASSED or FAILED with the failures."""
+        return report_text(self)
+
     @property
     def worst_relative_error(self) -> float:
         """Largest relative error of the reference-vs-Pinocchio comparisons."""
@@ -140,11 +148,6 @@ def skewness(matrices: np.ndarray, scale: float, tolerance: float, dof_names: li
     return Comparison(max_abs, max_abs / scale if scale > 0 else max_abs, tolerance, where)
 
 
-def _dof_names(robot: Robot) -> list[str]:
-    """The joint of every velocity coordinate (a floating base's six are its root joint)."""
-    return [joint.name for joint in robot.joints for _ in range(6 if joint.type == "floating" else 1)]
-
-
 def check_robot(
     source: str | os.PathLike | Robot,
     *,
@@ -183,36 +186,64 @@ def check_robot(
         floating_base=robot.floating_base,
     )
     report = CheckReport(robot.name, samples, seed, list(robot.joint_names))
-    extra = [name for name in robot.joint_names if name not in model.joint_names]
-    missing = [name for name in model.joint_names if name not in robot.joint_names]
-    if extra or missing:
-        where = ", ".join(
-            [f"joint {name!r} only in the robot" for name in extra]
-            + [f"joint {name!r} only in the reference" for name in missing]
-        )
-        report.comparisons["joints"] = Comparison(float(len(extra) + len(missing)), float(len(extra) + len(missing)), 0.0, where)
+    unmatched = _unmatched_joints(robot.joint_names, model.joint_names)
+    if unmatched is not None:
+        report.comparisons["joints"] = unmatched
         return report
-    # Index of each of robot's coordinates in the reference's (joints matched by name; a
-    # floating base's 7 position and 6 velocity coordinates come first in both).
-    base_q, base_v = (7, 6) if robot.floating_base else (0, 0)
-    joints = robot.joint_names[1:] if robot.floating_base else robot.joint_names
-    reference_joints = model.joint_names[1:] if robot.floating_base else model.joint_names
-    v_order = list(range(base_v)) + [base_v + reference_joints.index(name) for name in joints]
-    q_order = list(range(base_q)) + [base_q + reference_joints.index(name) for name in joints]
     rng = np.random.default_rng(seed)
     q = robot.random_configuration(rng, samples)
     v = rng.normal(size=(samples, robot.nv))
     a = rng.normal(size=(samples, robot.nv))
+    report.comparisons.update(_compare_dynamics(robot, _Matched(robot, model), q, v, a, tolerance))
+    return report
 
-    def to_reference(x: np.ndarray, order: list[int]) -> np.ndarray:
+
+def _unmatched_joints(robot_joints: list[str], reference_joints: list[str]) -> Comparison | None:
+    """A failed ``joints`` comparison naming the joints only one model has; ``None`` if none."""
+    extra = [name for name in robot_joints if name not in reference_joints]
+    missing = [name for name in reference_joints if name not in robot_joints]
+    if not (extra or missing):
+        return None
+    where = ", ".join(
+        [f"joint {name!r} only in the robot" for name in extra] + [f"joint {name!r} only in the reference" for name in missing]
+    )
+    return Comparison(float(len(extra) + len(missing)), float(len(extra) + len(missing)), 0.0, where)
+
+
+class _Matched:
+    """The reference model with its coordinates in the robot's order (joints matched by
+    name; a floating base's 7 position and 6 velocity coordinates come first in both)."""
+
+    def __init__(self, robot: Robot, model) -> None:
+        self.model = model
+        base_q, base_v = (7, 6) if robot.floating_base else (0, 0)
+        joints = robot.joint_names[1:] if robot.floating_base else robot.joint_names
+        reference_joints = model.joint_names[1:] if robot.floating_base else model.joint_names
+        self.v_order = list(range(base_v)) + [base_v + reference_joints.index(name) for name in joints]
+        self.q_order = list(range(base_q)) + [base_q + reference_joints.index(name) for name in joints]
+
+    def to_reference(self, x: np.ndarray, order: list[int]) -> np.ndarray:
+        """Samples (N, n) in the reference's order."""
         out = np.empty_like(x)
         out[:, order] = x
         return out
 
-    def from_reference(x: np.ndarray) -> np.ndarray:
-        return x[:, v_order] if x.ndim == 2 else x[:, v_order][:, :, v_order]
+    def from_reference(self, x: np.ndarray) -> np.ndarray:
+        """Vectors (N, nv) or matrices (N, nv, nv) of the reference in the robot's order."""
+        return x[:, self.v_order] if x.ndim == 2 else x[:, self.v_order][:, :, self.v_order]
 
-    q_ref, v_ref, a_ref = to_reference(q, q_order), to_reference(v, v_order), to_reference(a, v_order)
+    def states(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``q``, ``v``, ``a`` in the reference's order."""
+        return self.to_reference(q, self.q_order), self.to_reference(v, self.v_order), self.to_reference(a, self.v_order)
+
+
+def _compare_dynamics(
+    robot: Robot, matched: _Matched, q: np.ndarray, v: np.ndarray, a: np.ndarray, tolerance: float
+) -> dict[str, Comparison]:
+    """``tau``, ``M``, ``C v``, ``G`` (and, on a fixed base, ``C`` and ``Ṁ − 2C`` skew) of
+    both implementations at the states ``q`` (N, nq), ``v`` and ``a`` (N, nv)."""
+    model, from_reference = matched.model, matched.from_reference
+    q_ref, v_ref, a_ref = matched.states(q, v, a)
     reference_values = {
         "tau": from_reference(model.inverse_dynamics(q_ref, v_ref, a_ref)),
         "M": from_reference(model.mass_matrix(q_ref)),
@@ -224,30 +255,29 @@ def check_robot(
         "tau": robot.inverse_dynamics(q, v, a),
         "M": robot.mass_matrix(q),
         "Cv": np.einsum("nij,nj->ni", coriolis, v),
-        "C": coriolis,
         "G": robot.gravity(q),
     }
     # A term that vanishes (C of a single joint, G of joints on vertical axes) is compared
     # relative to its natural size: M times speeds, or the torques of the same states.
     mass_scale, speed, torque_scale = _largest(reference_values["M"]), _largest(v), _largest(reference_values["tau"])
     floors = {"tau": 0.0, "M": 0.0, "Cv": mass_scale * speed**2, "C": mass_scale * speed, "G": torque_scale}
-    dofs = _dof_names(robot)
-    for name in reference_values:
-        report.comparisons[name] = _compare(pinocchio_values[name], reference_values[name], tolerance, floors[name], dofs)
+    dofs = [dof.name for dof in robot.dofs]
+    comparisons = {
+        name: _compare(pinocchio_values[name], reference_values[name], tolerance, floors[name], dofs) for name in reference_values
+    }
     if robot.floating_base:  # C (and Ṁ − 2C) are in other coordinates there: τ, M, C v, G suffice
-        return report
-
-    reference_values["C"] = from_reference(model.coriolis_matrix(q_ref, v_ref))
-    report.comparisons["C"] = _compare(coriolis, reference_values["C"], tolerance, floors["C"], dofs)
+        return comparisons
+    reference_c = from_reference(model.coriolis_matrix(q_ref, v_ref))
+    comparisons["C"] = _compare(coriolis, reference_c, tolerance, floors["C"], dofs)
     step = 1e-6
     m_dot = (robot.mass_matrix(q + step * v) - robot.mass_matrix(q - step * v)) / (2 * step)
     # Relative to the size of Ṁ, or of M times the speeds when Ṁ happens to be tiny
     # (the finite difference's rounding error scales with M, not with Ṁ).
     scale = max(_largest(m_dot), mass_scale * speed)
-    report.comparisons["skew_pinocchio"] = skewness(m_dot - 2 * coriolis, scale, FINITE_DIFFERENCE_TOLERANCE, dofs)
+    comparisons["skew_pinocchio"] = skewness(m_dot - 2 * coriolis, scale, FINITE_DIFFERENCE_TOLERANCE, dofs)
     m_dot_reference = from_reference(model.mass_matrix_derivative(q_ref, v_ref))
-    report.comparisons["skew_reference"] = skewness(m_dot_reference - 2 * reference_values["C"], scale, tolerance, dofs)
-    return report
+    comparisons["skew_reference"] = skewness(m_dot_reference - 2 * reference_c, scale, tolerance, dofs)
+    return comparisons
 
 
 def report_dict(report: CheckReport) -> dict:

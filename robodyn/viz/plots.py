@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import io
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +30,7 @@ from matplotlib.text import Text
 from matplotlib.transforms import Bbox
 
 from robodyn.common.files import atomic_write_bytes
+from robodyn.dynamics.dofs import Dof
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import ViewerError
 from robodyn.sim.simulation import Trajectory
@@ -56,63 +56,6 @@ def save_png(figure: Figure, path: str | Path) -> Path | None:
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     return atomic_write_bytes(path, buffer.getvalue())
-
-
-# --------------------------------------------------------------------------------------
-# Which column is which joint, and its units
-# --------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Dof:
-    """One actuated degree of freedom as plotted.
-
-    Attributes:
-        name: Joint name.
-        q_column, v_column: Column in ``Trajectory.q`` and in ``v``/``a``/``tau``.
-        linear: Prismatic (positions in [m], efforts in [N]) or not ([rad], [N m]).
-        lower, upper: Position limits (±inf when unlimited).
-        effort: Effort limit (inf when not given).
-    """
-
-    name: str
-    q_column: int
-    v_column: int
-    linear: bool
-    lower: float
-    upper: float
-    effort: float
-
-    @property
-    def position_unit(self) -> str:
-        return "m" if self.linear else "rad"
-
-    @property
-    def effort_unit(self) -> str:
-        return "N" if self.linear else "N m"
-
-    @property
-    def effort_word(self) -> str:
-        return "force" if self.linear else "torque"
-
-
-def joint_dofs(robot: Robot) -> list[Dof]:
-    """The robot's joints (not the floating base) with their columns, read from the model."""
-    dofs = []
-    for joint in robot.joints:
-        if joint.type == "floating":
-            continue
-        model_joint = robot.model.joints[robot.model.getJointId(joint.name)]
-        dofs.append(
-            Dof(
-                joint.name,
-                model_joint.idx_q,
-                model_joint.idx_v,
-                joint.type == "prismatic",
-                joint.lower,
-                joint.upper,
-                joint.effort,
-            )
-        )
-    return dofs
 
 
 # --------------------------------------------------------------------------------------
@@ -161,57 +104,23 @@ def simulation_figure(
     Returns:
         The figure: one panel a quantity and unit; revolute and prismatic joints apart.
     """
-    dofs = joint_dofs(robot)
-    revolute = [d for d in dofs if not d.linear]
-    prismatic = [d for d in dofs if d.linear]
-    panels: list[tuple[str, list[Dof]]] = []
-    if revolute:
-        panels.append(("position [rad]", revolute))
-    if prismatic or robot.floating_base:
-        panels.append(("position [m]", prismatic))
-    if revolute:
-        panels.append(("torque [N m]", revolute))
-    if prismatic:
-        panels.append(("force [N]", prismatic))
+    panels = _joint_panels(robot)
     task = frame is not None and target is not None
     rows = len(panels) + 1 + int(task)
     figure = new_figure(9.0, 1.9 * rows + 0.6)
     axes = figure.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
-    t = trajectory.t
-    colors = {d.name: f"C{i % 10}" for i, d in enumerate(dofs)}
+    joints = [dof for dof in robot.dofs if not dof.is_base]
+    colors = {dof.name: f"C{i % 10}" for i, dof in enumerate(joints)}
     for axis, (ylabel, group) in zip(axes, panels, strict=False):
-        effort = ylabel.startswith(("torque", "force"))
-        data, limits = [], []
-        for dof in group:
-            torques = trajectory.tau if trajectory.tau is not None else np.zeros_like(trajectory.v)
-            column = torques[:, dof.v_column] if effort else trajectory.q[:, dof.q_column]
-            axis.plot(t, column, color=colors[dof.name], label=text_label(dof.name), linewidth=1.3)
-            low, high = (-dof.effort, dof.effort) if effort else (dof.lower, dof.upper)
-            _band(axis, low, high, colors[dof.name], min(0.07, 0.2 / len(group)))
-            data.append(column)
-            limits += [low, high]
-        if ylabel == "position [m]" and robot.floating_base:
-            for k, (axis_name, style) in enumerate(zip("xyz", (":", "-.", "--"), strict=True)):
-                column = trajectory.q[:, k]
-                axis.plot(t, column, color="0.3", linestyle=style, label=f"base {axis_name}", linewidth=1.3)
-                data.append(column)
-        _fit(axis, data, limits)
-        axis.set_ylabel(ylabel)
-        axis.grid(alpha=0.3)
+        _joint_panel(axis, robot, trajectory, ylabel, group, colors)
     row = len(panels)
     if frame is not None and target is not None:  # the task panel
         error = np.linalg.norm(robot.frame_position(trajectory.q, frame) - np.asarray(target, dtype=float), axis=1)
-        axes[row].semilogy(t, np.maximum(error, 1e-16), color="tab:red", label=f"|{text_label(frame)} − target|")
+        axes[row].semilogy(trajectory.t, np.maximum(error, 1e-16), color="tab:red", label=f"|{text_label(frame)} − target|")
         axes[row].set_ylabel("distance [m]")
         axes[row].grid(alpha=0.3, which="both")
         row += 1
-    kinetic = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v))
-    potential = np.atleast_1d(robot.potential_energy(trajectory.q))
-    axes[row].plot(t, kinetic, label="kinetic", color="black", linestyle="--")
-    axes[row].plot(t, potential, label="potential", color="black", linestyle=":")
-    axes[row].plot(t, kinetic + potential, label="total", color="black")
-    axes[row].set_ylabel("energy [J]")
-    axes[row].grid(alpha=0.3)
+    _energy_panel(axes[row], robot, trajectory)
     axes[-1].set_xlabel("time [s]")
     # One legend for the joints (a colour each, shared by every panel), one for the rest.
     handles, labels = [], []
@@ -221,8 +130,61 @@ def simulation_figure(
                 handles.append(handle)
                 labels.append(label)
     figure.legend(handles, labels, loc="outside right upper", fontsize="small", title="shaded: limits", title_fontsize="small")
-    figure.suptitle(f"{text_label(robot.name)}: simulation, {t[-1] - t[0]:.3g} s")
+    figure.suptitle(f"{text_label(robot.name)}: simulation, {trajectory.t[-1] - trajectory.t[0]:.3g} s")
     return figure
+
+
+def _joint_panels(robot: Robot) -> list[tuple[str, list[Dof]]]:
+    """The joint panels, one a quantity and unit: (y label, the joints drawn in it)."""
+    joints = [dof for dof in robot.dofs if not dof.is_base]
+    angular = [dof for dof in joints if not dof.linear]
+    linear = [dof for dof in joints if dof.linear]
+    panels: list[tuple[str, list[Dof]]] = []
+    if angular:
+        panels.append(("position [rad]", angular))
+    if linear or robot.floating_base:
+        panels.append(("position [m]", linear))
+    if angular:
+        panels.append(("torque [N m]", angular))
+    if linear:
+        panels.append(("force [N]", linear))
+    return panels
+
+
+def _joint_panel(axis: Axes, robot: Robot, trajectory: Trajectory, ylabel: str, group: list[Dof], colors: dict[str, str]) -> None:
+    """The positions or efforts of ``group`` over time, each with its limits shaded (and, in
+    the panel of lengths of a floating-base robot, the base's position)."""
+    effort = ylabel.startswith(("torque", "force"))
+    q_offset = robot.nq - robot.nv  # a floating base's quaternion: one q more than v
+    t = trajectory.t
+    data, limits = [], []
+    for dof in group:
+        torques = trajectory.tau if trajectory.tau is not None else np.zeros_like(trajectory.v)
+        column = torques[:, dof.index] if effort else trajectory.q[:, dof.index + q_offset]
+        axis.plot(t, column, color=colors[dof.name], label=text_label(dof.name), linewidth=1.3)
+        low, high = (-dof.effort_limit, dof.effort_limit) if effort else (dof.lower, dof.upper)
+        _band(axis, low, high, colors[dof.name], min(0.07, 0.2 / len(group)))
+        data.append(column)
+        limits += [low, high]
+    if ylabel == "position [m]" and robot.floating_base:
+        for k, style in enumerate((":", "-.", "--")):
+            column = trajectory.q[:, k]
+            axis.plot(t, column, color="0.3", linestyle=style, label=robot.configuration_names[k], linewidth=1.3)
+            data.append(column)
+    _fit(axis, data, limits)
+    axis.set_ylabel(ylabel)
+    axis.grid(alpha=0.3)
+
+
+def _energy_panel(axis: Axes, robot: Robot, trajectory: Trajectory) -> None:
+    """Kinetic, potential and total energy in [J] over time."""
+    kinetic = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v))
+    potential = np.atleast_1d(robot.potential_energy(trajectory.q))
+    axis.plot(trajectory.t, kinetic, label="kinetic", color="black", linestyle="--")
+    axis.plot(trajectory.t, potential, label="potential", color="black", linestyle=":")
+    axis.plot(trajectory.t, kinetic + potential, label="total", color="black")
+    axis.set_ylabel("energy [J]")
+    axis.grid(alpha=0.3)
 
 
 def plot_simulation(

@@ -27,7 +27,7 @@ import umsgpack
 
 from robodyn.common.files import atomic_write_text
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import RobodynError, ViewerError
+from robodyn.exceptions import InputError, RobodynError, ViewerError
 from robodyn.sim.simulation import Trajectory
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
 from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands
@@ -133,7 +133,7 @@ class Recording:
 
     def _time(self, at: float) -> float:
         if not (np.isfinite(at) and 0.0 <= at <= self.duration + 1e-9):
-            raise ViewerError(f"--at must lie within the motion, 0 to {self.duration:g} s; got {at:g}.")
+            raise InputError("at", f"within the motion, 0 to {self.duration:g} s", f"{at:g}")
         return float(at)
 
 

@@ -227,7 +227,7 @@ def video_of_page(
         raise ViewerError("videos need imageio: pip install 'robodyn[viewer]'.") from None
     count = int(np.floor(duration * fps + 1e-9)) + 1
     if count > 3600:
-        raise ViewerError(f"the video would have {count} frames (over 3600): lower --video-fps or shorten the motion.")
+        raise ViewerError(f"the video would have {count} frames (over 3600): lower the frame rate (fps=) or shorten the motion.")
     frames = capture(page, [k / fps for k in range(count)], size=size, progress=progress)
     with tempfile.TemporaryDirectory(prefix="robodyn-video-") as folder:
         scratch = Path(folder) / f"video{suffix}"

@@ -35,7 +35,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.common.text import printable_lines
-    from robodyn.verify.check import check_robot, report_dict, report_text
+    from robodyn.verify.check import check_robot
 
     robot = load_robot(arguments)
     report = check_robot(
@@ -46,5 +46,5 @@ def run(arguments: argparse.Namespace) -> int:
         check_inertia=arguments.check_inertia,
         reference_source=arguments.reference,
     )
-    print(json_text(report_dict(report)) if arguments.json else printable_lines(report_text(report)))
+    print(json_text(report.to_dict()) if arguments.json else printable_lines(report.text()))
     return 0 if report.passed else 1

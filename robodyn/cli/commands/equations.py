@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 
-from robodyn.cli import report
 from robodyn.cli.common import Progress, add_model_arguments, json_text, load_robot, lock_values, state, vector
 from robodyn.exceptions import InputError
 
@@ -148,6 +147,7 @@ def run(arguments: argparse.Namespace) -> int:
         return _base_parameters(arguments)
     if arguments.symbolic or arguments.lecture:
         return _symbolic(arguments)
+    from robodyn.dynamics.terms import dynamics_terms
     from robodyn.equations.output import check_precision
 
     check_precision(arguments.precision)
@@ -155,9 +155,6 @@ def run(arguments: argparse.Namespace) -> int:
     q = state(robot, arguments.q, "q", robot.nq, robot.default_configuration())
     v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
     a = state(robot, arguments.a, "a", robot.nv, np.zeros(robot.nv))
-    terms = report.equations_at(robot, q, v, a)
-    if arguments.json:
-        print(json_text(report.equations_dict(robot, terms)))
-    else:
-        print(report.equations_text(robot, terms, precision=arguments.precision))
+    terms = dynamics_terms(robot, q, v, a)
+    print(json_text(terms.to_dict()) if arguments.json else terms.text(precision=arguments.precision))
     return 0

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from robodyn.cli.common import add_model_arguments, load_robot
 from robodyn.exceptions import InputError
@@ -25,39 +24,24 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.common.files import atomic_write_text
-    from robodyn.ident import base_parameters, identified_urdf, identify
-    from robodyn.ident.render import printable, render_base_parameters
+    from robodyn.ident import base_parameters
+    from robodyn.ident.render import render_base_parameters
+    from robodyn.ident.run import identify_run
     from robodyn.sim.trajectory import Trajectory
 
-    if arguments.urdf_out and arguments.method != "physical":
-        raise InputError(
-            "--urdf-out", "used with --method physical (only it gives consistent standard parameters)", arguments.method
-        )
     if arguments.data is None and not arguments.base_parameters:
         raise InputError("DATA", "a trajectory file (or --base-parameters)", "nothing")
     robot = load_robot(arguments)
-    base = base_parameters(robot, friction=arguments.friction)
     if arguments.base_parameters:
-        print(render_base_parameters(base, arguments.format), end="")
+        print(render_base_parameters(base_parameters(robot, friction=arguments.friction), arguments.format), end="")
         return 0
-    data = Trajectory.load(arguments.data).for_robot(robot)
-    if data.tau is None:
-        raise InputError("DATA", "a trajectory file with tau[<joint>] columns (the measured torques)", repr(arguments.data))
-    result = identify(robot, data, method=arguments.method, base=base)  # type: ignore[arg-type]  # tau checked above
-    urdf = identified_urdf(robot, result.standard, base.columns) if arguments.urdf_out and result.standard is not None else None
-    width = max(len(printable(name)) for name in base.names)
-    print(
-        f"{printable(robot.name)}: {arguments.method} identification of {base.count} base parameters from {result.samples} samples"
+    run = identify_run(
+        robot,
+        Trajectory.load(arguments.data).for_robot(robot),
+        method=arguments.method,
+        friction=arguments.friction,
+        out=arguments.out,
+        urdf_out=arguments.urdf_out,
     )
-    print(f"condition number {result.condition:.4g}; relative torque error {result.relative_error:.3g}\n")
-    print(f"{'parameter':{width}s} {'identified':>12s} {'std':>10s} {'URDF':>12s}")
-    for name, value, std, nominal in zip(base.names, result.values, result.std, base.values, strict=True):
-        print(f"{printable(name):{width}s} {value:>12.6g} {std:>10.3g} {nominal:>12.6g}")
-    if arguments.out:
-        atomic_write_text(arguments.out, json.dumps(result.to_dict(), indent=2) + "\n")
-        print(f"\nwrote {arguments.out}")
-    if urdf is not None:
-        atomic_write_text(arguments.urdf_out, urdf)
-        print(f"wrote {arguments.urdf_out}")
+    print(run.text())
     return 0

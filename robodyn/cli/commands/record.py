@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import warnings
 
-from robodyn.cli.common import add_model_arguments, load_robot, vector
+from robodyn.cli.common import add_model_arguments, load_robot, vector, warn
 from robodyn.exceptions import InputError
 
 
@@ -40,7 +39,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.exceptions import MeshWarning
     from robodyn.sim.simulation import Trajectory
-    from robodyn.viz.recording import recording
+    from robodyn.viz.experiment import record_files
 
     if arguments.max_mesh_mb is not None and not arguments.max_mesh_mb > 0:
         raise InputError("--max-mesh-mb", "a positive size in MB", f"{arguments.max_mesh_mb:g}")
@@ -49,30 +48,25 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.filmstrip is not None and arguments.at != 0.0:
         raise InputError("--at", "not given with --filmstrip (its frames spread over the motion)", f"--at {arguments.at:g}")
     robot = load_robot(arguments)
-    trajectory = Trajectory.load(arguments.trajectory).for_robot(robot)
-    started = time.perf_counter()
     with warnings.catch_warnings():  # reported below, one line each
         warnings.simplefilter("ignore", MeshWarning)
-        axes = tuple(name for name in (arguments.axes or "").split(",") if name)
-        cap = {} if arguments.max_mesh_mb is None else {"max_mesh_bytes": int(arguments.max_mesh_mb * 1e6)}
-        made = recording(robot, trajectory, fps=arguments.fps, target=arguments.target, frame=arguments.frame, axes=axes, **cap)
-    for reason in made.placeholders:
-        print(f"robodyn: warning: {reason}; drawn as a placeholder box", file=sys.stderr)
-    if arguments.png:  # stills before the HTML is written: a failed still leaves no half result
-        if arguments.filmstrip is not None:
-            made.filmstrip(arguments.png, arguments.filmstrip)
-        else:
-            made.still(arguments.png, at=arguments.at)
-    videos = [path for path in (arguments.mp4, arguments.gif) if path]
-    for path in videos:
-        made.video(path, fps=arguments.video_fps)
-    path = made.save(arguments.out)
-    size = f"{len(made.html.encode()) / 1e6:.2f} MB"
-    print(
-        f"wrote {path or 'standard output'} ({size}, {made.duration:.3g} s at {arguments.fps:g} fps, "
-        f"{time.perf_counter() - started:.2f} s)",
-        file=sys.stderr if path is None else sys.stdout,
-    )
-    for extra in ([arguments.png] if arguments.png else []) + videos:
+        run = record_files(
+            robot,
+            Trajectory.load(arguments.trajectory).for_robot(robot),
+            arguments.out,
+            fps=arguments.fps,
+            target=arguments.target,
+            frame=arguments.frame,
+            axes=tuple(name for name in (arguments.axes or "").split(",") if name),
+            png=arguments.png,
+            at=arguments.at,
+            filmstrip=arguments.filmstrip,
+            videos=tuple(path for path in (arguments.mp4, arguments.gif) if path),
+            video_fps=arguments.video_fps,
+            max_mesh_bytes=None if arguments.max_mesh_mb is None else int(arguments.max_mesh_mb * 1e6),
+        )
+    warn([f"{reason}; drawn as a placeholder box" for reason in run.placeholders])
+    print(run.headline(), file=sys.stderr if run.path is None else sys.stdout)
+    for extra in run.extras:
         print(f"wrote {extra}")
     return 0

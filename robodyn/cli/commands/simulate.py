@@ -3,12 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-import numpy as np
-
-from robodyn.cli.common import RANGES, add_model_arguments, json_text, load_robot, vector
-from robodyn.common.files import outputs_together
+from robodyn.cli.common import RANGES, add_model_arguments, json_text, load_robot, vector, warn
+from robodyn.exceptions import printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -47,14 +44,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.cli.report import simulation_text
-    from robodyn.exceptions import printable
-    from robodyn.sim.experiment import run_simulation
-    from robodyn.sim.limits import LimitViolation, warning_text
+    from robodyn.viz.experiment import run_experiment
 
-    robot = load_robot(arguments)
-    trajectory, summary = run_simulation(
-        robot,
+    summary = run_experiment(
+        load_robot(arguments),
         controller=arguments.controller,
         target=arguments.target,
         frame=arguments.frame,
@@ -64,38 +57,16 @@ def run(arguments: argparse.Namespace) -> int:
         integrator=arguments.integrator,
         limits=arguments.limits,
         engine="compiled" if arguments.compiled else "pinocchio",
+        out=arguments.out,
+        plot=arguments.plot,
+        record=arguments.record,
+        png=arguments.png,
     )
-    frame = summary.get("frame")
-    task = np.asarray(summary["target_m"]) if "target_m" in summary else None
-    with outputs_together():  # every file of the run, or none of them
-        if arguments.out:
-            summary["trajectory"] = str(trajectory.save(arguments.out))
-        if arguments.plot:
-            from robodyn.viz.plots import plot_simulation
-
-            summary["plot"] = str(plot_simulation(robot, trajectory, arguments.plot, frame=frame, target=task))
-        if arguments.record:
-            from robodyn.viz.viewer import record
-
-            summary["recording"] = str(
-                record(robot, trajectory, arguments.record, png=arguments.png, target=task, frame=frame or robot.end_effector)
-            )
-            if arguments.png:
-                summary["poster"] = str(arguments.png)
-    violations = [LimitViolation(**_violation_fields(item)) for item in summary["limit_violations"]]
-    if violations:
-        print(f"robodyn: warning: {warning_text(robot.name, violations)}", file=sys.stderr)
-    if summary.get("target_reached") is False:
-        print(
-            f"robodyn: warning: {printable(robot.name)}: the target was not reached: final error {summary['final_error_m']:.3g} m "
-            "(a longer --duration, another --q0 or --target?)",
-            file=sys.stderr,
-        )
-    print(json_text(summary) if arguments.json else simulation_text(summary))
+    warn(summary.warnings())
+    if summary.task is not None and not summary.task.reached:
+        warn([
+            f"{printable(summary.robot)}: the target was not reached: final error {summary.task.final_error:.3g} m "
+            "(a longer --duration, another --q0 or --target?)"
+        ])  # fmt: skip
+    print(json_text(summary.to_dict()) if arguments.json else summary.text())
     return 0
-
-
-def _violation_fields(item: dict) -> dict:
-    fields = dict(item)
-    fields["first_time"] = fields.pop("first_time_s")
-    return fields

@@ -3,11 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import json
-import math
 
-from robodyn.cli.common import Progress, add_model_arguments, load_robot
-from robodyn.exceptions import InputError
+from robodyn.cli.common import Progress, add_model_arguments, json_text, load_robot
 
 
 def _rows(text: str) -> int:
@@ -47,42 +44,22 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.scale.torques import torques_file
-    from robodyn.sim.trajectory_columns import printable
+    from robodyn.scale.torques import torques_run
 
     robot = load_robot(arguments)
     progress = Progress("torques")
-    options = {
-        "gravity": arguments.gravity_torques,
-        "mass_matrix": arguments.mass_matrix,
-        "rows": arguments.chunk_rows,
-        "progress": lambda done, total: progress("inverse dynamics", done, total),
-    }
     try:
-        if arguments.scheduler:
-            from robodyn.scale.cluster import check_scheduler, connect
-
-            check_scheduler(arguments.scheduler)
-            with connect(arguments.scheduler) as client:
-                summary = torques_file(robot, arguments.trajectory, arguments.out, client=client, **options)
-        else:
-            summary = torques_file(robot, arguments.trajectory, arguments.out, **options)
+        summary = torques_run(
+            robot,
+            arguments.trajectory,
+            arguments.out,
+            scheduler=arguments.scheduler,
+            gravity=arguments.gravity_torques,
+            mass_matrix=arguments.mass_matrix,
+            rows=arguments.chunk_rows,
+            progress=lambda done, total: progress("inverse dynamics", done, total),
+        )
     finally:
         progress.close()
-    for key in ("peak_abs_torque", "rms_torque"):
-        if not all(math.isfinite(value) for value in summary[key].values()):
-            raise InputError("trajectory", "states whose torques are finite", "an overflow")
-    if arguments.json:
-        print(json.dumps(summary, indent=2))
-        return 0
-    units = {name: "N" if joint.type == "prismatic" else "N m" for joint in robot.joints for name in [joint.name]}
-    print(
-        f"robot: {printable(summary['robot'])}\ntrajectory: {printable(summary['trajectory'])}\nsamples: {summary['samples']} ({summary['chunks']} chunks)"
-    )
-    print("joint: peak |tau|, rms tau")
-    for name, peak in summary["peak_abs_torque"].items():
-        unit = units.get(name, "N" if name in ("base.x", "base.y", "base.z") else "N m")
-        print(f"  {printable(name)}: {peak:.6g} {unit}, {summary['rms_torque'][name]:.6g} {unit}")
-    if "out" in summary:
-        print(f"wrote {summary['out']}")
+    print(json_text(summary.to_dict()) if arguments.json else summary.text())
     return 0

@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
-import robodyn
 from robodyn.cli.common import RANGES, json_text, vector
-from robodyn.exceptions import InputError, printable
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -32,33 +30,19 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.cli.report import dof_units
-    from robodyn.sim.whatif import sweep, table_dict, table_text
-    from robodyn.viz.plots import plot_whatif
+    from robodyn.viz.experiment import run_whatif
 
-    materials = tuple(arguments.materials.split(",")) if arguments.materials else None
-    forces = ((0.0, 0.0, 0.0),) + ((tuple(arguments.force),) if arguments.force else ())
     if arguments.force and len(arguments.force) != 3:
         raise InputError("--force", "3 values FX,FY,FZ in [N]", f"{len(arguments.force)} values")
-    options: dict[str, Any] = {"materials": materials, "payloads": tuple(arguments.payloads), "forces": forces}
-    options |= {"duration": arguments.duration, "frame": arguments.frame}
-    if arguments.scheduler:
-        from robodyn.scale.cluster import connect
-        from robodyn.scale.sweeps import sweep as distributed_sweep
-
-        with connect(arguments.scheduler) as client:
-            rows = distributed_sweep(arguments.model, client=client, **options)
-    else:
-        rows = sweep(arguments.model, **options)
-    robot = robodyn.load(arguments.model)
-    units = dof_units(robot)["tau"]
-    if arguments.plot:
-        plot_whatif(rows, robot.joint_names, units, arguments.plot, effort_limits=[float(e) for e in rows[0].effort])
-    if arguments.json:
-        print(json_text(table_dict(rows, robot.joint_names, units)))
-    else:
-        print(f"{printable(robot.name)}: one rest-to-rest motion of {arguments.duration:g} s; torques of each joint\n")
-        print(table_text(rows, robot.joint_names, units))
-        if arguments.plot:
-            print(f"\nplot: {arguments.plot}")
+    table = run_whatif(
+        arguments.model,
+        scheduler=arguments.scheduler,
+        plot=arguments.plot,
+        materials=tuple(arguments.materials.split(",")) if arguments.materials else None,
+        payloads=tuple(arguments.payloads),
+        forces=((0.0, 0.0, 0.0),) + ((tuple(arguments.force),) if arguments.force else ()),
+        duration=arguments.duration,
+        frame=arguments.frame,
+    )
+    print(json_text(table.to_dict()) if arguments.json else table.text())
     return 0

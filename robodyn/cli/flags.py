@@ -1,0 +1,55 @@
+"""The one table from library parameter names to command-line flags.
+
+The library's errors name the parameter a caller passed (``target``, ``max_dof=``); the
+command line shows the flag its user typed (``--target``, ``--max-dof``). :func:`error_text`
+rewrites an error's message with this table before the CLI prints it.
+"""
+
+from __future__ import annotations
+
+import re
+
+from robodyn.common.text import printable
+from robodyn.exceptions import InputError, RobodynError
+
+#: Library parameter name -> the flag that sets it.
+FLAGS: dict[str, str] = {
+    "target": "--target",
+    "frame": "--frame",
+    "q0": "--q0",
+    "out": "--out",
+    "scheduler": "--scheduler",
+    "form": "--form",
+    "max_dof": "--max-dof",
+    "at": "--at",
+    "urdf_out": "--urdf-out",
+    "method": "--method",
+    "data": "DATA",
+}
+
+#: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.
+_KEYWORD = re.compile(r"\b(" + "|".join(map(re.escape, FLAGS)) + r")=(?:'(\w+)'(?!\w))?")
+
+
+def flag(parameter: str) -> str:
+    """The flag of a library parameter (``"target"`` -> ``"--target"``); others unchanged."""
+    return FLAGS.get(parameter, parameter)
+
+
+def error_text(error: RobodynError) -> str:
+    """The one-line message of ``error`` as the command line says it: flags, not parameters.
+
+    An :class:`InputError` about a parameter in :data:`FLAGS` names its flag; a keyword
+    argument the message suggests (``form='compact'``) becomes the flag (``--form compact``).
+    """
+    if isinstance(error, InputError) and error.argument in FLAGS:
+        return printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
+    return _KEYWORD.sub(_keyword_flag, str(error))
+
+
+def _keyword_flag(match: re.Match[str]) -> str:
+    name, value = match.group(1), match.group(2)
+    if value:  # form='compact' -> --form compact
+        return f"{FLAGS[name]} {value}"
+    rest = match.string[match.end() :]
+    return FLAGS[name] if not rest or rest[0] == " " else f"{FLAGS[name]} "  # scheduler='x' -> --scheduler 'x'

@@ -1,0 +1,64 @@
+"""IdentificationRun: ``robodyn identify`` as one library call with its text and files (issue 23)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn.cli import main
+from robodyn.exceptions import InputError
+from robodyn.ident.run import IdentificationRun, identify_run
+from robodyn.sim.trajectory import Trajectory
+
+
+@pytest.fixture
+def data(tmp_path):
+    """Exciting motion of the RP arm with its model's torques, as a file and loaded."""
+    robot = robodyn.load("rp_arm")
+    rng = np.random.default_rng(7)
+    count = 200
+    q = robot.random_configuration(rng, count)
+    v, a = rng.normal(size=(2, count, robot.nv))
+    tau = robot.inverse_dynamics(q, v, a)
+    path = tmp_path / "measured.csv"
+    Trajectory(np.arange(count) * 0.01, q, v, a, tau, list(robot.joint_names), robot.name).save(path)
+    return robot, path
+
+
+def test_the_run_text_and_files_are_what_the_cli_prints_and_writes(data, tmp_path, capsys):
+    robot, path = data
+    cli_out = tmp_path / "cli.json"
+    assert main(["identify", "rp_arm", str(path), "--method", "wls", "--out", str(cli_out)]) == 0
+    printed = capsys.readouterr().out
+    lib_out = tmp_path / "lib.json"
+    run = identify_run(robot, Trajectory.load(path).for_robot(robot), method="wls", out=lib_out)
+    assert isinstance(run, IdentificationRun)
+    assert printed.rstrip("\n") == run.text().replace(str(lib_out), str(cli_out))
+    assert json.loads(cli_out.read_text()) == json.loads(lib_out.read_text()) == json.loads(json.dumps(run.to_dict()))
+    assert run.identification.relative_error < 1e-9
+
+
+def test_a_urdf_out_without_the_physical_method_names_the_parameter_in_the_library_and_the_flag_in_the_cli(
+    data, tmp_path, capsys
+):
+    robot, path = data
+    with pytest.raises(InputError) as raised:
+        identify_run(robot, Trajectory.load(path).for_robot(robot), urdf_out=tmp_path / "x.urdf")
+    assert raised.value.argument == "urdf_out" and "--" not in str(raised.value)
+    assert main(["identify", "rp_arm", str(path), "--urdf-out", str(tmp_path / "x.urdf")]) == 2
+    assert capsys.readouterr().err.startswith("robodyn: error: --urdf-out must be used with method")
+    assert not (tmp_path / "x.urdf").exists()
+
+
+def test_data_without_torques_is_refused_naming_data(data, tmp_path, capsys):
+    robot, path = data
+    loaded = Trajectory.load(path).for_robot(robot)
+    bare = Trajectory(loaded.t, loaded.q, loaded.v, loaded.a, None, list(robot.joint_names), robot.name)
+    with pytest.raises(InputError, match=r"^data must be a trajectory with tau"):
+        identify_run(robot, bare)
+    bare.save(tmp_path / "bare.csv")
+    assert main(["identify", "rp_arm", str(tmp_path / "bare.csv")]) == 2
+    assert "DATA must be a trajectory with tau[<joint>] columns" in capsys.readouterr().err
