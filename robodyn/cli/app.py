@@ -19,8 +19,8 @@ from collections.abc import Sequence
 import robodyn
 from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, torques, view, whatif
 from robodyn.cli.common import attach_negative_values, check_ranges
-from robodyn.common.text import one_line_warnings, printable
-from robodyn.exceptions import RobodynError
+from robodyn.common.text import printable
+from robodyn.exceptions import RobodynError, one_line_warnings
 
 #: The commands, in the order ``robodyn --help`` lists them.
 COMMANDS = (listing, info, equations, check, lint, simulate, record, view, torques, whatif, excite, identify)

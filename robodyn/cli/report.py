@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import printable
 
 
 @dataclass(frozen=True)

@@ -7,8 +7,9 @@ import sys
 
 import numpy as np
 
-from robodyn.cli.common import RANGES, add_model_arguments, json_text, load_robot, vector
+from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector
 from robodyn.common.files import outputs_together
+from robodyn.common.text import json_text
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -48,7 +49,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.cli.report import simulation_text
-    from robodyn.exceptions import printable
+    from robodyn.common.text import printable
     from robodyn.sim.experiment import run_simulation
     from robodyn.sim.limits import LimitViolation, warning_text
 

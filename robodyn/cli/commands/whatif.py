@@ -6,8 +6,9 @@ import argparse
 from typing import Any
 
 import robodyn
-from robodyn.cli.common import RANGES, json_text, vector
-from robodyn.exceptions import InputError, printable
+from robodyn.cli.common import RANGES, vector
+from robodyn.common.text import json_text, printable
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
