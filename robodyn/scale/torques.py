@@ -22,7 +22,7 @@ import numpy as np
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, RobodynError, TrajectoryError
 from robodyn.scale.datasets import DEFAULT_ROWS, Dataset, DatasetWriter
-from robodyn.sim.trajectory import coordinate_names
+from robodyn.trajectory import coordinate_names
 
 
 def chunk_dynamics(

@@ -20,7 +20,8 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.limits import check_mode, limit_violations
-from robodyn.sim.simulation import Trajectory, simulate
+from robodyn.sim.simulation import simulate
+from robodyn.trajectory import Trajectory
 
 CONTROLLERS = ("passive", "pd", "computed-torque", "task-space")
 #: Final task error below which a target counts as reached, in [m].

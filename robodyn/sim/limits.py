@@ -26,9 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, printable
-from robodyn.sim.trajectory import Trajectory
+from robodyn.exceptions import InputError
+from robodyn.trajectory import Trajectory
 
 LIMIT_MODES = ("warn", "enforce", "ignore")
 #: Slack before a value counts as beyond its limit: absolute, plus relative to the limit.

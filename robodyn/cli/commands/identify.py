@@ -26,9 +26,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.common.files import atomic_write_text
+    from robodyn.common.text import printable
     from robodyn.ident import base_parameters, identified_urdf, identify
-    from robodyn.ident.render import printable, render_base_parameters
-    from robodyn.sim.trajectory import Trajectory
+    from robodyn.ident.render import render_base_parameters
+    from robodyn.trajectory import Trajectory
 
     if arguments.urdf_out and arguments.method != "physical":
         raise InputError(

@@ -47,8 +47,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    from robodyn.common.text import printable
     from robodyn.scale.torques import torques_file
-    from robodyn.sim.trajectory_columns import printable
 
     robot = load_robot(arguments)
     progress = Progress("torques")
