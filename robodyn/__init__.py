@@ -50,7 +50,7 @@ _LAZY = {
     "Robot": "robodyn.dynamics.robot",
     "JointInfo": "robodyn.dynamics.joints",
     "simulate": "robodyn.sim.simulation",
-    "Trajectory": "robodyn.sim.simulation",
+    "Trajectory": "robodyn.trajectory",
     "ExternalWrench": "robodyn.sim.simulation",
     "attach_payload": "robodyn.dynamics.payload",
     "record": "robodyn.viz.viewer",

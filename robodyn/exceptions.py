@@ -7,39 +7,38 @@ attributes and a one-sentence message naming the thing and the rule it broke.
 
 from __future__ import annotations
 
-import re
+import contextlib
+import sys
+import warnings
+from collections.abc import Iterator
 
-#: Characters that must never reach a terminal raw: C0 controls (newline and tab
-#: included) and DEL, C1 controls, bidi embeddings/overrides/isolates, line and paragraph
-#: separators, zero-width and other invisible format characters.
-_UNSAFE = re.compile("[\x00-\x1f\x7f-\x9f\u061c\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff]")
-
-
-_NAMED = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+from robodyn.common.text import printable, quoted
 
 
-def _escape(match: re.Match[str]) -> str:
-    character = match.group()
-    if character in _NAMED:
-        return _NAMED[character]
-    code = ord(character)
-    return f"\\x{code:02x}" if code <= 0xFF else f"\\u{code:04x}"
+@contextlib.contextmanager
+def one_line_warnings() -> Iterator[None]:
+    """Show each :class:`RobodynWarning` as one escaped stderr line.
 
-
-def printable(text: object) -> str:
-    """``text`` with every control, bidi and invisible format character escaped.
-
-    The one escaping function for terminal text (re-exported as
-    :func:`robodyn.common.text.printable`; it lives here because exceptions sit below
-    every other layer). Printable characters of any script are kept; the others become
-    ``\\xNN`` / ``\\uNNNN``, so the result holds no line break. Idempotent.
+    ``robodyn: warning: <message>`` instead of Python's two-line ``file:line: category``
+    format, each problem once (robodyn and the reference may both find it); other warnings
+    keep Python's format. The previous hook is restored on exit.
     """
-    return _UNSAFE.sub(_escape, str(text))
+    with warnings.catch_warnings():
+        previous = warnings.showwarning
+        shown: set[str] = set()
 
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, RobodynWarning):
+                text = printable(message)
+                problem = text.split(": ", 1)[-1]  # the same problem found by two loaders: once
+                if problem not in shown:
+                    shown.add(problem)
+                    print(f"robodyn: warning: {text}", file=file or sys.stderr)
+            else:
+                previous(message, category, filename, lineno, file, line)
 
-def quoted(name: object) -> str:
-    """A name from a URDF for a message: in single quotes, escaped like ``repr`` of a str."""
-    return "'" + printable(str(name).replace("\\", "\\\\").replace("'", "\\'")) + "'"
+        warnings.showwarning = show
+        yield
 
 
 class RobodynError(Exception):

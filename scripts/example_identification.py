@@ -36,7 +36,7 @@ import robodyn
 from robodyn.dynamics.regressor import body_links, inertial_parameters
 from robodyn.ident import base_parameters, excite, identify
 from robodyn.sim.control import ComputedTorque
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 
 PAYLOAD_MASS = 2.5  # [kg]
 PAYLOAD_COM = np.array([0.03, -0.02, 0.06])  # in the tool0 frame, [m]

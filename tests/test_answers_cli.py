@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.cli import common
 from robodyn.cli.app import main
+from robodyn.common import text as common
 
 
 def run(capsys, *argv):

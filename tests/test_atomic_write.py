@@ -16,7 +16,7 @@ import pytest
 
 from robodyn.common.files import atomic_write_bytes, atomic_write_text
 from robodyn.exceptions import OutputError
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 
 OLD = b"the previous content\n" * 100
 NEW = b"new content that must never be seen half-written\n" * 1000

@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn.common.text import comment_text, identifier, latex_text
+from robodyn.common.text import printable as terminal_text
 from robodyn.equations import derive_equations, render
-from robodyn.equations.naming import comment_text, identifier, latex_text, terminal_text
 
 CANARY = "CANARY"
 NAMES = [

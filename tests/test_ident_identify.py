@@ -16,7 +16,7 @@ from robodyn.dynamics.regressor import inertial_parameters
 from robodyn.exceptions import IdentificationError
 from robodyn.ident import base_parameters, excite, identified_urdf, identify
 from robodyn.ident.base import joint_ranges, random_states
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 from tests.conftest import ROOT
 
 

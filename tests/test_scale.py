@@ -231,7 +231,7 @@ def test_cli_scheduler_local_identical_to_local(tmp_path, capsys):
     assert main(["torques", "ur5", str(tmp_path / "m.npz"), "--out", str(tmp_path / "local.parquet"), "--chunk-rows", "500"]) == 0
     remote = ["torques", "ur5", str(tmp_path / "m.npz"), "--out", str(tmp_path / "remote.parquet"), "--chunk-rows", "500"]
     assert main([*remote, "--scheduler", "local:2"]) == 0
-    from robodyn.sim.trajectory import Trajectory
+    from robodyn.trajectory import Trajectory
 
     local, distributed = Trajectory.load(tmp_path / "local.parquet"), Trajectory.load(tmp_path / "remote.parquet")
     np.testing.assert_array_equal(distributed.tau, local.tau)

@@ -10,7 +10,8 @@ from robodyn import InputError
 from robodyn.dynamics.payload import attach_payload
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.experiment import controller_model
-from robodyn.sim.simulation import ExternalWrench, SimulationError, Trajectory, simulate
+from robodyn.sim.simulation import ExternalWrench, SimulationError, simulate
+from robodyn.trajectory import Trajectory
 from robodyn.urdf.models import pendulum_urdf
 from tests.conftest import ROOT
 

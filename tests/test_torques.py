@@ -17,7 +17,7 @@ from robodyn.exceptions import TrajectoryError
 from robodyn.scale.datasets import Dataset
 from robodyn.scale.torques import torques_file
 from robodyn.sim.simulation import simulate
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 
 
 @pytest.fixture(scope="module")

@@ -7,9 +7,11 @@ import pytest
 
 import robodyn
 from robodyn.cli import main
+from robodyn.dynamics.dofs import BASE_Q_NAMES as BASE_Q
+from robodyn.dynamics.dofs import BASE_V_NAMES as BASE_V
 from robodyn.exceptions import TrajectoryError
 from robodyn.sim.simulation import simulate
-from robodyn.sim.trajectory import BASE_Q, BASE_V, Trajectory, derive_velocities
+from robodyn.trajectory import Trajectory, derive_velocities
 
 
 @pytest.fixture(scope="module")

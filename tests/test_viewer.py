@@ -19,7 +19,8 @@ import umsgpack
 import robodyn
 from robodyn import RobodynError
 from robodyn.cli.app import main
-from robodyn.sim.simulation import Trajectory, simulate
+from robodyn.sim.simulation import simulate
+from robodyn.trajectory import Trajectory
 from robodyn.viz.viewer import capture, chromium, record, screenshot
 from tests.conftest import ROOT
 

@@ -9,7 +9,7 @@ import pytest
 
 import robodyn
 from robodyn.sim.experiment import run_simulation
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 from robodyn.viz.recording import recording
 from robodyn.viz.stills import capture, chromium
 

@@ -8,7 +8,7 @@ import numpy as np
 
 import robodyn
 from robodyn.dynamics.display import robot_html
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 from robodyn.viz.recording import recording
 
 HOSTILE = """<robot name="r&lt;script&gt;alert(1)&lt;/script&gt;">

@@ -12,7 +12,7 @@ import pytest
 
 import robodyn
 from robodyn.exceptions import MeshFileError, MeshWarning
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 from robodyn.viz.mesh_files import read_mesh
 from robodyn.viz.recording import recording
 from tests.conftest import ROOT

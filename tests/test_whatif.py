@@ -9,8 +9,8 @@ import pytest
 
 from robodyn import InputError
 from robodyn.cli.app import main
-from robodyn.sim.simulation import Trajectory
 from robodyn.sim.whatif import sweep
+from robodyn.trajectory import Trajectory
 from robodyn.urdf.materials import DENSITIES, box_inertia, density
 from robodyn.urdf.models import RPArmParameters
 

@@ -20,8 +20,7 @@ import robodyn
 from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, torques, view, whatif
 from robodyn.cli.common import attach_negative_values, check_ranges
 from robodyn.cli.flags import error_text
-from robodyn.common.text import one_line_warnings
-from robodyn.exceptions import RobodynError
+from robodyn.exceptions import RobodynError, one_line_warnings
 
 #: The commands, in the order ``robodyn --help`` lists them.
 COMMANDS = (listing, info, equations, check, lint, simulate, record, view, torques, whatif, excite, identify)

@@ -4,14 +4,12 @@ numeric ranges and strict JSON."""
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import re
 import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -220,22 +218,3 @@ def check_ranges(arguments: argparse.Namespace) -> None:
     dt, duration = getattr(arguments, "dt", None), getattr(arguments, "duration", None)
     if dt is not None and duration is not None and dt > duration:
         raise InputError("--dt", f"at most --duration ({duration:g} s)", f"{dt:g} s")
-
-
-def _finite_or_none(value: Any) -> Any:
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {key: _finite_or_none(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite_or_none(item) for item in value]
-    if isinstance(value, np.ndarray):
-        return _finite_or_none(value.tolist())
-    if isinstance(value, np.floating):
-        return _finite_or_none(float(value))
-    return value
-
-
-def json_text(data: Any) -> str:
-    """Strict JSON (RFC 8259): a non-finite number (an unlimited limit) becomes ``null``."""
-    return json.dumps(_finite_or_none(data), indent=2, allow_nan=False)

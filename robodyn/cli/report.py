@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import printable
 
 
 def dof_units(robot: Robot) -> dict[str, list[str]]:

@@ -11,7 +11,8 @@ import warnings
 
 import numpy as np
 
-from robodyn.exceptions import InputError, printable
+from robodyn.common.text import printable
+from robodyn.exceptions import InputError
 
 
 def as_state(value: object, name: str, size: int) -> np.ndarray:

@@ -1,7 +1,9 @@
-"""Rotation helpers in plain numpy (URDF roll-pitch-yaw, cross-product matrices, Rodrigues).
+"""Rotation helpers in plain numpy (URDF roll-pitch-yaw, cross-product matrices, Rodrigues,
+quaternion algebra).
 
 The one copy for the code that does not use Pinocchio: the URDF edits, the viewer, the
-equations and the reference. Angles in [rad].
+equations, the reference and the trajectory files. Angles in [rad]; quaternions stored
+``(x, y, z, w)`` as Pinocchio's configuration vectors store them.
 """
 
 from __future__ import annotations
@@ -9,6 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+#: Multiplying a quaternion (x, y, z, w) by this gives its conjugate.
+_CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
 
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
@@ -60,3 +65,44 @@ def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
     """Rodrigues' rotation by ``angle`` in [rad] about a unit ``axis`` (shape (3,)); shape (3, 3)."""
     cross = skew(np.asarray(axis, dtype=float))
     return np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
+
+
+def quaternion_conjugate(quaternions: np.ndarray) -> np.ndarray:
+    """Conjugates of quaternions (x, y, z, w): the inverse rotations of unit ones.
+
+    Args:
+        quaternions: Shape (..., 4).
+
+    Returns:
+        Shape (..., 4).
+    """
+    return quaternions * _CONJUGATE
+
+
+def quaternion_product(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """Hamilton products ``left ⊗ right`` of quaternions stored (x, y, z, w), row by row.
+
+    Args:
+        left: Shape (N, 4).
+        right: Shape (N, 4).
+
+    Returns:
+        Shape (N, 4).
+    """
+    lv, lw = left[:, :3], left[:, 3:]
+    rv, rw = right[:, :3], right[:, 3:]
+    return np.hstack([lw * rv + rw * lv + np.cross(lv, rv), lw * rw - np.sum(lv * rv, axis=1, keepdims=True)])
+
+
+def rotate_inverse(quaternions: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """``R(q)ᵀ v`` row by row: world-frame vectors in the frame a unit quaternion rotates to.
+
+    Args:
+        quaternions: Unit quaternions (x, y, z, w), shape (N, 4).
+        vectors: Shape (N, 3).
+
+    Returns:
+        Shape (N, 3): ``q̄ ⊗ (v, 0) ⊗ q`` (vector part).
+    """
+    pure = np.hstack([vectors, np.zeros((len(vectors), 1))])
+    return quaternion_product(quaternion_product(quaternion_conjugate(quaternions), pure), quaternions)[:, :3]

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics.dofs import Dof
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import printable
 
 #: The equation the terms make up.
 EQUATION = "tau = M(q) a + C(q, v) v + G(q)"

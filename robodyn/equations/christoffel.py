@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from robodyn.common.text import json_text
+from robodyn.common.text import printable as terminal_text
 from robodyn.equations import simplify
 from robodyn.equations.model import EquationsData
-from robodyn.equations.naming import json_text, terminal_text
 from robodyn.equations.printing import check_precision, to_text_expr
 from robodyn.exceptions import InputError
 

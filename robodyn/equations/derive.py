@@ -8,7 +8,7 @@ larger ones (``form="compact"``) as a short program of named intermediate variab
 (:func:`robodyn.equations.output.render`) turn the result into text, LaTeX, PDF, JSON, a
 standalone Python module (numpy only) or C source.
 
-Symbols are safe identifiers named after the joints (:func:`robodyn.equations.naming.identifier`):
+Symbols are safe identifiers named after the joints (:func:`robodyn.common.text.identifier`):
 ``q_<joint>``, ``qd_<joint>`` (velocity), ``qdd_<joint>`` (acceleration). With
 ``keep_params`` every link's mass ``m_<link>``, centre of mass ``c_<link>_x``..., inertia
 ``I_<link>_xx``..., every joint's offset ``d_<joint>_x``... and gravity ``g`` stay symbols.
@@ -24,10 +24,10 @@ from typing import Any
 import sympy as sp
 
 from robodyn import reference
+from robodyn.common.text import identifier
 from robodyn.equations import simplify
 from robodyn.equations.compact import derive_compact
 from robodyn.equations.model import EquationsData
-from robodyn.equations.naming import identifier
 from robodyn.equations.output import FORMATS, render
 from robodyn.equations.render_latex import latex_math
 from robodyn.exceptions import DerivationTooExpensiveError, InputError

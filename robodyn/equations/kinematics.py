@@ -19,9 +19,10 @@ import sympy as sp
 
 from robodyn import reference
 from robodyn.common.rotations import rpy_matrix
+from robodyn.common.text import comment_text, identifier, json_text, latex_text
+from robodyn.common.text import printable as terminal_text
 from robodyn.equations import simplify
 from robodyn.equations.model import numeric
-from robodyn.equations.naming import comment_text, identifier, json_text, latex_text, terminal_text
 from robodyn.equations.printing import check_precision, to_text_expr
 from robodyn.exceptions import FrameError, InputError
 from robodyn.reference.symbolic import Parameters, body_coordinates, body_poses, exact_matrix

@@ -1,7 +1,7 @@
 """The symbolic equations of one robot, as the renderers receive them, and their size.
 
 Every symbol in an :class:`EquationsData` (:class:`robodyn.equations.Equations` adds the
-notebook display) is a safe identifier (:mod:`robodyn.equations.naming`);
+notebook display) is a safe identifier (:mod:`robodyn.common.text`);
 the raw joint and robot names are kept only for the renderers to escape. Numbers are exact
 (rationals, ``π``, ``√2``) until a renderer turns them into floats (:func:`numeric`).
 """

@@ -1,16 +1,16 @@
 """The equations as C99 source.
 
 No name from the URDF reaches the code: joints are ``q[i]``, ``v[i]``, intermediate
-variables ``tN``, the size macro is built by :func:`naming.identifier`; names appear only
-in the leading comment through :func:`naming.comment_text`.
+variables ``tN``, the size macro is built by :func:`robodyn.common.text.identifier`; names appear only
+in the leading comment through :func:`robodyn.common.text.comment_text`.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
+from robodyn.common.text import comment_text, identifier
 from robodyn.equations.model import EquationsData, numeric
-from robodyn.equations.naming import comment_text, identifier
 from robodyn.equations.printing import code_ready, numbered
 
 

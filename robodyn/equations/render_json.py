@@ -1,10 +1,10 @@
-"""The equations as JSON: names through :func:`naming.json_text`, entries as sympy strings
+"""The equations as JSON: names through :func:`robodyn.common.text.json_text`, entries as sympy strings
 with 17-digit floats (``sympy.sympify`` reads them back)."""
 
 from __future__ import annotations
 
+from robodyn.common.text import json_text
 from robodyn.equations.model import EquationsData, numeric
-from robodyn.equations.naming import json_text
 
 
 def to_json(equations: EquationsData) -> str:

@@ -2,7 +2,7 @@
 
 Joints are numbered, ``q_1``, ``\\dot q_1``, ``\\ddot q_1``, with a legend table of the
 joint names; kept parameters carry their link or joint as an upright subscript
-(``m_{\\text{link1}}``); every name passes :func:`naming.latex_text`. Long entries are
+(``m_{\\text{link1}}``); every name passes :func:`robodyn.common.text.latex_text`. Long entries are
 broken across lines (at the sums, inside a parenthesised sum where needed) so nothing runs
 off the page; ``M`` is a matrix when it fits the line, else printed entry by entry (the
 upper triangle: it is symmetric).
@@ -19,8 +19,8 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
+from robodyn.common.text import latex_text
 from robodyn.equations.model import EquationsData, numeric
-from robodyn.equations.naming import latex_text
 from robodyn.equations.printing import format_float
 from robodyn.exceptions import MissingToolError, TypesettingError
 

@@ -1,7 +1,7 @@
 """The equations as a standalone Python module (numpy only).
 
 No name from the URDF reaches the code: joints are ``q[i]``, ``v[i]``, intermediate
-variables ``tN``; names appear only in the docstring through :func:`naming.comment_text`
+variables ``tN``; names appear only in the docstring through :func:`robodyn.common.text.comment_text`
 and in ``JOINT_NAMES`` as an ``ascii()`` literal.
 """
 
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import sympy as sp
 
+from robodyn.common.text import comment_text
 from robodyn.equations.model import EquationsData, numeric
-from robodyn.equations.naming import comment_text
 from robodyn.equations.printing import code_ready, numbered
 
 _FOOTER = '''

@@ -1,9 +1,9 @@
-"""The equations as readable text: every name through :func:`naming.terminal_text`."""
+"""The equations as readable text: every name through :func:`robodyn.common.text.printable`."""
 
 from __future__ import annotations
 
+from robodyn.common.text import printable as terminal_text
 from robodyn.equations.model import EquationsData
-from robodyn.equations.naming import terminal_text
 from robodyn.equations.printing import format_float, to_text_expr
 
 

@@ -71,7 +71,7 @@ class Excitation:
     def sample(self, robot: Robot, *, rate: float = 100.0, periods: int = 1) -> tuple[np.ndarray, ...]:
         """``t, q, v, a, tau`` sampled at ``rate`` [Hz] over ``periods`` periods, with
         ``tau`` the robot's inverse dynamics along it (shapes (M,) and (M, nv)); the
-        columns of :class:`robodyn.sim.trajectory.Trajectory`."""
+        columns of :class:`robodyn.trajectory.Trajectory`."""
         if not (np.isfinite(rate) and rate > 0) or periods < 1:
             raise InputError("rate and periods", "a positive rate in [Hz] and at least one period", f"{rate!r}, {periods!r}")
         t = np.arange(0.0, periods * self.period, 1.0 / rate)

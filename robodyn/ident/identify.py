@@ -1,6 +1,6 @@
 """Identification of the base parameters from measured motion and torques.
 
-The data are N samples of ``(q, v, a, tau)`` (e.g. a :class:`robodyn.sim.trajectory.Trajectory`).
+The data are N samples of ``(q, v, a, tau)`` (e.g. a :class:`robodyn.trajectory.Trajectory`).
 Stacking the base regressor gives the overdetermined system ``W β = y`` with
 ``y = tau − known torque`` (N·nv rows).
 
@@ -34,7 +34,7 @@ from robodyn.ident.base import BaseParameters, base_parameters
 
 class Samples(Protocol):
     """Measured data: anything with these attributes, e.g. a
-    :class:`robodyn.sim.trajectory.Trajectory` (``joint_names`` may be empty)."""
+    :class:`robodyn.trajectory.Trajectory` (``joint_names`` may be empty)."""
 
     q: np.ndarray
     v: np.ndarray

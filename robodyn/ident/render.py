@@ -10,21 +10,11 @@ from __future__ import annotations
 import json
 from typing import Any
 
+from robodyn.common.text import latex_text, printable
 from robodyn.exceptions import InputError
 from robodyn.ident.base import SYMBOLIC_MAX_JOINTS, BaseParameters
 
 FORMATS = ("text", "latex", "json")
-_LATEX_SPECIAL = {c: "\\" + c for c in "#$%&_{}"} | {"\\": r"\textbackslash{}", "^": r"\^{}", "~": r"\~{}"}
-
-
-def printable(text: str) -> str:
-    """``text`` with control and other unprintable characters escaped."""
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
-
-
-def latex_text(text: str) -> str:
-    """``text`` safe inside a LaTeX text argument."""
-    return "".join(_LATEX_SPECIAL.get(c, c) for c in printable(text))
 
 
 def _terms(base: BaseParameters, row: Any) -> list[tuple[Any, str]]:
@@ -107,4 +97,4 @@ def _signed(terms: list[tuple[Any, str]], *, latex: bool) -> str:
     return text
 
 
-__all__ = ["FORMATS", "latex_text", "printable", "render_base_parameters"]
+__all__ = ["FORMATS", "render_base_parameters"]

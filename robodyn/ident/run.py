@@ -16,8 +16,9 @@ from typing import Any, Protocol, cast
 import numpy as np
 
 from robodyn.common.files import atomic_write_text
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, printable
+from robodyn.exceptions import InputError
 from robodyn.ident.base import base_parameters
 from robodyn.ident.identify import Identification, Method, Samples, identify
 from robodyn.ident.urdf_out import identified_urdf

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from robodyn.exceptions import TrajectoryError
-from robodyn.sim.trajectory import format_rows, read_csv_header
+from robodyn.trajectory import format_rows, read_csv_header
 
 #: Whether pyarrow's CSV module is used (tests turn it off to cover the numpy path).
 USE_ARROW = importlib.util.find_spec("pyarrow") is not None

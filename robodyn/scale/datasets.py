@@ -1,7 +1,7 @@
 """Trajectory files larger than memory: read and written in chunks of rows.
 
 A :class:`Dataset` reads a trajectory file (CSV, NPZ, Parquet; the columns of
-:mod:`robodyn.sim.trajectory`) a chunk of rows at a time, with the same checks as
+:mod:`robodyn.trajectory`) a chunk of rows at a time, with the same checks as
 :meth:`Trajectory.load` (columns named, NaN/inf and non-increasing time refused with the
 row) and the same derived ``v`` and ``a`` when the file has only positions: each chunk is
 differentiated with three rows of the chunks before and after it, so the result equals the
@@ -27,7 +27,7 @@ import numpy as np
 
 from robodyn.exceptions import InputError, TrajectoryError
 from robodyn.scale.csvio import csv_tables, write_rows
-from robodyn.sim.trajectory import (
+from robodyn.trajectory import (
     Layout,
     Trajectory,
     check_table,

@@ -20,8 +20,9 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, RobodynError, TrajectoryError, printable
+from robodyn.exceptions import InputError, RobodynError, TrajectoryError
 from robodyn.scale.cluster import check_scheduler, connect
 from robodyn.scale.datasets import DEFAULT_ROWS, Dataset, DatasetWriter
 

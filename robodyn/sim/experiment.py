@@ -23,7 +23,8 @@ from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.report import SimulationSummary, TaskOutcome
-from robodyn.sim.simulation import Engine, Integrator, Trajectory, simulate
+from robodyn.sim.simulation import Engine, Integrator, simulate
+from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
 ControllerName = Literal["passive", "pd", "computed-torque", "task-space"]

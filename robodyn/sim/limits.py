@@ -27,9 +27,10 @@ from typing import Literal
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, printable
-from robodyn.sim.trajectory import Trajectory
+from robodyn.exceptions import InputError
+from robodyn.trajectory import Trajectory
 
 #: What a run does with joint limits (see the module docstring).
 LimitMode = Literal["warn", "enforce", "ignore"]

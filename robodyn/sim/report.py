@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics.dofs import BASE_V_NAMES
-from robodyn.exceptions import printable
 from robodyn.sim.limits import LimitViolation, warning_text
 
 

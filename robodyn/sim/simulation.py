@@ -44,7 +44,7 @@ from robodyn.exceptions import (
     SingularMassMatrixError,
 )
 from robodyn.sim.limits import JointLimits, LimitMode, check_mode, warning_text
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 
 #: A controller maps time in [s], q and v to joint torques, shape (nv,).
 Controller = Callable[[float, np.ndarray, np.ndarray], np.ndarray]

@@ -17,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.common.text import printable
 from robodyn.dynamics.loading import load
 from robodyn.dynamics.payload import attach_payload
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, printable
+from robodyn.exceptions import InputError
 from robodyn.sim.control import quintic_reference
 from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
 

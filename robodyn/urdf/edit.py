@@ -20,7 +20,8 @@ from typing import cast
 import numpy as np
 
 from robodyn.common.rotations import axis_rotation, matrix_rpy, rpy_matrix
-from robodyn.exceptions import InputError, quoted
+from robodyn.common.text import quoted
+from robodyn.exceptions import InputError
 from robodyn.urdf.validation import URDFSpec
 
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robodyn.exceptions import printable
+from robodyn.common.text import printable
 
 
 @dataclass(frozen=True)

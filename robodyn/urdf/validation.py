@@ -35,7 +35,8 @@ from typing import overload
 
 import numpy as np
 
-from robodyn.exceptions import RobodynWarning, URDFError, printable, quoted
+from robodyn.common.text import printable, quoted
+from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.inertias import BODY_SCALE, TRIANGLE_TOLERANCE, check_inertias, check_moving_masses, moving_links
 from robodyn.urdf.meshes import mesh_problems
 from robodyn.urdf.spec import Inertial, JointSpec, Mimic, Problem, URDFSpec, child_index

@@ -21,8 +21,8 @@ from robodyn.common.files import outputs_together
 from robodyn.dynamics.robot import Robot
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.report import SimulationSummary
-from robodyn.sim.simulation import Trajectory
 from robodyn.sim.whatif import WhatIfTable, what_if
+from robodyn.trajectory import Trajectory
 
 PathLike = str | Path
 

@@ -25,7 +25,7 @@ import umsgpack
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import ViewerError
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 
 if TYPE_CHECKING:
     import zmq

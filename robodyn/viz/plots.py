@@ -33,7 +33,7 @@ from robodyn.common.files import atomic_write_bytes
 from robodyn.dynamics.dofs import Dof
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import ViewerError
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 
 DPI = 110
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")

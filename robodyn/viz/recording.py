@@ -28,7 +28,7 @@ import umsgpack
 from robodyn.common.files import atomic_write_text
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, RobodynError, ViewerError
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
 from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands
 from robodyn.viz.task import axis_commands, task_commands

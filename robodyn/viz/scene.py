@@ -26,7 +26,7 @@ from meshcat.path import Path as MeshcatPath
 from robodyn.common.rotations import rpy_matrix
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import MeshFileError, MeshWarning, ViewerError
-from robodyn.sim.simulation import Trajectory
+from robodyn.trajectory import Trajectory
 from robodyn.urdf.meshes import MeshPathError, resolve_mesh
 from robodyn.viz.mesh_files import MAX_MESH_BYTES, read_mesh
 

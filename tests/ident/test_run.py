@@ -11,7 +11,7 @@ import robodyn
 from robodyn.cli import main
 from robodyn.exceptions import InputError
 from robodyn.ident.run import IdentificationRun, identify_run
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 
 
 @pytest.fixture

@@ -14,7 +14,7 @@ from robodyn.cli import main
 from robodyn.exceptions import InputError
 from robodyn.scale.torques import TorquesRun, torques_file
 from robodyn.sim.simulation import simulate
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 from tests.sim.robots import SLIDER_URDF
 
 

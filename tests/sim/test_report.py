@@ -9,7 +9,7 @@ import pytest
 
 import robodyn
 from robodyn.cli import main
-from robodyn.cli.common import json_text
+from robodyn.common.text import json_text
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.limits import LimitViolation
 from robodyn.sim.report import SimulationSummary

@@ -7,7 +7,7 @@ import json
 
 import robodyn
 from robodyn.cli import main
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 from robodyn.viz.experiment import run_experiment, run_whatif
 
 

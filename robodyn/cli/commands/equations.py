@@ -7,7 +7,8 @@ import sys
 
 import numpy as np
 
-from robodyn.cli.common import Progress, add_model_arguments, json_text, load_robot, lock_values, state, vector
+from robodyn.cli.common import Progress, add_model_arguments, load_robot, lock_values, state, vector
+from robodyn.common.text import json_text
 from robodyn.exceptions import InputError
 
 
@@ -60,9 +61,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def _symbolic(arguments: argparse.Namespace) -> int:
+    from robodyn.common.text import printable as terminal_text
     from robodyn.equations.derive import derive_equations
     from robodyn.equations.lecture import lecture_text
-    from robodyn.equations.naming import terminal_text
     from robodyn.equations.output import check_precision, render
 
     given = [f"--{name}" for name in ("q", "v", "a") if getattr(arguments, name) is not None]

@@ -30,9 +30,9 @@ def _limit(values: list[float] | None):
 
 
 def run(arguments: argparse.Namespace) -> int:
+    from robodyn.common.text import printable
     from robodyn.ident import base_parameters, excite
-    from robodyn.ident.render import printable
-    from robodyn.sim.trajectory import Trajectory
+    from robodyn.trajectory import Trajectory
 
     robot = load_robot(arguments)
     base = base_parameters(robot)

@@ -27,7 +27,7 @@ def run(arguments: argparse.Namespace) -> int:
     from robodyn.ident import base_parameters
     from robodyn.ident.render import render_base_parameters
     from robodyn.ident.run import identify_run
-    from robodyn.sim.trajectory import Trajectory
+    from robodyn.trajectory import Trajectory
 
     if arguments.data is None and not arguments.base_parameters:
         raise InputError("DATA", "a trajectory file (or --base-parameters)", "nothing")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from robodyn.exceptions import printable
+from robodyn.common.text import printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:

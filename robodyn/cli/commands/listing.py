@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 import robodyn
-from robodyn.cli.common import json_text
+from robodyn.common.text import json_text
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:

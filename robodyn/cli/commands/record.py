@@ -38,7 +38,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.exceptions import MeshWarning
-    from robodyn.sim.simulation import Trajectory
+    from robodyn.trajectory import Trajectory
     from robodyn.viz.experiment import record_files
 
     if arguments.max_mesh_mb is not None and not arguments.max_mesh_mb > 0:

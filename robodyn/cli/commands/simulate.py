@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import RANGES, add_model_arguments, json_text, load_robot, vector, warn
-from robodyn.exceptions import printable
+from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector, warn
+from robodyn.common.text import json_text, printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:

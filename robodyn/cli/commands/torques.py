@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import Progress, add_model_arguments, json_text, load_robot
+from robodyn.cli.common import Progress, add_model_arguments, load_robot
+from robodyn.common.text import json_text
 
 
 def _rows(text: str) -> int:

@@ -19,7 +19,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.sim.simulation import Trajectory
+    from robodyn.trajectory import Trajectory
     from robodyn.viz.live import LiveViewer, wait
 
     robot = load_robot(arguments)

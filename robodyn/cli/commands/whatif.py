@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import RANGES, json_text, vector
+from robodyn.cli.common import RANGES, vector
+from robodyn.common.text import json_text
 from robodyn.exceptions import InputError
 
 

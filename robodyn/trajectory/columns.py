@@ -1,9 +1,10 @@
-"""The columns of a trajectory file: names, layout, checks, derived velocities.
+"""The columns of a trajectory file: names, layout and checks.
 
-The format itself is described in :mod:`robodyn.sim.trajectory` and
-``docs/trajectory-format.md``; this module turns a header into a :class:`Layout` (every
-error names the columns), refuses NaN/inf and non-increasing time with the row, and derives
-velocities from positions (:func:`derive_velocities`).
+The format itself is described in :mod:`robodyn.trajectory` and
+``docs/trajectory-format.md``; this module names the coordinates (a floating base's by
+:data:`robodyn.dynamics.dofs.BASE_Q_NAMES` / :data:`~robodyn.dynamics.dofs.BASE_V_NAMES`),
+turns a header into a :class:`Layout` (every error names the columns) and refuses NaN/inf
+and non-increasing time with the row.
 """
 
 from __future__ import annotations
@@ -13,14 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robodyn.exceptions import InputError, TrajectoryError
+from robodyn.common.text import printable
+from robodyn.dynamics.dofs import BASE_Q_NAMES, BASE_V_NAMES
+from robodyn.exceptions import TrajectoryError
 
-#: Names of a floating base's configuration coordinates (position [m], quaternion x, y, z, w).
-BASE_Q = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
-#: Names of a floating base's velocity coordinates (linear [m/s], angular [rad/s], base frame).
-BASE_V = ("base.x", "base.y", "base.z", "base.rx", "base.ry", "base.rz")
 #: The name robodyn's loader gives a floating base's joint (first of ``Robot.joint_names``).
 ROOT_JOINT = "root_joint"
+#: Kinds of columns, in the order a table has them: positions, velocities, accelerations, torques.
 KINDS = ("q", "v", "a", "tau")
 #: Columns ``robodyn torques`` may add (gravity torques, mass-matrix entries); read back, they are skipped.
 EXTRA_KINDS = ("G", "M")
@@ -41,13 +41,13 @@ def coordinate_names(joint_names: list[str], floating_base: bool) -> tuple[list[
     """
     if floating_base:
         joints = list(joint_names[1:])
-        return [*BASE_Q, *joints], [*BASE_V, *joints]
+        return [*BASE_Q_NAMES, *joints], [*BASE_V_NAMES, *joints]
     return list(joint_names), list(joint_names)
 
 
-def printable(name: str) -> str:
-    """A name as it may reach a terminal: control characters escaped (``\\n``, ``\\x1b``)."""
-    return name if name.isprintable() else name.encode("unicode_escape").decode("ascii")
+def coordinate_names_to_joints(v_names: list[str], floating_base: bool) -> list[str]:
+    """``Robot.joint_names`` from velocity coordinate names (inverse of :func:`coordinate_names`)."""
+    return [ROOT_JOINT, *v_names[len(BASE_V_NAMES) :]] if floating_base else list(v_names)
 
 
 def short_list(names: list[str], limit: int = 4) -> str:
@@ -83,8 +83,7 @@ class Layout:
     @property
     def joint_names(self) -> list[str]:
         """``Robot.joint_names`` of the robot this layout belongs to."""
-        joints = list(self.q_names[len(BASE_Q) :] if self.floating_base else self.q_names)
-        return [ROOT_JOINT, *joints] if self.floating_base else joints
+        return coordinate_names_to_joints(list(self.v_names), self.floating_base)
 
 
 def parse_header(header: list[str], source: str, *, width: int | None = None) -> Layout:
@@ -123,14 +122,14 @@ def parse_header(header: list[str], source: str, *, width: int | None = None) ->
         raise TrajectoryError(source, "no q[<joint>] columns (joint positions)")
     q_names = list(found["q"])
     base = [name for name in q_names if name.startswith("base.")]
-    floating = any(name in BASE_Q for name in base)
+    floating = any(name in BASE_Q_NAMES for name in base)
     if floating:
-        missing = [f"q[{name}]" for name in BASE_Q if name not in found["q"]]
+        missing = [f"q[{name}]" for name in BASE_Q_NAMES if name not in found["q"]]
         if missing:
             raise TrajectoryError(source, f"missing columns {short_list(missing)} (a floating base has 7 coordinates)")
-    joints = [name for name in q_names if not (floating and name in BASE_Q)]
-    q_names = [*BASE_Q, *joints] if floating else joints
-    v_names = [*BASE_V, *joints] if floating else joints
+    joints = [name for name in q_names if not (floating and name in BASE_Q_NAMES)]
+    q_names = [*BASE_Q_NAMES, *joints] if floating else joints
+    v_names = [*BASE_V_NAMES, *joints] if floating else joints
     columns: dict[str, np.ndarray | None] = {"q": np.array([found["q"][name] for name in q_names])}
     for kind in ("v", "a", "tau"):
         present = found[kind]
@@ -189,48 +188,3 @@ def check_table(
         raise TrajectoryError(
             source, f"time does not increase (t = {times[row]!r} after {times[row - 1]!r})", rows=(first_row + row,) * 2
         )
-
-
-def _quaternion_product(left: np.ndarray, right: np.ndarray) -> np.ndarray:
-    """Hamilton product of quaternions stored (x, y, z, w), row by row."""
-    lv, lw = left[:, :3], left[:, 3:]
-    rv, rw = right[:, :3], right[:, 3:]
-    return np.hstack([lw * rv + rw * lv + np.cross(lv, rv), lw * rw - np.sum(lv * rv, axis=1, keepdims=True)])
-
-
-def _rotate_inverse(quaternion: np.ndarray, vectors: np.ndarray) -> np.ndarray:
-    """``R(quaternion)ᵀ vector`` row by row (world -> base frame)."""
-    conjugate = quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
-    pure = np.hstack([vectors, np.zeros((len(vectors), 1))])
-    return _quaternion_product(_quaternion_product(conjugate, pure), quaternion)[:, :3]
-
-
-def derive_velocities(t: np.ndarray, q: np.ndarray, *, floating_base: bool) -> np.ndarray:
-    """Velocities from sampled positions by second-order finite differences.
-
-    ``np.gradient(q, t, axis=0, edge_order=2)``: central differences inside (error
-    O(h²) for a step h, non-uniform steps allowed), one-sided second-order differences at
-    the first and last sample. A floating base's linear velocity is ``Rᵀ ṗ`` and its angular
-    velocity ``2 (q̄ ⊗ q̇)`` (vector part), both in the base frame, as Pinocchio's ``v``.
-    Applied to ``v`` this gives ``a`` (O(h²) inside, O(h) on the first and last two samples).
-
-    Args:
-        t: Times in [s], shape (N,), strictly increasing, N ≥ 3.
-        q: Positions, shape (N, nq).
-        floating_base: Whether ``q[:, :7]`` is a base pose.
-
-    Returns:
-        Shape (N, nv).
-    """
-    if len(t) < 3:
-        raise InputError("trajectory", "at least 3 samples to derive velocities from positions", f"{len(t)} samples")
-    if not floating_base:
-        return np.gradient(q, t, axis=0, edge_order=2)
-    quaternion = q[:, 3:7].copy()
-    flips = np.cumsum(np.sum(quaternion[1:] * quaternion[:-1], axis=1) < 0) % 2  # q and -q are one rotation
-    quaternion[1:][flips == 1] *= -1.0
-    rates = np.gradient(np.hstack([q[:, :3], quaternion, q[:, 7:]]), t, axis=0, edge_order=2)
-    linear = _rotate_inverse(quaternion, rates[:, :3])
-    conjugate = quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
-    angular = 2.0 * _quaternion_product(conjugate, rates[:, 3:7])[:, :3]
-    return np.hstack([linear, angular, rates[:, 7:]])
