@@ -20,6 +20,7 @@ import pytest
 import sympy as sp
 
 import robodyn
+from robodyn.cli.app import main
 from robodyn.equations import lecture
 from robodyn.equations.render_derivation import (
     Derivation,
@@ -249,6 +250,21 @@ def test_a_robot_with_more_than_four_moving_joints_is_refused_in_one_line():
     with pytest.raises(InputError) as error:
         derivation(str(DATA / "robots" / "mimic_tree.urdf"))
     assert error.value.argument == "source" and "--symbolic" in str(error.value) and "\n" not in str(error.value)
+
+
+def test_the_cli_prints_the_derivation_and_refuses_code_formats(capsys):
+    assert main(["equations", "rp_arm", "--derivation", "--format", "json"]) == 0
+    assert json.loads(capsys.readouterr().out)["robot"] == "rp_arm"
+    assert main(["equations", "rp_arm", "--derivation", "--format", "c"]) == 2
+    assert "format" in capsys.readouterr().err
+
+
+def test_lecture_refuses_any_robot_but_the_rp_arm(capsys):
+    assert main(["equations", str(DATA / "rrp_arm.urdf"), "--lecture"]) == 2
+    err = capsys.readouterr().err
+    assert "model" in err and "rrp_arm" in err and len(err.strip().splitlines()) == 1
+    assert main(["equations", "rp_arm", "--lecture"]) == 0
+    assert "errata" in capsys.readouterr().out
 
 
 def overfull_boxes(log: str) -> list[float]:
