@@ -292,19 +292,20 @@ def _names(steps: DerivationSteps) -> dict[sp.Symbol, str]:
     return names
 
 
-def _column(printer: _Printer, left: str, matrix: sp.Matrix) -> list[str]:
-    """A vector or matrix as one ``bmatrix`` row when it fits the line, else entry by entry."""
+def _column(printer: _Printer, symbol: str, matrix: sp.Matrix, tail: str = "") -> list[str]:
+    """``symbol tail = matrix`` as one ``bmatrix`` row when it fits the line, else entry by
+    entry as ``(symbol)_{x}`` (vectors) or ``(symbol)_{x1}`` (matrices)."""
     entries = [[printer.doprint(numeric(sp.sympify(e))) for e in matrix.row(i)] for i in range(matrix.rows)]
+    left = symbol + tail
     widest = max(sum(_width(e) + 3 for e in row) for row in entries)
     if widest + _width(left) + 8 <= LINE_WIDTH:
         body = r" \\ ".join(" & ".join(row) for row in entries)
         return [rf"{left} &= \begin{{bmatrix}} {body} \end{{bmatrix}}"]
     axes = "xyz" if matrix.rows == 3 else [str(k + 1) for k in range(matrix.rows)]
     if matrix.cols == 1:
-        return [_equation(printer, rf"{left}_{{{axes[r]}}}", matrix[r]) for r in range(matrix.rows)]
-    return [
-        _equation(printer, rf"{left}_{{{axes[r]}{c + 1}}}", matrix[r, c]) for r in range(matrix.rows) for c in range(matrix.cols)
-    ]
+        return [_equation(printer, rf"({symbol})_{{{axes[r]}}}", matrix[r]) for r in range(matrix.rows)]
+    cells = [(r, c) for r in range(matrix.rows) for c in range(matrix.cols)]
+    return [_equation(printer, rf"({symbol})_{{{axes[r]}{c + 1}}}", matrix[r, c]) for r, c in cells]
 
 
 def _latex_blocks(steps: DerivationSteps, printer: _Printer) -> list[list[str]]:
@@ -312,8 +313,8 @@ def _latex_blocks(steps: DerivationSteps, printer: _Printer) -> list[list[str]]:
     blocks: list[list[str]] = [[], [], [], [], [], []]
     for i, link in enumerate(steps.links, 1):
         blocks[0] += _column(printer, f"R_{{{i}}}", link.R) + _column(printer, f"p_{{{i}}}", link.p)
-        blocks[1] += _column(printer, rf"J_{{v,{i}}}", link.Jv) + _column(printer, rf"v_{{{i}}} = J_{{v,{i}}}\dot q", link.v)
-        blocks[1] += _column(printer, rf"\omega_{{{i}}} = J_{{\omega,{i}}}\dot q", link.omega)
+        blocks[1] += _column(printer, rf"J_{{v,{i}}}", link.Jv) + _column(printer, f"v_{{{i}}}", link.v, rf" = J_{{v,{i}}}\dot q")
+        blocks[1] += _column(printer, rf"\omega_{{{i}}}", link.omega, rf" = J_{{\omega,{i}}}\dot q")
         blocks[2] += [_equation(printer, f"m_{{{i}}}", link.mass), _equation(printer, f"T_{{{i}}}", link.T)]
         blocks[2] += [_equation(printer, f"U_{{{i}}}", link.U)]
     blocks[3] = [_equation(printer, r"L = \textstyle\sum_i T_i - \sum_i U_i", steps.L)]
