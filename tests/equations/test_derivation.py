@@ -27,6 +27,7 @@ from robodyn.equations.render_derivation import (
     derivation,
     derivation_document,
     latex_math,
+    render_derivation,
     to_dict,
     to_latex,
     to_text,
@@ -228,7 +229,7 @@ def test_the_lectures_errata_are_marked_at_the_steps_they_enter():
 
 def test_json_carries_every_step_in_the_equations_naming():
     steps = derived("rp_arm", None)
-    data = json.loads(derivation_document("rp_arm", format="json"))
+    data = json.loads(render_derivation(steps, "json"))
     keys = ["p", "v", "omega", "T", "U", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq", "tau", "M", "C", "G"]
     assert set(keys) <= set(data)
     assert data["q"] == ["q_joint1", "q_joint2"] and data["qdd"] == ["qdd_joint1", "qdd_joint2"]
@@ -294,3 +295,9 @@ def test_every_robots_latex_compiles_without_an_overfull_box(case):
     with tempfile.TemporaryDirectory() as folder:
         _, log = compile_latex(to_latex(derived(source, gravity)), Path(folder))
     assert max(overfull_boxes(log), default=0.0) <= 10.0
+
+
+def test_an_unknown_format_is_refused_before_any_derivation():
+    with pytest.raises(InputError) as error:
+        derivation_document("no such robot", format="python")  # type: ignore[arg-type]
+    assert error.value.argument == "format"
