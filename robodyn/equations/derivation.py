@@ -220,7 +220,7 @@ def _joint_terms(L: sp.Expr, T: sp.Expr, U: sp.Expr, q: list, qd: list, qdd: lis
     return rows
 
 
-def _matrix_form(L: sp.Expr, joints: list[dict], q: list, qd: list) -> dict[str, sp.Matrix]:
+def _matrix_form(joints: list[dict], q: list, qd: list) -> dict[str, sp.Matrix]:
     """Step 6 from step 5's parts: ``M``, ``C`` (Christoffel), ``C q̇`` and ``G``."""
     n = len(q)
     M = sp.Matrix(n, n, lambda i, j: sp.diff(joints[i]["dL_dqd"], qd[j]))
@@ -245,6 +245,18 @@ def _tidy(rename: dict, q: list, speeds: list):
     return tidy
 
 
+def _check_size(model: ReferenceRobot) -> None:
+    """Refuse a robot of more than :data:`MAX_MOVING_JOINTS` moving joints, in one line."""
+    moving = len(model.tree.bodies)
+    if moving > MAX_MOVING_JOINTS:
+        raise InputError(
+            "source",
+            f"a robot of at most {MAX_MOVING_JOINTS} moving joints for a derivation worked step by step "
+            "(derive_equations, or 'robodyn equations --symbolic', gives the equations of larger ones)",
+            f"{model.name!r} with {moving}",
+        )
+
+
 def derive_steps(
     source: str | os.PathLike,
     *,
@@ -265,14 +277,7 @@ def derive_steps(
         InputError: For a robot with more than :data:`MAX_MOVING_JOINTS` moving joints.
     """
     model = reference.load(source, lock=lock, gravity=gravity)
-    moving = len(model.tree.bodies)
-    if moving > MAX_MOVING_JOINTS:
-        raise InputError(
-            "source",
-            f"a robot of at most {MAX_MOVING_JOINTS} moving joints for a derivation worked step by step "
-            "(derive_equations, or 'robodyn equations --symbolic', gives the equations of larger ones)",
-            f"{model.name!r} with {moving}",
-        )
+    _check_size(model)
     is_lecture = model.name == LECTURE_ROBOT and list(model.joint_names) == ["joint1", "joint2"]
     taken: set[str] = set()
     q, qd, qdd = (
@@ -285,7 +290,7 @@ def derive_steps(
     U = sum((link["U"] for link in links), sp.Integer(0))
     L = sp.expand(T - U)
     joints = _joint_terms(L, T, U, q, qd, qdd)
-    matrices = _matrix_form(L, joints, q, qd)
+    matrices = _matrix_form(joints, q, qd)
     rename, values, labels = _parameter_names(params, is_lecture and keep_params)
     tidy = _tidy(rename, q, [*qd, *qdd])
     link_terms = tuple(
