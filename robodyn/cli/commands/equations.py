@@ -57,6 +57,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--lecture", action="store_true", help="rp_arm: the lecture's printed result, its correction and the URDF's, side by side"
     )
+    parser.add_argument("--derivation", action="store_true", help="the Lagrangian worked step by step (up to 4 moving joints)")
     parser.set_defaults(run=run)
 
 
@@ -81,8 +82,18 @@ def _symbolic(arguments: argparse.Namespace) -> int:
                 "pdflatex", "--format pdf", "install TeX Live (Debian: texlive-latex-base) or use --format latex"
             )
     if arguments.lecture:
+        if arguments.model != "rp_arm":
+            raise InputError("model", "rp_arm with --lecture (the lecture's arm)", repr(terminal_text(str(arguments.model))))
         print(lecture_text(), end="")
         return 0
+    if arguments.derivation:
+        from robodyn.equations.render_derivation import derivation_document
+
+        document = derivation_document(
+            arguments.model, format=arguments.format, keep_params=arguments.keep_params, gravity=arguments.gravity,
+            lock=lock_values(arguments.lock), precision=arguments.precision,
+        )  # fmt: skip
+        return _emit(arguments, document, "derivation")
     if arguments.kinematics is not None:
         from robodyn.equations.kinematics import derive_kinematics, render_kinematics
 
@@ -146,7 +157,7 @@ def _base_parameters(arguments: argparse.Namespace) -> int:
 def run(arguments: argparse.Namespace) -> int:
     if arguments.base_parameters:
         return _base_parameters(arguments)
-    if arguments.symbolic or arguments.lecture:
+    if arguments.symbolic or arguments.lecture or arguments.derivation:
         return _symbolic(arguments)
     from robodyn.dynamics.terms import dynamics_terms
     from robodyn.equations.output import check_precision
