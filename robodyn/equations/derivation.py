@@ -33,8 +33,8 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from robodyn import reference
+from robodyn.common.text import identifier
 from robodyn.equations import lecture, simplify
-from robodyn.equations.naming import identifier
 from robodyn.exceptions import InputError
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, body_coordinates, body_poses
@@ -252,7 +252,7 @@ def _check_size(model: ReferenceRobot) -> None:
         raise InputError(
             "source",
             f"a robot of at most {MAX_MOVING_JOINTS} moving joints for a derivation worked step by step "
-            "(derive_equations, or 'robodyn equations --symbolic', gives the equations of larger ones)",
+            "(derive_equations, the symbolic form, gives the equations of larger ones)",
             f"{model.name!r} with {moving}",
         )
 

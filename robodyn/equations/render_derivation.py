@@ -3,7 +3,7 @@
 :func:`derivation` gives a :class:`Derivation` (the steps, ``to_dict()`` and, in notebooks,
 ``_repr_latex_``); :func:`derivation_document` is the one call behind
 ``robodyn equations MODEL --derivation``. Every name from the URDF passes
-:mod:`robodyn.equations.naming`; numbers are exact until printed, then floats of
+:mod:`robodyn.common.text`; numbers are exact until printed, then floats of
 ``precision`` significant digits (17 in JSON, as the equations' JSON). LaTeX follows the
 equations' document: joints numbered ``q_1``, ``\\dot q_1``, links numbered in the order
 of the derivation, long entries broken across lines.
@@ -20,10 +20,11 @@ from typing import Any, Literal
 
 import sympy as sp
 
+from robodyn.common.text import json_text, latex_text
+from robodyn.common.text import printable as terminal_text
 from robodyn.equations import lecture
 from robodyn.equations.derivation import LECTURE_ERRATA_STEPS, DerivationSteps, derive_steps
 from robodyn.equations.model import numeric
-from robodyn.equations.naming import json_text, latex_text, terminal_text
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision, format_float, to_text_expr
 from robodyn.equations.render_latex import LINE_WIDTH, _equation, _Printer, _width, compile_latex
 from robodyn.exceptions import InputError

@@ -251,7 +251,7 @@ def test_the_notebook_shows_every_step_as_latex():
 def test_a_robot_with_more_than_four_moving_joints_is_refused_in_one_line():
     with pytest.raises(InputError) as error:
         derivation(str(DATA / "robots" / "mimic_tree.urdf"))
-    assert error.value.argument == "source" and "--symbolic" in str(error.value) and "\n" not in str(error.value)
+    assert error.value.argument == "source" and "derive_equations" in str(error.value) and "\n" not in str(error.value)
 
 
 def test_the_cli_prints_the_derivation_and_refuses_code_formats(capsys):
