@@ -1,9 +1,12 @@
-"""An identification run with its files: :func:`identify_run`, its text and its JSON.
+"""Identification runs with their files: :func:`identify_run` and :func:`excite_run`, their
+text and their JSON.
 
 :func:`identify_run` identifies the base parameters from measured data
 (:func:`robodyn.ident.identify`), optionally writes the result as JSON and (with the
 ``"physical"`` method) the identified URDF, and returns an :class:`IdentificationRun` whose
-:meth:`~IdentificationRun.text` is the table ``robodyn identify`` prints.
+:meth:`~IdentificationRun.text` is the table ``robodyn identify`` prints. :func:`excite_run`
+optimises an exciting trajectory, samples it and writes it as a trajectory file
+(:class:`ExcitationRun`, what ``robodyn excite`` prints).
 """
 
 from __future__ import annotations
@@ -20,8 +23,10 @@ from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.ident.base import base_parameters
+from robodyn.ident.excitation import Excitation, excite
 from robodyn.ident.identify import Identification, Method, Samples, identify
 from robodyn.ident.urdf_out import identified_urdf
+from robodyn.trajectory import Trajectory
 
 
 class Measured(Protocol):
@@ -107,3 +112,79 @@ def identify_run(
     if urdf is not None and urdf_out:
         atomic_write_text(urdf_out, urdf)
     return IdentificationRun(result, str(out) if out else None, str(urdf_out) if urdf is not None and urdf_out else None)
+
+
+@dataclass(frozen=True)
+class ExcitationRun:
+    """An exciting trajectory, sampled and written as a trajectory file.
+
+    Attributes:
+        excitation: The optimised excitation (coefficients, condition numbers).
+        base_count: Number of base parameters it excites.
+        harmonics: Harmonics per joint.
+        rate: Sampling rate of the file in [Hz].
+        samples: Rows written.
+        out: The trajectory file written.
+    """
+
+    excitation: Excitation
+    base_count: int
+    harmonics: int
+    rate: float
+    samples: int
+    out: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the period [s], harmonics, condition numbers and the file."""
+        excitation = self.excitation
+        return {
+            "robot": excitation.robot,
+            "base_parameters": self.base_count,
+            "period_s": excitation.period,
+            "harmonics": self.harmonics,
+            "condition_number": excitation.condition,
+            "initial_condition_number": excitation.initial_condition,
+            "samples": self.samples,
+            "rate_hz": self.rate,
+            "out": self.out,
+        }
+
+    def text(self) -> str:
+        """What ``robodyn excite`` prints: the base parameters, the conditioning, the file."""
+        excitation = self.excitation
+        return "\n".join(
+            [
+                f"{printable(excitation.robot)}: {self.base_count} base parameters; "
+                f"excitation of {excitation.period:g} s, {self.harmonics} harmonics",
+                f"condition number of the stacked base regressor: {excitation.condition:.4g} "
+                f"(start {excitation.initial_condition:.4g})",
+                f"wrote {self.out} ({self.samples} samples at {self.rate:g} Hz)",
+            ]
+        )
+
+
+def excite_run(
+    robot: Robot,
+    *,
+    out: str | os.PathLike,
+    rate: float = 100.0,
+    harmonics: int = 5,
+    **options: Any,
+) -> ExcitationRun:
+    """An exciting trajectory for ``robot`` (:func:`robodyn.ident.excite`), sampled at
+    ``rate`` [Hz] with the model's inverse dynamics as ``tau`` and written to ``out``
+    (.csv or .npz, the trajectory format).
+
+    Args:
+        robot: A fixed-base robot.
+        out: The trajectory file to write.
+        rate: Sampling rate in [Hz].
+        harmonics: Harmonics per joint.
+        **options: The other keyword arguments of :func:`robodyn.ident.excite`
+            (``duration``, ``velocity_limit``, ``acceleration_limit``, ``iterations``, ``seed``).
+    """
+    base = base_parameters(robot)
+    excitation = excite(robot, harmonics=harmonics, base=base, **options)
+    t, q, v, a, tau = excitation.sample(robot, rate=rate)
+    Trajectory(t, q, v, a, tau, list(robot.joint_names), robot.name).save(out)
+    return ExcitationRun(excitation, base.count, harmonics, rate, len(t), str(out))

@@ -10,7 +10,8 @@ import pytest
 import robodyn
 from robodyn.cli import main
 from robodyn.exceptions import InputError
-from robodyn.ident.run import IdentificationRun, identify_run
+from robodyn.ident import base_parameters
+from robodyn.ident.run import IdentificationRun, excite_run, identify_run
 from robodyn.trajectory import Trajectory
 
 
@@ -62,3 +63,14 @@ def test_data_without_torques_is_refused_naming_data(data, tmp_path, capsys):
     bare.save(tmp_path / "bare.csv")
     assert main(["identify", "rp_arm", str(tmp_path / "bare.csv")]) == 2
     assert "DATA must be a trajectory with tau[<joint>] columns" in capsys.readouterr().err
+
+
+def test_excite_run_writes_the_trajectory_its_text_and_json_describe(tmp_path):
+    robot = robodyn.load("rp_arm")
+    out = tmp_path / "excitation.csv"
+    run = excite_run(robot, out=out, rate=50.0, harmonics=2, duration=2.0, iterations=3, seed=1)
+    written = Trajectory.load(out).for_robot(robot)
+    assert run.samples == len(written.t) == 100 and run.to_dict()["samples"] == 100
+    np.testing.assert_allclose(written.tau, robot.inverse_dynamics(written.q, written.v, written.a), atol=1e-9)
+    assert run.to_dict()["base_parameters"] == run.base_count == base_parameters(robot).count
+    assert f"{run.excitation.condition:.4g}" in run.text() and str(out) in run.text()

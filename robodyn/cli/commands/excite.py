@@ -30,29 +30,18 @@ def _limit(values: list[float] | None):
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.common.text import printable
-    from robodyn.ident import base_parameters, excite
-    from robodyn.trajectory import Trajectory
+    from robodyn.ident.run import excite_run
 
-    robot = load_robot(arguments)
-    base = base_parameters(robot)
-    excitation = excite(
-        robot,
-        duration=arguments.duration,
+    run = excite_run(
+        load_robot(arguments),
+        out=arguments.out,
+        rate=arguments.rate,
         harmonics=arguments.harmonics,
+        duration=arguments.duration,
         velocity_limit=_limit(arguments.velocity_limit),
         acceleration_limit=_limit(arguments.acceleration_limit),
         iterations=arguments.iterations,
         seed=arguments.seed,
-        base=base,
     )
-    t, q, v, a, tau = excitation.sample(robot, rate=arguments.rate)
-    Trajectory(t, q, v, a, tau, list(robot.joint_names), robot.name).save(arguments.out)
-    print(
-        f"{printable(robot.name)}: {base.count} base parameters; excitation of {excitation.period:g} s, {arguments.harmonics} harmonics"
-    )
-    print(
-        f"condition number of the stacked base regressor: {excitation.condition:.4g} (start {excitation.initial_condition:.4g})"
-    )
-    print(f"wrote {arguments.out} ({len(t)} samples at {arguments.rate:g} Hz)")
+    print(run.text())
     return 0
