@@ -186,5 +186,5 @@ def excite_run(
     base = base_parameters(robot)
     excitation = excite(robot, harmonics=harmonics, base=base, **options)
     t, q, v, a, tau = excitation.sample(robot, rate=rate)
-    Trajectory(t, q, v, a, tau, list(robot.joint_names), robot.name).save(out)
+    Trajectory(t, q, v, a, tau, list(robot.joint_names), robot.name).save(os.fspath(out))
     return ExcitationRun(excitation, base.count, harmonics, rate, len(t), str(out))
