@@ -41,7 +41,7 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 
 #: Damping of the task inertia, relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
-TASK_DAMPING = 1e-6
+TASK_DAMPING = 1e-8
 #: Damping of the Jacobian's pseudo-inverse in the impedance law's null space, in [m²].
 PSEUDO_INVERSE_DAMPING = 1e-8
 
