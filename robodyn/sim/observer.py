@@ -8,8 +8,13 @@ With the momentum ``p = M(q) v``, the equations of motion and ``Ṁ = C + Cᵀ``
 obeys ``ṙ = K_O (τ_ext − r)``: it follows the external torques through a first-order lag
 of gain ``K_O`` [1/s] per joint (63 % of a step in ``1/K_O``). Both the offline estimate
 (:func:`estimate_external_torques`, on a recorded trajectory) and the online
-:class:`MomentumObserver` (one sample at a time, in a control loop) integrate by the
-trapezoidal rule, in which the implicit ``r`` term is solved exactly per step.
+:class:`MomentumObserver` (one sample at a time, in a control loop) integrate
+``Cᵀ v − G`` and ``r`` by the trapezoidal rule (the implicit ``r`` solved exactly per
+step) and the motor torque as it was applied (:data:`TorqueMode`): ``"held"``, each
+sample's torque acting unchanged until the next sample (a digital controller, MuJoCo,
+``simulate(..., hold=True)``), or ``"sampled"``, samples of a torque that varies
+continuously (``simulate`` without ``hold``). The wrong one leaves an error of about
+``Δτ / 2`` per step in the estimate of a fast-changing torque.
 
 From the residual: the wrench at a frame (:func:`external_wrench`, ``F = (Jᵀ)⁺ r``) and
 collision detection (:func:`detect_collision`: when the first ``|r_i|`` crosses its
@@ -21,12 +26,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.trajectory import Trajectory
+
+#: How the recorded motor torque acted between two samples.
+TorqueMode = Literal["held", "sampled"]
+TORQUE_MODES = ("held", "sampled")
 
 
 def _gain(robot: Robot, gain: float | np.ndarray) -> np.ndarray:
@@ -37,12 +47,22 @@ def _gain(robot: Robot, gain: float | np.ndarray) -> np.ndarray:
     return np.array(gains)
 
 
-def _momentum_terms(robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``p = M v`` and ``β = τ + Cᵀ v − G`` for one state (1-D) or stacked states (2-D)."""
+def _momentum_terms(robot: Robot, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``p = M v`` and ``β = Cᵀ v − G`` for one state (1-D) or stacked states (2-D)."""
     mass, coriolis, gravity = robot.mass_matrix(q), robot.coriolis_matrix(q, v), robot.gravity(q)
     momentum = np.einsum("...ij,...j->...i", mass, v)
-    beta = tau + np.einsum("...ji,...j->...i", coriolis, v) - gravity
+    beta = np.einsum("...ji,...j->...i", coriolis, v) - gravity
     return momentum, beta
+
+
+def _torque_step(dt: float | np.ndarray, before: np.ndarray, after: np.ndarray, torque: TorqueMode) -> np.ndarray:
+    """``∫ τ`` over a step from the torques at its two ends."""
+    return dt * before if torque == "held" else 0.5 * dt * (before + after)
+
+
+def _check_mode(torque: str) -> None:
+    if torque not in TORQUE_MODES:
+        raise InputError("torque", f"one of {', '.join(TORQUE_MODES)}", repr(torque))
 
 
 def _step(gain: np.ndarray, dt: float, offset: np.ndarray, integral: np.ndarray, r_previous: np.ndarray) -> np.ndarray:
@@ -51,7 +71,9 @@ def _step(gain: np.ndarray, dt: float, offset: np.ndarray, integral: np.ndarray,
     return gain * (offset - integral - 0.5 * dt * r_previous) / (1.0 + 0.5 * dt * gain)
 
 
-def estimate_external_torques(robot: Robot, trajectory: Trajectory, *, gain: float | np.ndarray) -> np.ndarray:
+def estimate_external_torques(
+    robot: Robot, trajectory: Trajectory, *, gain: float | np.ndarray, torque: TorqueMode = "held"
+) -> np.ndarray:
     """The external joint torques a recorded motion reveals (momentum observer).
 
     Args:
@@ -60,6 +82,8 @@ def estimate_external_torques(robot: Robot, trajectory: Trajectory, *, gain: flo
             torques ``tau`` (N, nv) (e.g. a :class:`~robodyn.Trajectory` from
             :func:`robodyn.simulate` or from a file).
         gain: ``K_O`` in [1/s], scalar or (nv,): the bandwidth of the estimate.
+        torque: ``"held"`` (each sample's ``tau`` acts until the next sample) or
+            ``"sampled"`` (``tau`` varies continuously between samples).
 
     Returns:
         The residual ``r``, shape (N, nv), in [N m] / [N]: ``r[0] = 0``, and after a few
@@ -67,19 +91,22 @@ def estimate_external_torques(robot: Robot, trajectory: Trajectory, *, gain: flo
 
     Raises:
         InputError: A trajectory without torques, of fewer than two samples or with
-            times that do not increase; a bad gain.
+            times that do not increase; a bad gain or torque mode.
         TrajectoryError: A trajectory of another robot.
     """
     if trajectory.tau is None:
         raise InputError("trajectory", "one with the applied torques tau", "no tau")
     trajectory.check(robot)
     gains = _gain(robot, gain)
+    _check_mode(torque)
     t = np.asarray(trajectory.t, float)
     if t.ndim != 1 or len(t) < 2 or not (np.diff(t) > 0).all():
         raise InputError("trajectory.t", "at least two strictly increasing times", f"{len(t)} times")
-    momentum, beta = _momentum_terms(robot, trajectory.q, trajectory.v, np.asarray(trajectory.tau, float))
+    momentum, beta = _momentum_terms(robot, trajectory.q, trajectory.v)
+    tau = np.asarray(trajectory.tau, float)
     steps = np.diff(t)[:, None]
-    integral_beta = np.concatenate([np.zeros((1, robot.nv)), np.cumsum(0.5 * steps * (beta[1:] + beta[:-1]), axis=0)])
+    increments = 0.5 * steps * (beta[1:] + beta[:-1]) + _torque_step(steps, tau[:-1], tau[1:], torque)
+    integral_beta = np.concatenate([np.zeros((1, robot.nv)), np.cumsum(increments, axis=0)])
     offset = momentum - momentum[0] - integral_beta
     residual = np.zeros_like(offset)
     integral = np.zeros(robot.nv)
@@ -103,22 +130,26 @@ class MomentumObserver:
     Attributes:
         model: The observer's model of the robot.
         gain: ``K_O`` in [1/s], scalar or (nv,).
+        torque: ``"held"`` (the torque given with a sample acts until the next one) or
+            ``"sampled"``, as for :func:`estimate_external_torques`.
         times: Times of the samples seen, in [s].
         residuals: The estimate at each of them, each (nv,).
     """
 
     model: Robot
     gain: float | np.ndarray
+    torque: TorqueMode = "held"
     times: list[float] = field(default_factory=list)
     residuals: list[np.ndarray] = field(default_factory=list)
     _gains: np.ndarray = field(init=False, repr=False)
     _start: np.ndarray | None = field(default=None, init=False, repr=False)
-    _previous: tuple[float, np.ndarray] | None = field(default=None, init=False, repr=False)
+    _previous: tuple[float, np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)
     _integral_beta: np.ndarray | None = field(default=None, init=False, repr=False)
     _integral: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._gains = _gain(self.model, self.gain)
+        _check_mode(self.torque)
 
     def update(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Take one sample and return the estimate ``r`` (nv,) in [N m] / [N].
@@ -127,20 +158,22 @@ class MomentumObserver:
             InputError: A time not after the previous sample's (e.g. the intermediate
                 calls of a Runge–Kutta step: simulate with ``hold=True``).
         """
-        momentum, beta = _momentum_terms(self.model, q, v, np.asarray(tau, dtype=float))
+        tau = np.asarray(tau, dtype=float)
+        momentum, beta = _momentum_terms(self.model, q, v)
         if self._previous is None or self._start is None or self._integral_beta is None or self._integral is None:
             self._start, self._integral_beta, self._integral = momentum, np.zeros(self.model.nv), np.zeros(self.model.nv)
             residual = np.zeros(self.model.nv)
         else:
-            last_t, last_beta = self._previous
+            last_t, last_beta, last_tau = self._previous
             if not t > last_t:
                 raise InputError("t", f"after the previous sample's {last_t:.9g} s (simulate with hold=True)", f"{t:.9g} s")
             dt = t - last_t
-            self._integral_beta = self._integral_beta + 0.5 * dt * (last_beta + beta)
+            step = 0.5 * dt * (last_beta + beta) + _torque_step(dt, last_tau, tau, self.torque)
+            self._integral_beta = self._integral_beta + step
             previous = self.residuals[-1]
             residual = _step(self._gains, dt, momentum - self._start - self._integral_beta, self._integral, previous)
             self._integral = self._integral + 0.5 * dt * (previous + residual)
-        self._previous = (float(t), beta)
+        self._previous = (float(t), beta, tau)
         self.times.append(float(t))
         self.residuals.append(residual)
         return residual
