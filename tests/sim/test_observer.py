@@ -183,3 +183,55 @@ def test_the_online_observer_in_simulate_gives_the_wrench_at_the_frame():
     assert np.abs(estimated - wrench).max() < 0.01 * np.abs(wrench).max()
     with pytest.raises(robodyn.InputError, match="hold=True"):  # Runge-Kutta stages are no samples
         robodyn.simulate(robot, q0, np.zeros(6), 0.01, DT, controller=MomentumObserver(robot, GAIN).wrap(hold))
+
+
+def test_the_sampled_rule_fits_a_torque_that_varies_within_the_step():
+    """robodyn.simulate without hold evaluates the controller at every Runge–Kutta stage."""
+    robot = robodyn.load("rp_arm")
+    q0 = CASES["rp_arm"][1]
+    inertia = robot.mass_matrix(q0)
+    omega = 2 * np.pi * 0.8
+    swing = lambda t, q, v: inertia @ (400.0 * (q0 + np.array([0.5, 0.1]) * np.sin(omega * t) - q) - 40.0 * v) + robot.gravity(q)  # noqa: E731
+    force = np.array([0.0, 0.0, -15.0])
+    push = robodyn.ExternalWrench(robot.end_effector, lambda t: force if t >= 0.5 - 1e-9 else np.zeros(3))
+    trajectory = robodyn.simulate(robot, q0, np.zeros(2), 1.0, DT, controller=swing, external=[push])
+    before = trajectory.t < 0.5 - 1e-9
+    reference = np.array([robot.wrench_torques(q, robot.end_effector, force) for q in trajectory.q])
+    reference[before] = 0.0
+    size = np.abs(reference).max()
+    lagged = np.zeros_like(reference)  # the reference through the observer's ideal lag
+    decay = np.exp(-GAIN * DT)
+    for k in range(len(reference) - 1):
+        lagged[k + 1] = decay * lagged[k] + (1 - decay) * reference[k]
+    sampled = estimate_external_torques(robot, trajectory, gain=GAIN, torque="sampled")
+    assert np.abs(sampled[before]).max() < 0.001 * size
+    assert np.abs(sampled - lagged).max() < 0.01 * size
+    held = estimate_external_torques(robot, trajectory, gain=GAIN, torque="held")  # negative control
+    assert np.abs(held[before]).max() > 0.01 * size  # fails the 1 % check
+
+
+def test_bad_observer_inputs_are_refused_by_name():
+    robot = robodyn.load("rp_arm")
+    trajectory = robodyn.Trajectory(
+        np.array([0.0, 0.1]), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros((2, 2)), None, ["joint1", "joint2"]
+    )
+    with pytest.raises(robodyn.InputError, match="tau"):
+        estimate_external_torques(robot, trajectory, gain=GAIN)
+    trajectory.tau = np.zeros((2, 2))
+    for options, name in (
+        ({"gain": -1.0}, "gain"),
+        ({"gain": [1.0, 2.0, 3.0]}, "gain"),
+        ({"gain": GAIN, "torque": "zoh"}, "torque"),
+    ):
+        with pytest.raises(robodyn.InputError) as refused:
+            estimate_external_torques(robot, trajectory, **options)
+        assert refused.value.argument == name
+    # an arm that stays still with no motor torque is held by the environment: r -> G(q)
+    t = np.arange(400) * DT
+    still = robodyn.Trajectory(
+        t, np.full((400, 2), 0.3), np.zeros((400, 2)), np.zeros((400, 2)), np.zeros((400, 2)), ["joint1", "joint2"]
+    )
+    estimate = estimate_external_torques(robot, still, gain=GAIN)
+    assert np.abs(estimate[-1] - robot.gravity(np.full(2, 0.3))).max() < 1e-6 * np.abs(robot.gravity(np.full(2, 0.3))).max()
+    with pytest.raises(robodyn.InputError, match="threshold"):
+        detect_collision(robot, t, estimate, -1.0)
