@@ -173,6 +173,20 @@ def test_the_ur5_follows_a_moving_target_by_the_linear_law():
     assert deviation < 1e-5, deviation
 
 
+def test_the_ur5_reaches_a_pose_given_as_a_quaternion_by_the_linear_law():
+    plant, model = robodyn.load("ur5"), robodyn.load("ur5")
+    target = _pose(plant, UR5_START + np.array([0.3, -0.2, 0.25, 0.3, -0.3, 0.4]), plant.end_effector)
+    quaternion = pin.Quaternion(target.rotation).coeffs()  # x, y, z, w
+    law = OperationalSpace(model, None, target.translation, orientation=quaternion, kp=KP, kd=KD)
+    trajectory = robodyn.simulate(plant, UR5_START, np.zeros(6), 1.2, DT, controller=law, limits="ignore")
+    deviation, errors = _transient_deviation(law, trajectory)
+    assert np.abs(errors[0, 3:]).max() > 0.2
+    assert deviation < 1e-5, deviation
+    reached = _pose(plant, trajectory.q[-1], plant.end_effector)
+    assert np.linalg.norm(reached.translation - target.translation) < 1e-6
+    assert np.linalg.norm(pin.log3(reached.rotation.T @ target.rotation)) < 1e-6
+
+
 def test_the_rp_arm_in_its_plane_follows_the_linear_law_and_without_the_bias_term_does_not(monkeypatch):
     plant, model = robodyn.load("rp_arm"), robodyn.load("rp_arm")
     q0 = np.array([0.4, 0.1])
@@ -218,6 +232,8 @@ def test_a_target_out_of_reach_is_refused_before_simulating():
         Impedance(robot, None, [0.0, 0.0, 2.5])
     with pytest.raises(robodyn.InputError, match="reach"):
         OperationalSpace(robot, None, _circle(np.array([3.0, 0.0, 0.5]), 0.1, 1.0))
+    with pytest.raises(robodyn.InputError, match="fixed rest position"):
+        Impedance(robot, None, _circle(np.array([0.3, 0.2, 0.4]), 0.05, 1.0))
     OperationalSpace(robot, None, [0.3, 0.2, 0.4])  # negative control: a reachable point passes
 
 
