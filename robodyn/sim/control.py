@@ -150,3 +150,9 @@ class QuinticReference:
 def quintic_reference(q_start: np.ndarray, q_end: np.ndarray, duration: float) -> QuinticReference:
     """A rest-to-rest joint motion from ``q_start`` to ``q_end`` in ``duration`` [s] (:class:`QuinticReference`)."""
     return QuinticReference(np.asarray(q_start, float), np.asarray(q_end, float), float(duration))
+
+
+# Operational-space and impedance control live in their own module; re-exported here with
+# the other controllers.
+from robodyn.sim.operational_space import Impedance as Impedance  # noqa: E402
+from robodyn.sim.operational_space import OperationalSpace as OperationalSpace  # noqa: E402

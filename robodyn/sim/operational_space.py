@@ -1,0 +1,383 @@
+"""Operational-space and impedance control of a frame's pose (the lecture's sequel).
+
+Both are controllers ``controller(t, q, v) -> tau`` for :func:`robodyn.simulate`, built on
+their **own** model of the robot like those of :mod:`robodyn.sim.control`.
+
+- :class:`OperationalSpace` — Khatib's operational-space control. With the frame Jacobian
+  ``J`` (6 × nv, or its 3 position rows), the task inertia ``Λ = (J M⁻¹ Jᵀ)⁻¹``, the
+  dynamically consistent inverse ``J̄ = M⁻¹ Jᵀ Λ`` and ``N = I − J̄ J``::
+
+      tau = Jᵀ Λ (ẍ* − J̇ v) + C v + G + Nᵀ τ₀
+
+  where ``ẍ*`` makes the task error obey ``ë + Kd ė + Kp e = 0`` (position: ``e = x_d − x``;
+  orientation: ``e`` is the SO(3) logarithm of the rotation from the frame to the target,
+  see :func:`orientation_error`) and ``τ₀ = M (Kp₀ (q₀ − q) − Kd₀ v)`` is the posture task,
+  which ``Nᵀ`` confines to the null space: it never changes the task's acceleration.
+- :class:`Impedance` — Cartesian impedance with gravity compensation::
+
+      tau = G + Jᵀ (K e − D J v) − N_Jᵀ d₀ v
+
+  so a steady external wrench ``F`` at the frame moves it by ``K⁻¹ F``. The last term
+  damps the joint motion the task leaves free (``N_J = I − J⁺ J``); it is zero at rest.
+
+Near singularities ``Λ`` is damped: with the eigen-decomposition ``J M⁻¹ Jᵀ = U S Uᵀ``,
+``Λ = U diag(s / (s² + λ²)) Uᵀ`` with ``λ = damping · max(s)`` (default
+:data:`TASK_DAMPING`). A direction the frame cannot move in (``s = 0``: out of a planar
+arm's plane, a stretched elbow) gets no force instead of an infinite one; elsewhere the
+relative change of ``Λ`` is ``(λ / s)²``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import KW_ONLY, dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from robodyn.common.rotations import rpy_matrix, skew
+from robodyn.dynamics import frames
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
+
+#: Damping of the task inertia, relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
+TASK_DAMPING = 1e-8
+#: Damping of the Jacobian's pseudo-inverse in the impedance law's null space, in [m²].
+PSEUDO_INVERSE_DAMPING = 1e-8
+
+#: A task reference: time in [s] -> (x_d in [m], ẋ_d in [m/s], ẍ_d in [m/s²]), each (3,).
+TaskReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+def target_rotation(orientation: np.ndarray | list[float]) -> np.ndarray:
+    """A target attitude as a rotation matrix (world axes), shape (3, 3).
+
+    Args:
+        orientation: A rotation matrix (3, 3), a unit quaternion ``(x, y, z, w)`` (4,) or
+            URDF roll-pitch-yaw angles in [rad] (3,).
+
+    Raises:
+        InputError: For another shape, non-finite values, a matrix that is not a rotation
+            or a quaternion that is not unit (to 1e-6).
+    """
+    value = np.asarray(orientation, dtype=float)
+    if not np.isfinite(value).all():
+        raise InputError("orientation", "finite values", "non-finite values")
+    if value.shape == (3,):
+        return rpy_matrix(value)
+    if value.shape == (4,):
+        if abs(np.linalg.norm(value) - 1) > 1e-6:
+            raise InputError("orientation", "a unit quaternion (x, y, z, w)", f"norm {np.linalg.norm(value):.6g}")
+        return pin.Quaternion(value[3], *value[:3]).toRotationMatrix()
+    if value.shape == (3, 3):
+        if not (np.allclose(value @ value.T, np.eye(3), atol=1e-6) and np.linalg.det(value) > 0):
+            raise InputError("orientation", "a rotation matrix (orthonormal, determinant +1)", "another 3 × 3 matrix")
+        return value
+    raise InputError(
+        "orientation", "a 3 × 3 rotation matrix, a quaternion (x, y, z, w) or roll, pitch, yaw", f"shape {value.shape}"
+    )
+
+
+def orientation_error(rotation: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """``log(Rᵀ R_d)``: the rotation from the frame to the target, as an axis times an angle.
+
+    The axis is the same in the frame's and in the target's axes; the angle, in [rad], is
+    the attitude error ``|e|`` (at most π).
+
+    Args:
+        rotation: The frame's attitude ``R``, shape (3, 3).
+        target: The target attitude ``R_d``, shape (3, 3).
+
+    Returns:
+        Shape (3,), in [rad].
+    """
+    return pin.log3(rotation.T @ target)
+
+
+#: Below this rotation angle in [rad], the log Jacobian's coefficients use their series.
+SMALL_ANGLE = 0.05
+
+
+def _log_jacobian(phi: np.ndarray) -> np.ndarray:
+    """``Jr⁻¹(φ) = I + φ̂/2 + c(θ) φ̂²``: ``d/dt log(R) = Jr⁻¹ ω_b`` (θ = |φ|, shape (3, 3))."""
+    cross = skew(phi)
+    return np.eye(3) + 0.5 * cross + _log_coefficients(float(np.linalg.norm(phi)))[0] * cross @ cross
+
+
+def _log_jacobian_rate(phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
+    """``d/dt Jr⁻¹(φ)`` along ``φ̇``, shape (3, 3)."""
+    cross, cross_dot = skew(phi), skew(phi_dot)
+    c, c_prime_over_theta = _log_coefficients(float(np.linalg.norm(phi)))
+    return (
+        0.5 * cross_dot + c * (cross_dot @ cross + cross @ cross_dot) + c_prime_over_theta * float(phi @ phi_dot) * cross @ cross
+    )
+
+
+def _log_coefficients(theta: float) -> tuple[float, float]:
+    """``c(θ) = 1/θ² − cot(θ/2)/(2θ)`` and ``c'(θ)/θ`` (series below :data:`SMALL_ANGLE`)."""
+    if theta < SMALL_ANGLE:
+        return 1 / 12 + theta**2 / 720 + theta**4 / 30240, 1 / 360 + theta**2 / 7560
+    cot = 1 / np.tan(theta / 2)
+    c = 1 / theta**2 - cot / (2 * theta)
+    c_prime = -2 / theta**3 + cot / (2 * theta**2) + 1 / (4 * theta * np.sin(theta / 2) ** 2)
+    return float(c), float(c_prime / theta)
+
+
+def check_reach(robot: Robot, frame: str, target: np.ndarray, *, parameter: str) -> None:
+    """Refuse a target position no configuration can reach (outside the chain's reach ball).
+
+    The ball is :func:`robodyn.dynamics.frames.reach` (an upper bound of the workspace:
+    what it refuses is certainly out of reach).
+
+    Args:
+        robot: The robot.
+        frame: The controlled frame.
+        target: Position in [m], shape (3,).
+        parameter: The argument's name, for the message.
+
+    Raises:
+        InputError: If the target lies outside the ball.
+    """
+    lower, upper = robot.physical_limits()
+    ball = frames.reach(robot.model, robot.frame_id(frame), lower, upper)
+    if ball is None:
+        return
+    centre, radius = ball
+    distance = float(np.linalg.norm(target - np.asarray(centre)))
+    if distance > radius:
+        where = ", ".join(f"{c:.3g}" for c in centre)
+        raise InputError(
+            parameter,
+            f"within the reach of {frame!r} ({radius:.3f} m of its first joint at ({where}) m)",
+            f"a point {distance:.3f} m away",
+        )
+
+
+def damped_task_inertia(inverse: np.ndarray, damping: float) -> np.ndarray:
+    """``Λ`` from ``Λ⁻¹ = J M⁻¹ Jᵀ``, damped near singularities (see the module's note).
+
+    Args:
+        inverse: ``J M⁻¹ Jᵀ``, shape (m, m), symmetric positive semi-definite.
+        damping: ``λ`` relative to its largest eigenvalue (0: the plain inverse).
+
+    Returns:
+        Shape (m, m).
+    """
+    values, vectors = np.linalg.eigh(inverse)
+    values = np.maximum(values, 0.0)
+    floor = (damping * values[-1]) ** 2
+    if floor == 0.0:
+        return vectors @ np.diag(1.0 / values) @ vectors.T
+    return vectors @ np.diag(values / (values**2 + floor)) @ vectors.T
+
+
+@dataclass
+class _FrameState:
+    """A frame's pose, Jacobian and ``J̇ v`` at one state (world-aligned axes)."""
+
+    position: np.ndarray  # (3,) [m]
+    rotation: np.ndarray  # (3, 3)
+    jacobian: np.ndarray  # (6, nv): linear rows, then angular
+    bias: np.ndarray  # (6,): classical linear [m/s²], angular [rad/s²]
+
+
+def _frame_state(robot: Robot, frame_id: int, q: np.ndarray, v: np.ndarray) -> _FrameState:
+    model, data = robot.model, robot.data
+    pin.computeJointJacobians(model, data, q)
+    pin.forwardKinematics(model, data, q, v, np.zeros(robot.nv))
+    placement = pin.updateFramePlacement(model, data, frame_id)
+    jacobian = pin.getFrameJacobian(model, data, frame_id, pin.LOCAL_WORLD_ALIGNED)
+    bias = pin.getFrameClassicalAcceleration(model, data, frame_id, pin.LOCAL_WORLD_ALIGNED).vector
+    return _FrameState(placement.translation.copy(), placement.rotation.copy(), jacobian.copy(), bias.copy())
+
+
+def _reference(position: np.ndarray | TaskReference, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(x_d, ẋ_d, ẍ_d) at a time, each shape (3,)."""
+    if callable(position):
+        x_d, dx_d, ddx_d = position(t)
+        return np.asarray(x_d, float), np.asarray(dx_d, float), np.asarray(ddx_d, float)
+    return position, np.zeros(3), np.zeros(3)
+
+
+def _checked_position(robot: Robot, frame: str, position: np.ndarray | TaskReference) -> np.ndarray | TaskReference:
+    """The target position (checked, as floats) or the reference function (its start checked)."""
+    start = _reference(position, 0.0)[0] if callable(position) else np.asarray(position, dtype=float)
+    if start.shape != (3,) or not np.isfinite(start).all():
+        raise InputError(
+            "position", "3 finite values X, Y, Z in [m] (or a function of time returning them)", f"shape {start.shape}"
+        )
+    check_reach(robot, frame, start, parameter="position")
+    return position if callable(position) else start
+
+
+@dataclass
+class OperationalSpace:
+    """Khatib's operational-space control of a frame's position or pose.
+
+    Attributes:
+        model: The controller's model of the robot.
+        frame: The controlled frame; ``None`` for the model's default end effector.
+        position: Target position of the frame's origin in [m], world axes, shape (3,), or a
+            function of time ``t -> (x_d, ẋ_d, ẍ_d)`` for a path (its start is checked).
+        orientation: Target attitude (rotation matrix, quaternion ``(x, y, z, w)`` or
+            roll-pitch-yaw in [rad]); ``None`` controls the position only.
+        kp: Task stiffness in [1/s²]. kd: Task damping in [1/s].
+        posture: A configuration (nq,) the arm is drawn toward in the task's null space;
+            ``None`` for damping alone there.
+        posture_kp: Posture stiffness in [1/s²]. posture_kd: Posture damping in [1/s]
+            (also applied without a posture, so that a redundant arm comes to rest).
+        damping: Damping of ``Λ`` relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
+
+    Raises:
+        FrameError: Unknown frame, or one no joint moves.
+        InputError: A bad position or orientation, a target outside the frame's reach, a
+            posture of the wrong size.
+    """
+
+    model: Robot
+    frame: str | None
+    position: np.ndarray | TaskReference
+    _: KW_ONLY
+    orientation: np.ndarray | None = None
+    kp: float = 100.0
+    kd: float = 20.0
+    posture: np.ndarray | None = None
+    posture_kp: float = 25.0
+    posture_kd: float = 10.0
+    damping: float = TASK_DAMPING
+    _frame_id: int = field(init=False, repr=False)
+    _rotation: np.ndarray | None = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.frame = self.model.task_frame(self.frame, "operational-space control")
+        self._frame_id = self.model.frame_id(self.frame)
+        self.position = _checked_position(self.model, self.frame, self.position)
+        self._rotation = None if self.orientation is None else target_rotation(self.orientation)
+        if self.posture is not None:
+            (self.posture,), _ = self.model.validate(q=self.posture)
+            if self.posture.ndim != 1:
+                raise InputError("posture", f"one configuration ({self.model.nq} values)", f"shape {self.posture.shape}")
+
+    def task_error(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The task error ``e`` and its rate ``ė`` (position in [m], [m/s], then orientation
+        in [rad], [rad/s] with an orientation target), each shape (3,) or (6,)."""
+        state = _frame_state(self.model, self._frame_id, q, v)
+        error, rate, _ = self._error(t, state, v)
+        return error, rate
+
+    def _error(self, t: float, state: _FrameState, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``e``, ``ė`` and the task acceleration ``ẍ*`` that gives ``ë = −Kd ė − Kp e``."""
+        x_d, dx_d, ddx_d = _reference(self.position, t)
+        velocity = state.jacobian @ v
+        error, rate = x_d - state.position, dx_d - velocity[:3]
+        command = ddx_d + self.kd * rate + self.kp * error
+        if self._rotation is None:
+            return error, rate, command
+        # φ = log(R_dᵀ R) = −e_o moves as φ̇ = Jr⁻¹(φ) ω_b with the body angular velocity
+        # ω_b = Rᵀ ω, so φ̈ = Jr⁻¹ ω̇_b + (d Jr⁻¹/dt) ω_b: solve for the ω̇ = R ω̇_b that
+        # gives ë_o = −Kd ė_o − Kp e_o.
+        angle_error = orientation_error(state.rotation, self._rotation)
+        body = state.rotation.T @ velocity[3:]
+        inverse_jacobian = _log_jacobian(-angle_error)
+        angle_rate = -inverse_jacobian @ body
+        wanted = -self.kd * angle_rate - self.kp * angle_error
+        rate_term = _log_jacobian_rate(-angle_error, -angle_rate) @ body
+        body_acceleration = np.linalg.solve(inverse_jacobian, -wanted - rate_term)
+        angular = state.rotation @ body_acceleration
+        return np.concatenate([error, angle_error]), np.concatenate([rate, angle_rate]), np.concatenate([command, angular])
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        model = self.model
+        state = _frame_state(model, self._frame_id, q, v)
+        rows = 3 if self._rotation is None else 6
+        jacobian, bias = state.jacobian[:rows], state.bias[:rows]
+        _, _, command = self._error(t, state, v)
+        mass = model.mass_matrix(q)
+        mass_inv_jt = np.linalg.solve(mass, jacobian.T)
+        inertia = damped_task_inertia(jacobian @ mass_inv_jt, self.damping)
+        null_space = np.eye(model.nv) - mass_inv_jt @ inertia @ jacobian  # N = I − J̄ J
+        posture_error = np.zeros(model.nv) if self.posture is None else pin.difference(model.model, q, self.posture)
+        posture = mass @ (self.posture_kp * posture_error - self.posture_kd * v)
+        task = jacobian.T @ (inertia @ (command - bias))
+        return task + model.nonlinear_effects(q, v) + null_space.T @ posture
+
+
+def _gains(value: float | np.ndarray | list[float], rows: int, name: str, units: str) -> np.ndarray:
+    """Impedance gains as a (rows,) array: a scalar, ``rows`` values, or 6 when ``rows`` is 3
+    (the rotational three unused)."""
+    gains = np.asarray(value, dtype=float)
+    if gains.ndim == 0:
+        gains = np.full(rows, float(gains))
+    elif gains.shape == (6,) and rows == 3:
+        gains = gains[:3]
+    if gains.shape != (rows,) or not (np.isfinite(gains).all() and (gains >= 0).all()):
+        raise InputError(name, f"a non-negative scalar or {rows} values ({units})", f"{np.asarray(value).size} values")
+    return gains
+
+
+@dataclass
+class Impedance:
+    """Cartesian impedance with gravity compensation: the frame as a spring–damper.
+
+    Attributes:
+        model: The controller's model of the robot.
+        frame: The controlled frame; ``None`` for the model's default end effector.
+        position: Rest position of the frame's origin in [m], world axes, shape (3,).
+        orientation: Rest attitude (as for :class:`OperationalSpace`); ``None`` leaves the
+            attitude free (only the first three stiffness and damping values are used).
+        stiffness: ``K``: [N/m] along x, y, z, then [N m/rad] about them (scalar, (3,)
+            or (6,)).
+        damping: ``D``: [N s/m], then [N m s/rad].
+        null_damping: ``d₀`` in [N m s/rad] (or [N s/m]): damps the joint motion the task
+            leaves free; zero at rest.
+
+    Raises:
+        FrameError: Unknown frame, or one no joint moves.
+        InputError: Bad position, orientation or gains; a target outside the frame's reach.
+    """
+
+    model: Robot
+    frame: str | None
+    position: np.ndarray
+    _: KW_ONLY
+    orientation: np.ndarray | None = None
+    stiffness: float | np.ndarray = field(default_factory=lambda: np.array([500.0] * 3 + [50.0] * 3))
+    damping: float | np.ndarray = field(default_factory=lambda: np.array([50.0] * 3 + [5.0] * 3))
+    null_damping: float = 1.0
+    _frame_id: int = field(init=False, repr=False)
+    _rotation: np.ndarray | None = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.frame = self.model.task_frame(self.frame, "impedance control")
+        self._frame_id = self.model.frame_id(self.frame)
+        position = _checked_position(self.model, self.frame, self.position)
+        if callable(position):
+            raise InputError("position", "a fixed rest position X, Y, Z in [m]", "a function")
+        self.position = position
+        self._rotation = None if self.orientation is None else target_rotation(self.orientation)
+        rows = 3 if self._rotation is None else 6
+        self.stiffness = _gains(self.stiffness, rows, "stiffness", "[N/m], then [N m/rad]")
+        self.damping = _gains(self.damping, rows, "damping", "[N s/m], then [N m s/rad]")
+
+    def deflection(self, q: np.ndarray) -> np.ndarray:
+        """The frame's displacement from rest: position in [m], then (with an orientation)
+        the rotation from rest as a rotation vector in world axes, in [rad]; shape (3,)
+        or (6,). A steady external wrench ``F`` at the frame makes it ``K⁻¹ F``."""
+        state = _frame_state(self.model, self._frame_id, q, np.zeros(self.model.nv))
+        shift = state.position - np.asarray(self.position)
+        if self._rotation is None:
+            return shift
+        return np.concatenate([shift, -state.rotation @ orientation_error(state.rotation, self._rotation)])
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        model = self.model
+        state = _frame_state(model, self._frame_id, q, v)
+        rows = 3 if self._rotation is None else 6
+        jacobian = state.jacobian[:rows]
+        error = np.asarray(self.position) - state.position
+        if self._rotation is not None:  # the spring's torque about the world axes
+            error = np.concatenate([error, state.rotation @ orientation_error(state.rotation, self._rotation)])
+        wrench = self.stiffness * error - self.damping * (jacobian @ v)
+        gram = jacobian @ jacobian.T + PSEUDO_INVERSE_DAMPING * np.eye(rows)
+        null_space = np.eye(model.nv) - jacobian.T @ np.linalg.solve(gram, jacobian)
+        return model.gravity(q) + jacobian.T @ wrench - null_space.T @ (self.null_damping * v)
