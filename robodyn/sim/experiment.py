@@ -16,12 +16,12 @@ from typing import Literal
 
 import numpy as np
 
-from robodyn.dynamics import frames
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
+from robodyn.sim.reach import check_reach
 from robodyn.sim.report import SimulationSummary, TaskOutcome
 from robodyn.sim.simulation import Engine, Integrator, simulate
 from robodyn.trajectory import Trajectory
@@ -144,7 +144,7 @@ def _control_law(
         assert target is not None  # checked by _check_request
         task = task_target(target)
         controlled = robot.task_frame(frame, "task-space control")
-        _check_reach(robot, controlled, task)
+        check_reach(robot, controlled, task, parameter="target")
         law = TaskSpace(controller_model(robot), controlled, task)
     given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
     if controller in ("pd", "computed-torque") and given != robot.nq:
@@ -157,20 +157,3 @@ def _task_outcome(robot: Robot, trajectory: Trajectory, frame: str, task: np.nda
     position = robot.frame_position(trajectory.q[-1], frame)
     error = float(np.linalg.norm(position - task))
     return TaskOutcome(frame, tuple(task.tolist()), tuple(position.tolist()), error, error < REACHED)
-
-
-def _check_reach(robot: Robot, frame: str, target: np.ndarray) -> None:
-    """Refuse a task target no configuration can reach (outside the chain's reach ball)."""
-    lower, upper = robot.physical_limits()
-    ball = frames.reach(robot.model, robot.frame_id(frame), lower, upper)
-    if ball is None:
-        return
-    centre, radius = ball
-    distance = float(np.linalg.norm(target - np.asarray(centre)))
-    if distance > radius:
-        where = ", ".join(f"{c:.3g}" for c in centre)
-        raise InputError(
-            "target",
-            f"within the reach of {frame!r} ({radius:.3f} m of its first joint at ({where}) m)",
-            f"a point {distance:.3f} m away",
-        )

@@ -32,7 +32,7 @@ import numpy as np
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
-from robodyn.sim.trajectory import Trajectory
+from robodyn.trajectory import Trajectory
 
 #: How the recorded motor torque acted between two samples.
 TorqueMode = Literal["held", "sampled"]

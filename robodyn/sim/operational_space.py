@@ -36,9 +36,9 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.common.rotations import rpy_matrix, skew
-from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.reach import check_reach
 
 #: Damping of the task inertia, relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
 TASK_DAMPING = 1e-8
@@ -121,36 +121,6 @@ def _log_coefficients(theta: float) -> tuple[float, float]:
     c = 1 / theta**2 - cot / (2 * theta)
     c_prime = -2 / theta**3 + cot / (2 * theta**2) + 1 / (4 * theta * np.sin(theta / 2) ** 2)
     return float(c), float(c_prime / theta)
-
-
-def check_reach(robot: Robot, frame: str, target: np.ndarray, *, parameter: str) -> None:
-    """Refuse a target position no configuration can reach (outside the chain's reach ball).
-
-    The ball is :func:`robodyn.dynamics.frames.reach` (an upper bound of the workspace:
-    what it refuses is certainly out of reach).
-
-    Args:
-        robot: The robot.
-        frame: The controlled frame.
-        target: Position in [m], shape (3,).
-        parameter: The argument's name, for the message.
-
-    Raises:
-        InputError: If the target lies outside the ball.
-    """
-    lower, upper = robot.physical_limits()
-    ball = frames.reach(robot.model, robot.frame_id(frame), lower, upper)
-    if ball is None:
-        return
-    centre, radius = ball
-    distance = float(np.linalg.norm(target - np.asarray(centre)))
-    if distance > radius:
-        where = ", ".join(f"{c:.3g}" for c in centre)
-        raise InputError(
-            parameter,
-            f"within the reach of {frame!r} ({radius:.3f} m of its first joint at ({where}) m)",
-            f"a point {distance:.3f} m away",
-        )
 
 
 def damped_task_inertia(inverse: np.ndarray, damping: float) -> np.ndarray:
