@@ -92,15 +92,18 @@ def warn(lines: Sequence[str]) -> None:
 
 
 class Progress:
-    """A progress bar on stderr, shown once a derivation takes more than ``DELAY`` seconds."""
+    """A progress bar on stderr, shown once a derivation takes more than ``DELAY`` seconds,
+    and only when stderr is a terminal: redraws with ``\\r`` would clutter a captured log
+    (CI, a file), so there nothing is written and an error stays alone on stderr."""
 
     DELAY = 0.5
 
     def __init__(self, label: str) -> None:
         self._label, self._start, self._shown = label, time.monotonic(), False
+        self._terminal = _is_terminal(sys.stderr)
 
     def __call__(self, stage: str, done: int, total: int) -> None:
-        if time.monotonic() - self._start < self.DELAY and not self._shown:
+        if not self._terminal or (time.monotonic() - self._start < self.DELAY and not self._shown):
             return
         self._shown = True
         filled = int(20 * done / max(total, 1))
@@ -110,6 +113,14 @@ class Progress:
     def close(self) -> None:
         if self._shown:
             sys.stderr.write("\n")
+
+
+def _is_terminal(stream: object) -> bool:
+    isatty = getattr(stream, "isatty", None)
+    try:
+        return bool(isatty()) if callable(isatty) else False
+    except (OSError, ValueError):  # a closed stream
+        return False
 
 
 # --------------------------------------------------------------------------------------

@@ -16,17 +16,26 @@ positions within ``[lower + margin, upper − margin]`` (``margin`` a fraction o
 :func:`robodyn.ident.base.joint_ranges`: unlimited joints are kept within [−π, π]). The objective is ``log cond(W_b)``, the
 condition number of the base regressor stacked at ``objective_points`` instants, minimised
 by scipy's SLSQP from a random feasible start.
+
+The result is the best *feasible* point the optimiser visited (its start included):
+SLSQP's last point may break a limit even when earlier iterates did not, so every iterate
+is kept and the one with the lowest condition number among those within the limits is
+returned. When none improves on the start (``Excitation.improved`` is false) a one-line
+:class:`ExcitationNotImprovedWarning` says so; the trajectory is then the random start,
+within the limits but not optimised (more ``iterations``, another ``seed`` or fewer
+``harmonics`` may help).
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import IdentificationError, InputError
+from robodyn.exceptions import IdentificationError, InputError, RobodynWarning
 from robodyn.ident.base import BaseParameters, base_parameters, joint_ranges
 
 #: Velocity and acceleration limits used when the URDF gives none, in [rad/s] or [m/s]
@@ -36,6 +45,12 @@ DEFAULT_ACCELERATION = 5.0
 #: The constraints at the sampled instants use this fraction of the limits, so that the
 #: motion between them stays within the limits (checked on a 10x finer grid).
 SAFETY = 0.99
+#: A point counts as within the linear limits when it breaks none by more than this.
+FEASIBLE = 1e-9
+
+
+class ExcitationNotImprovedWarning(RobodynWarning):
+    """The optimiser found no feasible point better conditioned than its random start."""
 
 
 @dataclass(frozen=True)
@@ -51,6 +66,8 @@ class Excitation:
         condition: ``cond(W_b)`` at the objective points.
         initial_condition: The same for the start of the optimisation.
         velocity_limit, acceleration_limit: The limits respected, shape (nv,).
+        improved: Whether the optimiser improved on its start (false: the trajectory is
+            the unoptimised random start).
     """
 
     robot: str
@@ -63,6 +80,7 @@ class Excitation:
     initial_condition: float
     velocity_limit: np.ndarray
     acceleration_limit: np.ndarray
+    improved: bool = True
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``q, v, a`` at times ``t`` (M,), each (M, nv)."""
@@ -198,22 +216,45 @@ def excite(
     if not (room > 0).all():
         raise IdentificationError(robot.name, "the joint limits leave no room for motion")
     x0[nv:] *= 0.5 * float(np.min(room / np.maximum(moving, 1e-300), initial=np.inf, where=moving > 0))
-    initial = float(np.exp(log_condition(x0)))
+    initial = log_condition(x0)
+    visited = [x0]
     result = scipy.optimize.minimize(
         log_condition,
         x0,
         method="SLSQP",
         constraints=[{"type": "ineq", "fun": lambda x: b - A @ x, "jac": lambda x: -A}],
         options={"maxiter": iterations, "ftol": 1e-6},
+        callback=lambda xk: visited.append(np.array(xk, dtype=float)),
     )
-    x = result.x if np.all(b - A @ result.x >= -1e-9) else x0
+    visited.append(np.asarray(result.x, dtype=float))
+    x, best = _best_feasible(visited, lambda x: bool(np.all(b - A @ x >= -FEASIBLE)), log_condition)
+    improved = best < initial
+    if not improved:
+        warnings.warn(
+            f"{robot.name}: the optimiser found nothing better conditioned than its random start in {iterations} "
+            "iterations; the excitation is that start, not optimised (try another seed or more iterations)",
+            ExcitationNotImprovedWarning,
+            stacklevel=2,
+        )
     offset, sine, cosine = _unpack(x, nv, harmonics)
     excitation = Excitation(
         robot.name, list(robot.joint_names), float(duration), offset, sine, cosine,
-        float(np.exp(log_condition(x))), initial, v_max, a_max,
+        float(np.exp(best)), float(np.exp(initial)), v_max, a_max, improved,
     )  # fmt: skip
     _check_limits(robot, excitation, lower, upper)
     return excitation
+
+
+def _best_feasible(visited: list[np.ndarray], feasible, objective) -> tuple[np.ndarray, float]:
+    """The feasible point of ``visited`` (the start first, then the iterates) with the
+    lowest objective, and that value; the start wins ties."""
+    best_x, best = visited[0], objective(visited[0])
+    for x in visited[1:]:
+        if np.all(np.isfinite(x)) and feasible(x):
+            value = objective(x)
+            if value < best:
+                best_x, best = x, value
+    return best_x, best
 
 
 def _check_limits(robot: Robot, excitation: Excitation, lower, upper) -> None:
@@ -234,4 +275,4 @@ def _check_limits(robot: Robot, excitation: Excitation, lower, upper) -> None:
             )
 
 
-__all__ = ["Excitation", "excite"]
+__all__ = ["Excitation", "ExcitationNotImprovedWarning", "excite"]

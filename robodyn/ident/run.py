@@ -144,6 +144,7 @@ class ExcitationRun:
             "harmonics": self.harmonics,
             "condition_number": excitation.condition,
             "initial_condition_number": excitation.initial_condition,
+            "improved": excitation.improved,
             "samples": self.samples,
             "rate_hz": self.rate,
             "out": self.out,
@@ -152,12 +153,18 @@ class ExcitationRun:
     def text(self) -> str:
         """What ``robodyn excite`` prints: the base parameters, the conditioning, the file."""
         excitation = self.excitation
+        conditioning = (
+            f"condition number of the stacked base regressor: {excitation.condition:.4g} "
+            f"(start {excitation.initial_condition:.4g})"
+            if excitation.improved
+            else f"not optimised: no point better than the random start was found; its condition number "
+            f"{excitation.condition:.4g}"
+        )
         return "\n".join(
             [
                 f"{printable(excitation.robot)}: {self.base_count} base parameters; "
                 f"excitation of {excitation.period:g} s, {self.harmonics} harmonics",
-                f"condition number of the stacked base regressor: {excitation.condition:.4g} "
-                f"(start {excitation.initial_condition:.4g})",
+                conditioning,
                 f"wrote {self.out} ({self.samples} samples at {self.rate:g} Hz)",
             ]
         )

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import io
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TextIO
@@ -147,7 +148,9 @@ def _read_csv(path: Path) -> tuple[np.ndarray, Layout, str]:
     with path.open(encoding="utf-8") as stream:
         names, robot, _ = read_csv_header(stream, source)
         try:
-            table = np.loadtxt(stream, delimiter=",", ndmin=2)
+            with warnings.catch_warnings():  # numpy's "input contained no data": the error below says it
+                warnings.simplefilter("ignore")
+                table = np.loadtxt(stream, delimiter=",", ndmin=2)
         except ValueError as error:
             raise TrajectoryError(source, f"a row is not a list of numbers ({error})") from None
     if table.size == 0:

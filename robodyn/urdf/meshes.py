@@ -4,8 +4,10 @@ A URDF's ``<mesh filename=...>`` may be ``package://NAME/...`` (resolved under t
 folders, e.g. example-robot-data's share folder), ``file://...``, absolute, or relative
 to the URDF file's folder. :func:`resolve_mesh` finds the file and refuses any path that
 leaves those folders (``../``, absolute paths elsewhere): a URDF must not make robodyn
-read arbitrary files. A mesh that is simply missing is a warning; the model still loads
-(only drawings need meshes). This module does not import Pinocchio.
+read arbitrary files. A mesh inside those folders that cannot be drawn — missing, or not a
+regular file (a FIFO, a device, a directory) — is a warning: the model still loads (only
+drawings need meshes) and drawings show a placeholder box (``robodyn.viz.mesh_files``
+refuses it without opening it). This module does not import Pinocchio.
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ def _inside(path: Path, folder: Path) -> bool:
 
 
 def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> Path | None:
-    """The file a mesh path names, or ``None`` if it cannot be found.
+    """The file a mesh path names (which may not be a regular file: see
+    :func:`is_regular_file`), or ``None`` if it cannot be found.
 
     Args:
         filename: The ``filename`` attribute of a ``<mesh>``.
@@ -37,8 +40,7 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
         package_dirs: Folders holding the packages ``package://`` names.
 
     Raises:
-        MeshPathError: If the path leaves the URDF's folder or the package folders, or
-            names something that is not a regular file (a FIFO, a device).
+        MeshPathError: If the path leaves the URDF's folder or the package folders.
     """
     roots = [Path(d) for d in package_dirs] + ([Path(base_dir)] if base_dir is not None else [])
     if filename.startswith("package://"):
@@ -48,7 +50,7 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
             candidate = Path(folder) / relative
             if not _inside(candidate, Path(folder) / package):
                 raise MeshPathError(filename, f"leaves its package {package!r}")
-            if _regular(candidate, filename):
+            if _exists(candidate):
                 return candidate
         return None
     if filename.startswith("file://"):
@@ -63,19 +65,27 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
             raise MeshPathError(filename, "leaves the URDF's folder")
     if not any(_inside(candidate, root) for root in roots):
         raise MeshPathError(filename, "is outside the URDF's folder and package folders")
-    return candidate if _regular(candidate, filename) else None
+    return candidate if _exists(candidate) else None
 
 
-def _regular(candidate: Path, filename: str) -> bool:
-    """Whether the mesh file exists (``False`` if not); refuses a FIFO, a device or a
-    directory (through symlinks), which reading would block on or never finish."""
+def _mode(candidate: Path) -> int | None:
+    """The file's mode through symlinks (``os.stat`` never opens it, so a FIFO cannot
+    block), or ``None`` if it is missing or its name impossible."""
     try:
-        mode = os.stat(candidate).st_mode
+        return os.stat(candidate).st_mode
     except (OSError, ValueError):  # missing, a name too long, a NUL byte
-        return False
-    if not stat.S_ISREG(mode):
-        raise MeshPathError(filename, "is not a regular file (a FIFO, device or directory)")
-    return True
+        return None
+
+
+def _exists(candidate: Path) -> bool:
+    return _mode(candidate) is not None
+
+
+def is_regular_file(path: Path) -> bool:
+    """Whether ``path`` is a regular file (not a FIFO, a device or a directory, which
+    reading would block on or never finish), following symlinks."""
+    mode = _mode(path)
+    return mode is not None and stat.S_ISREG(mode)
 
 
 def mesh_problems(root: ET.Element, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:
@@ -96,4 +106,9 @@ def mesh_problems(root: ET.Element, *, base_dir: Path | None, package_dirs: Sequ
                     continue
                 if found is None:
                     problems.append((where, f"{kind} mesh {filename!r} not found (the model loads without it)", "warning"))
+                elif not is_regular_file(found):
+                    problems.append(
+                        (where, f"{kind} mesh {filename!r} is not a regular file (a FIFO, device or directory): "
+                         "the model loads without it, drawings show a placeholder box", "warning")
+                    )  # fmt: skip
     return problems

@@ -133,6 +133,7 @@ def normalised_urdf(spec: URDFSpec) -> tuple[str, dict[str, str]]:
             continue
         ET.SubElement(node, "axis", xyz=_numbers(joint.axis))
         lower, upper = (-UNBOUNDED, UNBOUNDED) if joint.type == "continuous" else (joint.lower, joint.upper)
+        lower, upper = max(lower, -UNBOUNDED), min(upper, UNBOUNDED)  # no limit (lower > upper in the URDF)
         ET.SubElement(
             node,
             "limit",

@@ -15,7 +15,10 @@ Conventions enforced here and relied on downstream:
       positive semi-definite inertia (tolerance relative to the body's scale); breaking
       the triangle inequality is a loud warning (:class:`~robodyn.exceptions.RobodynWarning`),
       an error with ``strict=True``;
-    - a ``<mimic>`` of a joint that does not exist is dropped with a loud warning.
+    - a ``<mimic>`` of a joint that does not exist is dropped with a loud warning;
+    - a revolute or prismatic joint with ``lower > upper`` (Bullet's encoding of an
+      unlimited joint, e.g. pybullet_data's cube_no_rotation.urdf) has no position limit,
+      with a loud warning.
 
 The pieces live in :mod:`robodyn.urdf.xmltext` (XML and numbers), :mod:`robodyn.urdf.spec`
 (the result types) and :mod:`robodyn.urdf.inertias` (mass properties).
@@ -190,8 +193,8 @@ def _read_placement(
 
 
 def _read_limits(reader: _Reader, where: str, node: ET.Element, joint_type: str) -> tuple[float, float, float, float] | None:
-    """A joint's ``(lower, upper, effort, velocity)`` limits (±inf where not given), or
-    ``None`` for a revolute or prismatic joint without a finite, ordered range."""
+    """A joint's ``(lower, upper, effort, velocity)`` limits (±inf where not given, and for
+    ``lower > upper``), or ``None`` for a revolute or prismatic joint without finite limits."""
     limit = node.find("limit")
     lower, upper = -math.inf, math.inf
     effort = reader.number(where, limit, "effort", math.inf, bounded=False)
@@ -205,9 +208,13 @@ def _read_limits(reader: _Reader, where: str, node: ET.Element, joint_type: str)
         if not (math.isfinite(lower) and math.isfinite(upper)):
             reader.error(where, f"limits [{lower}, {upper}] must be finite")
             return None
-        if lower > upper:
-            reader.error(where, f"lower limit {lower} is above upper limit {upper}")
-            return None
+        if lower > upper:  # Bullet's (and urdfdom's) encoding of a joint without a position limit
+            reader.warn(
+                where,
+                f"lower limit {lower} is above upper limit {upper}: read as no position limit (Bullet's encoding)",
+                loud=True,
+            )
+            lower, upper = -math.inf, math.inf
     for label, value in (("effort", effort), ("velocity", velocity)):
         if value is not None and value < 0:
             reader.error(where, f"{label} limit {value} must not be negative")
@@ -323,7 +330,7 @@ def lint_urdf(
         check_inertia: If false, physically impossible inertias of moving links are
             warnings instead of errors (some published URDFs have them).
         strict: Loud warnings (an inertia breaking the triangle inequality, a mimic of a
-            joint that does not exist) are errors.
+            joint that does not exist, ``lower > upper`` read as no limit) are errors.
         base_dir: Folder of the URDF file, for relative mesh paths.
         package_dirs: Folders under which ``package://`` mesh paths resolve.
 

@@ -78,7 +78,6 @@ CASES: dict[str, tuple[str, str]] = {
     "planar_joint": (sub('type="prismatic"', 'type="planar"'), "planar joints inside a URDF are not supported"),
     "revolute_without_limit": (sub(JOINT1_LIMIT, ""), "a revolute joint needs a <limit> element"),
     "prismatic_without_limit": (sub(JOINT2_LIMIT, ""), "a prismatic joint needs a <limit> element"),
-    "limits_reversed": (sub('lower="0.0" upper="0.3"', 'lower="0.3" upper="0.0"'), "lower limit 0.3 is above upper limit 0.0"),
     "nan_limit": (sub('lower="0.0" upper="0.3"', 'lower="nan" upper="0.3"'), "lower='nan' is not a number"),
     "infinite_limit": (sub('lower="0.0" upper="0.3"', 'lower="0.0" upper="inf"'), "limits [0.0, inf] must be finite"),
     "negative_effort": (

@@ -1,0 +1,88 @@
+"""Foreign encodings the validator reads as urdfdom and Pinocchio do (issue 29, item 4)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn import reference
+from robodyn.cli import main
+from robodyn.exceptions import RobodynWarning, URDFError
+
+# pybullet_data's cube_no_rotation.urdf writes an unlimited slider as lower 1, upper -1.
+BULLET_SLIDER = """<?xml version="1.0"?>
+<robot name="bullet_slider">
+  <link name="base"/>
+  <link name="cube">
+    <inertial><origin xyz="0 0 0.1"/><mass value="1.0"/>
+      <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+  </link>
+  <link name="arm">
+    <inertial><origin xyz="0.2 0 0"/><mass value="0.5"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial>
+  </link>
+  <joint name="slide" type="prismatic">
+    <parent link="base"/><child link="cube"/><axis xyz="1 0 0"/>
+    <limit lower="1" upper="-1" effort="50" velocity="2"/>
+  </joint>
+  <joint name="turn" type="revolute">
+    <parent link="cube"/><child link="arm"/><origin xyz="0 0 0.2"/><axis xyz="0 1 0"/>
+    <limit lower="0.5" upper="-0.5" effort="10" velocity="3"/>
+  </joint>
+</robot>
+"""
+
+
+@pytest.fixture
+def bullet_urdf(tmp_path):
+    path = tmp_path / "bullet_slider.urdf"
+    path.write_text(BULLET_SLIDER)
+    return path
+
+
+def test_lower_above_upper_loads_as_unlimited_with_one_line_warning_per_joint(bullet_urdf):
+    with pytest.warns(RobodynWarning) as caught:
+        robot = robodyn.load(bullet_urdf)
+    messages = [str(w.message) for w in caught if "Bullet" in str(w.message)]
+    assert len(messages) == 2 and all("\n" not in m and "strict" in m for m in messages)
+    assert any('"slide"' in m and "lower limit 1.0 is above upper limit -1.0" in m for m in messages)
+    lower, upper = robot.physical_limits()
+    assert np.all(np.isneginf(lower)) and np.all(np.isposinf(upper))
+    q = np.array([3.0, 2.5])  # far outside [1, -1] either way: no limit to break
+    v, a = np.array([0.2, -0.4]), np.array([0.1, 0.3])
+    expected = reference.load(bullet_urdf).inverse_dynamics(q, v, a)
+    np.testing.assert_allclose(robot.inverse_dynamics(q, v, a), expected, atol=1e-10)
+
+
+def test_lower_above_upper_is_refused_under_strict(bullet_urdf, capsys):
+    with pytest.raises(URDFError, match="lower limit 1.0 is above upper limit -1.0"):
+        robodyn.load(bullet_urdf, strict=True)
+    assert main(["info", str(bullet_urdf), "--strict"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+
+
+@pytest.mark.parametrize("kind", ["floating", "locked", "mimic"])
+def test_lower_above_upper_crosses_the_other_load_options(bullet_urdf, kind, tmp_path):
+    text = BULLET_SLIDER
+    options: dict = {}
+    if kind == "floating":
+        options["floating_base"] = True
+    elif kind == "locked":
+        options["lock"] = {"slide": 5.0}  # outside [1, -1]: no limit, so no refusal
+    else:
+        text = text.replace(
+            '<limit lower="0.5" upper="-0.5" effort="10" velocity="3"/>',
+            '<limit lower="0.5" upper="-0.5" effort="10" velocity="3"/><mimic joint="slide" multiplier="2"/>',
+        ).replace('type="revolute"', 'type="prismatic"')
+    path = tmp_path / "crossed.urdf"
+    path.write_text(text)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RobodynWarning)
+        robot = robodyn.load(path, **options)
+    lower, upper = robot.physical_limits()
+    assert lower.size and np.all(np.isneginf(lower)) and np.all(np.isposinf(upper))
+    with pytest.raises(URDFError, match="above upper limit"):
+        robodyn.load(path, strict=True, **options)
