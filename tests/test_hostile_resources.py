@@ -92,7 +92,7 @@ def test_a_mesh_that_is_a_fifo_loads_without_a_hang_and_a_link_to_a_device_is_an
             with no_hang():
                 assert robodyn.load(path).nv == 2
         else:
-            with no_hang(), pytest.raises(URDFError, match="outside|leaves"):
+            with no_hang(), pytest.raises(URDFError, match=r"outside|leaves"):
                 robodyn.load(path)
 
 

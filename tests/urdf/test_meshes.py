@@ -14,7 +14,9 @@ from robodyn.cli import main
 from robodyn.trajectory import Trajectory
 from robodyn.urdf.sources import lint_source
 
-STL_TRIANGLE = b"\0" * 80 + (1).to_bytes(4, "little") + np.array([0, 0, 1, 0, 0, 0, 0.1, 0, 0, 0, 0.1, 0], "<f4").tobytes() + b"\0\0"
+STL_TRIANGLE = (
+    b"\0" * 80 + (1).to_bytes(4, "little") + np.array([0, 0, 1, 0, 0, 0, 0.1, 0, 0, 0, 0.1, 0], "<f4").tobytes() + b"\0\0"
+)
 
 
 @pytest.fixture

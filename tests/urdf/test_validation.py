@@ -58,7 +58,7 @@ def test_lower_above_upper_loads_as_unlimited_with_one_line_warning_per_joint(bu
 
 
 def test_lower_above_upper_is_refused_under_strict(bullet_urdf, capsys):
-    with pytest.raises(URDFError, match="lower limit 1.0 is above upper limit -1.0"):
+    with pytest.raises(URDFError, match=r"lower limit 1\.0 is above upper limit -1\.0"):
         robodyn.load(bullet_urdf, strict=True)
     assert main(["info", str(bullet_urdf), "--strict"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
