@@ -145,6 +145,7 @@ def test_progress_goes_to_stderr_and_json_stays_clean(capsys, monkeypatch):
     import robodyn.cli.common as cli_common
 
     monkeypatch.setattr(cli_common.Progress, "DELAY", 0.0)
+    monkeypatch.setattr(cli_common, "_is_terminal", lambda stream: True)  # progress only on a terminal
     assert main(["equations", "ur5", "--symbolic", "--format", "json"]) == 0
     captured = capsys.readouterr()
     json.loads(captured.out)

@@ -130,6 +130,7 @@ def test_cli_progress_on_stderr_and_same_file_refused(tmp_path, driven, capsys, 
 
     driven.save(tmp_path / "m.npz")
     monkeypatch.setattr(Progress, "DELAY", 0.0)
+    monkeypatch.setattr("robodyn.cli.common._is_terminal", lambda stream: True)  # progress only on a terminal
     assert main(["torques", "panda", str(tmp_path / "m.npz"), "--chunk-rows", "100"]) == 0
     captured = capsys.readouterr()
     assert "torques: inverse dynamics" in captured.err and "301/301" in captured.err

@@ -156,6 +156,29 @@ def _path_points(robot: Robot, trajectory: Trajectory, frame: str, fps: float) -
     return positions, np.round((trajectory.t[::step] - trajectory.t[0]) * fps)
 
 
+#: Most animation frames a recording holds (about 55 minutes at 30 fps): each frame stores
+#: every link's pose, so a longer span × fps would exhaust memory before the page is written.
+MAX_FRAMES = 100_000
+
+
+def frame_count(trajectory: Trajectory, fps: float) -> int:
+    """Frames of the animation of ``trajectory`` at ``fps``: ``⌊span × fps⌋ + 1``.
+
+    Raises:
+        InputError: Naming ``trajectory`` when its time span × ``fps`` exceeds
+            :data:`MAX_FRAMES` (checked before anything is allocated).
+    """
+    span = float(trajectory.t[-1] - trajectory.t[0]) if len(trajectory) else 0.0
+    frames = span * fps
+    if not (np.isfinite(frames) and frames < MAX_FRAMES):
+        raise InputError(
+            "trajectory",
+            f"at most {MAX_FRAMES} animation frames (time span × fps; a lower fps or a shorter span)",
+            f"{span:g} s × {fps:g} fps = {frames:.3g} frames",
+        )
+    return int(np.floor(frames + 1e-9)) + 1
+
+
 def motion_commands(
     robot: Robot,
     trajectory: Trajectory,
@@ -175,6 +198,7 @@ def motion_commands(
         raise ViewerError(f"the trajectory has {trajectory.q.shape[-1]} coordinates a sample; {robot.name} needs {robot.nq}.")
     if not (np.isfinite(fps) and 0 < fps <= 240):
         raise ViewerError(f"fps must lie in (0, 240], got {fps}.")
+    frame_count(trajectory, fps)
     scene = build_scene(robot, max_mesh_bytes=max_mesh_bytes)
     if not scene.commands:
         raise ViewerError(f"robot {robot.name!r} has no visual geometry robodyn can draw: the recording would be empty.")

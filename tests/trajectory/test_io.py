@@ -81,3 +81,23 @@ def test_a_file_that_is_not_a_trajectory_is_refused_naming_it(tmp_path):
     broken.write_bytes(b"not a zip file")
     with pytest.raises(TrajectoryError, match=r"broken\.npz: not a readable trajectory"):
         read_table(broken)
+
+
+def test_a_csv_with_only_a_header_is_one_error_and_no_numpy_warning(tmp_path, capsys):
+    # Issue 29, item 8: numpy's "loadtxt: input contained no data" used to leak before the error.
+    import warnings
+
+    from robodyn.cli import main
+
+    path = tmp_path / "header_only.csv"
+    path.write_text("t,q[joint1],q[joint2]\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(TrajectoryError, match="no data rows"):
+            Trajectory.load(path)
+    assert caught == []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(["record", "rp_arm", "--trajectory", str(path), "--out", str(tmp_path / "m.html")]) == 2
+    err = capsys.readouterr().err
+    assert caught == [] and err.count("\n") == 1 and "no data rows" in err
