@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol, cast
 
@@ -84,6 +85,7 @@ def identify_run(
     *,
     method: Method = "ls",
     friction: bool = False,
+    bodies: Sequence[str] | None = None,
     out: str | os.PathLike | None = None,
     urdf_out: str | os.PathLike | None = None,
 ) -> IdentificationRun:
@@ -94,6 +96,11 @@ def identify_run(
         data: Measured ``q``, ``v``, ``a`` and ``tau`` (a trajectory with torques).
         method: ``"ls"``, ``"wls"`` or ``"physical"``.
         friction: Identify viscous and Coulomb friction per joint too.
+        bodies: Identify only these bodies (link names of
+            :func:`robodyn.dynamics.regressor.body_links`); the others are held at the
+            URDF's values. Default: every body. With ``urdf_out`` only these links'
+            ``<inertial>`` change; without it the physical fit may move mass between
+            links that the data cannot tell apart (e.g. when only a payload is unknown).
         out: Write the result as JSON to this file.
         urdf_out: With ``method="physical"``: write the identified URDF to this file.
 
@@ -104,7 +111,7 @@ def identify_run(
         raise InputError("urdf_out", "used with method 'physical' (only it gives consistent standard parameters)", method)
     if data.tau is None:
         raise InputError("data", "a trajectory with tau[<joint>] columns (the measured torques)", "none")
-    base = base_parameters(robot, friction=friction)
+    base = base_parameters(robot, friction=friction, bodies=None if bodies is None else list(bodies))
     result = identify(robot, cast(Samples, data), method=method, base=base)  # tau checked above
     urdf = identified_urdf(robot, result.standard, base.columns) if urdf_out and result.standard is not None else None
     if out:

@@ -74,3 +74,52 @@ def test_excite_run_writes_the_trajectory_its_text_and_json_describe(tmp_path):
     np.testing.assert_allclose(written.tau, robot.inverse_dynamics(written.q, written.v, written.a), atol=1e-9)
     assert run.to_dict()["base_parameters"] == run.base_count == base_parameters(robot).count
     assert f"{run.excitation.condition:.4g}" in run.text() and str(out) in run.text()
+
+
+def _payload_data(tmp_path, count: int = 150):
+    """The RP arm whose slider carries an unknown 0.6 kg payload: measured torques of the true
+    robot, written as a file; the nominal model and the true one."""
+    nominal = robodyn.load("rp_arm")
+    true_text = robodyn.rp_arm_urdf().replace('<mass value="1.0"/>', '<mass value="1.6"/>', 1)
+    assert true_text != robodyn.rp_arm_urdf()
+    true = robodyn.load(true_text)
+    rng = np.random.default_rng(11)
+    q = nominal.random_configuration(rng, count)
+    v, a = rng.normal(size=(2, count, nominal.nv))
+    path = tmp_path / "payload.csv"
+    Trajectory(np.arange(count) * 0.01, q, v, a, true.inverse_dynamics(q, v, a), list(nominal.joint_names), "rp_arm").save(path)
+    return nominal, true, path
+
+
+def _inertial_of(text: str, link: str) -> str:
+    import xml.etree.ElementTree as ET
+
+    node = next(n for n in ET.fromstring(text).findall("link") if n.get("name") == link)
+    return ET.tostring(node.find("inertial"), encoding="unicode")
+
+
+def test_identify_bodies_on_the_command_line_changes_only_those_links(tmp_path, capsys):
+    # Issue 29, item 11: the library's bodies= reached from the CLI, with --urdf-out.
+    nominal, true, path = _payload_data(tmp_path)
+    urdf_out = tmp_path / "identified.urdf"
+    command = ["identify", "rp_arm", str(path), "--method", "physical", "--bodies", "link2", "--urdf-out", str(urdf_out)]
+    assert main(command) == 0
+    printed = capsys.readouterr().out
+    assert "[link1]" not in printed and "m[link2]" in printed
+    written = urdf_out.read_text()
+    assert _inertial_of(written, "link1") == _inertial_of(_text(nominal), "link1")  # untouched
+    identified = robodyn.load(written)
+    assert identified.total_mass == pytest.approx(true.total_mass, rel=1e-6)
+    q = nominal.random_configuration(np.random.default_rng(3), 20)
+    np.testing.assert_allclose(identified.inverse_dynamics(q, 0 * q, 0 * q), true.inverse_dynamics(q, 0 * q, 0 * q), atol=1e-6)
+    run = identify_run(nominal, Trajectory.load(path).for_robot(nominal), method="ls", bodies=["link2"])
+    names = run.identification.base.names
+    assert names and all("[link2]" in name for name in names)
+    assert main(["identify", "rp_arm", str(path), "--bodies", "link9"]) == 2
+    assert "link1, link2" in capsys.readouterr().err
+
+
+def _text(robot) -> str:
+    import xml.etree.ElementTree as ET
+
+    return ET.tostring(robot.spec.xml, encoding="unicode")

@@ -16,11 +16,27 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--method", choices=["ls", "wls", "physical"], default="ls", help="estimator (default ls)")
     parser.add_argument("--friction", action="store_true", help="also identify viscous and Coulomb friction per joint")
     parser.add_argument("--out", help="write the result as JSON to this file")
-    parser.add_argument("--urdf-out", help="with --method physical: write the identified URDF to this file")
+    parser.add_argument(
+        "--urdf-out",
+        help="with --method physical: write the identified URDF to this file (every body's <inertial> is refitted "
+        "unless --bodies names the unknown ones; mass may move between links the data cannot tell apart)",
+    )
+    parser.add_argument(
+        "--bodies",
+        type=_links,
+        action="extend",
+        metavar="LINK[,LINK...]",
+        help="identify only these bodies (link names; e.g. the link that carries an unknown payload); "
+        "the others keep the URDF's values",
+    )
     parser.add_argument("--base-parameters", action="store_true", help="print the base parameters of the model and stop")
     parser.add_argument("--format", choices=["text", "latex", "json"], default="text", help="with --base-parameters")
     parser.add_argument("--lock", help="freeze joints: name=value,... (e.g. panda_finger_joint1=0)")
     parser.set_defaults(run=run)
+
+
+def _links(text: str) -> list[str]:
+    return [name.strip() for name in text.split(",") if name.strip()]
 
 
 def run(arguments: argparse.Namespace) -> int:
@@ -33,13 +49,15 @@ def run(arguments: argparse.Namespace) -> int:
         raise InputError("DATA", "a trajectory file (or --base-parameters)", "nothing")
     robot = load_robot(arguments)
     if arguments.base_parameters:
-        print(render_base_parameters(base_parameters(robot, friction=arguments.friction), arguments.format), end="")
+        base = base_parameters(robot, friction=arguments.friction, bodies=arguments.bodies)
+        print(render_base_parameters(base, arguments.format), end="")
         return 0
     run = identify_run(
         robot,
         Trajectory.load(arguments.data).for_robot(robot),
         method=arguments.method,
         friction=arguments.friction,
+        bodies=arguments.bodies,
         out=arguments.out,
         urdf_out=arguments.urdf_out,
     )
