@@ -204,7 +204,10 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         rows: :class:`robodyn.sim.whatif.Variant` rows (``peak``, ``rms`` shape (nv,)).
         joint_names: One name a column of ``peak``.
         units: ``"N m"`` (a torque) or ``"N"`` (a force) a column.
-        effort_limits: Effort limit a column (drawn as a dashed line when finite).
+        effort_limits: Effort limit a column, drawn as a dashed red line when finite. Each
+            axis is scaled to the bars; a limit within a quarter of that range above them
+            widens it, a limit far above them (a kuka's 300 N m over bars of 10 N m) is
+            named at the top edge instead, so the bars stay readable.
     """
     if len(joint_names) != len(units) or any(len(r.peak) != len(units) for r in rows):
         raise ViewerError(
@@ -224,8 +227,7 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         axis.bar(positions - 0.2, [r.peak[index] for r in rows], width=0.4, color="C0", label="peak |effort|")
         axis.bar(positions + 0.2, [r.rms[index] for r in rows], width=0.4, color="C1", label="RMS effort")
         limit = effort_limits[index] if effort_limits is not None else np.inf
-        if np.isfinite(limit):
-            axis.axhline(limit, color="red", linestyle="--", linewidth=1.0, label="effort limit")
+        _whatif_limit(axis, max([*(r.peak[index] for r in rows), *(r.rms[index] for r in rows)], default=0.0), limit, unit)
         axis.set_ylabel(f"{text_label(name)}\n{word} [{unit}]")
         axis.grid(axis="y", alpha=0.3)
     axes[-1].set_xticks(positions, labels, fontsize="small")
@@ -235,7 +237,7 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
             if label not in legend_labels:
                 handles.append(handle)
                 legend_labels.append(label)
-    figure.legend(handles, legend_labels, loc="outside right upper", fontsize="small")
+    figure.legend(handles, legend_labels, loc="outside right center", fontsize="small")
     figure.suptitle("What if: link material, payload and force, over one motion")
     for angle in (45, 90):  # crowded: one line a label, tilted
         if not any("tick" in a and "tick" in b for a, b in text_overlaps(figure)):
@@ -244,6 +246,23 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         for label in axes[-1].get_xticklabels():
             label.set(rotation=angle, horizontalalignment="right", rotation_mode="anchor")
     return figure
+
+
+def _whatif_limit(axis: Axes, top: float, limit: float, unit: str) -> None:
+    """Scale a what-if axis to its bars (highest ``top``) and draw the effort ``limit``:
+    a dashed line when near the bars, else a note at the top edge."""
+    top = float(top) if np.isfinite(top) and top > 0 else 1.0
+    near = np.isfinite(limit) and 0 < limit <= 1.25 * top
+    high = 1.08 * max(top, limit) if near else 1.15 * top
+    axis.set_ylim(0.0, high)
+    if near:
+        axis.axhline(limit, color="red", linestyle="--", linewidth=1.0, label="effort limit")
+    elif np.isfinite(limit) and limit > 0:
+        axis.plot([], [], color="red", linestyle="--", linewidth=1.0, label="effort limit")  # legend entry
+        axis.annotate(
+            f"limit {limit:g} {unit} (above)", xy=(1.0, 1.0), xycoords="axes fraction", xytext=(-4, -4),
+            textcoords="offset points", ha="right", va="top", color="red", fontsize="small",
+        )  # fmt: skip
 
 
 def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path, **options) -> Path | None:
