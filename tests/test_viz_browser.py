@@ -91,7 +91,15 @@ def test_border_check_fails_when_the_camera_is_too_close(monkeypatch):  # negati
     from robodyn.viz.scene import camera_commands
 
     robot, trajectory, _ = _panda_motion()
-    monkeypatch.setattr(module, "camera_commands", lambda points: camera_commands(points, margin=0.4))
+
+    def too_close(points):  # the camera moved to a third of its distance (it looks at the origin)
+        commands = camera_commands(points)
+        for command in commands:
+            if command.get("property") == "position":
+                command["value"] = [value / 3 for value in command["value"]]
+        return commands
+
+    monkeypatch.setattr(module, "camera_commands", too_close)
     close = recording(robot, trajectory)
     (frame,) = capture(close.html, [0.0], size=SIZE, hide=("Axes", "task", "Grid", "Background"))
     mask = robot_mask(frame)

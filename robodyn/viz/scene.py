@@ -262,28 +262,40 @@ def pose_commands(robot: Robot, q: np.ndarray) -> list[dict]:
 
 
 def camera_commands(points: np.ndarray, *, fov_deg: float = CAMERA_FOV, margin: float = 1.15) -> list[dict]:
-    """Aim meshcat's camera at the points' bounding sphere so that all of it is in view.
+    """Place meshcat's camera so that the points' bounding sphere is all in view.
 
-    The distance is ``margin × radius / sin(fov / 2)``: the sphere fits the vertical field
-    of view (the narrower one for a landscape picture). A motion in the x-z plane (a planar
-    arm) is seen from the side, anything else from a corner above. Meshcat's own grid is
-    hidden (the task grid replaces it).
+    Meshcat's orbit controls make the camera look at the *world origin* whatever its parent
+    node's transform, so the camera node stays at the origin and the camera is moved back
+    from the points' centre, along a fixed direction, until the whole sphere (times
+    ``margin``) lies within the vertical field of view (the narrower one for a landscape
+    picture) as seen looking at the origin. The points are the whole motion, the initial
+    pose included. A motion in the x-z plane (a planar arm) is seen from the side, anything
+    else from a corner above. Meshcat's own grid is hidden (the task grid replaces it).
     """
     low, high = points.min(axis=0), points.max(axis=0)
     centre = (low + high) / 2
     radius = max(float(np.linalg.norm(high - low)) / 2, 0.05)
-    distance = margin * radius / np.sin(np.radians(fov_deg) / 2)
+    half = np.radians(fov_deg) / 2
     span = high - low
     planar = span[1] < 0.25 * max(span[0], span[2])
-    direction = np.array([0.25, 0.35, 1.0] if planar else [0.8, 0.6, 0.8])
-    direction /= np.linalg.norm(direction)
-    target = np.eye(4)
-    target[:3, 3] = centre
-    # The camera node's frame is y-up: (x, y, z) here is (x, z, -y) in the world.
+    local = np.array([0.25, 0.35, 1.0] if planar else [0.8, 0.6, 0.8])
+    # The camera node's frame is y-up: (x, y, z) there is (x, -z, y) in the world.
+    direction = np.array([local[0], -local[2], local[1]]) / np.linalg.norm(local)
+    distance = margin * radius / np.sin(half)
+    for _ in range(400):  # at most 1.02^400 ≈ 2750 times farther
+        position = centre + distance * direction
+        to_centre = centre - position
+        length = float(np.linalg.norm(to_centre))
+        sight = -position / max(float(np.linalg.norm(position)), 1e-12)
+        off_axis = float(np.arccos(np.clip(sight @ to_centre / length, -1.0, 1.0)))
+        if off_axis + np.arcsin(min(1.0, margin * radius / length)) <= half:
+            break
+        distance *= 1.02
+    world = centre + distance * direction
     camera = MeshcatPath(("Cameras", "default", "rotated", "<object>"))
     return [
-        SetTransform(target, path=MeshcatPath(("Cameras", "default"))).lower(),
-        SetProperty("position", (distance * direction).tolist(), path=camera).lower(),
+        SetTransform(np.eye(4), path=MeshcatPath(("Cameras", "default"))).lower(),
+        SetProperty("position", [float(world[0]), float(world[2]), float(-world[1])], path=camera).lower(),
         SetProperty("fov", fov_deg, path=camera).lower(),
         SetProperty("visible", False, path=MeshcatPath(("Grid",))).lower(),
     ]
