@@ -205,7 +205,7 @@ def whatif_figure(rows, joint_names: list[str], units: list[str], *, effort_limi
         joint_names: One name a column of ``peak``.
         units: ``"N m"`` (a torque) or ``"N"`` (a force) a column.
         effort_limits: Effort limit a column, drawn as a dashed red line when finite. Each
-            axis is scaled to the bars; a limit within a quarter of that range above them
+            axis is scaled to the bars; a limit at most half again above the tallest bar
             widens it, a limit far above them (a kuka's 300 N m over bars of 10 N m) is
             named at the top edge instead, so the bars stay readable.
     """
@@ -252,7 +252,7 @@ def _whatif_limit(axis: Axes, top: float, limit: float, unit: str) -> None:
     """Scale a what-if axis to its bars (highest ``top``) and draw the effort ``limit``:
     a dashed line when near the bars, else a note at the top edge."""
     top = float(top) if np.isfinite(top) and top > 0 else 1.0
-    near = np.isfinite(limit) and 0 < limit <= 1.25 * top
+    near = np.isfinite(limit) and 0 < limit <= 1.5 * top
     high = 1.08 * max(top, limit) if near else 1.15 * top
     axis.set_ylim(0.0, high)
     if near:
