@@ -10,7 +10,7 @@ physically consistent inertial parameter identification", 2017). Here each selec
 gets a PSD 4×4 variable ``J`` and its parameters are read off linearly
 (``m = J₃₃``, ``h = J[:3, 3]``, ``Ī = tr(Σ) 1 − Σ``), so the constraints hold by construction.
 Friction coefficients are constrained non-negative. Requires cvxpy (``pip install
-robodyn[ident]``).
+'.[ident]'`` in robodyn's clone).
 """
 
 from __future__ import annotations
@@ -64,7 +64,9 @@ def physical_parameters(
     try:
         import cvxpy as cp
     except ImportError:
-        raise IdentificationError(base.robot.name, "the physical method needs cvxpy (pip install 'robodyn[ident]')") from None
+        raise IdentificationError(
+            base.robot.name, "the physical method needs cvxpy (pip install cvxpy, or '.[ident]' in robodyn's clone)"
+        ) from None
     count = w.shape[-1]
     matrix = (w * weights[..., None]).reshape(-1, count)
     rhs = (target * weights).reshape(-1)

@@ -224,7 +224,9 @@ def video_of_page(
     try:
         import imageio.v2 as imageio
     except ImportError:
-        raise ViewerError("videos need imageio: pip install 'robodyn[viewer]'.") from None
+        raise ViewerError(
+            "videos need imageio: pip install imageio imageio-ffmpeg (or '.[viewer]' in robodyn's clone)."
+        ) from None
     count = int(np.floor(duration * fps + 1e-9)) + 1
     if count > 3600:
         raise ViewerError(f"the video would have {count} frames (over 3600): lower the frame rate (fps=) or shorten the motion.")
@@ -237,7 +239,9 @@ def video_of_page(
                     scratch, fps=fps, codec="libx264", quality=8, pixelformat="yuv420p", macro_block_size=16
                 )
             except (ImportError, ValueError, RuntimeError) as error:
-                raise ViewerError(f"no MP4 writer ({error}): pip install 'robodyn[viewer]' (imageio-ffmpeg).") from None
+                raise ViewerError(
+                    f"no MP4 writer ({error}): pip install imageio-ffmpeg (or '.[viewer]' in robodyn's clone)."
+                ) from None
             with writer:
                 for frame in frames:
                     writer.append_data(frame)
