@@ -17,9 +17,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--target", type=vector, help="task-space: frame position X,Z or X,Y,Z in [m]; pd / computed-torque: joint target"
     )
     parser.add_argument(
-        "--frame",
-        help="controlled frame for task-space (default: the end effector 'robodyn info' shows; it must move); "
-        "the frame whose path --record draws",
+        "--frame", help="controlled frame for task-space (default: the end effector 'robodyn info' shows; it must move)"
     )
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
