@@ -37,6 +37,11 @@ def c_combination(terms: Iterable[tuple[float, str]]) -> str:
     return " + ".join(parts) if parts else "0.0"
 
 
+#: Precedence of printed C (higher binds tighter): a sum, a product, a negation, an atom
+#: (a symbol, a number, a call or anything parenthesised).
+_ADD, _MUL, _UNARY, _ATOM = 1, 2, 3, 4
+
+
 class CPrinter:
     """Prints expressions as C99 doubles, symbols by the given names.
 
@@ -50,28 +55,62 @@ class CPrinter:
 
     def expression(self, expr: sp.Expr) -> str:
         """C for one expression."""
-        expr = sp.sympify(expr)
+        return self._print(sp.sympify(expr))[0]
+
+    def _print(self, expr: sp.Expr) -> tuple[str, int]:
+        """C text and its precedence (:data:`_ADD` < :data:`_MUL` < :data:`_UNARY` < :data:`_ATOM`)."""
         if expr.is_Symbol:
-            return self.names.get(expr, str(expr))
+            return self.names.get(expr, str(expr)), _ATOM
         if expr.is_Integer or expr.is_Float:
-            return c_number(float(expr))
+            text = c_number(float(expr))
+            return text, _UNARY if text.startswith("-") else _ATOM
         if expr.is_Rational:
-            return f"({c_number(expr.p)}/{c_number(expr.q)})"
+            return f"({c_number(expr.p)}/{c_number(expr.q)})", _ATOM
         if expr.is_Add:
-            return "(" + " + ".join(self.expression(arg) for arg in expr.args) + ")"
+            return self._sum(expr.args), _ADD
         if expr.is_Mul:
-            return "(" + "*".join(self.expression(arg) for arg in expr.args) + ")"
+            return self._product(expr.args)
         if expr.is_Pow and expr.exp == 2:
-            base = self.expression(expr.base)
-            return f"({base}*{base})"
+            base = self._operand(expr.base, _ATOM)
+            return f"({base}*{base})", _ATOM
         if expr.is_Pow and expr.exp == -1:
-            return f"(1.0/{self.expression(expr.base)})"
+            return f"(1.0/{self._operand(expr.base, _MUL + 1)})", _ATOM
         if expr.is_Pow and expr.exp.is_Integer:
-            return f"pow({self.expression(expr.base)}, {int(expr.exp)})"
+            return f"pow({self.expression(expr.base)}, {int(expr.exp)})", _ATOM
         if isinstance(expr, sp.cos | sp.sin) and len(expr.args) == 1:
-            return f"{type(expr).__name__}({self.expression(expr.args[0])})"
+            return f"{type(expr).__name__}({self.expression(expr.args[0])})", _ATOM
         named = {symbol: sp.Symbol(self.names[symbol]) for symbol in expr.free_symbols if symbol in self.names}
-        return sp.ccode(expr.xreplace(named), standard="C99")
+        text = sp.ccode(expr.xreplace(named), standard="C99")
+        called = expr.is_Pow or expr.is_NumberSymbol or isinstance(expr, sp.Function)  # sqrt(x), M_PI, fabs(x)
+        return (text, _ATOM) if called else (f"({text})", _ATOM)
+
+    def _operand(self, expr: sp.Expr, needed: int) -> str:
+        """``expr`` in parentheses unless it binds at least as tightly as ``needed``."""
+        text, precedence = self._print(expr)
+        return text if precedence >= needed else f"({text})"
+
+    def _sum(self, terms: tuple[sp.Expr, ...]) -> str:
+        """``a + b - c``: a term with a negative coefficient is subtracted (exactly the same
+        double as adding its negative), evaluated left to right as sympy lists the terms."""
+        text = self._operand(terms[0], _ADD)
+        for term in terms[1:]:
+            if term.is_Number and term < 0:
+                text += " - " + self._operand(-term, _MUL)
+            elif term.is_Mul and term.args[0].is_Number and term.args[0] < 0:
+                coefficient = -term.args[0]
+                factors = term.args[1:] if coefficient == 1 else (coefficient, *term.args[1:])
+                product, precedence = self._product(factors) if len(factors) > 1 else self._print(factors[0])
+                text += " - " + (product if precedence >= _MUL else f"({product})")
+            else:
+                text += " + " + self._operand(term, _ADD)
+        return text
+
+    def _product(self, factors: tuple[sp.Expr, ...]) -> tuple[str, int]:
+        """``a*b*c`` (left to right), ``-a*b`` for a coefficient of -1."""
+        if factors[0] == -1 and len(factors) > 1:
+            rest = self._product(factors[1:])[0] if len(factors) > 2 else self._operand(factors[1], _UNARY)
+            return "-" + rest, _UNARY
+        return "*".join(self._operand(factor, _MUL) for factor in factors), _MUL
 
     def assignment(self, symbol: sp.Symbol, expr: sp.Expr) -> str:
         """``const double <name> = <expr>;`` (printed once per symbol, then reused)."""
