@@ -85,7 +85,9 @@ def check_fixed_base(robot: ReferenceRobot) -> None:
     """Refuse a floating base (its six virtual joints are not Pinocchio's coordinates)."""
     if robot.floating_base:
         raise InputError(
-            "robot", "a fixed-base robot (floating_base=False): the Newton–Euler program models fixed bases", f"a floating {robot.name}"
+            "robot",
+            "a fixed-base robot (floating_base=False): the Newton–Euler program models fixed bases",
+            f"a floating {robot.name}",
         )
 
 
@@ -227,9 +229,7 @@ def newton_euler(
     ``tau``; with the speed alone ``C q̇``; with gravity alone ``G``; with the acceleration
     alone ``M q̈`` (of the bodies' coordinates).
     """
-    motion = forward_pass(
-        bodies, builder, speed=speed, acceleration=acceleration, base_acceleration=base_acceleration, tag=tag
-    )
+    motion = forward_pass(bodies, builder, speed=speed, acceleration=acceleration, base_acceleration=base_acceleration, tag=tag)
     force, moment = backward_pass(bodies, builder, motion, tag=tag)
     return [project(body, moment[b], force[b]) for b, body in enumerate(bodies)]
 
@@ -266,9 +266,7 @@ def derive_newton_euler(
     builder = ProgramBuilder()
     bodies = symbolic_bodies(robot, list(theta), builder, params, snap=snap)
     gravity = -params.gravity(robot.gravity_vector)  # the base "accelerates upwards"
-    tau_bodies = newton_euler(
-        bodies, builder, speed=list(theta_dot), acceleration=list(theta_ddot), base_acceleration=gravity
-    )
+    tau_bodies = newton_euler(bodies, builder, speed=list(theta_dot), acceleration=list(theta_ddot), base_acceleration=gravity)
     tau = exact_matrix(robot.tree.selection, 0.0).T * sp.Matrix(tau_bodies)  # tau = Sᵀ tau_bodies
     program = builder.program({"q": tuple(q), "qd": tuple(qd), "qdd": tuple(qdd)}, {"tau": list(tau)})
     return Program(program.inputs, program.assignments, program.outputs, params.values, params.labels)

@@ -175,7 +175,12 @@ def kinematics_latex(kinematics: Kinematics, *, precision: int = 6) -> str:
     rows = [rf"p_{{{i + 1}}} &= {printer.doprint(numeric(e))}" for i, e in enumerate(k.position)]
     rows += [rf"J_{{{i + 1}{j + 1}}} &= {printer.doprint(numeric(k.jacobian[i, j]))}" for i in range(6) for j in range(n)]
     legend = ", ".join(rf"$q_{{{i + 1}}}$: \texttt{{{latex_text(j)}}}" for i, j in enumerate(k.joint_names))
-    return rf"Frame \texttt{{{latex_text(k.frame)}}} ({legend})." + "\n\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}\n"
+    return (
+        rf"Frame \texttt{{{latex_text(k.frame)}}} ({legend})."
+        + "\n\\begin{align*}\n"
+        + " \\\\\n".join(rows)
+        + "\n\\end{align*}\n"
+    )
 
 
 def tex_engine() -> str | None:
