@@ -33,11 +33,15 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from robodyn.equations.newton_euler import SNAP, SymbolicBody, check_fixed_base, newton_euler, project, symbolic_bodies
+from robodyn.equations.newton_euler import SymbolicBody, check_fixed_base, newton_euler, project, symbolic_bodies
 from robodyn.equations.program import Program, ProgramBuilder
 from robodyn.equations.sharing import shortened, without_copies
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, body_coordinates, exact_matrix, joint_symbols
+
+#: Default tolerance for exact rotation and axis entries: loose enough that a URDF's
+#: 1.5707963 prints as π/2 (the equations are for reading; the compiled engine passes 1e-15).
+SNAP = 1e-8
 
 
 @dataclass

@@ -34,9 +34,10 @@ from robodyn.exceptions import InputError
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, axis_rotation, body_coordinates, exact_matrix, joint_symbols
 
-#: Default tolerance for exact rotation and axis entries (the equations' printing choice;
-#: the compiled engine passes float rounding only).
-SNAP = 1e-8
+#: Default tolerance for exact rotation and axis entries of the program: float rounding only
+#: (cos(π/2) = 6e-17), so the program is the URDF's robot. The printed equations snap more
+#: (:data:`robodyn.equations.compact.SNAP`): a URDF's 1.5707963 then prints as π/2.
+SNAP = 1e-15
 
 _ZERO = sp.zeros(3, 1)
 
@@ -97,7 +98,7 @@ def symbolic_bodies(
     builder: ProgramBuilder,
     params: Parameters,
     *,
-    snap: float = SNAP,
+    snap: float,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> list[SymbolicBody]:
     """Every body's frame (``cos``/``sin`` of its angle, rotation, or offset along its axis)
