@@ -20,7 +20,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import Any
+from typing import Any, Literal
 
 import sympy as sp
 
@@ -37,6 +37,8 @@ from robodyn.reference.symbolic import derive, exact_number
 from robodyn.urdf.sources import resolve_source
 
 __all__ = ["CLOSED_FORM_JOINTS", "FORMATS", "Equations", "derive_equations", "estimate_closed_form_seconds", "render"]
+
+Form = Literal["auto", "closed", "compact"]
 
 #: Largest number of joints derived in closed form by ``form="auto"``.
 CLOSED_FORM_JOINTS = 3
@@ -85,7 +87,7 @@ def _safe_parameters(
     )
 
 
-def _check_request(source: str | os.PathLike, form: str, floating_base: bool | None) -> None:
+def _check_request(source: str | os.PathLike, form: Form, floating_base: bool | None) -> None:
     """Refuse an unknown form or a floating base (before the robot is loaded)."""
     if form not in ("auto", "closed", "compact"):
         raise InputError("form", "closed, compact or auto", repr(form))
@@ -155,7 +157,7 @@ def _closed_form(
 def derive_equations(
     source: str | os.PathLike,
     *,
-    form: str = "auto",
+    form: Form = "auto",
     keep_params: bool = False,
     gravity: Sequence[float] | None = None,
     lock: dict[str, float] | None = None,

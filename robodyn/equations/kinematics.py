@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from typing import Literal
 
 import numpy as np
 import sympy as sp
@@ -24,6 +25,8 @@ from robodyn.equations.naming import identifier
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
 from robodyn.exceptions import FrameError, InputError
 from robodyn.reference.symbolic import Parameters, body_coordinates, body_poses, exact_matrix
+
+KinematicsFormat = Literal["text", "latex", "json", "python", "c"]
 
 
 def derive_kinematics(
@@ -91,7 +94,7 @@ def derive_kinematics(
     return Kinematics(model.name, frame, list(model.joint_names), q, position, rotation, jacobian)
 
 
-def render_kinematics(kinematics: Kinematics, format: str = "text", *, precision: int = DEFAULT_PRECISION) -> str:
+def render_kinematics(kinematics: Kinematics, format: KinematicsFormat = "text", *, precision: int = DEFAULT_PRECISION) -> str:
     """The frame's position and Jacobian as ``text``, ``latex`` (a fragment), ``json``,
     ``python`` (a module with ``frame_position(q)`` and ``frame_jacobian(q)``) or ``c``
     (the same two functions, one state, arrays of doubles): one renderer a format, as for
