@@ -1,4 +1,5 @@
-"""The equations as a LaTeX document (amsmath), or compiled to PDF.
+"""The equations as a LaTeX document (amsmath), or compiled to PDF; a frame's kinematics as a
+LaTeX fragment.
 
 Joints are numbered, ``q_1``, ``\\dot q_1``, ``\\ddot q_1``, with a legend table of the
 joint names; kept parameters carry their link or joint as an upright subscript
@@ -20,7 +21,7 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from robodyn.common.text import latex_text
-from robodyn.equations.model import EquationsData, numeric
+from robodyn.equations.model import EquationsData, Kinematics, numeric
 from robodyn.equations.printing import format_float
 from robodyn.exceptions import MissingToolError, TypesettingError
 
@@ -164,6 +165,22 @@ def to_latex(equations: EquationsData, *, precision: int = 6) -> str:
         ]
     body += [latex_math(equations, precision=precision), r"\end{document}", ""]
     return "\n".join(body)
+
+
+def kinematics_latex(kinematics: Kinematics, *, precision: int = 6) -> str:
+    """The frame's position and Jacobian as an ``align*`` fragment, with the joints' legend."""
+    k = kinematics
+    n = len(k.q)
+    printer = _Printer(precision, {s: rf"q_{{{i + 1}}}" for i, s in enumerate(k.q)})
+    rows = [rf"p_{{{i + 1}}} &= {printer.doprint(numeric(e))}" for i, e in enumerate(k.position)]
+    rows += [rf"J_{{{i + 1}{j + 1}}} &= {printer.doprint(numeric(k.jacobian[i, j]))}" for i in range(6) for j in range(n)]
+    legend = ", ".join(rf"$q_{{{i + 1}}}$: \texttt{{{latex_text(j)}}}" for i, j in enumerate(k.joint_names))
+    return (
+        rf"Frame \texttt{{{latex_text(k.frame)}}} ({legend})."
+        + "\n\\begin{align*}\n"
+        + " \\\\\n".join(rows)
+        + "\n\\end{align*}\n"
+    )
 
 
 def tex_engine() -> str | None:
