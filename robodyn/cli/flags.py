@@ -20,6 +20,7 @@ FLAGS: dict[str, str] = {
     "out": "--out",
     "scheduler": "--scheduler",
     "form": "--form",
+    "format": "--format",
     "max_dof": "--max-dof",
     "at": "--at",
     "urdf_out": "--urdf-out",
