@@ -92,7 +92,9 @@ def _check_request(source: str | os.PathLike, form: Form, floating_base: bool | 
     if form not in ("auto", "closed", "compact"):
         raise InputError("form", "closed, compact or auto", repr(form))
     if floating_base or (floating_base is None and resolve_source(source).floating_base):
-        raise InputError("floating_base", "False: symbolic equations model fixed bases (--fixed-base)", f"a floating {source}")
+        raise InputError(
+            "floating_base", "False: symbolic equations model fixed bases (floating_base=False)", f"a floating {source}"
+        )
 
 
 def _compact_form(

@@ -124,7 +124,7 @@ def _check(source: str | os.PathLike, what: str, request: Request) -> None:
     if request.format not in FORMATS[what]:
         raise InputError("format", f"one of {', '.join(FORMATS[what])} for the {what}", repr(request.format))
     if request.format == "pdf" and tex_engine() is None:
-        raise MissingToolError("pdflatex", "a PDF", "install TeX Live (Debian: texlive-latex-base) or use format 'latex'")
+        raise MissingToolError("pdflatex", "a PDF", "install TeX Live (Debian: texlive-latex-base) or use format='latex'")
     if what == "lecture" and source != LECTURE_ROBOT:
         raise InputError("model", f"{LECTURE_ROBOT} for the lecture (the lecture's arm)", repr(printable(str(source))))
     if what == "kinematics" and not request.frame:

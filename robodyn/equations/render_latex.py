@@ -197,7 +197,7 @@ def compile_latex(tex: str, folder: Path) -> tuple[Path, str]:
     """
     engine = tex_engine()
     if engine is None:
-        raise MissingToolError("pdflatex", "PDF output", "install TeX Live (Debian: texlive-latex-base) or use --format latex")
+        raise MissingToolError("pdflatex", "PDF output", "install TeX Live (Debian: texlive-latex-base) or use format='latex'")
     source = folder / "equations.tex"
     source.write_text(tex)
     result = subprocess.run(
