@@ -5,7 +5,7 @@
 The pictures come from the demo the Makefile runs (the RP arm driven by the task-space
 controller to the target 0.7, 0.7, its first second) and the default what-if sweep with a 10 N downward
 force. docs/pictures.json records a hash of the inputs (the code that draws them) and of
-each picture; tests/test_viz_pictures.py fails when the inputs changed since, or a picture
+each picture; tests/integration/test_pictures.py fails when the inputs changed since, or a picture
 was edited by hand: then run this script again.
 """
 

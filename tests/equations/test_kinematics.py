@@ -15,7 +15,7 @@ import robodyn
 from robodyn.cli.app import main
 from robodyn.equations.kinematics import derive_kinematics, render_kinematics
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 CASES = [(str(DATA / "rrp_arm.urdf"), "slider"), (str(DATA / "mimic_arm.urdf"), "tip"), ("rp_arm", "link2")]
 
 

@@ -17,7 +17,7 @@ from robodyn.equations.model import numeric
 from robodyn.equations.simplify import chop
 from robodyn.exceptions import InputError
 
-RRP = str(Path(__file__).parent / "data" / "rrp_arm.urdf")
+RRP = str(Path(__file__).parents[1] / "data" / "rrp_arm.urdf")
 CLOSED = ["rp_arm", "double_pendulum", RRP]
 
 

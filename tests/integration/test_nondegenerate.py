@@ -4,10 +4,9 @@ The robots of ``tests/data/robots`` have mimic joints with multipliers other tha
 non-zero offsets (revolute, prismatic, and a mimic on another branch than its source),
 non-unit oblique axes (``axis="0 3 4"``), joint origins with all six values non-zero; they
 are also loaded with a floating base (states with non-identity orientations) and with
-joints locked at non-zero positions. On each: the dynamics identities (M symmetric
-positive definite, Ṁ − 2C skew by finite differences, τ = M a + C v + G, ABA∘RNEA = id,
-the energy balance dE/dt = vᵀτ), the reference comparison, locks against the unlocked
-robot, and the generated Python code against the Robot.
+joints locked at non-zero positions. On each: the reference comparison, locks against the
+unlocked robot, and the generated Python code against the Robot; the dynamics identities run
+on them in tests/dynamics/test_robot.py, together with the URDFs and zoo robots.
 """
 
 from __future__ import annotations
@@ -22,26 +21,14 @@ import robodyn.reference
 from robodyn.equations.derive import derive_equations, render
 from robodyn.exceptions import AmbiguousEndEffectorError, InputError, URDFError
 from robodyn.verify.check import check_robot, report_text
+from tests.conftest import NONDEGENERATE_CASES, random_states
 
-ROBOTS = Path(__file__).parent / "data" / "robots"
+ROBOTS = Path(__file__).parents[1] / "data" / "robots"
 OBLIQUE = ROBOTS / "oblique.urdf"
 GRIPPER = ROBOTS / "mimic_gripper.urdf"
 MIMIC_TREE = ROBOTS / "mimic_tree.urdf"
 
-#: name -> (URDF, load options). Locks at non-zero positions, negative ones included.
-CASES = {
-    "oblique": (OBLIQUE, {}),
-    "oblique_floating": (OBLIQUE, {"floating_base": True}),
-    "oblique_locked": (OBLIQUE, {"lock": {"j_twist": 0.7, "j_extend": 0.13}}),
-    "oblique_locked_negative": (OBLIQUE, {"lock": {"j_extend": -0.08, "j_tool": -1.1}}),
-    "gripper": (GRIPPER, {}),
-    "gripper_floating": (GRIPPER, {"floating_base": True}),
-    "gripper_locked_sources": (GRIPPER, {"lock": {"j_rotate": 0.6, "j_left": 0.03}}),
-    "gripper_locked_prismatic": (GRIPPER, {"lock": {"j_left": -0.015}}),
-    "mimic_tree": (MIMIC_TREE, {}),
-    "mimic_tree_floating": (MIMIC_TREE, {"floating_base": True}),
-    "mimic_tree_locked": (MIMIC_TREE, {"lock": {"j_shoulder": 0.5, "j_slide": 0.07}}),
-}
+CASES = NONDEGENERATE_CASES
 
 #: Pinocchio 4.1's crba (LOCAL convention) accumulates into its data across calls when a
 #: mimic joint sits between two independent joints of a chain (mimic_tree's j_elbow);
@@ -54,115 +41,17 @@ def cases(*, mass: bool):
     return list(CASES)
 
 
-@pytest.mark.parametrize("name", cases(mass=True))
-def test_mass_matrix_is_repeatable(name):
-    """The same q gives the same M on every call (Pinocchio's crba kept state for mimic chains)."""
-    path, options = CASES[name]
-    robot = robodyn.load(path, **options)
-    q = robot.random_configuration(np.random.default_rng(11))
-    first = robot.mass_matrix(q)
-    for _ in range(3):
-        robot.mass_matrix(robot.random_configuration(np.random.default_rng(_)))
-    np.testing.assert_array_equal(robot.mass_matrix(q), first)
-
-
 def load(name: str) -> robodyn.Robot:
     path, options = CASES[name]
     return robodyn.load(path, **options)
 
 
 def states(robot: robodyn.Robot, seed: int = 7, count: int = 4):
-    """Random states; a floating base also gets one with an explicit tilted, yawed pose."""
-    rng = np.random.default_rng(seed)
-    q = robot.random_configuration(rng, count)
-    if robot.floating_base:
-        q[0] = robot.floating_configuration([0.3, -0.2, 0.5], [0.4, -0.3, 0.9], q[0, 7:])
-        assert abs(q[0, 6]) < 0.99  # not the identity orientation
-    return q, rng.normal(size=(count, robot.nv)), rng.normal(size=(count, robot.nv))
+    return random_states(robot, np.random.default_rng(seed), count)
 
 
 def scale(x: np.ndarray) -> float:
     return float(np.max(np.abs(x))) + 1e-300
-
-
-# ------------------------------------------------------------------------------------
-# Dynamics identities
-# ------------------------------------------------------------------------------------
-@pytest.mark.parametrize("name", cases(mass=False))  # the accumulation of a few calls keeps M SPD
-def test_mass_matrix_is_symmetric_positive_definite(name):
-    robot = load(name)
-    q, _, _ = states(robot)
-    for qi in q:
-        mass = robot.mass_matrix(qi)
-        np.testing.assert_allclose(mass, mass.T, atol=1e-12 * scale(mass))
-        assert np.linalg.eigvalsh(mass)[0] > 0
-
-
-@pytest.mark.parametrize("name", cases(mass=True))
-def test_mass_matrix_does_not_depend_on_earlier_calls(name):
-    robot = load(name)
-    q, _, _ = states(robot)
-    first = robot.mass_matrix(q[0]).copy()
-    for qi in q[1:]:
-        robot.mass_matrix(qi)
-    np.testing.assert_allclose(robot.mass_matrix(q[0]), first, rtol=0, atol=1e-12 * scale(first))
-
-
-@pytest.mark.parametrize("name", cases(mass=True))
-def test_mass_matrix_derivative_minus_2c_is_skew(name):
-    robot = load(name)
-    q, v, _ = states(robot)
-    h = 1e-6
-    for qi, vi in zip(q, v, strict=True):
-        m_dot = (robot.mass_matrix(robot.integrate(qi, h * vi)) - robot.mass_matrix(robot.integrate(qi, -h * vi))) / (2 * h)
-        s = m_dot - 2 * robot.coriolis_matrix(qi, vi)
-        bound = 1e-6 * max(scale(m_dot), scale(robot.mass_matrix(qi)) * scale(vi))
-        assert np.max(np.abs(s + s.T)) < bound
-
-
-@pytest.mark.parametrize("name", cases(mass=True))
-def test_inverse_dynamics_is_m_a_plus_c_v_plus_g(name):
-    robot = load(name)
-    q, v, a = states(robot)
-    tau = robot.inverse_dynamics(q, v, a)
-    assembled = np.stack(
-        [
-            robot.mass_matrix(qi) @ ai + robot.coriolis_matrix(qi, vi) @ vi + robot.gravity(qi)
-            for qi, vi, ai in zip(q, v, a, strict=True)
-        ]
-    )
-    np.testing.assert_allclose(tau, assembled, atol=1e-10 * scale(tau))
-    np.testing.assert_allclose(robot.nonlinear_effects(q, v), robot.inverse_dynamics(q, v, 0 * a), atol=1e-10 * scale(tau))
-    np.testing.assert_allclose(robot.gravity(q), robot.inverse_dynamics(q, 0 * v, 0 * a), atol=1e-10 * scale(tau))
-
-
-@pytest.mark.parametrize("name", cases(mass=True))
-def test_forward_dynamics_inverts_inverse_dynamics(name):
-    robot = load(name)
-    q, v, a = states(robot)
-    for qi, vi, ai in zip(q, v, a, strict=True):  # one state at a time: the single-state paths
-        np.testing.assert_allclose(robot.forward_dynamics(qi, vi, robot.inverse_dynamics(qi, vi, ai)), ai, atol=1e-8 * scale(ai))
-    np.testing.assert_allclose(robot.forward_dynamics(q, v, robot.inverse_dynamics(q, v, a)), a, atol=1e-8 * scale(a))
-
-
-@pytest.mark.parametrize("name", cases(mass=True))
-def test_energy_balance(name):
-    """dE/dt = vᵀ τ along the motion a = ABA(q, v, τ), E = T + U, by central differences."""
-    robot = load(name)
-    q, v, tau = states(robot, seed=11)
-    h = 1e-5
-    for qi, vi, taui in zip(q, v, tau, strict=True):
-        ai = robot.forward_dynamics(qi, vi, taui)
-
-        def energy(sign, qi=qi, vi=vi, ai=ai):
-            q_t = robot.integrate(qi, sign * h * vi + 0.5 * h * h * ai)
-            v_t = vi + sign * h * ai
-            return robot.kinetic_energy(q_t, v_t) + robot.potential_energy(q_t)
-
-        power = vi @ taui
-        rate = (energy(1) - energy(-1)) / (2 * h)
-        size = abs(power) + robot.kinetic_energy(qi, vi) + abs(vi @ robot.gravity(qi))
-        assert abs(rate - power) < 1e-6 * size, (rate, power)
 
 
 # ------------------------------------------------------------------------------------

@@ -25,7 +25,7 @@ import robodyn
 import robodyn.reference
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 OBLIQUE = DATA / "robots" / "oblique.urdf"
 GRIPPER = DATA / "robots" / "mimic_gripper.urdf"
 GANTRY = DATA / "gantry.urdf"

@@ -12,7 +12,7 @@ from robodyn.cli.app import main
 from robodyn.equations import derive_equations, render
 from robodyn.equations.render_latex import compile_latex
 
-RRP = str(Path(__file__).parent / "data" / "rrp_arm.urdf")
+RRP = str(Path(__file__).parents[1] / "data" / "rrp_arm.urdf")
 DOCUMENTS = [
     ("rp_arm", {}),
     ("rp_arm", {"keep_params": True}),

@@ -14,7 +14,7 @@ from robodyn.cli.app import main
 from robodyn.equations import derive_equations, render
 from robodyn.exceptions import DerivationTooExpensiveError
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 RRP = str(DATA / "rrp_arm.urdf")
 MIMIC = str(DATA / "mimic_arm.urdf")
 SIDEWAYS = (9.81, 0.0, 0.0)

@@ -244,7 +244,7 @@ def test_zoo_report_with_a_scheduler_writes_the_same_listing(tmp_path):
     import sys
     from pathlib import Path
 
-    script = Path(__file__).resolve().parent.parent / "scripts" / "zoo_report.py"
+    script = Path(__file__).resolve().parents[2] / "scripts" / "zoo_report.py"
     only = ["--only", "double_pendulum,ur5,z1"]
     subprocess.run([sys.executable, str(script), *only, "--out", str(tmp_path / "local.md")], check=True)
     subprocess.run([sys.executable, str(script), *only, "--scheduler", "local:2", "--out", str(tmp_path / "dask.md")], check=True)

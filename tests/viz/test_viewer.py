@@ -140,7 +140,7 @@ def _drawn_pixels(png_or_image) -> np.ndarray:
     return np.abs(image - background).sum(axis=2) > 0.15
 
 
-@pytest.mark.slow  # tests/test_viz_browser.py keeps a browser test in the fast tier
+@pytest.mark.slow  # tests/viz/test_stills.py keeps a browser test in the fast tier
 def test_recording_plays_in_a_real_browser(swinging, tmp_path):
     _need_chromium()
     robot, trajectory = swinging

@@ -11,7 +11,7 @@ import pytest
 from robodyn.common.extras import require
 from robodyn.exceptions import MissingExtraError, RobodynError
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 CORE = ("pin", "yourdfpy", "numpy", "sympy")
 
 
