@@ -200,7 +200,7 @@ def test_mutated_urdfs_load_or_are_refused_cleanly(seed, ops):
 FUZZ_PROGRAM = """
 import random, sys
 sys.path.insert(0, {root!r})
-from tests.test_fuzz_urdf import SEEDS, check_one, mutate
+from tests.dynamics.test_loading import SEEDS, check_one, mutate
 rng = random.Random({seed})
 outcomes = {{"ok": 0, "refused": 0}}
 for case in range({count}):

@@ -12,7 +12,7 @@ from robodyn.dynamics.regressor import inertial_parameters, regressor
 from robodyn.exceptions import IdentificationError
 from robodyn.ident import base_parameters
 from robodyn.ident.base import random_states
-from tests.test_ident_regressor import MIMIC_URDF
+from tests.dynamics.test_regressor import MIMIC_URDF
 
 
 def fresh_states(robot, count=40, seed=12345):

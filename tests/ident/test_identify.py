@@ -203,7 +203,7 @@ def test_friction_is_identified(rp_arm):
 def test_written_urdf_merges_welded_links_and_the_reference_agrees(rng):
     import robodyn.reference as reference
     from robodyn.reference.regressor import reference_body_links, reference_parameters
-    from tests.test_ident_regressor import MIMIC_URDF
+    from tests.dynamics.test_regressor import MIMIC_URDF
 
     robot = robodyn.load(MIMIC_URDF)  # l3 carries the welded l4 (0.3 kg)
     q, v, a = random_states(robot, 150, rng)

@@ -16,7 +16,7 @@ from robodyn.trajectory import Trajectory
 from robodyn.viz.mesh_files import read_mesh
 from robodyn.viz.recording import recording
 from tests.conftest import ROOT
-from tests.test_viewer import commands_of
+from tests.viz.test_viewer import commands_of
 
 
 def _stl(triangles: int = 2) -> bytes:

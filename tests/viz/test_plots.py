@@ -8,7 +8,6 @@ import pytest
 from matplotlib.figure import Figure
 
 import robodyn
-from robodyn.cli.report import dof_units
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.whatif import sweep
 from robodyn.viz.plots import plot_simulation, simulation_figure, text_overlaps, whatif_figure
@@ -172,7 +171,7 @@ def test_whatif_figure_is_clean_with_forces_in_newton(crowded):
     robot = robodyn.load("rp_arm")
     options = {"materials": ("abs", "aluminium", "steel", "2000"), "forces": ((0, 0, 0), (1.0, 0, -5.0))} if crowded else {}
     rows = sweep("rp_arm", duration=0.5, **options)
-    units = dof_units(robot)["tau"]
+    units = [dof.effort_unit for dof in robot.dofs]
     figure = whatif_figure(rows, robot.joint_names, units, effort_limits=[j.effort for j in robot.joints])
     assert text_overlaps(figure) == []
     assert whatif_unit_problems(figure, robot) == []

@@ -69,7 +69,7 @@ def test_recording_repr_html_is_one_sandboxed_iframe():
 
 def test_axes_ride_on_their_links():
     from robodyn import FrameError
-    from tests.test_viewer import commands_of
+    from tests.viz.test_viewer import commands_of
 
     robot = robodyn.load("rp_arm")
     t = np.linspace(0, 0.5, 6)
