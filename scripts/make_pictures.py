@@ -5,7 +5,7 @@
 The pictures come from the demo the Makefile runs (the RP arm driven by the task-space
 controller to the target 0.7, 0.7, its first second) and the default what-if sweep with a 10 N downward
 force. docs/pictures.json records a hash of the inputs (the code that draws them) and of
-each picture; tests/test_viz_pictures.py fails when the inputs changed since, or a picture
+each picture; tests/integration/test_pictures.py fails when the inputs changed since, or a picture
 was edited by hand: then run this script again.
 """
 
@@ -48,7 +48,6 @@ def file_hash(path: Path) -> str:
 
 def main() -> None:
     import robodyn
-    from robodyn.cli.report import dof_units
     from robodyn.sim.experiment import run_simulation
     from robodyn.sim.whatif import sweep
     from robodyn.viz.plots import plot_whatif
@@ -62,7 +61,7 @@ def main() -> None:
     made.still(DOCS / "rp_arm_poster.png", at=0.25)
     made.filmstrip(DOCS / "rp_arm_filmstrip.png", 5, size=(320, 240))
     rows = sweep("rp_arm", forces=((0.0, 0.0, 0.0), (0.0, 0.0, -10.0)))
-    plot_whatif(rows, robot.joint_names, dof_units(robot)["tau"], DOCS / "rp_arm_whatif.png",
+    plot_whatif(rows, robot.joint_names, [dof.effort_unit for dof in robot.dofs], DOCS / "rp_arm_whatif.png",
                 effort_limits=[joint.effort for joint in robot.joints])  # fmt: skip
     record = {"inputs_sha256": inputs_hash(), "pictures": {name: file_hash(DOCS / name) for name in PICTURES}}
     (DOCS / "pictures.json").write_text(json.dumps(record, indent=2) + "\n")

@@ -9,6 +9,24 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 URDF_FILES = sorted((ROOT / "urdf").glob("*.urdf"))
+#: Robots that are not degenerate where bugs live (tests/data/robots): mimic joints with
+#: multipliers other than ±1 and offsets, oblique non-unit axes, six-valued origins.
+NONDEGENERATE = ROOT / "tests" / "data" / "robots"
+#: name -> (URDF, load options): those robots fixed, floating (tilted in the states drawn by
+#: ``random_states``) and with joints locked at non-zero positions, negative ones included.
+NONDEGENERATE_CASES = {
+    "oblique": (NONDEGENERATE / "oblique.urdf", {}),
+    "oblique_floating": (NONDEGENERATE / "oblique.urdf", {"floating_base": True}),
+    "oblique_locked": (NONDEGENERATE / "oblique.urdf", {"lock": {"j_twist": 0.7, "j_extend": 0.13}}),
+    "oblique_locked_negative": (NONDEGENERATE / "oblique.urdf", {"lock": {"j_extend": -0.08, "j_tool": -1.1}}),
+    "gripper": (NONDEGENERATE / "mimic_gripper.urdf", {}),
+    "gripper_floating": (NONDEGENERATE / "mimic_gripper.urdf", {"floating_base": True}),
+    "gripper_locked_sources": (NONDEGENERATE / "mimic_gripper.urdf", {"lock": {"j_rotate": 0.6, "j_left": 0.03}}),
+    "gripper_locked_prismatic": (NONDEGENERATE / "mimic_gripper.urdf", {"lock": {"j_left": -0.015}}),
+    "mimic_tree": (NONDEGENERATE / "mimic_tree.urdf", {}),
+    "mimic_tree_floating": (NONDEGENERATE / "mimic_tree.urdf", {"floating_base": True}),
+    "mimic_tree_locked": (NONDEGENERATE / "mimic_tree.urdf", {"lock": {"j_shoulder": 0.5, "j_slide": 0.07}}),
+}
 #: Zoo robots used by the fast tier: a spread of joint types and sizes.
 FAST_ZOO = ["panda", "ur5", "double_pendulum_continuous", "so100", "z1"]
 
@@ -16,6 +34,16 @@ FAST_ZOO = ["panda", "ur5", "double_pendulum_continuous", "so100", "z1"]
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261123)
+
+
+def random_states(robot, rng: np.random.Generator, count: int = 4):
+    """``count`` random states (one a row); a floating base's first one gets an explicit
+    tilted, yawed pose (not the identity orientation)."""
+    q = robot.random_configuration(rng, count)
+    if robot.floating_base:
+        q[0] = robot.floating_configuration([0.3, -0.2, 0.5], [0.4, -0.3, 0.9], q[0, 7:])
+        assert abs(q[0, 6]) < 0.99
+    return q, rng.normal(size=(count, robot.nv)), rng.normal(size=(count, robot.nv))
 
 
 def random_state(robot, rng: np.random.Generator, count: int | None = None):

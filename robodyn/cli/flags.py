@@ -20,11 +20,20 @@ FLAGS: dict[str, str] = {
     "out": "--out",
     "scheduler": "--scheduler",
     "form": "--form",
+    "format": "--format",
     "max_dof": "--max-dof",
     "at": "--at",
     "urdf_out": "--urdf-out",
     "method": "--method",
     "data": "DATA",
+}
+
+#: Boolean keyword arguments a message suggests -> the switch that sets them.
+SWITCHES: dict[str, str] = {
+    "floating_base=False": "--fixed-base",
+    "floating_base=True": "--floating-base",
+    "check_inertia=False": "--no-check-inertia",
+    "strict=True": "--strict",
 }
 
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.
@@ -40,11 +49,15 @@ def error_text(error: RobodynError) -> str:
     """The one-line message of ``error`` as the command line says it: flags, not parameters.
 
     An :class:`InputError` about a parameter in :data:`FLAGS` names its flag; a keyword
-    argument the message suggests (``form='compact'``) becomes the flag (``--form compact``).
+    argument the message suggests (``form='compact'``) becomes the flag (``--form compact``),
+    a boolean one (``floating_base=False``) its switch (``--fixed-base``).
     """
     if isinstance(error, InputError) and error.argument in FLAGS:
         return printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
-    return _KEYWORD.sub(_keyword_flag, str(error))
+    text = str(error)
+    for keyword, switch in SWITCHES.items():
+        text = text.replace(keyword, switch)
+    return _KEYWORD.sub(_keyword_flag, text)
 
 
 def _keyword_flag(match: re.Match[str]) -> str:

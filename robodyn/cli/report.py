@@ -14,11 +14,6 @@ from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
 
 
-def dof_units(robot: Robot) -> dict[str, list[str]]:
-    """Units of each entry of ``v``, ``a`` and ``tau``, by velocity coordinate (``robot.dofs``)."""
-    return {quantity: [dof.unit(quantity) for dof in robot.dofs] for quantity in ("v", "a", "tau")}
-
-
 def end_effector_text(robot: Robot) -> tuple[str | None, str]:
     """The default end effector, or ``None`` and why there is none."""
     from robodyn.exceptions import AmbiguousEndEffectorError

@@ -124,8 +124,7 @@ def cached_kernels(key: str) -> str | None:
 def locked(key: str) -> Iterator[None]:
     """Hold an exclusive lock on a robot key (``lock-<key>`` in the cache, ``flock``) while
     deriving and building it: a second process compiling the same robot waits, then finds it
-    cached. (The derivation is not bit-for-bit deterministic across processes, so without the
-    lock two processes could each build a module.) No lock where the cache is read-only or
+    cached, instead of deriving and building it a second time. No lock where the cache is read-only or
     the platform has no ``fcntl``."""
     try:
         import fcntl

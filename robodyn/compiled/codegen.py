@@ -1,8 +1,10 @@
-"""C kernels of one robot's dynamics, generated from the compact (intermediate-variable) equations.
+"""C kernels of one robot's dynamics, generated from the equations layer's programs.
 
 The compact program (:func:`robodyn.equations.compact.derive_compact`) gives ``M``, ``C v``
-and ``G`` of the reference's bodies (mimic joints as bodies of their own) as sympy
-assignments. This module writes them as C99 functions of plain arrays, in the order of
+and ``G`` of the reference's bodies (mimic joints as bodies of their own), the Newton–Euler
+program (:func:`robodyn.equations.newton_euler.derive_newton_euler`) gives ``tau`` in O(n),
+both as sympy assignments. This module writes them as C99 functions of plain arrays (through
+the one C printer, :mod:`robodyn.equations.c_printer`), in the order of
 :attr:`robodyn.Robot.joint_names`:
 
 - the body coordinates are the robot's linear map ``theta = Q q + offset``, ``thetȧ = S v``
@@ -27,32 +29,20 @@ factorisation). ``runtime.c`` supplies everything else.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Sequence
 
 import numpy as np
 import sympy as sp
 
-from robodyn.compiled.rnea import NewtonEuler
+from robodyn.equations.c_printer import CPrinter, c_combination, c_number
 from robodyn.equations.compact import CompactDynamics
+from robodyn.equations.program import Program, needed
 
 #: Bumped whenever the generated code changes meaning (part of every cache key).
 CODEGEN_VERSION = "2"
 
-
-def _number(value: float) -> str:
-    """A double literal that reads back to exactly ``value``."""
-    return repr(float(value))
-
-
-def _needed(assignments: list[tuple[sp.Symbol, sp.Expr]], outputs: Iterable[sp.Expr]) -> list[tuple[sp.Symbol, sp.Expr]]:
-    """The assignments the outputs depend on, in their original order."""
-    wanted = set().union(*(expr.free_symbols for expr in outputs))
-    kept = []
-    for symbol, expr in reversed(assignments):
-        if symbol in wanted:
-            kept.append((symbol, expr))
-            wanted |= expr.free_symbols
-    return kept[::-1]
+#: The body coordinates' C names, and the robot's arrays they are made of.
+_COORDINATES = (("th", "q", True), ("thd", "v", False), ("thdd", "a", False))
 
 
 class KernelWriter:
@@ -65,8 +55,8 @@ class KernelWriter:
         offset: Shape (n_bodies,).
         parents: For each of the robot's coordinates, the coordinate of its parent joint
             (-1 for a root), shape (nv,); a parent precedes its children.
-        newton_euler: ``tau`` as a Newton–Euler program over the same bodies (O(n));
-            without it ``tau = M a + C v + G``.
+        newton_euler: ``tau`` as a Newton–Euler program over the same bodies (O(n), inputs
+            ``q``, ``qd``, ``qdd``, output ``tau``); without it ``tau = M a + C v + G``.
     """
 
     def __init__(
@@ -75,7 +65,7 @@ class KernelWriter:
         selection: np.ndarray,
         offset: np.ndarray,
         parents: list[int],
-        newton_euler: NewtonEuler | None = None,
+        newton_euler: Program | None = None,
     ):
         self.equations = equations
         self.newton_euler = newton_euler
@@ -83,86 +73,53 @@ class KernelWriter:
         self.offset = np.asarray(offset, float)
         self.parents = list(parents)
         self.bodies, self.nv = self.selection.shape
-        # Local names: assignments t0, t1, ...; body coordinates th0, thd0, ... .
-        self._names: dict[sp.Symbol, sp.Symbol] = {}
-        self._printed: dict[sp.Symbol, str] = {}
-        for index, (symbol, _) in enumerate(equations.assignments):
-            self._names[symbol] = sp.Symbol(f"t{index}", real=True)
-        for b in range(self.bodies):
-            self._names[equations.q[b]] = sp.Symbol(f"th{b}", real=True)
-            self._names[equations.qd[b]] = sp.Symbol(f"thd{b}", real=True)
+        # Local names: assignments t0, t1, ... (r0, r1, ... in tau); body coordinates th0, thd0, thdd0.
+        self._compact = CPrinter(self._names(equations.assignments, "t", (equations.q, equations.qd)))
         if newton_euler is not None:
-            for b in range(self.bodies):
-                self._names[newton_euler.q[b]] = sp.Symbol(f"th{b}", real=True)
-                self._names[newton_euler.qd[b]] = sp.Symbol(f"thd{b}", real=True)
-                self._names[newton_euler.qdd[b]] = sp.Symbol(f"thdd{b}", real=True)
+            inputs = newton_euler.inputs
+            self._tau = CPrinter(self._names(newton_euler.assignments, "r", (inputs["q"], inputs["qd"], inputs["qdd"])))
 
-    def _c(self, expr: sp.Expr) -> str:
-        """C for an expression of the program (a small printer: ``sympy.ccode`` is the
-        slowest step of a compile; anything unusual still goes to it)."""
-        expr = sp.sympify(expr)
-        if expr.is_Symbol:
-            return str(self._names.get(expr, expr))
-        if expr.is_Integer or expr.is_Float:
-            return _number(float(expr))
-        if expr.is_Rational:
-            return f"({_number(expr.p)}/{_number(expr.q)})"
-        if expr.is_Add:
-            return "(" + " + ".join(self._c(arg) for arg in expr.args) + ")"
-        if expr.is_Mul:
-            return "(" + "*".join(self._c(arg) for arg in expr.args) + ")"
-        if expr.is_Pow and expr.exp == 2:
-            base = self._c(expr.base)
-            return f"({base}*{base})"
-        if expr.is_Pow and expr.exp == -1:
-            return f"(1.0/{self._c(expr.base)})"
-        if expr.is_Pow and expr.exp.is_Integer:
-            return f"pow({self._c(expr.base)}, {int(expr.exp)})"
-        if isinstance(expr, sp.cos | sp.sin) and len(expr.args) == 1:
-            return f"{type(expr).__name__}({self._c(expr.args[0])})"
-        return sp.ccode(expr.xreplace(self._names), standard="C99")
+    @staticmethod
+    def _names(
+        assignments: Sequence[tuple[sp.Symbol, sp.Expr]], prefix: str, coordinates: Sequence[Sequence[sp.Symbol]]
+    ) -> dict[sp.Symbol, str]:
+        names = {symbol: f"{prefix}{index}" for index, (symbol, _) in enumerate(assignments)}
+        for symbols, (local, _, _) in zip(coordinates, _COORDINATES, strict=False):
+            names.update({symbol: f"{local}{b}" for b, symbol in enumerate(symbols)})
+        return names
 
-    def _combination(self, terms: list[tuple[float, str]]) -> str:
-        """``c0*x0 + c1*x1 + ...`` with unit coefficients written as they are."""
-        parts = [name if coefficient == 1.0 else f"{_number(coefficient)}*{name}" for coefficient, name in terms]
-        return " + ".join(parts) if parts else "0.0"
-
-    def _coordinates(self, symbols: set[sp.Symbol], velocity: bool) -> list[str]:
-        """``th``/``thd`` declarations for the body coordinates the code uses."""
+    def _coordinates(self, used: set[sp.Basic], coordinates: Sequence[Sequence[sp.Symbol]]) -> list[str]:
+        """``th``/``thd``/``thdd`` declarations for the body coordinates the code uses."""
         lines = []
         for b in range(self.bodies):
-            uses_q = self.equations.q[b] in symbols
-            if uses_q:
-                terms = [(self.selection[b, j], f"q[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
-                value = self._combination(terms)
-                if self.offset[b] != 0:
-                    value += f" + {_number(self.offset[b])}"
-                lines.append(f"    const double th{b} = {value};")
-            if velocity and self.equations.qd[b] in symbols:
-                terms = [(self.selection[b, j], f"v[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
-                lines.append(f"    const double thd{b} = {self._combination(terms)};")
+            for symbols, (local, array, shifted) in zip(coordinates, _COORDINATES, strict=False):
+                if symbols[b] not in used:
+                    continue
+                terms = [(self.selection[b, j], f"{array}[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
+                value = c_combination(terms)
+                if shifted and self.offset[b] != 0:
+                    value += f" + {c_number(self.offset[b])}"
+                lines.append(f"    const double {local}{b} = {value};")
         return lines
+
+    def _program(
+        self, printer: CPrinter, assignments, outputs: list[sp.Expr], coordinates: Sequence[Sequence[sp.Symbol]]
+    ) -> list[str]:
+        """Coordinates and the assignments ``outputs`` need, as C declarations."""
+        program = needed(assignments, outputs)
+        used = set().union(*(sp.sympify(e).free_symbols for e in outputs), *(e.free_symbols for _, e in program))
+        return self._coordinates(used, coordinates) + printer.statements(program)
 
     def _body(self, outputs: list[sp.Expr], velocity: bool) -> list[str]:
-        """Coordinates and the assignments ``outputs`` need, as C declarations."""
-        program = _needed(self.equations.assignments, outputs)
-        used = set().union(*(expr.free_symbols for expr in outputs), *(expr.free_symbols for _, expr in program))
-        lines = self._coordinates(used, velocity)
-        lines += [f"    const double {self._names[symbol]} = {self._assignment(symbol, expr)};" for symbol, expr in program]
-        return lines
-
-    def _assignment(self, symbol: sp.Symbol, expr: sp.Expr) -> str:
-        """An assignment's C expression (printed once, used by several kernels)."""
-        if symbol not in self._printed:
-            self._printed[symbol] = self._c(expr)
-        return self._printed[symbol]
+        e = self.equations
+        return self._program(self._compact, e.assignments, outputs, (e.q, e.qd) if velocity else (e.q,))
 
     def _project_vector(self, local: str, out: str) -> list[str]:
         """``out = Sᵀ local`` (``local`` a C array of body entries)."""
         lines = []
         for j in range(self.nv):
             terms = [(self.selection[b, j], f"{local}[{b}]") for b in range(self.bodies) if self.selection[b, j] != 0]
-            lines.append(f"    {out}[{j}] = {self._combination(terms)};")
+            lines.append(f"    {out}[{j}] = {c_combination(terms)};")
         return lines
 
     def _project_matrix(self, local: str, out: str) -> list[str]:
@@ -177,21 +134,27 @@ class KernelWriter:
                     for c in range(nb)
                     if S[b, j] != 0 and S[c, k] != 0
                 ]
-                lines.append(f"    {out}[{j * n + k}] = {self._combination(terms)};")
+                lines.append(f"    {out}[{j * n + k}] = {c_combination(terms)};")
                 if j != k:
                     lines.append(f"    {out}[{k * n + j}] = {out}[{j * n + k}];")
         return lines
+
+    def _vector_lines(self, printer: CPrinter, local: str, out: str, entries: list[sp.Expr]) -> list[str]:
+        """``local[b] = entry`` for every body, then ``out = Sᵀ local``."""
+        lines = [f"    double {local}[{self.bodies}];"]
+        lines += [f"    {local}[{b}] = {printer.expression(entry)};" for b, entry in enumerate(entries)]
+        return lines + self._project_vector(local, out)
 
     def _mass_lines(self) -> list[str]:
         nb, M = self.bodies, self.equations.M
         lines = [f"    double mb[{nb * nb}];"]
         for b in range(nb):
             for c in range(b + 1):
-                lines.append(f"    mb[{b * nb + c}] = mb[{c * nb + b}] = {self._c(M[b, c])};")
-        return lines
+                lines.append(f"    mb[{b * nb + c}] = mb[{c * nb + b}] = {self._compact.expression(M[b, c])};")
+        return lines + self._project_matrix("mb", "M")
 
     def _tau_kernel(self) -> list[str]:
-        n, nb = self.nv, self.bodies
+        n = self.nv
         head = "static void rd_tau(const double *q, const double *v, const double *a, double *tau) {"
         if self.newton_euler is None:
             return [
@@ -204,25 +167,10 @@ class KernelWriter:
                 "",
             ]
         ne = self.newton_euler
-        program = _needed(ne.assignments, ne.tau)
-        used = set().union(*(expr.free_symbols for expr in ne.tau), *(expr.free_symbols for _, expr in program))
-        lines = [head]
-        for b in range(nb):
-            for symbols, array, prefix, offset in (
-                (ne.q, "q", "th", True),
-                (ne.qd, "v", "thd", False),
-                (ne.qdd, "a", "thdd", False),
-            ):
-                if symbols[b] not in used:
-                    continue
-                terms = [(self.selection[b, j], f"{array}[{j}]") for j in range(n) if self.selection[b, j] != 0]
-                value = self._combination(terms)
-                if offset and self.offset[b] != 0:
-                    value += f" + {_number(self.offset[b])}"
-                lines.append(f"    const double {prefix}{b} = {value};")
-        lines += [f"    const double {symbol} = {self._c(expr)};" for symbol, expr in program]
-        lines += [f"    double tb[{nb}];", *[f"    tb[{b}] = {self._c(ne.tau[b])};" for b in range(nb)]]
-        return [*lines, *self._project_vector("tb", "tau"), "}", ""]
+        tau = list(ne.outputs["tau"])
+        coordinates = (ne.inputs["q"], ne.inputs["qd"], ne.inputs["qdd"])
+        lines = [head, *self._program(self._tau, ne.assignments, tau, coordinates)]
+        return [*lines, *self._vector_lines(self._tau, "tb", "tau", tau), "}", ""]
 
     def source(self) -> str:
         """The kernels' C source (no includes; ``runtime.c`` is appended after it)."""
@@ -236,33 +184,24 @@ class KernelWriter:
             "",
             "static void rd_gravity(const double *q, double *g) {",
             *self._body(list(e.G), velocity=False),
-            f"    double gb[{nb}];",
-            *[f"    gb[{b}] = {self._c(e.G[b])};" for b in range(nb)],
-            *self._project_vector("gb", "g"),
+            *self._vector_lines(self._compact, "gb", "g", list(e.G)),
             "}",
             "",
             "static void rd_nle(const double *q, const double *v, double *nle) {",
             *self._body(nle, velocity=True),
-            f"    double hb[{nb}];",
-            *[f"    hb[{b}] = {self._c(nle[b])};" for b in range(nb)],
-            *self._project_vector("hb", "nle"),
+            *self._vector_lines(self._compact, "hb", "nle", nle),
             "}",
             "",
             "static void rd_mass(const double *q, double *M) {",
             *self._body(mass_entries, velocity=False),
             *self._mass_lines(),
-            *self._project_matrix("mb", "M"),
             "}",
             "",
             "static void rd_mass_nle(const double *q, const double *v, double *M, double *nle) {",
             *self._body(mass_entries + nle, velocity=True),
             *self._mass_lines(),
-            *self._project_matrix("mb", "M"),
-            f"    double hb[{nb}];",
-            *[f"    hb[{b}] = {self._c(nle[b])};" for b in range(nb)],
-            *self._project_vector("hb", "nle"),
+            *self._vector_lines(self._compact, "hb", "nle", nle),
             "}",
             "",
         ]
-        out += self._tau_kernel()
-        return "\n".join(out)
+        return "\n".join(out + self._tau_kernel())

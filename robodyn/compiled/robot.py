@@ -24,13 +24,13 @@ from typing import cast
 
 import numpy as np
 
-from robodyn.compiled import build, codegen, rnea
+from robodyn.compiled import build, codegen
 from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
-from robodyn.compiled.rnea import derive_newton_euler
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
-from robodyn.equations import compact
+from robodyn.equations import c_printer, compact, newton_euler, program, sharing
 from robodyn.equations.compact import derive_compact
+from robodyn.equations.newton_euler import derive_newton_euler
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
 from robodyn.reference import symbolic as reference_symbolic
 from robodyn.reference import tree as reference_tree
@@ -49,7 +49,7 @@ _QUANTITIES = {"tau": "tau", "mass": "M", "nle": "C v + G", "gravity": "G", "fd"
 def _generator_source() -> str:
     """The code that turns a URDF into kernels (part of the key: a change there, by anyone,
     must not reuse kernels generated before it)."""
-    modules = (codegen, rnea, compact, reference_tree, reference_symbolic)
+    modules = (codegen, c_printer, program, sharing, newton_euler, compact, reference_tree, reference_symbolic)
     # cast: these modules are loaded from source files, so __file__ is set
     return "".join(Path(cast(str, module.__file__)).read_text(encoding="utf-8") for module in modules)
 
@@ -80,8 +80,8 @@ def generate_kernels(robot: Robot) -> str:
     free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
     reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
     equations = derive_compact(reference, snap=SNAP)
-    newton_euler = derive_newton_euler(reference, snap=SNAP)
-    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), newton_euler).source()
+    tau = derive_newton_euler(reference, snap=SNAP)
+    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), tau).source()
 
 
 def coordinate_parents(robot: Robot) -> list[int]:

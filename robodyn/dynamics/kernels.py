@@ -127,7 +127,7 @@ def mass_matrix_function(
     lower_triangle = np.tri(model.nv, model.nv, -1, dtype=bool)
     # With a mimic joint between two free joints, Pinocchio 4.1's crba in its default LOCAL
     # convention accumulates into data from call to call; the WORLD convention does not
-    # (tests/test_nondegenerate.py, mimic_tree).
+    # (tests/dynamics/test_robot.py, mimic_tree).
     convention = pin.Convention.LOCAL if mimic is None else pin.Convention.WORLD
 
     def mass_matrix(q: np.ndarray) -> np.ndarray:

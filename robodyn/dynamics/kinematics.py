@@ -72,7 +72,8 @@ def frame_jacobian(handle: ModelHandle, q: np.ndarray, frame: str) -> np.ndarray
     model, data = handle.model, handle.data
 
     def jacobian(qi: np.ndarray) -> np.ndarray:
-        return pin.computeFrameJacobian(model, data, qi, index, pin.LOCAL_WORLD_ALIGNED).copy()
+        # reshape: Pinocchio hands a 6×1 Jacobian (one degree of freedom) back as a vector
+        return pin.computeFrameJacobian(model, data, qi, index, pin.LOCAL_WORLD_ALIGNED).reshape(6, model.nv)
 
     return handle.evaluate(Kernel("frame Jacobian", ("q",), jacobian), q)
 

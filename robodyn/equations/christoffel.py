@@ -8,6 +8,8 @@ like the dynamics. (For the compact form, derive the closed form of a small chai
 
 from __future__ import annotations
 
+from typing import Literal
+
 import sympy as sp
 
 from robodyn.common.text import json_text
@@ -25,7 +27,7 @@ def christoffel_symbols(equations: EquationsData) -> dict[tuple[int, int, int], 
         InputError: For the compact form (its ``M`` is a program, not expressions in ``q``).
     """
     if equations.form != "closed":
-        raise InputError("form", "closed for the Christoffel symbols (--form closed)", repr(equations.form))
+        raise InputError("form", "closed for the Christoffel symbols", repr(equations.form))
     M, q = equations.M, equations.q
     n = len(q)
     symbols = {}
@@ -39,7 +41,7 @@ def christoffel_symbols(equations: EquationsData) -> dict[tuple[int, int, int], 
     return symbols
 
 
-def render_christoffel(equations: EquationsData, format: str = "text", *, precision: int = 6) -> str:
+def render_christoffel(equations: EquationsData, format: Literal["text", "json"] = "text", *, precision: int = 6) -> str:
     """The symbols as ``text`` (``Gamma[i,j,k] = ...``, 1-based) or ``json``."""
     check_precision(precision)
     symbols = christoffel_symbols(equations)
@@ -52,7 +54,7 @@ def render_christoffel(equations: EquationsData, format: str = "text", *, precis
         }
         return json_text(data, indent=2) + "\n"
     if format != "text":
-        raise InputError("--format", "text or json with --christoffel", repr(format))
+        raise InputError("format", "text or json for the Christoffel symbols", repr(format))
     lines = [
         f"{terminal_text(equations.robot)}: Christoffel symbols of the first kind, C_ij = sum_k Gamma[i,j,k] qd_k"
         " (Gamma[i,j,k] = Gamma[i,k,j]; zeros left out)"

@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Sequence
-from typing import Any
+from dataclasses import replace
+from typing import Any, Literal
 
 import sympy as sp
 
@@ -32,9 +33,12 @@ from robodyn.equations.output import FORMATS, render
 from robodyn.equations.render_latex import latex_math
 from robodyn.exceptions import DerivationTooExpensiveError, InputError
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.symbolic import derive
+from robodyn.reference.symbolic import derive, exact_number
+from robodyn.urdf.sources import resolve_source
 
 __all__ = ["CLOSED_FORM_JOINTS", "FORMATS", "Equations", "derive_equations", "estimate_closed_form_seconds", "render"]
+
+Form = Literal["auto", "closed", "compact"]
 
 #: Largest number of joints derived in closed form by ``form="auto"``.
 CLOSED_FORM_JOINTS = 3
@@ -83,10 +87,79 @@ def _safe_parameters(
     )
 
 
+def _check_request(source: str | os.PathLike, form: Form, floating_base: bool | None) -> None:
+    """Refuse an unknown form or a floating base (before the robot is loaded)."""
+    if form not in ("auto", "closed", "compact"):
+        raise InputError("form", "closed, compact or auto", repr(form))
+    if floating_base or (floating_base is None and resolve_source(source).floating_base):
+        raise InputError(
+            "floating_base", "False: symbolic equations model fixed bases (floating_base=False)", f"a floating {source}"
+        )
+
+
+def _compact_form(
+    model: ReferenceRobot,
+    symbols: tuple[list[sp.Symbol], ...],
+    taken: set[str],
+    *,
+    keep_params: bool,
+    progress: Callable[[str, int, int], None] | None,
+) -> dict[str, Any]:
+    """The compact form's fields of :class:`Equations` (kept parameters renamed safely)."""
+    q, qd, qdd = symbols
+    compact = derive_compact(model, keep_params=keep_params, symbols=(q, qd, qdd), progress=progress)
+    rename, parameters, labels = _safe_parameters(compact.parameters, compact.labels, taken)
+    return {
+        "form": "compact",
+        "assignments": [(s, e.xreplace(rename)) for s, e in compact.assignments],
+        "M": compact.M.xreplace(rename),
+        "Cv": compact.Cv.xreplace(rename),
+        "G": compact.G.xreplace(rename),
+        "parameters": parameters,
+        "labels": labels,
+    }
+
+
+def _closed_form(
+    model: ReferenceRobot,
+    symbols: tuple[list[sp.Symbol], ...],
+    taken: set[str],
+    *,
+    keep_params: bool,
+    progress: Callable[[str, int, int], None] | None,
+) -> dict[str, Any]:
+    """The closed form's fields of :class:`Equations`: the Lagrangian, each entry simplified."""
+    q, qd, qdd = symbols
+    if progress:
+        progress("Lagrangian", 0, 3)
+    closed = derive(model, keep_params=keep_params, symbols=(q, qd, qdd), simplify=False)
+    rename, parameters, labels = _safe_parameters(closed.parameters, closed.labels, taken)
+    if progress:
+        progress("simplification", 1, 3)
+    tidy = lambda e: simplify.entry(e.xreplace(rename), q, qd)  # noqa: E731
+    M = closed.M.applyfunc(tidy)
+    C = closed.C.applyfunc(tidy)
+    Cv = (closed.C * sp.Matrix(qd)).applyfunc(tidy)
+    G = closed.G.applyfunc(tidy)
+    used = set().union(*(m.free_symbols for m in (M, C, G)))
+    if progress:
+        progress("simplification", 3, 3)
+    return {
+        "form": "closed",
+        "assignments": [],
+        "M": M,
+        "Cv": Cv,
+        "G": G,
+        "C": C,
+        "parameters": {s: v for s, v in parameters.items() if s in used},
+        "labels": {s: label for s, label in labels.items() if s in used},
+    }
+
+
 def derive_equations(
     source: str | os.PathLike,
     *,
-    form: str = "auto",
+    form: Form = "auto",
     keep_params: bool = False,
     gravity: Sequence[float] | None = None,
     lock: dict[str, float] | None = None,
@@ -111,12 +184,7 @@ def derive_equations(
         DerivationTooExpensiveError: For a closed form estimated to take longer than
             :data:`CLOSED_FORM_LIMIT_S` (the compact form is fast).
     """
-    from robodyn.urdf.sources import resolve_source
-
-    if form not in ("auto", "closed", "compact"):
-        raise InputError("form", "closed, compact or auto", repr(form))
-    if floating_base or (floating_base is None and resolve_source(source).floating_base):
-        raise InputError("floating_base", "False: symbolic equations model fixed bases (--fixed-base)", f"a floating {source}")
+    _check_request(source, form, floating_base)
     model = reference.load(source, lock=lock, gravity=gravity)
     if form == "auto":
         form = "closed" if model.nv <= CLOSED_FORM_JOINTS else "compact"
@@ -125,64 +193,24 @@ def derive_equations(
         if estimate > CLOSED_FORM_LIMIT_S:
             raise DerivationTooExpensiveError(model.name, model.nv, estimate, CLOSED_FORM_LIMIT_S)
     taken: set[str] = set()
-    q, qd, qdd = _symbols(model.joint_names, taken)
-    common: dict[str, Any] = {
-        "robot": model.name,
-        "joint_names": list(model.joint_names),
-        "gravity": tuple(float(g) for g in model.gravity_vector),
-    }
-    if form == "compact":
-        compact = derive_compact(model, keep_params=keep_params, symbols=(q, qd, qdd), progress=progress)
-        rename, parameters, labels = _safe_parameters(compact.parameters, compact.labels, taken)
-        return Equations(
-            form="compact",
-            q=q,
-            qd=qd,
-            qdd=qdd,
-            assignments=[(s, e.xreplace(rename)) for s, e in compact.assignments],
-            M=compact.M.xreplace(rename),
-            Cv=compact.Cv.xreplace(rename),
-            G=compact.G.xreplace(rename),
-            parameters=parameters,
-            labels=labels,
-            **common,
-        )
-    if progress:
-        progress("Lagrangian", 0, 3)
-    closed = derive(model, keep_params=keep_params, symbols=(q, qd, qdd), simplify=False)
-    rename, parameters, labels = _safe_parameters(closed.parameters, closed.labels, taken)
-    if progress:
-        progress("simplification", 1, 3)
-    tidy = lambda e: simplify.entry(e.xreplace(rename), q, qd)  # noqa: E731
-    M = closed.M.applyfunc(tidy)
-    C = closed.C.applyfunc(tidy)
-    Cv = (closed.C * sp.Matrix(qd)).applyfunc(tidy)
-    G = closed.G.applyfunc(tidy)
-    used = set().union(*(m.free_symbols for m in (M, C, G)))
-    if progress:
-        progress("simplification", 3, 3)
+    symbols = _symbols(model.joint_names, taken)
+    derived = (_compact_form if form == "compact" else _closed_form)(
+        model, symbols, taken, keep_params=keep_params, progress=progress
+    )
+    q, qd, qdd = symbols
     return Equations(
-        form="closed",
+        robot=model.name,
+        joint_names=list(model.joint_names),
+        gravity=(float(model.gravity_vector[0]), float(model.gravity_vector[1]), float(model.gravity_vector[2])),
         q=q,
         qd=qd,
         qdd=qdd,
-        assignments=[],
-        M=M,
-        Cv=Cv,
-        G=G,
-        C=C,
-        parameters={s: v for s, v in parameters.items() if s in used},
-        labels={s: label for s, label in labels.items() if s in used},
-        **common,
+        **derived,
     )
 
 
 def substitute_parameters(equations: EquationsData) -> EquationsData:
     """The equations with every kept parameter replaced by its (exact) value."""
-    from dataclasses import replace
-
-    from robodyn.reference.symbolic import exact_number
-
     values = {s: exact_number(v) for s, v in equations.parameters.items()}
     matrices: dict[str, Any] = {
         name: getattr(equations, name).xreplace(values) if getattr(equations, name) is not None else None

@@ -12,42 +12,21 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import sympy as sp
 
 from robodyn import reference
 from robodyn.common.rotations import rpy_matrix
-from robodyn.common.text import comment_text, identifier, json_text, latex_text
-from robodyn.common.text import printable as terminal_text
-from robodyn.equations import simplify
-from robodyn.equations.model import numeric
-from robodyn.equations.printing import check_precision, to_text_expr
+from robodyn.common.text import identifier
+from robodyn.equations import render_c, render_json, render_latex, render_python, render_text, simplify
+from robodyn.equations.model import Kinematics
+from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
 from robodyn.exceptions import FrameError, InputError
 from robodyn.reference.symbolic import Parameters, body_coordinates, body_poses, exact_matrix
 
-
-@dataclass
-class Kinematics:
-    """A frame's pose and Jacobian as functions of ``q``.
-
-    Attributes:
-        robot: Robot name (raw). frame: Frame name (raw).
-        joint_names: Joints in the order of ``q`` (raw).
-        q: Position symbols (safe identifiers).
-        position: World position of the frame's origin, 3×1, in [m].
-        rotation: World rotation of the frame, 3×3.
-        jacobian: 6×n: linear rows then angular rows (world-aligned).
-    """
-
-    robot: str
-    frame: str
-    joint_names: list[str]
-    q: list[sp.Symbol]
-    position: sp.Matrix
-    rotation: sp.Matrix
-    jacobian: sp.Matrix
+KinematicsFormat = Literal["text", "latex", "json", "python", "c"]
 
 
 def derive_kinematics(
@@ -115,104 +94,23 @@ def derive_kinematics(
     return Kinematics(model.name, frame, list(model.joint_names), q, position, rotation, jacobian)
 
 
-def render_kinematics(kinematics: Kinematics, format: str = "text", *, precision: int = 6) -> str:
+def render_kinematics(kinematics: Kinematics, format: KinematicsFormat = "text", *, precision: int = DEFAULT_PRECISION) -> str:
     """The frame's position and Jacobian as ``text``, ``latex`` (a fragment), ``json``,
     ``python`` (a module with ``frame_position(q)`` and ``frame_jacobian(q)``) or ``c``
-    (the same two functions, one state, arrays of doubles)."""
+    (the same two functions, one state, arrays of doubles): one renderer a format, as for
+    the equations (:func:`robodyn.equations.output.render`).
+
+    Raises:
+        InputError: For an unknown format or precision.
+    """
     check_precision(precision)
-    k = kinematics
-    n = len(k.q)
-    if format == "text":
-        lines = [
-            f"{terminal_text(k.robot)}: frame {terminal_text(k.frame)}",
-            "joints: " + ", ".join(f"{terminal_text(j)} (q = {s})" for j, s in zip(k.joint_names, k.q, strict=True)),
-        ]
-        lines += [f"p[{i + 1}] = {to_text_expr(e, precision)}" for i, e in enumerate(k.position)]
-        lines += [f"J[{i + 1},{j + 1}] = {to_text_expr(k.jacobian[i, j], precision)}" for i in range(6) for j in range(n)]
-        return "\n".join(lines) + "\n"
-    if format == "json":
-        data = {
-            "robot": k.robot,
-            "frame": k.frame,
-            "joint_names": k.joint_names,
-            "q": [str(s) for s in k.q],
-            "position": [str(numeric(e)) for e in k.position],
-            "rotation": [[str(numeric(k.rotation[i, j])) for j in range(3)] for i in range(3)],
-            "jacobian": [[str(numeric(k.jacobian[i, j])) for j in range(n)] for i in range(6)],
-        }
-        return json_text(data, indent=2) + "\n"
-    if format == "latex":
-        from robodyn.equations.render_latex import _Printer
-
-        names = {s: rf"q_{{{i + 1}}}" for i, s in enumerate(k.q)}
-        printer = _Printer(precision, names)
-        rows = [rf"p_{{{i + 1}}} &= {printer.doprint(numeric(e))}" for i, e in enumerate(k.position)]
-        rows += [rf"J_{{{i + 1}{j + 1}}} &= {printer.doprint(numeric(k.jacobian[i, j]))}" for i in range(6) for j in range(n)]
-        legend = ", ".join(rf"$q_{{{i + 1}}}$: \texttt{{{latex_text(j)}}}" for i, j in enumerate(k.joint_names))
-        return (
-            rf"Frame \texttt{{{latex_text(k.frame)}}} ({legend})."
-            + "\n\\begin{align*}\n"
-            + " \\\\\n".join(rows)
-            + "\n\\end{align*}\n"
-        )
-    if format == "python":
-        from sympy.printing.numpy import NumPyPrinter
-
-        printer = NumPyPrinter({"fully_qualified_modules": True})
-        to_array = {s: sp.Symbol(f"q[{i}]") for i, s in enumerate(k.q)}
-
-        def code(e: sp.Expr) -> str:
-            return printer.doprint(numeric(e.xreplace(to_array))).replace("numpy.", "np.") + " + z"
-
-        position = ", ".join(code(e) for e in k.position)
-        jacobian = ", ".join("[" + ", ".join(code(k.jacobian[i, j]) for j in range(n)) + "]" for i in range(6))
-        return "\n".join(
-            [
-                f'"""Forward kinematics of frame {comment_text(k.frame)} of {comment_text(k.robot)}, generated by robodyn.',
-                "",
-                "q: shape (n,) or (N, n). frame_position: (3,) or (N, 3) in [m]; frame_jacobian: (6, n) or",
-                '(N, 6, n), linear rows then angular rows, world-aligned."""',
-                "",
-                "import numpy as np",
-                "",
-                f"JOINT_NAMES = [{', '.join(ascii(j) for j in k.joint_names)}]",
-                "",
-                "",
-                "def frame_position(q):",
-                "    q = np.asarray(q, dtype=float).T",
-                "    z = np.zeros_like(q[0])",
-                f"    p = np.array([{position}], dtype=float)",
-                "    return p.T",
-                "",
-                "",
-                "def frame_jacobian(q):",
-                "    q = np.asarray(q, dtype=float).T",
-                "    z = np.zeros_like(q[0])",
-                f"    J = np.array([{jacobian}], dtype=float)",
-                "    return J if J.ndim == 2 else np.moveaxis(J, -1, 0)",
-                "",
-            ]
-        )
-    if format == "c":
-        to_array = {s: sp.Symbol(f"q[{i}]") for i, s in enumerate(k.q)}
-
-        def c_code(e: sp.Expr) -> str:
-            return sp.ccode(numeric(e.xreplace(to_array)), standard="C99")
-
-        lines = [
-            f"/* Forward kinematics of frame {comment_text(k.frame)} of {comment_text(k.robot)}, generated by robodyn.",
-            f"   Joints: {', '.join(comment_text(j) for j in k.joint_names)}. p in [m]; J row-major 6 x {n},",
-            "   linear rows then angular rows, world-aligned. */",
-            "#include <math.h>",
-            "",
-            "void frame_position(const double *q, double *p) {",
-            *(f"    p[{i}] = {c_code(e)};" for i, e in enumerate(k.position)),
-            "}",
-            "",
-            "void frame_jacobian(const double *q, double *J) {",
-            *(f"    J[{i * n + j}] = {c_code(k.jacobian[i, j])};" for i in range(6) for j in range(n)),
-            "}",
-            "",
-        ]
-        return "\n".join(lines)
-    raise InputError("format", "text, latex, json, python or c for kinematics", repr(format))
+    renderers: dict[str, Callable[[Kinematics], str]] = {
+        "text": lambda k: render_text.kinematics_text(k, precision=precision),
+        "latex": lambda k: render_latex.kinematics_latex(k, precision=precision),
+        "json": render_json.kinematics_json,
+        "python": render_python.kinematics_python,
+        "c": render_c.kinematics_c,
+    }
+    if format not in renderers:
+        raise InputError("format", "text, latex, json, python or c for kinematics", repr(format))
+    return renderers[format](kinematics)

@@ -17,6 +17,8 @@ in the lecture's symbols ``l1, m1, m2, Iz1, Iz2, g``:
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import sympy as sp
 
 from robodyn.reference.symbolic import SymbolicDynamics, lagrangian_dynamics
@@ -87,8 +89,6 @@ def in_lecture_symbols(equations):
     Args:
         equations: :class:`robodyn.equations.Equations` of ``rp_arm`` with kept parameters.
     """
-    from dataclasses import replace
-
     by_name = {symbol.name: symbol for symbol in equations.parameters}
     lecture_names = {
         "m_link1": m1,

@@ -1,8 +1,9 @@
-"""The symbolic equations of one robot, as the renderers receive them, and their size.
+"""The symbolic results the renderers receive (the equations of one robot and their size, a
+frame's kinematics).
 
 Every symbol in an :class:`EquationsData` (:class:`robodyn.equations.Equations` adds the
-notebook display) is a safe identifier (:mod:`robodyn.common.text`);
-the raw joint and robot names are kept only for the renderers to escape. Numbers are exact
+notebook display) or a :class:`Kinematics` is a safe identifier (:mod:`robodyn.common.text`);
+the raw joint, frame and robot names are kept only for the renderers to escape. Numbers are exact
 (rationals, ``π``, ``√2``) until a renderer turns them into floats (:func:`numeric`).
 """
 
@@ -66,3 +67,25 @@ def operation_count(equations: EquationsData) -> int:
     multiplication, not a multiplication and a division)."""
     expressions = [e for _, e in equations.assignments] + [*equations.M, *equations.Cv, *equations.G]
     return int(sum(sp.count_ops(numeric(e)) for e in expressions))
+
+
+@dataclass
+class Kinematics:
+    """A frame's pose and Jacobian as functions of ``q``.
+
+    Attributes:
+        robot: Robot name (raw). frame: Frame name (raw).
+        joint_names: Joints in the order of ``q`` (raw).
+        q: Position symbols (safe identifiers).
+        position: World position of the frame's origin, 3×1, in [m].
+        rotation: World rotation of the frame, 3×3.
+        jacobian: 6×n: linear rows then angular rows (world-aligned).
+    """
+
+    robot: str
+    frame: str
+    joint_names: list[str]
+    q: list[sp.Symbol]
+    position: sp.Matrix
+    rotation: sp.Matrix
+    jacobian: sp.Matrix

@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Literal
 
 from robodyn.equations import render_c, render_json, render_latex, render_python, render_text
 from robodyn.equations.model import EquationsData
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
 from robodyn.exceptions import InputError
 
-FORMATS = ("text", "latex", "pdf", "json", "python", "c")
+Format = Literal["text", "latex", "pdf", "json", "python", "c"]
+FORMATS: tuple[Format, ...] = ("text", "latex", "pdf", "json", "python", "c")
 
 
-def render(equations: EquationsData, format: str = "text", *, precision: int = DEFAULT_PRECISION) -> str | bytes:
+def render(equations: EquationsData, format: Format = "text", *, precision: int = DEFAULT_PRECISION) -> str | bytes:
     """The equations in one of :data:`FORMATS` (``"pdf"`` gives bytes).
 
     Args:

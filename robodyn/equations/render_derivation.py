@@ -26,7 +26,7 @@ from robodyn.equations import lecture
 from robodyn.equations.derivation import LECTURE_ERRATA_STEPS, DerivationSteps, derive_steps
 from robodyn.equations.model import numeric
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision, format_float, to_text_expr
-from robodyn.equations.render_latex import LINE_WIDTH, _equation, _Printer, _width, compile_latex
+from robodyn.equations.render_latex import LINE_WIDTH, PREAMBLE, EquationPrinter, compile_latex, latex_equation, latex_width
 from robodyn.exceptions import InputError
 
 DerivationFormat = Literal["text", "latex", "pdf", "json"]
@@ -293,38 +293,38 @@ def _names(steps: DerivationSteps) -> dict[sp.Symbol, str]:
     return names
 
 
-def _column(printer: _Printer, symbol: str, matrix: sp.Matrix, tail: str = "") -> list[str]:
+def _column(printer: EquationPrinter, symbol: str, matrix: sp.Matrix, tail: str = "") -> list[str]:
     """``symbol tail = matrix`` as one ``bmatrix`` row when it fits the line, else entry by
     entry as ``(symbol)_{x}`` (vectors) or ``(symbol)_{x1}`` (matrices)."""
     entries = [[printer.doprint(numeric(sp.sympify(e))) for e in matrix.row(i)] for i in range(matrix.rows)]
     left = symbol + tail
-    widest = max(sum(_width(e) + 3 for e in row) for row in entries)
-    if widest + _width(left) + 8 <= LINE_WIDTH:
+    widest = max(sum(latex_width(e) + 3 for e in row) for row in entries)
+    if widest + latex_width(left) + 8 <= LINE_WIDTH:
         body = r" \\ ".join(" & ".join(row) for row in entries)
         return [rf"{left} &= \begin{{bmatrix}} {body} \end{{bmatrix}}"]
     axes = "xyz" if matrix.rows == 3 else [str(k + 1) for k in range(matrix.rows)]
     if matrix.cols == 1:
-        return [_equation(printer, rf"({symbol})_{{{axes[r]}}}", matrix[r]) for r in range(matrix.rows)]
+        return [latex_equation(printer, rf"({symbol})_{{{axes[r]}}}", matrix[r]) for r in range(matrix.rows)]
     cells = [(r, c) for r in range(matrix.rows) for c in range(matrix.cols)]
-    return [_equation(printer, rf"({symbol})_{{{axes[r]}{c + 1}}}", matrix[r, c]) for r, c in cells]
+    return [latex_equation(printer, rf"({symbol})_{{{axes[r]}{c + 1}}}", matrix[r, c]) for r, c in cells]
 
 
-def _latex_blocks(steps: DerivationSteps, printer: _Printer) -> list[list[str]]:
+def _latex_blocks(steps: DerivationSteps, printer: EquationPrinter) -> list[list[str]]:
     """The ``align*`` rows of each of the six steps."""
     blocks: list[list[str]] = [[], [], [], [], [], []]
     for i, link in enumerate(steps.links, 1):
         blocks[0] += _column(printer, f"R_{{{i}}}", link.R) + _column(printer, f"p_{{{i}}}", link.p)
         blocks[1] += _column(printer, rf"J_{{v,{i}}}", link.Jv) + _column(printer, f"v_{{{i}}}", link.v, rf" = J_{{v,{i}}}\dot q")
         blocks[1] += _column(printer, rf"\omega_{{{i}}}", link.omega, rf" = J_{{\omega,{i}}}\dot q")
-        blocks[2] += [_equation(printer, f"m_{{{i}}}", link.mass), _equation(printer, f"T_{{{i}}}", link.T)]
-        blocks[2] += [_equation(printer, f"U_{{{i}}}", link.U)]
-    blocks[3] = [_equation(printer, r"L = \textstyle\sum_i T_i - \sum_i U_i", steps.L)]
+        blocks[2] += [latex_equation(printer, f"m_{{{i}}}", link.mass), latex_equation(printer, f"T_{{{i}}}", link.T)]
+        blocks[2] += [latex_equation(printer, f"U_{{{i}}}", link.U)]
+    blocks[3] = [latex_equation(printer, r"L = \textstyle\sum_i T_i - \sum_i U_i", steps.L)]
     for i, joint in enumerate(steps.joints, 1):
         blocks[4] += [
-            _equation(printer, rf"\frac{{\partial L}}{{\partial \dot q_{{{i}}}}}", joint.dL_dqd),
-            _equation(printer, rf"\frac{{d}}{{dt}}\frac{{\partial L}}{{\partial \dot q_{{{i}}}}}", joint.ddt_dL_dqd),
-            _equation(printer, rf"\frac{{\partial L}}{{\partial q_{{{i}}}}}", joint.dL_dq),
-            _equation(printer, rf"\tau_{{{i}}}", joint.tau),
+            latex_equation(printer, rf"\frac{{\partial L}}{{\partial \dot q_{{{i}}}}}", joint.dL_dqd),
+            latex_equation(printer, rf"\frac{{d}}{{dt}}\frac{{\partial L}}{{\partial \dot q_{{{i}}}}}", joint.ddt_dL_dqd),
+            latex_equation(printer, rf"\frac{{\partial L}}{{\partial q_{{{i}}}}}", joint.dL_dq),
+            latex_equation(printer, rf"\tau_{{{i}}}", joint.tau),
         ]
     n = len(steps.q)
     trace = [
@@ -332,11 +332,13 @@ def _latex_blocks(steps: DerivationSteps, printer: _Printer) -> list[list[str]]:
         r"(C\dot q)_i &= \textstyle\sum_j \frac{\partial^2 L}{\partial \dot q_i\,\partial q_j}\dot q_j - \frac{\partial T}{\partial q_i},"
         r"\quad G_i = \frac{\partial U}{\partial q_i}",
     ]
-    blocks[5] = trace + [_equation(printer, f"M_{{{i + 1}{j + 1}}}", steps.M[i, j]) for i in range(n) for j in range(i, n)]
-    blocks[5] += [_equation(printer, rf"(C\dot q)_{{{i + 1}}}", steps.Cv[i]) for i in range(n)]
-    blocks[5] += [_equation(printer, f"G_{{{i + 1}}}", steps.G[i]) for i in range(n)]
+    blocks[5] = trace + [latex_equation(printer, f"M_{{{i + 1}{j + 1}}}", steps.M[i, j]) for i in range(n) for j in range(i, n)]
+    blocks[5] += [latex_equation(printer, rf"(C\dot q)_{{{i + 1}}}", steps.Cv[i]) for i in range(n)]
+    blocks[5] += [latex_equation(printer, f"G_{{{i + 1}}}", steps.G[i]) for i in range(n)]
     if steps.lecture:
-        blocks[5] += [_equation(printer, rf"\tau_{{{i + 1}}}^{{\text{{printed}}}}", e) for i, e in enumerate(printed_tau(steps))]
+        blocks[5] += [
+            latex_equation(printer, rf"\tau_{{{i + 1}}}^{{\text{{printed}}}}", e) for i, e in enumerate(printed_tau(steps))
+        ]
     return blocks
 
 
@@ -354,7 +356,7 @@ def _errata_tex(steps: DerivationSteps, step: int) -> list[str]:
 
 def latex_math(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> str:
     """Every step as ``align*`` environments, titles and errata as text rows (for notebooks)."""
-    printer = _Printer(precision, _names(steps))
+    printer = EquationPrinter(precision, _names(steps))
     out = []
     for number, (title, rows) in enumerate(zip(STEP_TITLES, _latex_blocks(steps, printer), strict=True), 1):
         notes = [rf"&\text{{{_prose(f'Erratum {n}: {text}')}}}" for n, text, _ in errata_at(steps, number)]
@@ -364,15 +366,10 @@ def latex_math(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) ->
 
 def to_latex(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> str:
     """A complete LaTeX document (amsmath): legends, then the six steps with their errata."""
-    printer = _Printer(precision, _names(steps))
+    printer = EquationPrinter(precision, _names(steps))
     names = _names(steps)
     body = [
-        r"\documentclass[10pt]{article}",
-        r"\usepackage[T1]{fontenc}",
-        r"\usepackage{amsmath}",
-        r"\usepackage[a4paper,margin=2cm]{geometry}",
-        r"\allowdisplaybreaks",
-        r"\begin{document}",
+        *PREAMBLE,
         rf"\section*{{The Lagrangian of \texttt{{{latex_text(steps.robot)}}}, step by step}}",
         r"$\tau = \frac{d}{dt}\frac{\partial L}{\partial \dot q} - \frac{\partial L}{\partial q} = M(q)\,\ddot q + C(q,\dot q)\,\dot q + G(q)$, "
         r"gravity $g = (" + ", ".join(format_float(g, precision) for g in steps.gravity) + r")\,\mathrm{m/s^2}$.",

@@ -1,10 +1,10 @@
-"""The equations as JSON: names through :func:`robodyn.common.text.json_text`, entries as sympy strings
+"""The equations, and a frame's kinematics, as JSON: names through :func:`robodyn.common.text.json_text`, entries as sympy strings
 with 17-digit floats (``sympy.sympify`` reads them back)."""
 
 from __future__ import annotations
 
 from robodyn.common.text import json_text
-from robodyn.equations.model import EquationsData, numeric
+from robodyn.equations.model import EquationsData, Kinematics, numeric
 
 
 def to_json(equations: EquationsData) -> str:
@@ -30,5 +30,21 @@ def to_json(equations: EquationsData) -> str:
         "G": [text(e) for e in equations.G],
         "C": None if equations.C is None else [[text(equations.C[i, j]) for j in range(n)] for i in range(n)],
         "operations": equations.operation_count(),
+    }
+    return json_text(data, indent=2) + "\n"
+
+
+def kinematics_json(kinematics: Kinematics) -> str:
+    """The frame's names, ``q``, position, rotation and Jacobian (entries as sympy strings)."""
+    k = kinematics
+    n = len(k.q)
+    data = {
+        "robot": k.robot,
+        "frame": k.frame,
+        "joint_names": k.joint_names,
+        "q": [str(s) for s in k.q],
+        "position": [str(numeric(e)) for e in k.position],
+        "rotation": [[str(numeric(k.rotation[i, j])) for j in range(3)] for i in range(3)],
+        "jacobian": [[str(numeric(k.jacobian[i, j])) for j in range(n)] for i in range(6)],
     }
     return json_text(data, indent=2) + "\n"

@@ -1,4 +1,5 @@
-"""The equations as a LaTeX document (amsmath), or compiled to PDF.
+"""The equations as a LaTeX document (amsmath), or compiled to PDF; a frame's kinematics as a
+LaTeX fragment.
 
 Joints are numbered, ``q_1``, ``\\dot q_1``, ``\\ddot q_1``, with a legend table of the
 joint names; kept parameters carry their link or joint as an upright subscript
@@ -20,7 +21,7 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from robodyn.common.text import latex_text
-from robodyn.equations.model import EquationsData, numeric
+from robodyn.equations.model import EquationsData, Kinematics, numeric
 from robodyn.equations.printing import format_float
 from robodyn.exceptions import MissingToolError, TypesettingError
 
@@ -28,7 +29,7 @@ from robodyn.exceptions import MissingToolError, TypesettingError
 LINE_WIDTH = 72
 
 
-class _Printer(LatexPrinter):
+class EquationPrinter(LatexPrinter):
     def __init__(self, precision: int, names: dict[sp.Symbol, str]) -> None:
         super().__init__({"symbol_names": names, "mul_symbol": None})
         self.precision = precision
@@ -39,6 +40,17 @@ class _Printer(LatexPrinter):
             mantissa, exponent = text.split("e")
             return rf"{mantissa} \cdot 10^{{{int(exponent)}}}"
         return text
+
+
+#: The start of every LaTeX document robodyn writes (amsmath, A4, breaks between lines allowed).
+PREAMBLE = (
+    r"\documentclass[10pt]{article}",
+    r"\usepackage[T1]{fontenc}",
+    r"\usepackage{amsmath}",
+    r"\usepackage[a4paper,margin=2cm]{geometry}",
+    r"\allowdisplaybreaks",
+    r"\begin{document}",
+)
 
 
 def _symbol_names(equations: EquationsData) -> dict[sp.Symbol, str]:
@@ -56,7 +68,7 @@ def _symbol_names(equations: EquationsData) -> dict[sp.Symbol, str]:
     return names
 
 
-def _width(tex: str) -> float:
+def latex_width(tex: str) -> float:
     """Roughly how many characters wide ``tex`` typesets."""
     text = re.sub(r"\\(left|right|bigl|bigr|mathit|text|operatorname)\b", "", tex)
     text = re.sub(r"\\(dot|ddot)\b", "", text)
@@ -66,27 +78,27 @@ def _width(tex: str) -> float:
     return len(text) - 0.4 * subscripts
 
 
-def _signed(printer: _Printer, term: sp.Expr) -> tuple[str, str]:
+def _signed(printer: EquationPrinter, term: sp.Expr) -> tuple[str, str]:
     if term.could_extract_minus_sign():
         return "-", printer.doprint(-term)
     return "+", printer.doprint(term)
 
 
-def _lines(printer: _Printer, expr: sp.Expr, width: float) -> list[str]:
+def _lines(printer: EquationPrinter, expr: sp.Expr, width: float) -> list[str]:
     """``expr`` broken into display lines no wider than ``width`` (where it can be)."""
     tex = printer.doprint(expr)
-    if _width(tex) <= width:
+    if latex_width(tex) <= width:
         return [tex]
     if expr.is_Add:
         terms = sorted(expr.args, key=sp.default_sort_key)
         lines: list[str] = []
         for position, term in enumerate(terms):
             sign, body = _signed(printer, term)
-            pieces = _lines(printer, -term if sign == "-" else term, width - 4) if _width(body) > width else [body]
+            pieces = _lines(printer, -term if sign == "-" else term, width - 4) if latex_width(body) > width else [body]
             prefix = ("" if sign == "+" else "-") if position == 0 else sign + " "
             for k, piece in enumerate(pieces):
                 piece = (prefix + piece) if k == 0 else piece
-                if lines and k == 0 and _width(lines[-1] + piece) <= width:
+                if lines and k == 0 and latex_width(lines[-1] + piece) <= width:
                     lines[-1] += " " + piece
                 else:
                     lines.append(piece)
@@ -106,28 +118,28 @@ def _lines(printer: _Printer, expr: sp.Expr, width: float) -> list[str]:
     return [tex]
 
 
-def _equation(printer: _Printer, left: str, expr: sp.Expr) -> str:
+def latex_equation(printer: EquationPrinter, left: str, expr: sp.Expr) -> str:
     """One ``align*`` row, continued with ``&\\quad`` lines where long."""
-    lines = _lines(printer, numeric(expr), LINE_WIDTH - _width(left))
+    lines = _lines(printer, numeric(expr), LINE_WIDTH - latex_width(left))
     rows = [f"{left} &= {lines[0]}"] + [rf"&\quad {line}" for line in lines[1:]]
     return " \\\\\n".join(rows)
 
 
 def latex_math(equations: EquationsData, *, precision: int = 6) -> str:
     """The equations as ``align*`` environments (for a document or a notebook)."""
-    printer = _Printer(precision, _symbol_names(equations))
+    printer = EquationPrinter(precision, _symbol_names(equations))
     n = len(equations.q)
     rows = []
     if equations.assignments:
-        rows.append([_equation(printer, printer.doprint(s), e) for s, e in equations.assignments])
+        rows.append([latex_equation(printer, printer.doprint(s), e) for s, e in equations.assignments])
     entries = [[printer.doprint(numeric(equations.M[i, j])) for j in range(n)] for i in range(n)]
-    if not equations.assignments and max(sum(_width(e) + 3 for e in row) for row in entries) + 8 <= LINE_WIDTH:
+    if not equations.assignments and max(sum(latex_width(e) + 3 for e in row) for row in entries) + 8 <= LINE_WIDTH:
         matrix = r" \\ ".join(" & ".join(row) for row in entries)
         rows.append([rf"M(q) &= \begin{{bmatrix}} {matrix} \end{{bmatrix}}"])
     else:  # too wide for a matrix: entry by entry, the upper triangle (M is symmetric)
-        rows.append([_equation(printer, f"M_{{{i + 1}{j + 1}}}", equations.M[i, j]) for i in range(n) for j in range(i, n)])
-    rows.append([_equation(printer, rf"(C\dot q)_{{{i + 1}}}", equations.Cv[i]) for i in range(n)])
-    rows.append([_equation(printer, f"G_{{{i + 1}}}", equations.G[i]) for i in range(n)])
+        rows.append([latex_equation(printer, f"M_{{{i + 1}{j + 1}}}", equations.M[i, j]) for i in range(n) for j in range(i, n)])
+    rows.append([latex_equation(printer, rf"(C\dot q)_{{{i + 1}}}", equations.Cv[i]) for i in range(n)])
+    rows.append([latex_equation(printer, f"G_{{{i + 1}}}", equations.G[i]) for i in range(n)])
     return "\n".join(r"\begin{align*}" + "\n" + " \\\\\n".join(block) + "\n" + r"\end{align*}" for block in rows)
 
 
@@ -138,12 +150,7 @@ def to_latex(equations: EquationsData, *, precision: int = 6) -> str:
         rf"${names[q]}$ & \texttt{{{latex_text(name)}}} \\" for q, name in zip(equations.q, equations.joint_names, strict=True)
     ]
     body = [
-        r"\documentclass[10pt]{article}",
-        r"\usepackage[T1]{fontenc}",
-        r"\usepackage{amsmath}",
-        r"\usepackage[a4paper,margin=2cm]{geometry}",
-        r"\allowdisplaybreaks",
-        r"\begin{document}",
+        *PREAMBLE,
         rf"\section*{{Equations of motion of \texttt{{{latex_text(equations.robot)}}}}}",
         r"$\tau = M(q)\,\ddot q + C(q,\dot q)\,\dot q + G(q)$ "
         rf"({latex_text(equations.form)} form, {equations.operation_count()} operations), gravity "
@@ -166,6 +173,22 @@ def to_latex(equations: EquationsData, *, precision: int = 6) -> str:
     return "\n".join(body)
 
 
+def kinematics_latex(kinematics: Kinematics, *, precision: int = 6) -> str:
+    """The frame's position and Jacobian as an ``align*`` fragment, with the joints' legend."""
+    k = kinematics
+    n = len(k.q)
+    printer = EquationPrinter(precision, {s: rf"q_{{{i + 1}}}" for i, s in enumerate(k.q)})
+    rows = [rf"p_{{{i + 1}}} &= {printer.doprint(numeric(e))}" for i, e in enumerate(k.position)]
+    rows += [rf"J_{{{i + 1}{j + 1}}} &= {printer.doprint(numeric(k.jacobian[i, j]))}" for i in range(6) for j in range(n)]
+    legend = ", ".join(rf"$q_{{{i + 1}}}$: \texttt{{{latex_text(j)}}}" for i, j in enumerate(k.joint_names))
+    return (
+        rf"Frame \texttt{{{latex_text(k.frame)}}} ({legend})."
+        + "\n\\begin{align*}\n"
+        + " \\\\\n".join(rows)
+        + "\n\\end{align*}\n"
+    )
+
+
 def tex_engine() -> str | None:
     """The path of ``pdflatex``, or ``None`` when it is not installed."""
     return shutil.which("pdflatex")
@@ -180,7 +203,7 @@ def compile_latex(tex: str, folder: Path) -> tuple[Path, str]:
     """
     engine = tex_engine()
     if engine is None:
-        raise MissingToolError("pdflatex", "PDF output", "install TeX Live (Debian: texlive-latex-base) or use --format latex")
+        raise MissingToolError("pdflatex", "PDF output", "install TeX Live (Debian: texlive-latex-base) or use format='latex'")
     source = folder / "equations.tex"
     source.write_text(tex)
     result = subprocess.run(

@@ -1,9 +1,10 @@
-"""The equations as readable text: every name through :func:`robodyn.common.text.printable`."""
+"""The equations, and a frame's kinematics, as readable text: every name through
+:func:`robodyn.common.text.printable`."""
 
 from __future__ import annotations
 
 from robodyn.common.text import printable as terminal_text
-from robodyn.equations.model import EquationsData
+from robodyn.equations.model import EquationsData, Kinematics
 from robodyn.equations.printing import format_float, to_text_expr
 
 
@@ -39,4 +40,17 @@ def to_text(equations: EquationsData, *, precision: int = 6) -> str:
         lines += [f"C[{i + 1},{j + 1}] = {text(equations.C[i, j])}" for i in range(n) for j in range(n)]
     lines += [f"(C qd)[{i + 1}] = {text(equations.Cv[i])}" for i in range(n)]
     lines += [f"G[{i + 1}] = {text(equations.G[i])}" for i in range(n)]
+    return "\n".join(lines) + "\n"
+
+
+def kinematics_text(kinematics: Kinematics, *, precision: int = 6) -> str:
+    """The frame, its joints, then every entry of ``p`` and ``J`` (1-based)."""
+    k = kinematics
+    n = len(k.q)
+    lines = [
+        f"{terminal_text(k.robot)}: frame {terminal_text(k.frame)}",
+        "joints: " + ", ".join(f"{terminal_text(j)} (q = {s})" for j, s in zip(k.joint_names, k.q, strict=True)),
+    ]
+    lines += [f"p[{i + 1}] = {to_text_expr(e, precision)}" for i, e in enumerate(k.position)]
+    lines += [f"J[{i + 1},{j + 1}] = {to_text_expr(k.jacobian[i, j], precision)}" for i in range(6) for j in range(n)]
     return "\n".join(lines) + "\n"

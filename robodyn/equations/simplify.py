@@ -18,6 +18,7 @@ import contextlib
 from collections.abc import Iterable
 
 import sympy as sp
+from sympy.simplify.fu import TR10i
 
 #: A term smaller than this, relative to the largest of its entry, is round-off.
 RELATIVE_ROUND_OFF = 1e-12
@@ -129,8 +130,6 @@ def completed_square(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
 
 def coefficient(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
     """The shortest of several equivalent forms of a function of ``q``."""
-    from sympy.simplify.fu import TR10i
-
     reduced = pythagoras(expr)
     if reduced.is_number:
         return reduced

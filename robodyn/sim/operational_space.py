@@ -158,7 +158,8 @@ def _frame_state(robot: Robot, frame_id: int, q: np.ndarray, v: np.ndarray) -> _
     placement = pin.updateFramePlacement(model, data, frame_id)
     jacobian = pin.getFrameJacobian(model, data, frame_id, pin.LOCAL_WORLD_ALIGNED)
     bias = pin.getFrameClassicalAcceleration(model, data, frame_id, pin.LOCAL_WORLD_ALIGNED).vector
-    return _FrameState(placement.translation.copy(), placement.rotation.copy(), jacobian.copy(), bias.copy())
+    # reshape: Pinocchio hands a 6×1 Jacobian (one degree of freedom) back as a vector
+    return _FrameState(placement.translation.copy(), placement.rotation.copy(), jacobian.reshape(6, robot.nv).copy(), bias.copy())
 
 
 def _reference(position: np.ndarray | TaskReference, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -412,7 +412,7 @@ def parse_urdf(
         first = next(problem for problem in problems if problem.severity == "error")
         rule = first.rule
         if "inertia" in rule and check_inertia:
-            rule += " (check_inertia=False or --no-check-inertia loads it anyway)"
+            rule += " (check_inertia=False loads it anyway)"
         raise URDFError(source, rule, first.element)
     for problem in problems:
         if problem.loud:

@@ -7,6 +7,7 @@ The library says ``target``; ``robodyn`` maps it to ``--target`` through one tab
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -26,8 +27,8 @@ NOT_OUR_FLAGS = {
 }
 #: Files whose every ``--`` literal is a flag of the program they run.
 OTHER_PROGRAMS = {"viz/stills.py"}
-#: Flags still named by a library module another part of issue 23 owns (to be removed there).
-PENDING = {("equations/christoffel.py", "--format")}
+#: A flag anywhere in a string: two dashes and a word, not part of a longer word or rule.
+FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
 
 
 def _dash_literals() -> set[tuple[str, str]]:
@@ -36,16 +37,28 @@ def _dash_literals() -> set[tuple[str, str]]:
         relative = path.relative_to(PACKAGE).as_posix()
         if relative.startswith("cli/") or relative in OTHER_PROGRAMS:
             continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value.startswith("--"):
-                found.add((relative, node.value))
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        docstrings = {
+            id(node.body[0].value)
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef)
+            and node.body
+            and isinstance(node.body[0], ast.Expr)
+            and isinstance(node.body[0].value, ast.Constant)
+        }
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+                found.update((relative, flag) for flag in FLAG.findall(node.value))
+                if node.value == "--":
+                    found.add((relative, "--"))
     return found
 
 
-def test_no_string_literal_of_the_library_outside_the_cli_starts_with_two_dashes():
+def test_no_string_of_the_library_outside_the_cli_names_a_flag():
     found = _dash_literals()
-    assert found <= NOT_OUR_FLAGS | PENDING, sorted(found - NOT_OUR_FLAGS - PENDING)
+    assert found <= NOT_OUR_FLAGS, sorted(found - NOT_OUR_FLAGS)
     assert ("viz/plots.py", "--") in found  # the scan sees literals at all (a negative control)
+    assert FLAG.findall("or use --format latex (check_inertia=False)") == ["--format"]  # and flags mid-sentence
 
 
 def test_a_library_call_with_a_bad_target_names_the_parameter_target():
@@ -96,3 +109,14 @@ def test_every_flag_of_the_table_is_a_flag_or_a_positional_argument_of_some_comm
         for name in [*action.option_strings, action.dest.upper()]
     }
     assert set(FLAGS.values()) <= known, sorted(set(FLAGS.values()) - known)
+
+
+def test_a_suggested_boolean_keyword_becomes_its_switch_on_the_command_line(capsys):
+    from robodyn.cli import main
+    from robodyn.equations import derive_equations
+
+    with pytest.raises(InputError, match=r"\(floating_base=False\)"):
+        derive_equations("solo12")
+    assert main(["equations", "solo12", "--symbolic"]) == 2
+    err = capsys.readouterr().err
+    assert "(--fixed-base)" in err and "floating_base=" not in err

@@ -13,7 +13,7 @@ peers load). ``expected.json`` maps each file to ``{"family", "outcome", "fragme
   shows).
 
 Cases that need the file system (FIFOs, devices, huge files, long names) are made at test
-time (tests/test_hostile_resources.py).
+time (tests/urdf/test_sources.py).
 """
 
 from __future__ import annotations

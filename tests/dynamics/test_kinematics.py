@@ -54,3 +54,14 @@ def test_the_fast_path_still_refuses_what_the_boundary_refuses(function):
     q[3:7] = [0.0, 0.0, 0.0, 1.5]  # Pinocchio takes it; robodyn refuses a non-unit quaternion
     with pytest.raises(robodyn.InputError, match="quaternion"):
         getattr(floating, function)(q, frame)
+
+
+def test_a_robot_of_one_degree_of_freedom_has_a_six_by_one_jacobian_one_state_and_a_batch():
+    """Pinocchio hands a 6×1 Jacobian back as a vector of 6: the shape rule holds anyway."""
+    robot = robodyn.load("rp_arm", lock={"joint2": 0.1})
+    q = robot.random_configuration(np.random.default_rng(3), 3)
+    assert robot.nv == 1
+    assert robot.frame_jacobian(q[0], "end_effector").shape == (6, 1)
+    batch = robot.frame_jacobian(q, "end_effector")
+    assert batch.shape == (3, 6, 1)
+    np.testing.assert_array_equal(batch[1], robot.frame_jacobian(q[1], "end_effector"))

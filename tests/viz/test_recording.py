@@ -1,17 +1,95 @@
-"""Recordings bound their frames before allocating them (issue 29, item 7)."""
+"""robot_html (for Robot._repr_html_) and Recording._repr_html_: escaped, complete."""
 
 from __future__ import annotations
+
+import html.parser
 
 import numpy as np
 import pytest
 
 import robodyn
 from robodyn.cli import main
+from robodyn.dynamics.display import robot_html
 from robodyn.exceptions import InputError
 from robodyn.trajectory import Trajectory
 from robodyn.viz.recording import MAX_FRAMES, frame_count, recording
 
+HOSTILE = """<robot name="r&lt;script&gt;alert(1)&lt;/script&gt;">
+  <link name="base"/>
+  <link name="l&lt;b&gt;1"><inertial><mass value="1.5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><box size="0.1 0.2 0.3"/></geometry></visual></link>
+  <joint name="j&quot;&gt;&lt;img src=x onerror=alert(2)&gt;" type="prismatic"><parent link="base"/><child link="l&lt;b&gt;1"/>
+    <axis xyz="0 0.6 0.8"/><limit lower="-0.25" upper="0.5" effort="40" velocity="1"/></joint>
+</robot>"""
 
+
+class _Tags(html.parser.HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.tags, self.cells = [], []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+
+    def handle_data(self, data):
+        self.cells.append(data)
+
+
+def _parse(text: str) -> _Tags:
+    parser = _Tags()
+    parser.feed(text)
+    return parser
+
+
+def test_robot_html_escapes_names_and_lists_joints():
+    robot = robodyn.load(HOSTILE)
+    parsed = _parse(robot_html(robot))
+    assert "script" not in parsed.tags and "img" not in parsed.tags
+    text = "|".join(parsed.cells)
+    assert "<img src=x onerror=alert(2)>" in text and "<script>" in text  # shown as text
+    assert "prismatic" in text and "-0.25 m … 0.5 m" in text and "40 N" in text and "1.5 kg" in text
+
+
+def test_robot_html_on_zoo_robots():
+    for name in ("panda", "ur5"):
+        robot = robodyn.load(name)
+        parsed = _parse(robot_html(robot))
+        assert parsed.tags.count("tr") == len(robot.joints) + 1
+        assert "N m" in "".join(parsed.cells)
+    solo = robodyn.load("solo12", floating_base=True)
+    assert "floating" in robot_html(solo)
+
+
+def test_recording_repr_html_is_one_sandboxed_iframe():
+    robot = robodyn.load(HOSTILE)
+    t = np.linspace(0, 0.5, 6)
+    q = np.linspace(0, 0.3, 6)[:, None]
+    made = recording(robot, Trajectory(t, q, 0 * q, 0 * q, 0 * q, robot.joint_names, robot.name))
+    parsed = _parse(made._repr_html_())
+    assert parsed.tags == ["iframe"]
+    assert "<title>robodyn: r&lt;script&gt;" in made.html
+
+
+def test_axes_ride_on_their_links():
+    from robodyn import FrameError
+    from tests.viz.test_viewer import commands_of
+
+    robot = robodyn.load("rp_arm")
+    t = np.linspace(0, 0.5, 6)
+    q = np.column_stack([np.linspace(0, 0.3, 6), np.full(6, 0.1)])
+    motion = Trajectory(t, q, 0 * q, 0 * q, 0 * q, robot.joint_names, robot.name)
+    made = recording(robot, motion, axes=("end_effector",))
+    paths = [c["path"] for c in commands_of(made.html) if c["type"] == "set_object"]
+    assert "/robodyn/end_effector/axes" in paths
+    import pytest
+
+    with pytest.raises(FrameError, match="no frame named 'nowhere'"):
+        recording(robot, motion, axes=("nowhere",))
+
+
+# --------------------------------------------------------------------------------------
+# Issue 29: Recordings bound their frames before allocating them (issue 29, item 7).
+# --------------------------------------------------------------------------------------
 def _motion(robot, end: float) -> Trajectory:
     t = np.array([0.0, 0.5, end])
     q = np.array([[0.0, 0.0], [0.3, 0.1], [0.5, 0.2]])

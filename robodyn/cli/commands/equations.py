@@ -62,71 +62,29 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def _symbolic(arguments: argparse.Namespace) -> int:
-    from robodyn.common.text import printable as terminal_text
-    from robodyn.equations.derive import derive_equations
-    from robodyn.equations.lecture import lecture_text
-    from robodyn.equations.output import check_precision, render
+    from robodyn.common.text import printable
+    from robodyn.equations.document import What, equations_document
 
     given = [f"--{name}" for name in ("q", "v", "a") if getattr(arguments, name) is not None]
     if given:
         raise InputError(", ".join(given), "left out with --symbolic (the equations hold for every state)", "a state")
-    check_precision(arguments.precision)
-    if arguments.format == "pdf":
-        from robodyn.equations.render_latex import tex_engine
-        from robodyn.exceptions import MissingToolError
-
-        if not arguments.out:
-            raise InputError("--out", "given with --format pdf (a PDF is not printed)", "no --out")
-        if tex_engine() is None:
-            raise MissingToolError(
-                "pdflatex", "--format pdf", "install TeX Live (Debian: texlive-latex-base) or use --format latex"
-            )
-    if arguments.lecture:
-        if arguments.model != "rp_arm":
-            raise InputError("model", "rp_arm with --lecture (the lecture's arm)", repr(terminal_text(str(arguments.model))))
-        print(lecture_text(), end="")
-        return 0
-    if arguments.derivation:
-        from robodyn.equations.render_derivation import derivation_document
-
-        document = derivation_document(
-            arguments.model, format=arguments.format, keep_params=arguments.keep_params, gravity=arguments.gravity,
-            lock=lock_values(arguments.lock), precision=arguments.precision,
-        )  # fmt: skip
-        return _emit(arguments, document, "derivation")
-    if arguments.kinematics is not None:
-        from robodyn.equations.kinematics import derive_kinematics, render_kinematics
-
-        if arguments.format not in ("text", "latex", "json", "python", "c"):
-            raise InputError("--format", "text, latex, json, python or c with --kinematics", repr(arguments.format))
-        progress = Progress(f"kinematics of {terminal_text(arguments.kinematics)[:40]}")
-        try:
-            kinematics = derive_kinematics(
-                arguments.model, arguments.kinematics, lock=lock_values(arguments.lock), progress=progress
-            )
-        finally:
-            progress.close()
-        return _emit(arguments, render_kinematics(kinematics, arguments.format, precision=arguments.precision), "kinematics")
-    label = terminal_text(str(arguments.model))
-    progress = Progress(f"deriving {label if len(label) <= 60 else label[:57] + '...'}")
+    if arguments.format == "pdf" and not arguments.out:
+        raise InputError("--out", "given with --format pdf (a PDF is not printed)", "no --out")
+    documents: tuple[What, ...] = ("lecture", "derivation", "kinematics", "christoffel")
+    what: What = next((w for w in documents if getattr(arguments, w)), "equations")
+    label = printable(str(arguments.kinematics if what == "kinematics" else arguments.model))
+    progress = Progress(
+        f"{'kinematics of' if what == 'kinematics' else 'deriving'} {label if len(label) <= 60 else label[:57] + '...'}"
+    )
     try:
-        equations = derive_equations(
-            arguments.model,
-            form=arguments.form,
-            keep_params=arguments.keep_params,
-            gravity=arguments.gravity,
-            lock=lock_values(arguments.lock),
-            floating_base=arguments.floating_base,
-            progress=progress,
-        )
+        document = equations_document(
+            arguments.model, what, progress=progress, format=arguments.format, form=arguments.form,
+            keep_params=arguments.keep_params, gravity=arguments.gravity, lock=lock_values(arguments.lock),
+            floating_base=arguments.floating_base, frame=arguments.kinematics, precision=arguments.precision,
+        )  # fmt: skip
     finally:
         progress.close()
-    if arguments.christoffel:
-        from robodyn.equations.christoffel import render_christoffel
-
-        return _emit(arguments, render_christoffel(equations, arguments.format, precision=arguments.precision), "Christoffel")
-    output = render(equations, arguments.format, precision=arguments.precision)
-    return _emit(arguments, output, f"{equations.form} form, {equations.operation_count()} operations")
+    return _emit(arguments, document.content, document.description)
 
 
 def _emit(arguments: argparse.Namespace, output: str | bytes, what: str) -> int:

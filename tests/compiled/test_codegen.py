@@ -1,0 +1,56 @@
+"""The compiled kernels are the equations layer's programs printed by the one C printer."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+
+import numpy as np
+
+import robodyn
+from robodyn.compiled.codegen import KernelWriter
+from robodyn.compiled.robot import SNAP, _generator_source, coordinate_parents
+from robodyn.equations import c_printer, compact, newton_euler, program, sharing
+from robodyn.equations.compact import derive_compact
+from robodyn.equations.newton_euler import derive_newton_euler
+from robodyn.equations.program import needed
+from robodyn.reference.numeric import ReferenceRobot
+from robodyn.reference.tree import build_tree
+from tests.conftest import ROOT
+
+
+def _writer(name: str) -> tuple[KernelWriter, robodyn.Robot]:
+    """The kernel writer of a robot, as :func:`robodyn.compiled.robot.generate_kernels` makes it."""
+    robot = robodyn.load(name)
+    tree = build_tree(robot.spec, robot.urdf, floating_base=False)
+    count = len(tree.bodies)
+    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
+    model = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
+    column = [tree.joint_names.index(j) for j in robot.joint_names]
+    tau = derive_newton_euler(model, snap=SNAP)
+    writer = KernelWriter(
+        derive_compact(model, snap=SNAP), tree.selection[:, column], tree.offset, coordinate_parents(robot), tau
+    )
+    return writer, robot
+
+
+def test_the_tau_kernel_is_the_newton_euler_program_printed():
+    writer, robot = _writer(str(ROOT / "tests/data/mimic_arm.urdf"))
+    source = writer.source()
+    kernel = source[source.index("static void rd_tau") :]
+    ne = writer.newton_euler
+    assert ne is not None
+    statements = re.findall(r"const double r\d+ = ", kernel)
+    assert len(statements) == len(needed(ne.assignments, ne.outputs["tau"])) > 0
+    # The mimic body's coordinate is made of its leader's, in every array.
+    assert re.search(r"const double th\d+ = [-0-9.e]+\*q\[\d\]", source)
+    assert robot.nv == len(re.findall(r"    tau\[\d\] = ", kernel))
+
+
+def test_the_cache_key_covers_the_one_program_and_the_one_printer():
+    """A change to the Newton–Euler program, the passes or the C printer never reuses kernels
+    generated before it."""
+    source = _generator_source()
+    for module in (newton_euler, program, sharing, compact, c_printer):
+        assert Path(module.__file__).read_text(encoding="utf-8") in source
