@@ -145,7 +145,7 @@ def test_interrupt_just_after_the_rename_propagates_and_leaves_nothing(target, m
     assert _leftovers(target.parent, target.name) == []
 
 
-def _leftovers(folder: Path) -> list[str]:
+def _temporaries(folder: Path) -> list[str]:
     return sorted(name for name in os.listdir(folder) if ".robodyn-tmp-" in name)
 
 
@@ -156,7 +156,7 @@ def test_new_and_existing_regular_files_are_replaced(tmp_path):
     atomic_write_text(path, "two")
     assert path.read_text() == "two"
     assert stat.S_IMODE(path.stat().st_mode) == 0o640  # the user's mode is kept
-    assert _leftovers(tmp_path) == []
+    assert _temporaries(tmp_path) == []
 
 
 def test_dash_is_standard_output(capfd, tmp_path, monkeypatch):
@@ -192,7 +192,7 @@ def test_a_symlink_to_a_device_is_refused(tmp_path):
     with pytest.raises(OutputError, match="not a regular file"):
         atomic_write_text(link, "x")
     assert link.is_symlink()
-    assert _leftovers(tmp_path) == []
+    assert _temporaries(tmp_path) == []
 
 
 def test_a_fifo_is_refused_without_blocking(tmp_path):
@@ -248,7 +248,7 @@ def test_folders_that_refuse_new_files_give_one_line(code, reason, tmp_path, mon
         atomic_write_text(path, "new")
     assert "\n" not in str(raised.value)
     monkeypatch.undo()
-    assert path.read_text() == "precious" and _leftovers(tmp_path) == []
+    assert path.read_text() == "precious" and _temporaries(tmp_path) == []
 
 
 def test_a_full_disk_keeps_the_previous_file(tmp_path, monkeypatch):
@@ -264,7 +264,7 @@ def test_a_full_disk_keeps_the_previous_file(tmp_path, monkeypatch):
     assert "\n" not in str(raised.value)
     monkeypatch.undo()
     assert path.read_text() == "precious"
-    assert _leftovers(tmp_path) == []
+    assert _temporaries(tmp_path) == []
 
 
 def test_outputs_are_committed_together_or_not_at_all(tmp_path):
@@ -283,7 +283,7 @@ def test_outputs_are_committed_together_or_not_at_all(tmp_path):
         out.write_bytes(second, b"page")
         assert first.read_text() == "old csv"  # nothing visible before the commit
     assert first.read_text() == "new csv" and second.read_bytes() == b"page"
-    assert _leftovers(tmp_path) == []
+    assert _temporaries(tmp_path) == []
 
 
 def test_temporary_files_of_killed_runs_are_recognisable_and_cleaned(tmp_path):
@@ -324,7 +324,7 @@ def test_outputs_together_makes_every_write_of_a_block_one_transaction(tmp_path)
         atomic_write_text(html, "page")
         assert csv.read_text() == "the user's old trajectory"
     assert csv.read_text() == "new trajectory" and html.read_text() == "page"
-    assert _leftovers(tmp_path) == []
+    assert _temporaries(tmp_path) == []
 
 
 def test_dash_writes_a_command_output_to_stdout(tmp_path, capfd, monkeypatch):

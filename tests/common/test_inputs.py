@@ -19,6 +19,7 @@ from robodyn.exceptions import InputError, RobodynWarning
 from tests.conftest import ROOT, random_state
 
 
+@pytest.fixture(scope="module")
 def robot():
     return robodyn.load("rp_arm")
 
@@ -115,6 +116,7 @@ def test_consecutive_results_are_independent_arrays(robot):
     np.testing.assert_array_equal(first, kept)
 
 
+@pytest.fixture(scope="module")
 def arm():
     return robodyn.load("rp_arm")
 

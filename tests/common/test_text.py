@@ -227,17 +227,17 @@ def test_the_escaping_module_imports_the_standard_library_only():
     assert modules and {module.split(".")[0] for module in modules} <= set(sys.stdlib_module_names) | {"__future__"}
 
 
-HOSTILE = "\n robodyn: ok: everything fine \x1b[31m red \x9b2J \u202e gnp.exe \r\x00\x7f\x85\u2028\u2066\ufeff"
+HOSTILE_LINE = "\n robodyn: ok: everything fine \x1b[31m red \x9b2J \u202e gnp.exe \r\x00\x7f\x85\u2028\u2066\ufeff"
 RAW = re.compile("[\x00-\x09\x0b-\x1f\x7f-\x9f\u061c\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff]")
 
 
 def test_printable_escapes_every_unsafe_character_and_keeps_the_rest():
-    text = printable(HOSTILE)
+    text = printable(HOSTILE_LINE)
     assert not RAW.search(text) and "\n" not in text
     assert "\\n robodyn: ok" in text and "\\x1b[31m" in text and "\\x9b" in text and "\\u202e" in text
     assert printable("Größe 質量 ü ⟂ 'x'") == "Größe 質量 ü ⟂ 'x'"  # printable text of any script kept
     assert printable(text) == text  # idempotent
-    assert is_printable(text) and not is_printable(HOSTILE)
+    assert is_printable(text) and not is_printable(HOSTILE_LINE)
 
 
 def test_quoted_names_read_like_repr():
@@ -249,11 +249,11 @@ def test_quoted_names_read_like_repr():
 @pytest.mark.parametrize(
     "error",
     [
-        URDFError(HOSTILE, HOSTILE, HOSTILE),
-        InputError(HOSTILE, HOSTILE, HOSTILE),
-        UnknownRobotError(HOSTILE, [HOSTILE]),
-        FrameError(HOSTILE, HOSTILE, [HOSTILE]),
-        OutputError(HOSTILE, HOSTILE),
+        URDFError(HOSTILE_LINE, HOSTILE_LINE, HOSTILE_LINE),
+        InputError(HOSTILE_LINE, HOSTILE_LINE, HOSTILE_LINE),
+        UnknownRobotError(HOSTILE_LINE, [HOSTILE_LINE]),
+        FrameError(HOSTILE_LINE, HOSTILE_LINE, [HOSTILE_LINE]),
+        OutputError(HOSTILE_LINE, HOSTILE_LINE),
     ],
 )
 def test_every_robodyn_error_message_is_one_printable_line(error):
@@ -265,7 +265,7 @@ def test_a_subclass_added_later_is_escaped_too():
     class NewError(RobodynError):
         pass
 
-    assert str(NewError(HOSTILE)) == printable(HOSTILE)
+    assert str(NewError(HOSTILE_LINE)) == printable(HOSTILE_LINE)
 
 
 def test_names_and_paths_with_control_characters_give_one_cli_line(tmp_path, capsys):

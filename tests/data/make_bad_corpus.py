@@ -147,7 +147,7 @@ CASES: dict[str, tuple[str, str]] = {
     "no_links": ('<robot name="nothing"/>', "the robot has no links"),
     "no_moving_joint": (
         '<robot name="statue"><link name="a"/><link name="b"/><joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint></robot>',
-        "the robot has no moving joint (floating_base=True gives",
+        "the robot has no moving joint (",  # then floating_base=True (library) or --floating-base (CLI)
     ),
 }
 # Moved to tests/data/hostile (they load with a RobodynWarning, see make_hostile_corpus.py):

@@ -212,7 +212,7 @@ CASES: dict[str, tuple[str, str, str, str, bool]] = {
         "error",
         '<robot name="statue"><link name="a"><inertial><mass value="1"/>'
         '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>',
-        "floating_base=True",
+        "gives its root six degrees of freedom",  # floating_base=True (library), --floating-base (CLI)
         True,
     ),
 }

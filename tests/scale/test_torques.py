@@ -28,6 +28,7 @@ from robodyn.trajectory import Trajectory
 from tests.sim.robots import SLIDER_URDF
 
 
+@pytest.fixture
 def slider_run(tmp_path):
     """A floating-base robot with a revolute and a prismatic joint, and a motion of it."""
     robot = robodyn.load(SLIDER_URDF, floating_base=True)
@@ -87,6 +88,7 @@ def test_an_overflow_is_refused_by_the_library_naming_trajectory_and_leaves_no_f
     assert not out.exists() and not list(tmp_path.glob("*.part"))
 
 
+@pytest.fixture(scope="module")
 def panda():
     return robodyn.load("panda")
 

@@ -92,6 +92,7 @@ def test_a_file_that_is_not_a_trajectory_is_refused_naming_it(tmp_path):
         read_table(broken)
 
 
+@pytest.fixture(scope="module")
 def ur5():
     return robodyn.load("ur5")
 
