@@ -36,6 +36,8 @@ PLACEHOLDER_COLOR = 0xFF00FF
 PLACEHOLDER_SIZE = 0.05
 #: Vertical field of view of the camera, in [deg] (meshcat's default 75° distorts the edges).
 CAMERA_FOV = 45.0
+#: Largest sideways tilt of the camera from its preferred direction towards the points, in [deg].
+CAMERA_TILT = 35.0
 _UNIT_CUBE = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 
 
@@ -265,37 +267,55 @@ def camera_commands(points: np.ndarray, *, fov_deg: float = CAMERA_FOV, margin: 
     """Place meshcat's camera so that the points' bounding sphere is all in view.
 
     Meshcat's orbit controls make the camera look at the *world origin* whatever its parent
-    node's transform, so the camera node stays at the origin and the camera is moved back
-    from the points' centre, along a fixed direction, until the whole sphere (times
-    ``margin``) lies within the vertical field of view (the narrower one for a landscape
-    picture) as seen looking at the origin. The points are the whole motion, the initial
-    pose included. A motion in the x-z plane (a planar arm) is seen from the side, anything
-    else from a corner above. Meshcat's own grid is hidden (the task grid replaces it).
+    node's transform, so the camera node stays at the origin and only the camera's position
+    is chosen: along a direction near the preferred one (a motion in the x-z plane, such as
+    a planar arm, is seen from the side, anything else from a corner above), tilted at most
+    :data:`CAMERA_TILT` sideways towards the points' centre, at the smallest distance at which the
+    whole sphere (times ``margin``) lies within the vertical field of view (the narrower
+    one for a landscape picture) as seen looking at the origin. The points are the whole
+    motion, the initial pose included. Meshcat's own grid is hidden (the task grid replaces
+    it).
     """
     low, high = points.min(axis=0), points.max(axis=0)
     centre = (low + high) / 2
     radius = max(float(np.linalg.norm(high - low)) / 2, 0.05)
-    half = np.radians(fov_deg) / 2
     span = high - low
     planar = span[1] < 0.25 * max(span[0], span[2])
     local = np.array([0.25, 0.35, 1.0] if planar else [0.8, 0.6, 0.8])
     # The camera node's frame is y-up: (x, y, z) there is (x, -z, y) in the world.
-    direction = np.array([local[0], -local[2], local[1]]) / np.linalg.norm(local)
-    distance = margin * radius / np.sin(half)
+    preferred = np.array([local[0], -local[2], local[1]]) / np.linalg.norm(local)
+    level = np.array([centre[0], centre[1], 0.0])  # only sideways: an upright arm stays seen from the side
+    towards = level / max(float(np.linalg.norm(level)), 1e-12)
+    best = None
+    for weight in np.linspace(0.0, 1.0, 11):
+        direction = (1 - weight) * preferred + weight * towards
+        direction /= max(float(np.linalg.norm(direction)), 1e-12)
+        if np.degrees(np.arccos(np.clip(direction @ preferred, -1.0, 1.0))) > CAMERA_TILT:
+            break
+        position = _camera_position(centre, radius * margin, direction, np.radians(fov_deg) / 2)
+        if best is None or np.linalg.norm(position) < np.linalg.norm(best):
+            best = position
+    assert best is not None  # weight 0 is the preferred direction itself
+    camera = MeshcatPath(("Cameras", "default", "rotated", "<object>"))
+    return [
+        SetTransform(np.eye(4), path=MeshcatPath(("Cameras", "default"))).lower(),
+        SetProperty("position", [float(best[0]), float(best[2]), float(-best[1])], path=camera).lower(),
+        SetProperty("fov", fov_deg, path=camera).lower(),
+        SetProperty("visible", False, path=MeshcatPath(("Grid",))).lower(),
+    ]
+
+
+def _camera_position(centre: np.ndarray, radius: float, direction: np.ndarray, half: float) -> np.ndarray:
+    """The nearest ``centre + d · direction`` from which, looking at the world origin, the
+    sphere (``centre``, ``radius``) lies within the half-angle ``half`` [rad]."""
+    distance = radius / np.sin(half)
     for _ in range(400):  # at most 1.02^400 ≈ 2750 times farther
         position = centre + distance * direction
         to_centre = centre - position
         length = float(np.linalg.norm(to_centre))
         sight = -position / max(float(np.linalg.norm(position)), 1e-12)
         off_axis = float(np.arccos(np.clip(sight @ to_centre / length, -1.0, 1.0)))
-        if off_axis + np.arcsin(min(1.0, margin * radius / length)) <= half:
+        if off_axis + np.arcsin(min(1.0, radius / length)) <= half:
             break
         distance *= 1.02
-    world = centre + distance * direction
-    camera = MeshcatPath(("Cameras", "default", "rotated", "<object>"))
-    return [
-        SetTransform(np.eye(4), path=MeshcatPath(("Cameras", "default"))).lower(),
-        SetProperty("position", [float(world[0]), float(world[2]), float(-world[1])], path=camera).lower(),
-        SetProperty("fov", fov_deg, path=camera).lower(),
-        SetProperty("visible", False, path=MeshcatPath(("Grid",))).lower(),
-    ]
+    return centre + distance * direction

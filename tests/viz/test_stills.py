@@ -52,7 +52,7 @@ def test_demo_shows_robot_target_and_a_growing_path(demo):
     masks = capture(demo.html, [0.1, 0.6], size=SIZE, hide=("Axes", "task", "Grid", "Background"))
     for image, mask in zip((early, late), masks, strict=True):
         assert robot_mask(mask).sum() > 800  # the robot
-        assert red(image).sum() > 80  # the target marker
+        assert red(image).sum() > 40  # the target marker (smaller since issue 29: the camera frames the whole motion)
     assert not orange(start).any()  # the path is empty at the start,
     assert orange(early).sum() > 20
     assert orange(late).sum() > orange(early).sum() + 100  # and grew
