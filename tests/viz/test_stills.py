@@ -52,10 +52,12 @@ def test_demo_shows_robot_target_and_a_growing_path(demo):
     masks = capture(demo.html, [0.1, 0.6], size=SIZE, hide=("Axes", "task", "Grid", "Background"))
     for image, mask in zip((early, late), masks, strict=True):
         assert robot_mask(mask).sum() > 800  # the robot
-        assert red(image).sum() > 40  # the target marker (smaller since issue 29: the camera frames the whole motion)
+        # Since issue 29 the camera frames the whole motion looking at the world origin (as
+        # meshcat does), so the picture is about 0.6 times as large: thresholds 80, 20, 100 -> 30, 5, 40
+        assert red(image).sum() > 30  # the target marker
     assert not orange(start).any()  # the path is empty at the start,
-    assert orange(early).sum() > 20
-    assert orange(late).sum() > orange(early).sum() + 100  # and grew
+    assert orange(early).sum() > 5
+    assert orange(late).sum() > orange(early).sum() + 40  # and grew
     for mask in masks:  # negative control: the same frames with the task hidden
         assert red(mask).sum() == 0 and orange(mask).sum() == 0
 
