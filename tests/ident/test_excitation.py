@@ -83,3 +83,15 @@ def test_no_improvement_is_a_one_line_warning_and_the_text_never_calls_the_start
     assert "not optimised" in captured.out and "(start " not in captured.out
     warning_lines = [line for line in captured.err.splitlines() if "warning" in line]
     assert len(warning_lines) == 1 and "random start" in warning_lines[0]
+
+
+def test_the_best_feasible_point_is_chosen_the_start_winning_ties():
+    from robodyn.ident.excitation import _best_feasible
+
+    start, better, outside, same, broken = (np.array(v, float) for v in ([1, 1], [2, 2], [9, 9], [2, 2], [np.nan, 3]))
+    feasible = lambda x: bool(x[0] < 5)  # noqa: E731
+    objective = lambda x: -float(np.sum(x))  # noqa: E731  (larger points are better)
+    x, value = _best_feasible([start, better, outside, same, broken], feasible, objective)
+    assert x is better and value == -4.0  # not the infeasible, better one; the first of two equals
+    x, value = _best_feasible([start, outside], feasible, objective)
+    assert x is start and value == -2.0

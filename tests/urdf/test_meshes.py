@@ -53,3 +53,14 @@ def test_record_draws_a_fifo_mesh_as_the_placeholder_box_with_one_warning(fifo_a
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("robodyn: warning: link ") and "placeholder box" in lines[0]
     assert "not a regular file" in lines[0] and out.stat().st_size > 10_000
+
+
+def test_is_regular_file_follows_links_and_never_opens(tmp_path):
+    from robodyn.urdf.meshes import is_regular_file
+
+    (tmp_path / "mesh.stl").write_bytes(b"solid x\nendsolid x\n")
+    os.mkfifo(tmp_path / "pipe.stl")
+    (tmp_path / "link.stl").symlink_to(tmp_path / "mesh.stl")
+    assert is_regular_file(tmp_path / "mesh.stl") and is_regular_file(tmp_path / "link.stl")
+    assert not is_regular_file(tmp_path / "pipe.stl") and not is_regular_file(tmp_path / "missing.stl")
+    assert not is_regular_file(tmp_path)

@@ -103,6 +103,10 @@ def test_the_frame_count_is_the_span_times_fps_and_bounded():
     with pytest.raises(InputError, match="trajectory") as raised:
         frame_count(_motion(robot, 1e9), 30.0)
     assert "3e+10 frames" in str(raised.value) and "\n" not in str(raised.value)
+    assert raised.value.argument == "trajectory" and f"at most {MAX_FRAMES} animation frames" in str(raised.value)
+    late = _motion(robot, 2.0)
+    shifted = Trajectory(late.t + 100.0, late.q, late.v, late.a, late.tau, late.joint_names, late.robot)
+    assert frame_count(shifted, 30.0) == 61  # the span, not the end time
     with pytest.raises(InputError, match="trajectory"):
         recording(robot, _motion(robot, MAX_FRAMES / 30.0), fps=30.0)
 
