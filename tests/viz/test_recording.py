@@ -107,6 +107,10 @@ def test_the_frame_count_is_the_span_times_fps_and_bounded():
     late = _motion(robot, 2.0)
     shifted = Trajectory(late.t + 100.0, late.q, late.v, late.a, late.tau, late.joint_names, late.robot)
     assert frame_count(shifted, 30.0) == 61  # the span, not the end time
+    empty = Trajectory(np.zeros(0), *(np.zeros((0, 2)),) * 4, robot.joint_names, robot.name)
+    assert frame_count(empty, 30.0) == 1
+    with pytest.raises(robodyn.RobodynError, match="empty"):  # the one-line refusal, no IndexError
+        recording(robot, empty)
     with pytest.raises(InputError, match="trajectory"):
         recording(robot, _motion(robot, MAX_FRAMES / 30.0), fps=30.0)
 
