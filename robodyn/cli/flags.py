@@ -25,6 +25,17 @@ FLAGS: dict[str, str] = {
     "urdf_out": "--urdf-out",
     "method": "--method",
     "data": "DATA",
+    "posture": "--posture",
+    "stiffness": "--stiffness",
+    "damping": "--damping",
+    "force_at": "--force-at",
+    "external": "--force-at",
+    "observer_gain": "--observer-gain",
+    "observer": "--observer-gain",
+    "gain": "--gain",
+    "threshold": "--threshold",
+    "torque": "--torque",
+    "plot": "--plot",
 }
 
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.
