@@ -340,12 +340,17 @@ def _pose_outcome(
     )
 
 
+def applied_torques(robot: Robot, trajectory: Trajectory, external: Sequence[ExternalWrench]) -> np.ndarray:
+    """The joint torques external wrenches applied at each sample, ``Σ J(q)ᵀ w(t)``, shape (N, nv)."""
+    return np.array([external_torques(robot, q, float(t), external) for t, q in zip(trajectory.t, trajectory.q, strict=True)])
+
+
 def _observer_outcome(
     robot: Robot, trajectory: Trajectory, observer: MomentumObserver, external: list[ExternalWrench]
 ) -> ObserverOutcome:
     """The observer's residual at every sample, against the external torques applied there."""
     residual = np.array(observer.residuals)
-    applied = np.array([external_torques(robot, q, float(t), external) for t, q in zip(trajectory.t, trajectory.q, strict=True)])
+    applied = applied_torques(robot, trajectory, external)
     gain = float(np.max(np.asarray(observer.gain, dtype=float)))
     error = float(np.abs(residual[-1] - applied[-1]).max())
     return ObserverOutcome(gain, tuple(residual[-1].tolist()), tuple(applied[-1].tolist()), error, residual, applied)

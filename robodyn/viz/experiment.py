@@ -19,7 +19,7 @@ import numpy as np
 
 from robodyn.common.files import outputs_together
 from robodyn.dynamics.robot import Robot
-from robodyn.sim.experiment import push_wrenches, run_simulation
+from robodyn.sim.experiment import applied_torques, push_wrenches, run_simulation
 from robodyn.sim.observer import ObservationRun, observe_file
 from robodyn.sim.operational_space import target_rotation
 from robodyn.sim.report import SimulationSummary
@@ -54,7 +54,8 @@ def run_experiment(
 
     Returns:
         The run's summary; its ``files`` name what was written (``trajectory``: with an
-        observer also its ``tau_ext[<joint>]`` columns and the applied ``tau_env[<joint>]``;
+        observer also its ``tau_ext[<joint>]`` columns, with pushes the torques they
+        applied, ``tau_env[<joint>]``;
         ``plot``, ``recording`` (the target pose as a triad, pushes as arrows), ``poster``).
     """
     trajectory, summary = run_simulation(robot, **settings)
@@ -62,9 +63,9 @@ def run_experiment(
     task = np.asarray(summary.task.target) if summary.task is not None else None
     with outputs_together():  # every file of the run, or none of them
         if out:
-            extras = (
-                {} if summary.observer is None else {"tau_ext": summary.observer.residual, "tau_env": summary.observer.applied}
-            )
+            extras = {} if summary.observer is None else {"tau_ext": summary.observer.residual}
+            if summary.pushes:
+                extras["tau_env"] = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes, "")[1])
             summary = summary.with_file("trajectory", str(write_with_extras(Path(out), trajectory, extras)))
         if plot:
             from robodyn.viz.plots import plot_simulation  # matplotlib: only when a figure is asked for
