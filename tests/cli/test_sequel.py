@@ -92,7 +92,7 @@ def test_observe_writes_the_estimate_the_wrench_and_finds_the_push(tmp_path, cap
     residual = estimate_external_torques(robot, trajectory, gain=40.0, torque="sampled")
     wrench = external_wrench(robot, trajectory.q, residual, "end_effector")
     columns = _columns(out)
-    assert list(columns)[0] == "t" and np.array_equal(columns["t"], trajectory.t)
+    assert next(iter(columns)) == "t" and np.array_equal(columns["t"], trajectory.t)
     for index, dof in enumerate(robot.dofs):
         assert np.array_equal(columns[f"tau_ext[{dof.name}]"], residual[:, index])
     for index, axis in enumerate("xyz"):

@@ -64,7 +64,7 @@ def test_the_recording_draws_the_target_pose_and_the_push(pushed, tmp_path):
 
     paths = [c.get("path", "") for c in motion_commands(robot, trajectory, target=[0.9, 0.0, 0.5])[0]]
     assert not any("target_pose" in p for p in paths)  # negative control: no attitude, no triad
-    triad = target_pose_commands(np.array([0.9, 0.0, 0.5]), np.eye(3), np.zeros((2, 3)) + [[0, 0, 0], [1, 1, 1]])
+    triad = target_pose_commands(np.array([0.9, 0.0, 0.5]), np.eye(3), np.array([[0.0, 0, 0], [1, 1, 1]]))
     assert triad[0]["path"].endswith("target_pose") and triad[1]["matrix"][12:15] == pytest.approx([0.9, 0.0, 0.5])
 
 
