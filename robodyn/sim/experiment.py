@@ -102,8 +102,11 @@ class _StepForce:
         return self.force if t >= self.start else self.zero
 
 
-def push_wrenches(robot: Robot, pushes: Sequence[str | Push], frame: str) -> tuple[tuple[Push, ...], list[ExternalWrench]]:
-    """The pushes (frames resolved: ``frame`` when a push names none) and their wrenches."""
+def push_wrenches(
+    robot: Robot, pushes: Sequence[str | Push], frame: str | None = None
+) -> tuple[tuple[Push, ...], list[ExternalWrench]]:
+    """The pushes (frames resolved: ``frame`` when a push names none, then the robot's end
+    effector) and their wrenches."""
     resolved = []
     for push in pushes:
         push = parse_push(push) if isinstance(push, str) else push
@@ -167,7 +170,7 @@ def run_simulation(
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
     options = {"posture": posture, "stiffness": stiffness, "damping": damping}
     law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
-    pushes, external = push_wrenches(robot, force_at, controlled or robot.end_effector)
+    pushes, external = push_wrenches(robot, force_at, controlled or None)
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
     began = time.perf_counter()
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns

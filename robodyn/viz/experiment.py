@@ -65,7 +65,7 @@ def run_experiment(
         if out:
             extras = {} if summary.observer is None else {"tau_ext": summary.observer.residual}
             if summary.pushes:
-                extras["tau_env"] = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes, "")[1])
+                extras["tau_env"] = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes)[1])
             summary = summary.with_file("trajectory", str(write_with_extras(Path(out), trajectory, extras)))
         if plot:
             from robodyn.viz.plots import plot_simulation  # matplotlib: only when a figure is asked for
@@ -75,7 +75,7 @@ def run_experiment(
             from robodyn.viz.recording import record as write_recording  # meshcat: only for an animation
 
             rpy = None if summary.task is None or summary.task.target_rpy is None else summary.task.target_rpy
-            _, forces = push_wrenches(robot, summary.pushes, frame or robot.end_effector)
+            _, forces = push_wrenches(robot, summary.pushes, frame)
             written = write_recording(
                 robot, trajectory, record, png=png, target=task, frame=frame or robot.end_effector,
                 target_rotation=None if rpy is None else target_rotation(np.asarray(rpy)), forces=tuple(forces),

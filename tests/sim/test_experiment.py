@@ -144,3 +144,13 @@ def test_the_compiled_engine_refuses_pushes_and_observers_by_name(rp_arm):
     with pytest.raises(InputError) as raised:
         run_simulation(rp_arm, observer_gain=10.0, duration=0.01, engine="compiled")
     assert raised.value.argument == "observer"
+
+
+def test_a_robot_without_a_default_end_effector_still_simulates_and_its_pushes_need_a_frame():
+    robot = robodyn.load("solo12", floating_base=True)
+    _, summary = run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore")
+    assert summary.pushes == ()
+    _, summary = run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore", force_at=["0:0,0,-5@FL_FOOT"])
+    assert summary.pushes == (Push(0.0, (0.0, 0.0, -5.0), "FL_FOOT"),)
+    with pytest.raises(robodyn.RobodynError, match="FL_FOOT"):  # negative control: no frame, no default to push at
+        run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore", force_at=["0:0,0,-5"])

@@ -71,7 +71,7 @@ def test_the_recording_draws_the_target_pose_and_the_push(pushed, tmp_path):
 def test_the_estimate_against_the_applied_torques_is_one_panel_a_unit_without_overlaps(pushed):
     robot, trajectory, summary = pushed
     names, units = [d.name for d in robot.dofs], [d.effort_unit for d in robot.dofs]
-    applied = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes, "")[1])
+    applied = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes)[1])
     assert np.array_equal(applied, summary.observer.applied)
     figure = external_torques_figure(trajectory.t, summary.observer.residual, applied, names, units, gain=50.0)
     assert len(figure.axes) == 2 and text_overlaps(figure) == []
