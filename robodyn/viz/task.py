@@ -6,7 +6,7 @@
   switches visible as the motion reaches them (so the path grows with time);
 - x/y/z triads (red, green, blue) riding on chosen links;
 - the target pose (position and attitude) as a triad (:func:`target_pose_commands`);
-- external forces as arrows (an orange shaft and tip at the frame the force acts on,
+- external forces as arrows (an orange shaft and cone from the frame the force acts on,
   pointing along it, its length in proportion, shown while the force acts:
   :func:`force_commands`).
 """
@@ -185,8 +185,9 @@ def force_commands(
     scale = FORCE_LENGTH * _scene_size(points) / largest
     for index, (item, force) in enumerate(zip(forces, values, strict=True)):
         name = f"force{index:02d}"
-        parts = ((mg.Cylinder(0.8, radius=0.015), "shaft", 0.4), (mg.Cylinder(0.2, radius=0.045), "tip", 0.9))
-        for geometry, part, offset in parts:  # a unit arrow along y (meshcat's cylinders' axis)
+        shaft, tip = mg.Cylinder(0.8, radius=0.015), mg.Cylinder(0.2, radiusTop=0.0, radiusBottom=0.045)
+        parts = ((shaft, "shaft", 0.4), (tip, "tip", 0.9))
+        for geometry, part, offset in parts:  # a unit arrow along y (meshcat's cylinders' axis) from the origin
             matrix = np.eye(4)
             matrix[1, 3] = offset
             commands.append(SetObject(geometry, mg.MeshLambertMaterial(color=FORCE_COLOUR), path=_task_path(name, part)).lower())
