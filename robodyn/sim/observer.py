@@ -351,7 +351,9 @@ class ObservationRun:
             f"final tau_ext: {values(self.residual[-1])}",
         ]
         if self.applied is not None:
-            lines.append(f"final |tau_ext - applied|: {float(np.abs(self.residual[-1] - self.applied[-1]).max()):.3g} (largest)")
+            lines.append(
+                f"final |tau_ext - applied|: {float(np.abs(self.residual[-1] - self.applied[-1]).max()):.3g} N m / N (largest)"
+            )
         if self.frame is not None and self.wrench is not None:
             force, moment = self.wrench[-1, :3], self.wrench[-1, 3:]
             lines.append(

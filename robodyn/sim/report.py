@@ -84,6 +84,11 @@ class TaskOutcome:
             }
         return data
 
+    def _state(self) -> str:
+        if self.reached:
+            return "reached"
+        return "NOT reached" if self.deflection is None else "held off by the push"
+
     def lines(self) -> list[str]:
         """The outcome as lines of text."""
         lines = [f"frame: {printable(self.frame)}", f"target: {vector_text(self.target, 6)} m"]
@@ -91,7 +96,7 @@ class TaskOutcome:
             lines.append(f"target roll, pitch, yaw: {vector_text(self.target_rpy, 6)} rad")
         lines += [
             f"final position: {vector_text(self.final_position, 6)} m",
-            f"final error: {_number(self.final_error, 3)} m ({'reached' if self.reached else 'NOT reached'})",
+            f"final error: {_number(self.final_error, 3)} m ({self._state()})",
         ]
         if self.orientation_error is not None:
             lines.append(f"final orientation error: {_number(self.orientation_error, 3)} rad")
