@@ -17,13 +17,27 @@ import traceback
 from collections.abc import Sequence
 
 import robodyn
-from robodyn.cli.commands import check, equations, excite, identify, info, lint, listing, record, simulate, torques, view, whatif
+from robodyn.cli.commands import (
+    check,
+    equations,
+    excite,
+    identify,
+    info,
+    lint,
+    listing,
+    observe,
+    record,
+    simulate,
+    torques,
+    view,
+    whatif,
+)
 from robodyn.cli.common import attach_negative_values, check_ranges
 from robodyn.cli.flags import error_text
 from robodyn.exceptions import RobodynError, one_line_warnings
 
 #: The commands, in the order ``robodyn --help`` lists them.
-COMMANDS = (listing, info, equations, check, lint, simulate, record, view, torques, whatif, excite, identify)
+COMMANDS = (listing, info, equations, check, lint, simulate, observe, record, view, torques, whatif, excite, identify)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -26,6 +26,17 @@ FLAGS: dict[str, str] = {
     "urdf_out": "--urdf-out",
     "method": "--method",
     "data": "DATA",
+    "posture": "--posture",
+    "stiffness": "--stiffness",
+    "damping": "--damping",
+    "force_at": "--force-at",
+    "external": "--force-at",
+    "observer_gain": "--observer-gain",
+    "observer": "--observer-gain",
+    "gain": "--gain",
+    "threshold": "--threshold",
+    "torque": "--torque",
+    "plot": "--plot",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

@@ -5,31 +5,48 @@ simulates, and returns the trajectory with a :class:`~robodyn.sim.report.Simulat
 final error, peak torque, energy change, real-time factor, and every joint limit the run
 broke (joint, first time, worst value, limit; ``limits="enforce"`` saturates torques and stops joints,
 see :mod:`robodyn.sim.limits`). Used by ``robodyn simulate``.
+
+The sequel's controllers (:mod:`robodyn.sim.operational_space`): ``"osc"`` drives the
+frame to a position or a full pose (``target`` X,Y,Z[,ROLL,PITCH,YAW]) with an optional
+``posture`` in the null space; ``"impedance"`` holds it there as a spring of ``stiffness``.
+``force_at`` pushes (``T:FX,FY,FZ[@FRAME]``) become
+:class:`~robodyn.sim.simulation.ExternalWrench` es; the summary reports the final pose
+error (by the robot's forward kinematics) and, for the impedance under a push, the
+deflection against ``K⁻¹ F``. ``observer_gain`` runs a
+:class:`~robodyn.sim.observer.MomentumObserver` along the simulation.
 """
 
 from __future__ import annotations
 
 import time
 import warnings
+from collections.abc import Sequence
 from dataclasses import replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
+import pinocchio as pin
 
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
+from robodyn.sim.observer import MomentumObserver
+from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
 from robodyn.sim.reach import check_reach
-from robodyn.sim.report import SimulationSummary, TaskOutcome
-from robodyn.sim.simulation import Engine, Integrator, simulate
+from robodyn.sim.report import ObserverOutcome, Push, SimulationSummary, TaskOutcome
+from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
-ControllerName = Literal["passive", "pd", "computed-torque", "task-space"]
-CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space")
-#: Final task error below which a target counts as reached, in [m].
+ControllerName = Literal["passive", "pd", "computed-torque", "task-space", "osc", "impedance"]
+CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space", "osc", "impedance")
+#: The controllers of a frame's pose (position, or position and attitude).
+POSE_CONTROLLERS = ("osc", "impedance")
+#: The controllers that drive a frame (``frame`` applies to them).
+FRAME_CONTROLLERS = ("task-space", *POSE_CONTROLLERS)
+#: Final task error below which a target counts as reached, in [m] (and [rad]).
 REACHED = 1e-3
 
 
@@ -48,6 +65,55 @@ def task_target(values: list[float] | np.ndarray) -> np.ndarray:
     raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
 
 
+def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """A pose target from ``X,Y,Z`` (position only) or ``X,Y,Z,ROLL,PITCH,YAW``.
+
+    Returns:
+        The position in [m], shape (3,), and roll, pitch, yaw in [rad], shape (3,) (``None``
+        for a position target).
+    """
+    values = np.asarray(values, dtype=float)
+    if values.shape not in ((3,), (6,)) or not np.isfinite(values).all():
+        raise InputError("target", "X,Y,Z in [m] or X,Y,Z,ROLL,PITCH,YAW (rad) for pose control", f"{values.size} values")
+    return values[:3], (values[3:] if values.size == 6 else None)
+
+
+def parse_push(text: str) -> Push:
+    """A push from ``T:FX,FY,FZ`` or ``T:FX,FY,FZ@FRAME`` (time in [s], force in [N])."""
+    head, _, frame = text.partition("@")
+    start, _, force = head.partition(":")
+    try:
+        time_ = float(start)
+        values = [float(value) for value in force.replace(",", " ").split()]
+    except ValueError:
+        values, time_ = [], float("nan")
+    if len(values) != 3 or not np.isfinite([time_, *values]).all() or time_ < 0:
+        raise InputError("force_at", "T:FX,FY,FZ[@FRAME] (a time >= 0 in [s], a force in [N])", repr(text))
+    return Push(time_, (values[0], values[1], values[2]), frame.strip() or None)
+
+
+class _StepForce:
+    """A force that starts at a time: zero before, constant after (a callable wrench)."""
+
+    def __init__(self, start: float, force: tuple[float, ...]) -> None:
+        self.start, self.force, self.zero = start, np.asarray(force, dtype=float), np.zeros(3)
+
+    def __call__(self, t: float) -> np.ndarray:
+        return self.force if t >= self.start else self.zero
+
+
+def push_wrenches(
+    robot: Robot, pushes: Sequence[str | Push], frame: str | None = None
+) -> tuple[tuple[Push, ...], list[ExternalWrench]]:
+    """The pushes (frames resolved: ``frame`` when a push names none, then the robot's end
+    effector) and their wrenches."""
+    resolved = []
+    for push in pushes:
+        push = parse_push(push) if isinstance(push, str) else push
+        resolved.append(replace(push, frame=robot.task_frame(push.frame or frame, "a push")))
+    return tuple(resolved), [ExternalWrench(push.frame, _StepForce(push.time, push.force)) for push in resolved]  # type: ignore[arg-type]
+
+
 def run_simulation(
     robot: Robot,
     *,
@@ -60,6 +126,11 @@ def run_simulation(
     integrator: Integrator = "rk4",
     limits: LimitMode = "warn",
     engine: Engine = "pinocchio",
+    posture: list[float] | None = None,
+    stiffness: list[float] | None = None,
+    damping: list[float] | None = None,
+    force_at: Sequence[str | Push] = (),
+    observer_gain: float | None = None,
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -67,14 +138,23 @@ def run_simulation(
         robot: The plant.
         controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target),
             ``"computed-torque"`` (quintic from ``q0`` to a joint target in half the
-            duration) or ``"task-space"`` (drive ``frame`` to a position target).
-        target: Joint target (nq values) or task target (X,Z or X,Y,Z in [m]).
-        frame: Controlled frame for task-space control (default the robot's end effector;
-            it must be a frame some joint moves).
+            duration), ``"task-space"`` (drive ``frame`` to a position target), ``"osc"``
+            (operational-space control of ``frame``'s position or pose) or
+            ``"impedance"`` (Cartesian impedance about the target pose).
+        target: Joint target (nq values), task target (X,Z or X,Y,Z in [m]) or, for osc
+            and impedance, X,Y,Z in [m] with optionally ROLL,PITCH,YAW in [rad].
+        frame: Controlled frame for task-space, osc and impedance control (default the
+            robot's end effector; it must be a frame some joint moves).
         q0: Initial configuration; default :meth:`Robot.default_configuration` (the
             neutral one clipped into the joint limits).
         duration, dt, integrator, limits, engine: As for :func:`robodyn.simulate` (with
-            ``engine="compiled"`` the task-space controller is sampled every step).
+            ``engine="compiled"`` the task-space controllers are sampled every step).
+        posture: osc only: a configuration (nq) drawn toward in the task's null space.
+        stiffness: impedance only: ``K``, 3 values [N/m] (or 6, then [N m/rad]).
+        damping: impedance only: ``D``, [N s/m] (then [N m s/rad]).
+        force_at: Pushes, each a :class:`~robodyn.sim.report.Push` or ``T:FX,FY,FZ[@FRAME]``
+            (default frame: the controlled frame, or the end effector).
+        observer_gain: ``K_O`` in [1/s]: run a momentum observer along (``None``: none).
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -84,21 +164,52 @@ def run_simulation(
         InputError: Naming the parameter (``controller``, ``target``, ``frame``, ...).
     """
     _check_request(robot, controller, target, frame, limits)
+    _check_pose_options(controller, posture, stiffness, damping)
+    if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
+        raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
-    law, task, controlled = _control_law(robot, controller, target, frame, start, duration)
+    options = {"posture": posture, "stiffness": stiffness, "damping": damping}
+    law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
+    pushes, external = push_wrenches(robot, force_at, controlled or None)
+    observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
     began = time.perf_counter()
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
         trajectory = simulate(
-            robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits, engine=engine
-        )
+            robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits,
+            engine=engine, external=external, observer=observer,
+        )  # fmt: skip
     elapsed = time.perf_counter() - began
+    settings = {
+        "controller": controller,
+        "integrator": integrator,
+        "limits": limits,
+        "engine": engine,
+        "duration": duration,
+        "dt": dt,
+    }
+    summary = replace(_summary(robot, trajectory, settings, elapsed), pushes=pushes)
+    if observer is not None:
+        summary = replace(summary, observer=_observer_outcome(robot, trajectory, observer, external))
+    if isinstance(law, OperationalSpace | Impedance):
+        return trajectory, replace(summary, task=_pose_outcome(robot, trajectory, law, pushes))
+    if task is not None:
+        return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
+    if controller != "passive":
+        error = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
+        return trajectory, replace(summary, final_joint_error=error)
+    return trajectory, summary
+
+
+def _summary(robot: Robot, trajectory: Trajectory, settings: dict[str, Any], elapsed: float) -> SimulationSummary:
+    """The summary every run has (no task, no joint error); ``settings``: the run's
+    controller, integrator, limits, engine, duration and dt."""
     torques = trajectory.tau
     assert torques is not None  # simulate records the applied torques
+    duration, limits = settings["duration"], settings["limits"]
     energy = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v)) + np.atleast_1d(robot.potential_energy(trajectory.q))
-    summary = SimulationSummary(
-        robot=robot.name, controller=controller, integrator=integrator, limits=limits, engine=engine,
-        duration=duration, dt=dt, steps=len(trajectory) - 1,
+    return SimulationSummary(
+        robot=robot.name, **settings, steps=len(trajectory) - 1,
         real_time_factor=duration / elapsed if elapsed > 0 else None,
         joint_names=tuple(robot.joint_names),
         dof_names=tuple(dof.name for dof in robot.dofs),
@@ -108,12 +219,6 @@ def run_simulation(
         energy_change=float(energy[-1] - energy[0]),
         violations=() if limits == "ignore" else tuple(limit_violations(robot, trajectory)),
     )  # fmt: skip
-    if task is not None:
-        return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
-    if controller != "passive":
-        error = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
-        return trajectory, replace(summary, final_joint_error=error)
-    return trajectory, summary
 
 
 def _check_request(robot: Robot, controller: str, target: list[float] | None, frame: str | None, limits: str) -> None:
@@ -125,16 +230,31 @@ def _check_request(robot: Robot, controller: str, target: list[float] | None, fr
         raise InputError("target", f"given for the {controller} controller", "nothing")
     if controller == "passive" and target is not None:
         raise InputError("target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
-    if controller != "task-space" and frame is not None:
-        raise InputError("frame", "given only with the task-space controller", repr(frame))
+    if controller not in FRAME_CONTROLLERS and frame is not None:
+        raise InputError("frame", "given only with the task-space, osc or impedance controller", repr(frame))
+
+
+def _check_pose_options(controller: str, posture: Any, stiffness: Any, damping: Any) -> None:
+    """Refuse a posture without osc, and impedance gains without the impedance controller."""
+    if posture is not None and controller != "osc":
+        raise InputError("posture", "given only with the osc controller", f"{np.size(posture)} values")
+    for name, value in (("stiffness", stiffness), ("damping", damping)):
+        if value is not None and controller != "impedance":
+            raise InputError(name, "given only with the impedance controller", f"{np.size(value)} values")
 
 
 def _control_law(
-    robot: Robot, controller: str, target: list[float] | None, frame: str | None, start: np.ndarray, duration: float
-) -> tuple[PDGravity | ComputedTorque | TaskSpace | None, np.ndarray | None, str]:
+    robot: Robot,
+    controller: str,
+    target: list[float] | None,
+    frame: str | None,
+    start: np.ndarray,
+    duration: float,
+    options: dict[str, Any],
+) -> tuple[PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | None, np.ndarray | None, str]:
     """The controller (on its own model), the task target in [m] and the controlled frame
-    (task-space control only: ``None`` and ``""`` otherwise)."""
-    law: PDGravity | ComputedTorque | TaskSpace | None = None
+    (task-space, osc and impedance control only: ``None`` and ``""`` otherwise)."""
+    law: PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | None = None
     task, controlled = None, ""
     if controller == "pd":
         law = PDGravity(controller_model(robot), np.asarray(target, float))
@@ -146,10 +266,38 @@ def _control_law(
         controlled = robot.task_frame(frame, "task-space control")
         check_reach(robot, controlled, task, parameter="target")
         law = TaskSpace(controller_model(robot), controlled, task)
+    elif controller in POSE_CONTROLLERS:
+        assert target is not None  # checked by _check_request
+        task, rpy = pose_target(target)
+        controlled = robot.task_frame(frame, f"{controller} control")
+        check_reach(robot, controlled, task, parameter="target")
+        law = _pose_law(robot, controller, controlled, task, rpy, options)
     given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
     if controller in ("pd", "computed-torque") and given != robot.nq:
         raise InputError("target", f"{robot.nq} joint values for the {controller} controller", f"{given} values")
     return law, task, controlled
+
+
+def _pose_law(
+    robot: Robot, controller: str, frame: str, position: np.ndarray, rpy: np.ndarray | None, options: dict[str, Any]
+) -> OperationalSpace | Impedance:
+    """The operational-space or impedance controller of ``frame`` (on its own model)."""
+    if controller == "osc":
+        posture = options["posture"]
+        if posture is not None and np.size(posture) != robot.nq:
+            raise InputError("posture", f"{robot.nq} joint values", f"{np.size(posture)} values")
+        return OperationalSpace(
+            controller_model(robot),
+            frame,
+            position,
+            orientation=rpy,
+            posture=None if posture is None else np.asarray(posture, float),
+        )
+    gains: dict[str, Any] = {n: np.asarray(options[n], float) for n in ("stiffness", "damping") if options[n] is not None}
+    for name, values in gains.items():
+        if values.size not in (1, 3, 6):
+            raise InputError(name, "1, 3 or 6 values", f"{values.size} values")
+    return Impedance(controller_model(robot), frame, position, orientation=rpy, **gains)
 
 
 def _task_outcome(robot: Robot, trajectory: Trajectory, frame: str, task: np.ndarray) -> TaskOutcome:
@@ -157,3 +305,55 @@ def _task_outcome(robot: Robot, trajectory: Trajectory, frame: str, task: np.nda
     position = robot.frame_position(trajectory.q[-1], frame)
     error = float(np.linalg.norm(position - task))
     return TaskOutcome(frame, tuple(task.tolist()), tuple(position.tolist()), error, error < REACHED)
+
+
+def frame_pose(robot: Robot, q: np.ndarray, frame: str) -> tuple[np.ndarray, np.ndarray]:
+    """A frame's position in [m] (3,) and attitude (3, 3), by the robot's forward kinematics."""
+    model, data = robot.model, robot.data
+    pin.framesForwardKinematics(model, data, np.asarray(q, dtype=float))
+    placement = data.oMf[robot.frame_id(frame)]
+    return placement.translation.copy(), placement.rotation.copy()
+
+
+def _pose_outcome(
+    robot: Robot, trajectory: Trajectory, law: OperationalSpace | Impedance, pushes: tuple[Push, ...]
+) -> TaskOutcome:
+    """Where an osc or impedance run left its frame (the plant's forward kinematics), and an
+    impedance's deflection against ``K⁻¹ F`` when every push acts at that frame."""
+    frame = str(law.frame)
+    target = np.asarray(law.position, dtype=float)
+    position, rotation = frame_pose(robot, trajectory.q[-1], frame)
+    error = float(np.linalg.norm(position - target))
+    rpy = None if law.orientation is None else np.asarray(law.orientation, dtype=float)
+    angle = None if rpy is None else float(np.linalg.norm(orientation_error(rotation, target_rotation(rpy))))
+    outcome = TaskOutcome(
+        frame, tuple(target.tolist()), tuple(position.tolist()), error, error < REACHED and (angle or 0.0) < REACHED,
+        None if rpy is None else tuple(rpy.tolist()), angle,
+    )  # fmt: skip
+    end = float(trajectory.t[-1])
+    acting = [push for push in pushes if push.time <= end]
+    if not isinstance(law, Impedance) or not acting or any(push.frame != frame for push in acting):
+        return outcome
+    force = np.sum([push.force for push in acting], axis=0)
+    expected = force / np.asarray(law.stiffness, dtype=float)[:3]
+    deflection = position - target
+    relative = float(np.linalg.norm(deflection - expected) / max(float(np.linalg.norm(expected)), 1e-300))
+    return replace(
+        outcome, deflection=tuple(deflection.tolist()), expected_deflection=tuple(expected.tolist()), deflection_error=relative
+    )
+
+
+def applied_torques(robot: Robot, trajectory: Trajectory, external: Sequence[ExternalWrench]) -> np.ndarray:
+    """The joint torques external wrenches applied at each sample, ``Σ J(q)ᵀ w(t)``, shape (N, nv)."""
+    return np.array([external_torques(robot, q, float(t), external) for t, q in zip(trajectory.t, trajectory.q, strict=True)])
+
+
+def _observer_outcome(
+    robot: Robot, trajectory: Trajectory, observer: MomentumObserver, external: list[ExternalWrench]
+) -> ObserverOutcome:
+    """The observer's residual at every sample, against the external torques applied there."""
+    residual = np.array(observer.residuals)
+    applied = applied_torques(robot, trajectory, external)
+    gain = float(np.max(np.asarray(observer.gain, dtype=float)))
+    error = float(np.abs(residual[-1] - applied[-1]).max())
+    return ObserverOutcome(gain, tuple(residual[-1].tolist()), tuple(applied[-1].tolist()), error, residual, applied)

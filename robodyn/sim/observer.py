@@ -20,19 +20,25 @@ From the residual: the wrench at a frame (:func:`external_wrench`, ``F = (Jᵀ)�
 collision detection (:func:`detect_collision`: when the first ``|r_i|`` crosses its
 threshold, and the last joint whose residual is significant — a force on a link moves
 only the joints before it, so that joint's child link is the one that was hit).
+:func:`observe_file` does all of it for a trajectory file (``robodyn observe``) and returns
+an :class:`ObservationRun`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Literal
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 
+from robodyn.common.files import atomic_write_text
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.trajectory import Trajectory
+from robodyn.trajectory.io import csv_preamble, format_rows, read_extra
 
 #: How the recorded motor torque acted between two samples.
 TorqueMode = Literal["held", "sampled"]
@@ -257,3 +263,157 @@ def detect_collision(robot: Robot, t: np.ndarray, residual: np.ndarray, threshol
     peak = residual[start:end].max(axis=0)
     index = int(np.flatnonzero(peak > limits)[-1])
     return Collision(float(t[start]), index, robot.dofs[index].name, peak)
+
+
+#: Column names of the wrench at a frame in ``robodyn observe``'s output: [N], then [N m].
+WRENCH_COLUMNS = ("force[x]", "force[y]", "force[z]", "torque[x]", "torque[y]", "torque[z]")
+
+
+@dataclass(frozen=True)
+class ObservationRun:
+    """The external torques a recorded motion reveals (``robodyn observe``), summarised.
+
+    Attributes:
+        robot: The robot's name; ``source``: the trajectory file read.
+        gain: ``K_O`` in [1/s]; ``torque``: how the recorded torque acted (``held``/``sampled``).
+        dof_names: One name a velocity coordinate (``robot.dofs``); ``units``: their torque units.
+        t: Times in [s], shape (N,); ``residual``: the estimate, shape (N, nv).
+        applied: The external torques the file says were applied (its ``tau_env``
+            columns), shape (N, nv), or ``None``.
+        frame: The frame of ``wrench`` (``None``: no wrench asked for); ``wrench``: force
+            [N] and torque [N m] at its origin explaining the residual, shape (N, 6).
+        threshold: The collision threshold in [N m] / [N] (``None``: no detection).
+        collision: The first contact found (``None``: none or no threshold).
+        out: The file written (``None``: none).
+        plot: The figure written (set by the caller that draws it).
+    """
+
+    robot: str
+    source: str
+    gain: float
+    torque: str
+    dof_names: tuple[str, ...]
+    units: tuple[str, ...]
+    t: np.ndarray = field(repr=False, compare=False)
+    residual: np.ndarray = field(repr=False, compare=False)
+    applied: np.ndarray | None = field(default=None, repr=False, compare=False)
+    frame: str | None = None
+    wrench: np.ndarray | None = field(default=None, repr=False, compare=False)
+    threshold: float | None = None
+    collision: Collision | None = None
+    out: str | None = None
+    plot: str | None = None
+
+    def table(self) -> tuple[list[str], np.ndarray]:
+        """The output file's header (``t``, ``tau_ext[<dof>]``, the wrench's six) and rows."""
+        header = ["t", *(f"tau_ext[{name}]" for name in self.dof_names)]
+        parts = [self.t[:, None], self.residual]
+        if self.wrench is not None:
+            header += list(WRENCH_COLUMNS)
+            parts.append(self.wrench)
+        return header, np.hstack(parts)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready, units in the keys (torques in ``torque_units``)."""
+        data: dict[str, Any] = {
+            "robot": self.robot, "source": self.source, "gain_per_s": self.gain, "torque": self.torque,
+            "samples": len(self.t), "duration_s": float(self.t[-1] - self.t[0]),
+            "dof_names": list(self.dof_names), "torque_units": list(self.units),
+            "peak_abs_tau_ext": np.abs(self.residual).max(axis=0).tolist(), "final_tau_ext": self.residual[-1].tolist(),
+        }  # fmt: skip
+        if self.applied is not None:
+            data["final_tau_ext_error"] = float(np.abs(self.residual[-1] - self.applied[-1]).max())
+        if self.frame is not None and self.wrench is not None:
+            data |= {
+                "frame": self.frame,
+                "final_force_N": self.wrench[-1, :3].tolist(),
+                "final_torque_Nm": self.wrench[-1, 3:].tolist(),
+            }
+        if self.threshold is not None:
+            data["threshold"] = self.threshold
+            data["collision"] = None if self.collision is None else {
+                "time_s": self.collision.time, "dof": self.collision.dof, "index": self.collision.index,
+                "peak_abs_tau_ext": self.collision.peak.tolist(),
+            }  # fmt: skip
+        return data | {"out": self.out, "plot": self.plot}
+
+    def text(self) -> str:
+        """Readable text: six significant digits, units."""
+
+        def values(row: np.ndarray) -> str:
+            return ", ".join(f"{printable(n)} {v:.4g} {u}" for n, v, u in zip(self.dof_names, row, self.units, strict=True))
+
+        lines = [
+            f"robot: {printable(self.robot)}",
+            f"trajectory: {printable(self.source)} ({len(self.t)} samples, {float(self.t[-1] - self.t[0]):.6g} s)",
+            f"observer: gain {self.gain:.6g} /s, torque {self.torque}",
+            f"peak |tau_ext|: {values(np.abs(self.residual).max(axis=0))}",
+            f"final tau_ext: {values(self.residual[-1])}",
+        ]
+        if self.applied is not None:
+            lines.append(
+                f"final |tau_ext - applied|: {float(np.abs(self.residual[-1] - self.applied[-1]).max()):.3g} N m / N (largest)"
+            )
+        if self.frame is not None and self.wrench is not None:
+            force, moment = self.wrench[-1, :3], self.wrench[-1, 3:]
+            lines.append(
+                f"final wrench at {printable(self.frame)}: force {np.round(force, 6).tolist()} N, torque {np.round(moment, 6).tolist()} N m"
+            )
+        if self.threshold is not None:
+            lines.append(
+                f"collision: none above {self.threshold:.6g}" if self.collision is None
+                else f"collision: at {self.collision.time:.6g} s, last significant joint {printable(self.collision.dof)} "
+                f"(threshold {self.threshold:.6g})"
+            )  # fmt: skip
+        lines += [f"{kind}: {path}" for kind, path in (("out", self.out), ("plot", self.plot)) if path]
+        return "\n".join(lines)
+
+
+def observe_file(
+    robot: Robot,
+    path: str | Path,
+    *,
+    gain: float | np.ndarray,
+    frame: str | None = None,
+    threshold: float | None = None,
+    torque: TorqueMode = "held",
+    out: str | Path | None = None,
+) -> ObservationRun:
+    """Estimate the external torques of a recorded trajectory file, detect a contact, write CSV.
+
+    Args:
+        robot: The model (``M``, ``C``, ``G``) of the robot that moved.
+        path: A trajectory file with ``tau`` columns (``.csv``, ``.npz``, ``.parquet``).
+        gain: ``K_O`` in [1/s] (scalar or (nv,)).
+        frame: Also the wrench at this frame's origin, ``(Jᵀ)⁺ r``.
+        threshold: Collision threshold in [N m] / [N] (:func:`detect_collision`).
+        torque: ``"held"`` or ``"sampled"`` (:func:`estimate_external_torques`).
+        out: CSV file to write (atomically): ``t``, ``tau_ext[<dof>]`` and with ``frame``
+            ``force[x|y|z]`` [N], ``torque[x|y|z]`` [N m].
+
+    Raises:
+        InputError: A bad gain, threshold, torque mode, or an ``out`` that is not ``.csv``.
+        TrajectoryError: An unreadable file, or one of another robot.
+        FrameError: An unknown frame or one no joint moves.
+    """
+    if out is not None and Path(out).suffix != ".csv":
+        raise InputError("out", "a .csv file name", repr(str(out)))
+    trajectory = Trajectory.load(path).for_robot(robot)
+    residual = estimate_external_torques(robot, trajectory, gain=gain, torque=torque)
+    applied = read_extra(Path(path), "tau_env")
+    wrench = None if frame is None else external_wrench(robot, trajectory.q, residual, frame)
+    collision = None if threshold is None else detect_collision(robot, trajectory.t, residual, threshold)
+    run = ObservationRun(
+        robot.name, str(path), float(np.max(np.asarray(gain, dtype=float))), torque,
+        tuple(dof.name for dof in robot.dofs), tuple(dof.effort_unit for dof in robot.dofs),
+        np.asarray(trajectory.t, dtype=float), residual, applied,
+        None if frame is None else robot.task_frame(frame, "an external wrench"), wrench,
+        None if threshold is None else float(threshold), collision,
+    )  # fmt: skip
+    if out is None:
+        return run
+    header, table = run.table()
+    atomic_write_text(
+        out, csv_preamble(robot.name, header).replace("trajectory of", "external torques of", 1) + format_rows(table)
+    )
+    return replace(run, out=str(out))

@@ -18,15 +18,40 @@ from robodyn.sim.limits import LimitViolation, warning_text
 
 
 @dataclass(frozen=True)
+class Push:
+    """A push during a run: a constant force at a frame's origin from a time on.
+
+    Attributes:
+        time: When it starts, in [s].
+        force: The force in [N], world axes, shape (3,).
+        frame: Where it acts; ``None`` for the controlled frame (the end effector).
+    """
+
+    time: float
+    force: tuple[float, float, float]
+    frame: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready, units in the keys."""
+        return {"time_s": self.time, "force_N": list(self.force), "frame": self.frame}
+
+
+@dataclass(frozen=True)
 class TaskOutcome:
-    """Where a task-space run left its frame.
+    """Where a task-space, operational-space or impedance run left its frame.
 
     Attributes:
         frame: The controlled frame.
         target: The target position in [m], shape (3,).
         final_position: The frame's final position in [m], shape (3,).
         final_error: Distance between the two in [m].
-        reached: Whether ``final_error`` is below :data:`robodyn.sim.experiment.REACHED`.
+        reached: Whether ``final_error`` (and ``orientation_error``) are below
+            :data:`robodyn.sim.experiment.REACHED` (in [m], and [rad]).
+        target_rpy: The target attitude as roll, pitch, yaw in [rad] (``None``: position only).
+        orientation_error: The final attitude error ``|log(Rᵀ R_d)|`` in [rad].
+        deflection: Impedance under a push: the frame's final displacement from its rest
+            position in [m], shape (3,); ``expected_deflection``: ``K⁻¹ F`` in [m];
+            ``deflection_error``: ``|δ − K⁻¹ F| / |K⁻¹ F|``.
     """
 
     frame: str
@@ -34,15 +59,83 @@ class TaskOutcome:
     final_position: tuple[float, ...]
     final_error: float
     reached: bool
+    target_rpy: tuple[float, ...] | None = None
+    orientation_error: float | None = None
+    deflection: tuple[float, ...] | None = None
+    expected_deflection: tuple[float, ...] | None = None
+    deflection_error: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, units in the keys."""
-        return {
+        data: dict[str, Any] = {
             "frame": self.frame,
             "target_m": list(self.target),
             "final_position_m": list(self.final_position),
             "final_error_m": self.final_error,
             "target_reached": self.reached,
+        }
+        if self.target_rpy is not None:
+            data |= {"target_rpy_rad": list(self.target_rpy), "final_orientation_error_rad": self.orientation_error}
+        if self.deflection is not None and self.expected_deflection is not None:
+            data |= {
+                "deflection_m": list(self.deflection),
+                "expected_deflection_m": list(self.expected_deflection),
+                "deflection_error": self.deflection_error,
+            }
+        return data
+
+    def _state(self) -> str:
+        if self.reached:
+            return "reached"
+        return "NOT reached" if self.deflection is None else "held off by the push"
+
+    def lines(self) -> list[str]:
+        """The outcome as lines of text."""
+        lines = [f"frame: {printable(self.frame)}", f"target: {vector_text(self.target, 6)} m"]
+        if self.target_rpy is not None:
+            lines.append(f"target roll, pitch, yaw: {vector_text(self.target_rpy, 6)} rad")
+        lines += [
+            f"final position: {vector_text(self.final_position, 6)} m",
+            f"final error: {_number(self.final_error, 3)} m ({self._state()})",
+        ]
+        if self.orientation_error is not None:
+            lines.append(f"final orientation error: {_number(self.orientation_error, 3)} rad")
+        if self.deflection is not None and self.expected_deflection is not None:
+            lines += [
+                f"deflection: {vector_text(self.deflection, 6)} m",
+                f"K^-1 F: {vector_text(self.expected_deflection, 6)} m "
+                f"(deflection off by {_number(100 * (self.deflection_error or 0.0), 3)} %)",
+            ]
+        return lines
+
+
+@dataclass(frozen=True)
+class ObserverOutcome:
+    """What the momentum observer run along a simulation estimated.
+
+    Attributes:
+        gain: ``K_O`` in [1/s].
+        final_estimate: The residual at the end, per velocity coordinate, in [N m] / [N].
+        final_applied: The external torques applied at the end (``J(q)ᵀ F`` of the pushes).
+        final_error: Largest ``|r − τ_env|`` at the end, in [N m] / [N].
+        residual: The estimate at every sample, shape (N, nv) (written as ``tau_ext``).
+        applied: The applied external torques at every sample, shape (N, nv) (``tau_env``).
+    """
+
+    gain: float
+    final_estimate: tuple[float, ...]
+    final_applied: tuple[float, ...]
+    final_error: float
+    residual: np.ndarray = field(repr=False, compare=False)
+    applied: np.ndarray = field(repr=False, compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready, units in the keys (torques in ``torque_units``)."""
+        return {
+            "observer_gain_per_s": self.gain,
+            "final_tau_ext_estimate": list(self.final_estimate),
+            "final_tau_ext_applied": list(self.final_applied),
+            "final_tau_ext_error": self.final_error,
         }
 
 
@@ -62,6 +155,8 @@ class SimulationSummary:
         energy_change: Total energy at the end minus at the start, in [J].
         task: Where a task-space run left its frame (``None`` for other controllers).
         final_joint_error: Largest |q − target| at the end (pd, computed torque), rad or m.
+        pushes: The pushes applied during the run.
+        observer: What a momentum observer run along estimated (``None`` without one).
         violations: Every limit the run broke (none with ``limits="ignore"``).
         files: Files written for the run, by kind (``trajectory``, ``plot``, ``recording``,
             ``poster``), in the order written.
@@ -84,6 +179,8 @@ class SimulationSummary:
     energy_change: float
     task: TaskOutcome | None = None
     final_joint_error: float | None = None
+    pushes: tuple[Push, ...] = ()
+    observer: ObserverOutcome | None = None
     violations: tuple[LimitViolation, ...] = ()
     files: tuple[tuple[str, str], ...] = field(default=())
 
@@ -114,6 +211,10 @@ class SimulationSummary:
             data |= self.task.to_dict()
         if self.final_joint_error is not None:
             data["final_joint_error"] = self.final_joint_error
+        if self.pushes:
+            data["pushes"] = [push.to_dict() for push in self.pushes]
+        if self.observer is not None:
+            data |= self.observer.to_dict()
         data["limit_violations"] = [violation.as_dict() for violation in self.violations]
         return data | dict(self.files)
 
@@ -137,13 +238,12 @@ class SimulationSummary:
             f"simulated: {_number(self.duration)} s in {self.steps} steps of {_number(self.dt)} s"
             + (f", {_number(self.real_time_factor, 3)}× real time" if self.real_time_factor else ""),
         ]
+        lines += [
+            f"push: {vector_text(push.force, 6)} N at {printable(push.frame or '(the end effector)')} from {_number(push.time)} s"
+            for push in self.pushes
+        ]
         if self.task is not None:
-            lines += [
-                f"frame: {printable(self.task.frame)}",
-                f"target: {vector_text(self.task.target, 6)} m",
-                f"final position: {vector_text(self.task.final_position, 6)} m",
-                f"final error: {_number(self.task.final_error, 3)} m ({'reached' if self.task.reached else 'NOT reached'})",
-            ]
+            lines += self.task.lines()
         if self.final_joint_error is not None:
             lines.append(f"final joint error: {_number(self.final_joint_error, 3)} (largest |q - target|, rad or m)")
         floating = tuple(self.dof_names[: len(BASE_V_NAMES)]) == BASE_V_NAMES
@@ -155,6 +255,12 @@ class SimulationSummary:
         ]
         lines.append(f"peak |torque|: {', '.join(peaks)}")
         lines.append(f"energy change: {_number(self.energy_change, 4)} J")
+        if self.observer is not None:
+            lines += [
+                f"observer (gain {_number(self.observer.gain)} /s): final tau_ext {vector_text(self.observer.final_estimate, 4)}",
+                f"  applied {vector_text(self.observer.final_applied, 4)} (largest difference "
+                f"{_number(self.observer.final_error, 3)} N m / N)",
+            ]
         if self.limits == "ignore":
             lines.append('limits: not checked (mode "ignore")')
         elif not self.violations:

@@ -12,7 +12,10 @@ relative); joints keep fourth order.
 The controller is a continuous-time law evaluated wherever the integrator evaluates the
 dynamics (every Runge–Kutta stage); with ``hold=True`` it is sampled once per step and its
 torque held during the step (zero-order hold, as on a digital controller). External
-wrenches are evaluated at every stage. The
+wrenches are evaluated at every stage. An ``observer=`` (a
+:class:`~robodyn.sim.observer.MomentumObserver`) is updated once per step, at the state
+actually reached, with the torque applied there; its ``residuals`` are then the external
+torques it estimated, one a sample. The
 result is a :class:`Trajectory` (one row a sample) that saves to and loads from CSV and NPZ.
 
 Joint limits (``limits=``, see :mod:`robodyn.sim.limits`): ``"warn"`` (default) reports
@@ -44,6 +47,7 @@ from robodyn.exceptions import (
     SingularMassMatrixError,
 )
 from robodyn.sim.limits import JointLimits, LimitMode, check_mode, warning_text
+from robodyn.sim.observer import MomentumObserver
 from robodyn.trajectory import Trajectory
 
 #: A controller maps time in [s], q and v to joint torques, shape (nv,).
@@ -100,6 +104,7 @@ def simulate(
     limits: LimitMode = "warn",
     engine: Engine = "pinocchio",
     control_period: float | None = None,
+    observer: MomentumObserver | None = None,
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
 
@@ -122,6 +127,10 @@ def simulate(
             every ``control_period`` [s] and its torque held in between.
         control_period: With ``engine="compiled"`` and a Python controller, in [s] (a whole
             number of steps; default ``dt``).
+        observer: A momentum observer fed every sample (time, state, applied torque) as
+            the run goes (Pinocchio engine); afterwards ``observer.residuals`` holds its
+            estimate of the external torques at each sample. Give it ``torque="held"``
+            with ``hold=True``, ``"sampled"`` otherwise.
 
     Returns:
         The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0`` (``tau`` is
@@ -140,6 +149,8 @@ def simulate(
     """
     _check_modes(integrator, limits, engine)
     if engine == "compiled":
+        if observer is not None:
+            raise InputError("observer", "none with engine='compiled' (use the Pinocchio engine)", "an observer")
         return _simulate_compiled(
             robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
             limits=limits, control_period=control_period,
@@ -157,7 +168,7 @@ def simulate(
     if enforce and controller is not None:
         commanded = controller
         controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
-    stepper = _Stepper(robot, external, controller, hold=hold, rk4=integrator == "rk4")
+    stepper = _Stepper(robot, external, controller, hold=hold, rk4=integrator == "rk4", observer=observer)
     qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, joint_limits if enforce else None)
     trajectory = Trajectory(
         np.arange(steps + 1) * dt, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques),
@@ -195,9 +206,17 @@ class _Stepper:
     """One integration step of ``(q, v)`` under a controller: RK4 or semi-implicit Euler."""
 
     def __init__(
-        self, robot: Robot, external: Sequence[ExternalWrench], controller: Controller | None, *, hold: bool, rk4: bool
+        self,
+        robot: Robot,
+        external: Sequence[ExternalWrench],
+        controller: Controller | None,
+        *,
+        hold: bool,
+        rk4: bool,
+        observer: MomentumObserver | None = None,
     ) -> None:
         self.controller = controller
+        self.observer = observer
         self.forward = _accelerator(robot, external)
         if controller is None or hold:  # the step's torque (zero when passive) holds
             self.accelerate = self.forward
@@ -212,6 +231,11 @@ class _Stepper:
     def torque(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The controller's torque at the step's start, shape (nv,) (zero when passive)."""
         return self.zero if self.controller is None else np.asarray(self.controller(t, q, v), dtype=float)
+
+    def observe(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
+        """Feed the observer (if any) a sample and the torque applied there."""
+        if self.observer is not None:
+            self.observer.update(t, q, v, tau)
 
     def step(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
         """``(q, v)`` after one step of ``dt`` from time ``t`` with acceleration ``a`` there."""
@@ -252,6 +276,7 @@ def _integrate(
             vs.append(v)
             tau = stepper.torque(t, q, v)
             torques.append(tau)
+            stepper.observe(t, q, v, tau)
             a = stepper.forward(t, q, v, tau)
             accelerations.append(a)
             q, v = stepper.step(t, dt, q, v, tau, a)
@@ -270,6 +295,7 @@ def _integrate(
     qs.append(q)
     vs.append(v)
     torques.append(torques[-1] if steps else stepper.zero)
+    stepper.observe(steps * dt, q, v, torques[-1])
     accelerations.append(stepper.forward(steps * dt, q, v, torques[-1]))  # the last sample's own acceleration
     return qs, vs, accelerations, torques
 

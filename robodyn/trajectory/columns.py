@@ -22,10 +22,15 @@ from robodyn.exceptions import TrajectoryError
 ROOT_JOINT = "root_joint"
 #: Kinds of columns, in the order a table has them: positions, velocities, accelerations, torques.
 KINDS = ("q", "v", "a", "tau")
-#: Columns ``robodyn torques`` may add (gravity torques, mass-matrix entries); read back, they are skipped.
-EXTRA_KINDS = ("G", "M")
+#: Columns a file may add besides the trajectory's own; read back as a trajectory, they are
+#: skipped (:func:`extra_columns` reads them): gravity torques and mass-matrix entries
+#: (``robodyn torques``), the external torques an observer estimated (``tau_ext``: the
+#: residual of :class:`robodyn.sim.observer.MomentumObserver`, ``robodyn simulate
+#: --observer-gain``) and those the environment applied (``tau_env``: ``J(q)ᵀ w`` of the
+#: pushes of ``robodyn simulate --force-at``), in [N m] / [N], named as ``v``.
+EXTRA_KINDS = ("G", "M", "tau_ext", "tau_env")
 _COLUMN = re.compile(r"^(q|v|a|tau)\[(.*)\]$", re.DOTALL)
-_EXTRA = re.compile(r"^(G|M)\[(.*)\]$", re.DOTALL)
+_EXTRA = re.compile(r"^(G|M|tau_ext|tau_env)\[(.*)\]$", re.DOTALL)
 _LEGACY_Q = re.compile(r"^q(\d+)$")
 
 
@@ -188,3 +193,27 @@ def check_table(
         raise TrajectoryError(
             source, f"time does not increase (t = {times[row]!r} after {times[row - 1]!r})", rows=(first_row + row,) * 2
         )
+
+
+def extra_columns(table: np.ndarray, layout: Layout, kind: str) -> np.ndarray | None:
+    """The columns of an extra kind (``tau_ext``, ``tau_env``, ``G``), in ``v``'s order.
+
+    Args:
+        table: Rows of values, shape (N, layout.width).
+        layout: Its columns (:func:`parse_header`).
+        kind: One of :data:`EXTRA_KINDS` named like ``v`` (not ``M``).
+
+    Returns:
+        Shape (N, nv), or ``None`` when the table has no column of that kind.
+
+    Raises:
+        TrajectoryError: When some but not all of the kind's columns are present.
+    """
+    names = [f"{kind}[{name}]" for name in layout.v_names]
+    present = [name for name in names if name in layout.header]
+    if not present:
+        return None
+    if len(present) != len(names):
+        missing = [name for name in names if name not in layout.header]
+        raise TrajectoryError("the table", f"missing columns {short_list(missing)}")
+    return np.asarray(table, dtype=float)[:, [layout.header.index(name) for name in names]]

@@ -20,7 +20,7 @@ import numpy as np
 
 from robodyn.common.files import atomic_write_bytes, atomic_write_text
 from robodyn.exceptions import InputError, TrajectoryError
-from robodyn.trajectory.columns import EXTRA_KINDS, KINDS, Layout, coordinate_names, parse_header, short_list
+from robodyn.trajectory.columns import EXTRA_KINDS, KINDS, Layout, coordinate_names, extra_columns, parse_header, short_list
 
 #: File name suffixes :func:`read_table` reads.
 READ_SUFFIXES = (".csv", ".npz", ".parquet")
@@ -223,4 +223,63 @@ def _read_parquet(path: Path) -> tuple[np.ndarray, Layout, str]:
     return values, parse_header(header, str(path)), robot
 
 
-__all__ = ["csv_preamble", "format_rows", "npz_columns", "read_csv_header", "read_table", "write_csv", "write_npz"]
+def write_with_extras(path: Path, trajectory: Any, extras: dict[str, np.ndarray]) -> Path:
+    """Write a trajectory with extra columns (:data:`~robodyn.trajectory.columns.EXTRA_KINDS`
+    named like ``v``, e.g. ``tau_ext[<joint>]``), atomically, to ``.csv`` or ``.npz``.
+
+    Args:
+        path: The file.
+        trajectory: A :class:`robodyn.Trajectory`.
+        extras: Kind -> values, each shape (N, nv), in [N m] / [N].
+
+    Returns:
+        The path written.
+
+    Raises:
+        InputError: For another suffix, an unknown kind or a wrong shape.
+    """
+    path = Path(path)
+    shape = trajectory.v.shape
+    for kind, values in extras.items():
+        if kind not in EXTRA_KINDS or kind == "M" or np.shape(values) != shape:
+            raise InputError("extras", f"kinds of {EXTRA_KINDS} but M, each of shape {shape}", f"{kind!r}: {np.shape(values)}")
+    if path.suffix not in (".csv", ".npz"):
+        raise InputError("path", "a .csv or .npz file name", repr(str(path)))
+    if not extras:
+        return trajectory.save(path)
+    q_names, v_names = trajectory.coordinate_names
+    if path.suffix == ".csv":
+        header = trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names]
+        write_csv(path, trajectory.robot, header, np.column_stack([trajectory.table(), *extras.values()]))
+        return path
+    arrays = {"t": trajectory.t, "q": trajectory.q, "v": trajectory.v, "a": trajectory.a}
+    arrays |= {} if trajectory.tau is None else {"tau": trajectory.tau}
+    write_npz(path, arrays | extras, q_names=q_names, v_names=v_names, joint_names=trajectory.joint_names, robot=trajectory.robot)
+    return path
+
+
+def read_extra(path: Path, kind: str) -> np.ndarray | None:
+    """The extra columns of one kind a trajectory file holds (``tau_ext``, ``tau_env``, ``G``).
+
+    Returns:
+        Shape (N, nv) in the file's ``v`` order, or ``None`` when the file has none.
+    """
+    path = Path(path)
+    table, layout, _ = read_table(path)
+    if path.suffix == ".npz":
+        with np.load(path, allow_pickle=False) as data:
+            return np.asarray(data[kind], dtype=float) if kind in data else None
+    return extra_columns(table, layout, kind)
+
+
+__all__ = [
+    "csv_preamble",
+    "format_rows",
+    "npz_columns",
+    "read_csv_header",
+    "read_extra",
+    "read_table",
+    "write_csv",
+    "write_npz",
+    "write_with_extras",
+]

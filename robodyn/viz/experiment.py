@@ -19,10 +19,13 @@ import numpy as np
 
 from robodyn.common.files import outputs_together
 from robodyn.dynamics.robot import Robot
-from robodyn.sim.experiment import run_simulation
+from robodyn.sim.experiment import applied_torques, push_wrenches, run_simulation
+from robodyn.sim.observer import ObservationRun, observe_file
+from robodyn.sim.operational_space import target_rotation
 from robodyn.sim.report import SimulationSummary
 from robodyn.sim.whatif import WhatIfTable, what_if
 from robodyn.trajectory import Trajectory
+from robodyn.trajectory.io import write_with_extras
 
 PathLike = str | Path
 
@@ -46,18 +49,24 @@ def run_experiment(
         record: Self-contained HTML animation (meshcat).
         png: With ``record``: a still of the first frame (needs Chromium).
         **settings: ``controller``, ``target``, ``frame``, ``q0``, ``duration``, ``dt``,
-            ``integrator``, ``limits``, ``engine``.
+            ``integrator``, ``limits``, ``engine``, ``posture``, ``stiffness``,
+            ``damping``, ``force_at``, ``observer_gain``.
 
     Returns:
-        The run's summary; its ``files`` name what was written (``trajectory``, ``plot``,
-        ``recording``, ``poster``).
+        The run's summary; its ``files`` name what was written (``trajectory``: with an
+        observer also its ``tau_ext[<joint>]`` columns, with pushes the torques they
+        applied, ``tau_env[<joint>]``;
+        ``plot``, ``recording`` (the target pose as a triad, pushes as arrows), ``poster``).
     """
     trajectory, summary = run_simulation(robot, **settings)
     frame = summary.task.frame if summary.task is not None else None
     task = np.asarray(summary.task.target) if summary.task is not None else None
     with outputs_together():  # every file of the run, or none of them
         if out:
-            summary = summary.with_file("trajectory", str(trajectory.save(out)))
+            extras = {} if summary.observer is None else {"tau_ext": summary.observer.residual}
+            if summary.pushes:
+                extras["tau_env"] = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes)[1])
+            summary = summary.with_file("trajectory", str(write_with_extras(Path(out), trajectory, extras)))
         if plot:
             from robodyn.viz.plots import plot_simulation  # matplotlib: only when a figure is asked for
 
@@ -65,11 +74,44 @@ def run_experiment(
         if record:
             from robodyn.viz.recording import record as write_recording  # meshcat: only for an animation
 
-            written = write_recording(robot, trajectory, record, png=png, target=task, frame=frame or robot.end_effector)
+            rpy = None if summary.task is None or summary.task.target_rpy is None else summary.task.target_rpy
+            _, forces = push_wrenches(robot, summary.pushes, frame)
+            written = write_recording(
+                robot, trajectory, record, png=png, target=task, frame=frame or robot.end_effector,
+                target_rotation=None if rpy is None else target_rotation(np.asarray(rpy)), forces=tuple(forces),
+            )  # fmt: skip
             summary = summary.with_file("recording", str(written))
             if png:
                 summary = summary.with_file("poster", str(png))
     return summary
+
+
+def run_observation(
+    robot: Robot,
+    path: PathLike,
+    *,
+    out: PathLike | None = None,
+    plot: PathLike | None = None,
+    **options: Any,
+) -> ObservationRun:
+    """:func:`robodyn.sim.observer.observe_file` plus its figure (``robodyn observe``).
+
+    Args:
+        robot: The model of the robot that moved.
+        path: The trajectory file (with torques).
+        out: CSV of the estimate (``t``, ``tau_ext[<joint>]``, with a frame its wrench).
+        plot: PNG: the estimate against the applied external torques (the file's
+            ``tau_env`` columns, when it has them).
+        **options: ``gain``, ``frame``, ``threshold``, ``torque``.
+    """
+    with outputs_together():  # the estimate and its figure, or neither
+        run = observe_file(robot, path, out=out, **options)
+        if plot:
+            from robodyn.viz.plots import plot_external_torques  # matplotlib: only when a figure is asked for
+
+            plot_external_torques(run.t, run.residual, run.applied, run.dof_names, run.units, plot, gain=run.gain)
+            run = replace(run, plot=str(plot))
+    return run
 
 
 def run_whatif(
@@ -184,7 +226,7 @@ def record_files(
     from robodyn.viz.recording import recording  # meshcat (the viewer extra): only when recording
 
     started = time.perf_counter()
-    cap = {} if max_mesh_bytes is None else {"max_mesh_bytes": max_mesh_bytes}
+    cap: dict[str, Any] = {} if max_mesh_bytes is None else {"max_mesh_bytes": max_mesh_bytes}
     made = recording(robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, **cap)
     if png:
         if filmstrip is not None:

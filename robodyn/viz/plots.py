@@ -345,3 +345,62 @@ def text_overlaps(figure: Figure, *, tolerance: float = 0.5) -> list[tuple[str, 
                 if box.overlaps(axis.get_window_extent()):
                     problems.append((name, f"axes {number} data"))
     return problems
+
+
+def external_torques_figure(
+    t: np.ndarray,
+    estimate: np.ndarray,
+    applied: np.ndarray | None,
+    dof_names: list[str] | tuple[str, ...],
+    units: list[str] | tuple[str, ...],
+    *,
+    gain: float | None = None,
+) -> Figure:
+    """The observer's estimate of the external torques against those applied, over time.
+
+    One panel a unit ([N m] for revolute joints, [N] for prismatic ones); a joint has one
+    colour: solid its estimate, dashed the applied torque (when known).
+
+    Args:
+        t: Times in [s], shape (N,).
+        estimate: Estimated external torques, shape (N, nv).
+        applied: Applied external torques, shape (N, nv), or ``None``.
+        dof_names, units: Names and torque units of the nv coordinates.
+        gain: The observer's gain in [1/s], for the title.
+    """
+    kinds = list(dict.fromkeys(units))
+    figure = new_figure(9.0, 2.6 * len(kinds) + 0.6)
+    axes = figure.subplots(len(kinds), 1, sharex=True, squeeze=False)[:, 0]
+    colors = {name: f"C{index % 10}" for index, name in enumerate(dof_names)}
+    for axis, unit in zip(axes, kinds, strict=True):
+        for index, name in enumerate(dof_names):
+            if units[index] != unit:
+                continue
+            axis.plot(t, estimate[:, index], color=colors[name], label=f"{text_label(name)} estimated")
+            if applied is not None:
+                axis.plot(t, applied[:, index], color=colors[name], linestyle="--", label=f"{text_label(name)} applied")
+        axis.set_ylabel(f"external [{unit}]")
+        axis.grid(alpha=0.3)
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+    axes[-1].set_xlabel("time [s]")
+    title = (
+        "external torques: observer estimate (solid) vs applied (dashed)"
+        if applied is not None
+        else "external torques: observer estimate"
+    )
+    figure.suptitle(title + (f", gain {gain:g} /s" if gain else ""), fontsize=10)
+    return figure
+
+
+def plot_external_torques(
+    t: np.ndarray,
+    estimate: np.ndarray,
+    applied: np.ndarray | None,
+    dof_names: list[str] | tuple[str, ...],
+    units: list[str] | tuple[str, ...],
+    path: str | Path,
+    *,
+    gain: float | None = None,
+) -> Path | None:
+    """Write :func:`external_torques_figure` as a PNG (atomically); ``None`` for ``-``."""
+    return save_png(external_torques_figure(t, estimate, applied, dof_names, units, gain=gain), path)

@@ -31,7 +31,7 @@ from robodyn.exceptions import InputError, RobodynError, ViewerError
 from robodyn.trajectory import Trajectory
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
 from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands
-from robodyn.viz.task import axis_commands, task_commands
+from robodyn.viz.task import axis_commands, force_commands, target_pose_commands, task_commands
 
 _PAGE = """<!DOCTYPE html>
 <html>
@@ -188,6 +188,8 @@ def motion_commands(
     frame: str | None = None,
     axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
+    target_rotation: np.ndarray | None = None,
+    forces: tuple = (),
 ) -> tuple[list[dict], float, list[str]]:
     """The meshcat commands of a motion with its task (see :func:`recording`).
 
@@ -215,10 +217,15 @@ def motion_commands(
     points = moved.points(scene)
     framed = np.vstack([points, *([target_m[None]] if target_m is not None else [])])
     task, task_clips = task_commands(points, target=target_m, path=path, path_frames=frames, fps=fps)
+    if target_m is not None and target_rotation is not None:
+        task += target_pose_commands(target_m, np.asarray(target_rotation, dtype=float), points)
+    arrows, arrow_clips = force_commands(robot, moved.times, moved.configurations, forces, points, fps)
+    task_clips |= arrow_clips
     commands = [
         *scene.commands,
         *axis_commands(robot, axes, points),
         *task,
+        *arrows,
         *pose_commands(robot, moved.configurations[0]),
         *camera_commands(framed),
         lower_animation({**clips, **task_clips}),
@@ -235,6 +242,8 @@ def recording(
     frame: str | None = None,
     axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
+    target_rotation: np.ndarray | None = None,
+    forces: tuple = (),
 ) -> Recording:
     """Draw a trajectory: the robot, the ground, the target and the end effector's path.
 
@@ -247,14 +256,17 @@ def recording(
             the robot has no default and none is given).
         axes: Links (or frames) that carry a small x/y/z triad (red, green, blue).
         max_mesh_bytes: Largest mesh file drawn; larger ones become placeholder boxes.
+        target_rotation: The target's attitude (3, 3): the target pose drawn as a triad.
+        forces: :class:`robodyn.ExternalWrench` es drawn as arrows while they act.
 
     Raises:
         RobodynError: If the trajectory is empty, does not fit the robot, or nothing of the
             robot can be drawn.
     """
     commands, duration, placeholders = motion_commands(
-        robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes
-    )
+        robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes,
+        target_rotation=target_rotation, forces=forces,
+    )  # fmt: skip
     return Recording(page(commands, title=f"robodyn: {robot.name}"), duration, fps, robot.name, placeholders)
 
 
@@ -270,6 +282,8 @@ def record(
     frame: str | None = None,
     axes: tuple[str, ...] = (),
     max_mesh_bytes: int = MAX_MESH_BYTES,
+    target_rotation: np.ndarray | None = None,
+    forces: tuple = (),
 ) -> Path | None:
     """Write a self-contained HTML animation of a trajectory (plays on open).
 
@@ -284,6 +298,7 @@ def record(
         frame: Frame whose path is drawn (default ``robot.end_effector``).
         axes: Links that carry an x/y/z triad.
         max_mesh_bytes: Largest mesh file drawn (see :mod:`robodyn.viz.mesh_files`).
+        target_rotation, forces: As for :func:`recording`.
 
     Returns:
         The HTML path (``None`` for standard output, ``-``).
@@ -292,7 +307,10 @@ def record(
         RobodynError: If the trajectory is empty or does not fit the robot, or the still
             cannot be made.
     """
-    made = recording(robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes)
+    made = recording(
+        robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes,
+        target_rotation=target_rotation, forces=forces,
+    )  # fmt: skip
     if png is not None:
         made.still(png, at=at)
     return made.save(path)

@@ -4,13 +4,21 @@
 - the target as a red sphere;
 - the end effector's path as an orange line with dots, in segments that the animation
   switches visible as the motion reaches them (so the path grows with time);
-- x/y/z triads (red, green, blue) riding on chosen links.
+- x/y/z triads (red, green, blue) riding on chosen links;
+- the target pose (position and attitude) as a triad (:func:`target_pose_commands`);
+- external forces as arrows (an orange shaft and cone from the frame the force acts on,
+  pointing along it, its length in proportion, shown while the force acts:
+  :func:`force_commands`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import meshcat.geometry as mg
 import numpy as np
+import pinocchio as pin
 from meshcat.animation import AnimationClip
 from meshcat.commands import SetObject, SetTransform
 from meshcat.path import Path as MeshcatPath
@@ -121,3 +129,77 @@ def axis_commands(robot: Robot, links: tuple[str, ...] | list[str], points: np.n
             raise FrameError(link, robot.name)
         commands.append(SetObject(mg.triad(0.1 * size), path=MeshcatPath((*ROOT_PATH, link, "axes"))).lower())
     return commands
+
+
+#: Colour of the force arrows.
+FORCE_COLOUR = 0xFF6A00
+#: Length of the largest force's arrow, relative to the scene's size.
+FORCE_LENGTH = 0.25
+
+
+def _scene_size(points: np.ndarray) -> float:
+    return max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 0.1)
+
+
+def target_pose_commands(position: np.ndarray, rotation: np.ndarray, points: np.ndarray) -> list[dict]:
+    """The target pose as an x/y/z triad (red, green, blue; a sixth of the scene's size).
+
+    Args:
+        position: Target position in [m], shape (3,).
+        rotation: Target attitude, world axes, shape (3, 3).
+        points: Everything the robot's visuals cover over the motion, shape (K, 3), in [m].
+    """
+    matrix = np.eye(4)
+    matrix[:3, :3], matrix[:3, 3] = rotation, position
+    path = _task_path("target_pose")
+    return [SetObject(mg.triad(_scene_size(points) / 6), path=path).lower(), SetTransform(matrix, path=path).lower()]
+
+
+def force_commands(
+    robot: Any,
+    times: np.ndarray,
+    configurations: np.ndarray,
+    forces: Sequence[Any],
+    points: np.ndarray,
+    fps: float = 30.0,
+) -> tuple[list[dict], dict[tuple[str, ...], AnimationClip]]:
+    """External forces as arrows at the frames they act on, animated with the motion.
+
+    Args:
+        robot: The robot (:class:`robodyn.Robot`).
+        times: Animation times in [s], shape (F,).
+        configurations: The configuration at each, shape (F, nq).
+        forces: :class:`robodyn.ExternalWrench` es (their force part is drawn).
+        points: Everything the robot's visuals cover over the motion, shape (K, 3), in [m].
+        fps: Frames per second of the animation.
+
+    Returns:
+        Commands (the arrows' geometry) and animation clips (their poses and visibility).
+    """
+    commands: list[dict] = []
+    clips: dict[tuple[str, ...], AnimationClip] = {}
+    values = [np.array([np.asarray(item.value(float(t)), float)[:3] for t in times]) for item in forces]
+    largest = max((float(np.linalg.norm(v, axis=1).max()) for v in values), default=0.0)
+    if largest == 0.0:
+        return commands, clips
+    scale = FORCE_LENGTH * _scene_size(points) / largest
+    for index, (item, force) in enumerate(zip(forces, values, strict=True)):
+        name = f"force{index:02d}"
+        shaft, tip = mg.Cylinder(0.8, radius=0.015), mg.Cylinder(0.2, radiusTop=0.0, radiusBottom=0.045)
+        parts = ((shaft, "shaft", 0.4), (tip, "tip", 0.9))
+        for geometry, part, offset in parts:  # a unit arrow along y (meshcat's cylinders' axis) from the origin
+            matrix = np.eye(4)
+            matrix[1, 3] = offset
+            commands.append(SetObject(geometry, mg.MeshLambertMaterial(color=FORCE_COLOUR), path=_task_path(name, part)).lower())
+            commands.append(SetTransform(matrix, path=_task_path(name, part)).lower())
+        clip = AnimationClip(fps=fps)
+        for frame, (q, f) in enumerate(zip(configurations, force, strict=True)):
+            length = float(np.linalg.norm(f))
+            direction = f / length if length > 0 else np.array([0.0, 1.0, 0.0])
+            rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), direction).coeffs()
+            clip.set_property(frame, "position", "vector3", robot.frame_position(q, item.frame).tolist())
+            clip.set_property(frame, "quaternion", "quaternion", rotation.tolist())
+            clip.set_property(frame, "scale", "vector3", [max(scale * length, 1e-6)] * 3)
+            clip.set_property(frame, "visible", "boolean", length > 0)
+        clips[(*TASK_PATH, name)] = clip
+    return commands, clips

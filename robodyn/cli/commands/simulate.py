@@ -12,12 +12,35 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
     add_model_arguments(parser)
-    parser.add_argument("--controller", choices=["passive", "pd", "computed-torque", "task-space"], default="passive")
     parser.add_argument(
-        "--target", type=vector, help="task-space: frame position X,Z or X,Y,Z in [m]; pd / computed-torque: joint target"
+        "--controller", choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance"], default="passive"
     )
     parser.add_argument(
-        "--frame", help="controlled frame for task-space (default: the end effector 'robodyn info' shows; it must move)"
+        "--target",
+        type=vector,
+        help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
+        "pd / computed-torque: joint target",
+    )
+    parser.add_argument(
+        "--frame",
+        help="controlled frame for task-space, osc, impedance (default: the end effector 'robodyn info' shows; it must move)",
+    )
+    parser.add_argument("--posture", type=vector, help="osc: a configuration drawn toward in the task's null space")
+    parser.add_argument("--stiffness", type=vector, help="impedance: K, 3 values in [N/m] (or 6, then [N m/rad])")
+    parser.add_argument("--damping", type=vector, help="impedance: D, in [N s/m] (then [N m s/rad])")
+    parser.add_argument(
+        "--force-at",
+        dest="force_at",
+        action="append",
+        default=[],
+        metavar="T:FX,FY,FZ[@FRAME]",
+        help="a push of FX,FY,FZ [N] from time T [s] on, at FRAME (default: the controlled frame); repeatable",
+    )
+    parser.add_argument(
+        "--observer-gain",
+        dest="observer_gain",
+        type=float,
+        help="run a momentum observer of this gain [1/s]; --out then has tau_ext[<joint>] columns",
     )
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
@@ -57,13 +80,18 @@ def run(arguments: argparse.Namespace) -> int:
         integrator=arguments.integrator,
         limits=arguments.limits,
         engine="compiled" if arguments.compiled else "pinocchio",
+        posture=arguments.posture,
+        stiffness=arguments.stiffness,
+        damping=arguments.damping,
+        force_at=arguments.force_at,
+        observer_gain=arguments.observer_gain,
         out=arguments.out,
         plot=arguments.plot,
         record=arguments.record,
         png=arguments.png,
     )
     warn(summary.warnings())
-    if summary.task is not None and not summary.task.reached:
+    if summary.task is not None and not summary.task.reached and summary.task.deflection is None:
         warn([
             f"{printable(summary.robot)}: the target was not reached: final error {summary.task.final_error:.3g} m "
             "(a longer --duration, another --q0 or --target?)"

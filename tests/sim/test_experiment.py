@@ -1,0 +1,156 @@
+"""run_simulation with the sequel's controllers, pushes and an online momentum observer.
+
+Every check has a negative control: the impedance's deflection is ``K⁻¹ F`` only once the
+push has settled; the observer's recorded residual equals the offline estimate only when
+both integrate the torque the same way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robodyn
+from robodyn.exceptions import InputError
+from robodyn.sim.experiment import parse_push, run_simulation
+from robodyn.sim.observer import MomentumObserver, estimate_external_torques
+from robodyn.sim.report import Push
+
+RP_TARGET = [0.9, 0.0, 0.5]
+RP_START = [0.5, 0.13]
+RP_STIFFNESS = [300.0, 300.0, 200.0]
+PANDA_READY = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785, 0.0]
+
+
+@pytest.fixture(scope="module")
+def rp_arm():
+    return robodyn.load("rp_arm")
+
+
+@pytest.fixture(scope="module")
+def pushed(rp_arm):
+    """The RP arm under impedance, pushed by (5, 0, -4) N from 0.2 s, observed at K_O = 50 /s."""
+    return run_simulation(
+        rp_arm, controller="impedance", target=RP_TARGET, q0=RP_START, stiffness=RP_STIFFNESS, force_at=["0.2:5,0,-4"],
+        observer_gain=50.0, duration=2.0, limits="ignore",
+    )  # fmt: skip
+
+
+def test_a_push_on_the_impedance_deflects_the_frame_by_k_inverse_f_within_one_percent(rp_arm, pushed):
+    trajectory, summary = pushed
+    task = summary.task
+    expected = np.array([5.0, 0.0, -4.0]) / np.array(RP_STIFFNESS)
+    measured = rp_arm.frame_position(trajectory.q[-1], "end_effector") - np.array(RP_TARGET)  # independent of the summary
+    assert np.allclose(task.expected_deflection, expected, rtol=0, atol=1e-15)
+    assert np.allclose(task.deflection, measured, rtol=0, atol=1e-12)
+    assert np.linalg.norm(measured - expected) < 0.01 * np.linalg.norm(expected)
+    assert task.deflection_error < 0.01
+    assert "deflection off by" in summary.text() and summary.to_dict()["deflection_error"] == task.deflection_error
+
+
+def test_the_deflection_is_not_k_inverse_f_before_the_push_has_settled(rp_arm):
+    # negative control: the same push 50 ms before the end has not yet moved the arm by K⁻¹F
+    _, summary = run_simulation(
+        rp_arm, controller="impedance", target=RP_TARGET, q0=RP_START, stiffness=RP_STIFFNESS, force_at=["0.45:5,0,-4"],
+        duration=0.5, limits="ignore",
+    )  # fmt: skip
+    assert summary.task.deflection_error > 0.05
+
+
+def test_the_observer_recorded_in_the_run_equals_the_offline_estimate_of_its_trajectory(rp_arm, pushed):
+    trajectory, summary = pushed
+    offline = estimate_external_torques(rp_arm, trajectory, gain=50.0, torque="sampled")
+    assert summary.observer.residual.shape == (len(trajectory), rp_arm.nv)
+    assert np.abs(summary.observer.residual - offline).max() <= 1e-9
+    held = estimate_external_torques(rp_arm, trajectory, gain=50.0, torque="held")
+    assert np.abs(summary.observer.residual - held).max() > 1e-6  # negative control: another torque rule
+
+
+def test_the_observer_follows_the_applied_external_torques_after_settling(rp_arm, pushed):
+    trajectory, summary = pushed
+    applied = summary.observer.applied
+    q_end = trajectory.q[-1]
+    jacobian = rp_arm.frame_jacobian(q_end, "end_effector")[:3]
+    assert np.allclose(applied[-1], jacobian.T @ np.array([5.0, 0.0, -4.0]), atol=1e-12)
+    assert not applied[: int(0.2 / 1e-3)].any()  # nothing before the push
+    settled = trajectory.t > 0.2 + 10 / 50.0
+    scale = np.abs(applied[-1]).max()
+    assert np.abs(summary.observer.residual[settled] - applied[settled]).max() < 0.01 * scale
+    assert np.abs(summary.observer.residual[trajectory.t < 0.2]).max() < 0.01 * scale  # before: nothing estimated
+
+
+def test_simulate_feeds_the_observer_once_a_step_at_the_reached_state(rp_arm):
+    from robodyn.sim.experiment import controller_model
+    from robodyn.sim.simulation import ExternalWrench, simulate
+
+    observer = MomentumObserver(controller_model(rp_arm), 40.0, torque="held")
+    hold = np.array(RP_START)
+    law = lambda t, q, v: rp_arm.gravity(q) + 400.0 * (hold - q) - 40.0 * v  # noqa: E731
+    push = ExternalWrench("end_effector", [0.0, 0.0, -6.0])
+    trajectory = simulate(
+        rp_arm, np.array(RP_START), np.zeros(2), 1.0, 1e-3, controller=law, hold=True, external=[push], observer=observer
+    )
+    assert observer.times == pytest.approx(trajectory.t.tolist(), abs=1e-12)
+    residual = np.array(observer.residuals)
+    assert np.abs(residual - estimate_external_torques(rp_arm, trajectory, gain=40.0, torque="held")).max() <= 1e-9
+    expected = rp_arm.wrench_torques(trajectory.q[-1], "end_effector", np.array([0.0, 0.0, -6.0]))
+    assert np.abs(residual[-1] - expected).max() < 0.01 * np.abs(expected).max()
+
+
+@pytest.mark.slow
+def test_operational_space_control_reaches_a_full_pose_on_the_panda_with_a_posture():
+    robot = robodyn.load("panda")
+    target = [0.35, 0.05, 0.55, np.pi, 0.0, 0.0]
+    trajectory, summary = run_simulation(robot, controller="osc", target=target, posture=PANDA_READY, duration=3.0)
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, trajectory.q[-1])
+    placement = data.oMf[robot.model.getFrameId(robot.end_effector)]
+    wanted = pin.rpy.rpyToMatrix(*target[3:])
+    assert np.linalg.norm(placement.translation - target[:3]) < 1e-6
+    assert np.linalg.norm(pin.log3(placement.rotation.T @ wanted)) < 1e-6
+    assert summary.task.final_error < 1e-6 and summary.task.orientation_error < 1e-6 and summary.task.reached
+
+
+def test_a_push_is_read_from_time_force_and_frame():
+    assert parse_push("0.5:8,-6,10") == Push(0.5, (8.0, -6.0, 10.0), None)
+    assert parse_push("1:0 0 -3@link2") == Push(1.0, (0.0, 0.0, -3.0), "link2")
+    for bad in ("8,-6,10", "0.5:8,-6", "-1:1,2,3", "x:1,2,3"):
+        with pytest.raises(InputError) as raised:
+            parse_push(bad)
+        assert raised.value.argument == "force_at"
+
+
+def test_pose_options_are_refused_where_they_do_not_apply(rp_arm):
+    cases = [
+        ({"controller": "task-space", "target": [0.6, 0.3], "posture": [0.0, 0.1]}, "posture"),
+        ({"controller": "osc", "target": RP_TARGET, "stiffness": [1.0, 2.0, 3.0]}, "stiffness"),
+        ({"controller": "osc", "target": [0.9, 0.0]}, "target"),
+        ({"controller": "osc", "target": RP_TARGET, "posture": [0.0]}, "posture"),
+        ({"controller": "impedance", "target": RP_TARGET, "stiffness": [1.0, 2.0]}, "stiffness"),
+        ({"controller": "osc", "target": [5.0, 0.0, 0.5]}, "target"),
+        ({"controller": "osc", "target": RP_TARGET, "observer_gain": -1.0}, "observer_gain"),
+    ]
+    for options, parameter in cases:
+        with pytest.raises(InputError) as raised:
+            run_simulation(rp_arm, duration=0.01, **options)
+        assert raised.value.argument == parameter, options
+
+
+def test_the_compiled_engine_refuses_pushes_and_observers_by_name(rp_arm):
+    with pytest.raises(InputError) as raised:
+        run_simulation(rp_arm, force_at=["0:1,0,0"], duration=0.01, engine="compiled")
+    assert raised.value.argument == "external"
+    with pytest.raises(InputError) as raised:
+        run_simulation(rp_arm, observer_gain=10.0, duration=0.01, engine="compiled")
+    assert raised.value.argument == "observer"
+
+
+def test_a_robot_without_a_default_end_effector_still_simulates_and_its_pushes_need_a_frame():
+    robot = robodyn.load("solo12", floating_base=True)
+    _, summary = run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore")
+    assert summary.pushes == ()
+    _, summary = run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore", force_at=["0:0,0,-5@FL_FOOT"])
+    assert summary.pushes == (Push(0.0, (0.0, 0.0, -5.0), "FL_FOOT"),)
+    with pytest.raises(robodyn.RobodynError, match="FL_FOOT"):  # negative control: no frame, no default to push at
+        run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore", force_at=["0:0,0,-5"])
