@@ -193,7 +193,10 @@ class MissingExtraError(RobodynError, ImportError):
         self.module = module
         self.extra = extra
         self.purpose = purpose
-        super().__init__(f"{purpose} need {module!r}, which is not installed: pip install 'robodyn[{extra}]'.")
+        super().__init__(
+            f"{purpose} need {module!r}, which is not installed: the 'robodyn[{extra}]' extra "
+            f"(pip install '.[{extra}]' in a clone of robodyn)."
+        )
 
 
 class OutputError(RobodynError, OSError):

@@ -21,6 +21,8 @@ FLAGS: dict[str, str] = {
     "scheduler": "--scheduler",
     "form": "--form",
     "format": "--format",
+    "fps": "--fps",
+    "bodies": "--bodies",
     "max_dof": "--max-dof",
     "at": "--at",
     "urdf_out": "--urdf-out",

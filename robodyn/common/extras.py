@@ -1,6 +1,7 @@
 """Optional dependencies: import them by name, or refuse in one line naming the extra to install.
 
-``pip install robodyn`` brings loading, dynamics, the reference and the equations. The rest
+``pip install .`` in a clone of robodyn brings loading, dynamics, the reference and the
+equations. The rest
 comes with extras: ``robodyn[zoo]`` (example-robot-data's robots), ``robodyn[viewer]``
 (meshcat recordings and the live viewer), ``robodyn[plots]`` (matplotlib figures), and
 ``robodyn[all]`` for everything.

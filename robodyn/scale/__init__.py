@@ -10,7 +10,7 @@
 - :mod:`robodyn.scale.sweeps`: the what-if table and the zoo check, one Dask task a row;
 - :mod:`robodyn.scale.csvio`: CSV rows through pyarrow when installed, numpy otherwise.
 
-Dask and pyarrow are optional (``pip install 'robodyn[scale]'``); CSV and NPZ need neither.
+Dask and pyarrow are optional (the ``robodyn[scale]`` extra: ``pip install '.[scale]'`` in a clone); CSV and NPZ need neither.
 Layer: above :mod:`robodyn.sim`, below :mod:`robodyn.viz`.
 """
 

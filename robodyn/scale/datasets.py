@@ -136,7 +136,10 @@ class Dataset:
         try:
             import pyarrow.parquet as pq
         except ImportError:
-            raise TrajectoryError(self.source, "reading Parquet needs pyarrow (pip install 'robodyn[scale]')") from None
+            raise TrajectoryError(
+                self.source,
+                "reading Parquet needs pyarrow (the 'robodyn[scale]' extra: pip install '.[scale]' in a clone of robodyn)",
+            ) from None
         self._parquet = pq.ParquetFile(self.path)
         metadata = self._parquet.schema_arrow.metadata or {}
         self.robot = metadata.get(b"robot", b"").decode("utf-8", "replace")

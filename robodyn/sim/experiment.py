@@ -144,7 +144,8 @@ def run_simulation(
         target: Joint target (nq values), task target (X,Z or X,Y,Z in [m]) or, for osc
             and impedance, X,Y,Z in [m] with optionally ROLL,PITCH,YAW in [rad].
         frame: Controlled frame for task-space, osc and impedance control (default the
-            robot's end effector; it must be a frame some joint moves).
+            robot's end effector; it must be a frame some joint moves); under the other
+            controllers it only names the path a recording draws.
         q0: Initial configuration; default :meth:`Robot.default_configuration` (the
             neutral one clipped into the joint limits).
         duration, dt, integrator, limits, engine: As for :func:`robodyn.simulate` (with
@@ -230,8 +231,7 @@ def _check_request(robot: Robot, controller: str, target: list[float] | None, fr
         raise InputError("target", f"given for the {controller} controller", "nothing")
     if controller == "passive" and target is not None:
         raise InputError("target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
-    if controller not in FRAME_CONTROLLERS and frame is not None:
-        raise InputError("frame", "given only with the task-space, osc or impedance controller", repr(frame))
+    # Under the other controllers a frame names only the path a recording draws (checked by it).
 
 
 def _check_pose_options(controller: str, posture: Any, stiffness: Any, damping: Any) -> None:

@@ -215,7 +215,9 @@ def _read_parquet(path: Path) -> tuple[np.ndarray, Layout, str]:
     try:
         import pyarrow.parquet as pq
     except ImportError:
-        raise TrajectoryError(str(path), "reading Parquet needs pyarrow (pip install 'robodyn[scale]')") from None
+        raise TrajectoryError(
+            str(path), "reading Parquet needs pyarrow (the 'robodyn[scale]' extra: pip install '.[scale]' in a clone of robodyn)"
+        ) from None
     table = pq.read_table(path)
     header = table.column_names
     robot = (table.schema.metadata or {}).get(b"robot", b"").decode("utf-8", "replace")

@@ -59,7 +59,8 @@ def run_experiment(
         ``plot``, ``recording`` (the target pose as a triad, pushes as arrows), ``poster``).
     """
     trajectory, summary = run_simulation(robot, **settings)
-    frame = summary.task.frame if summary.task is not None else None
+    # The controlled frame, else the frame asked for (it names the drawn path), else none.
+    frame = summary.task.frame if summary.task is not None else settings.get("frame")
     task = np.asarray(summary.task.target) if summary.task is not None else None
     with outputs_together():  # every file of the run, or none of them
         if out:
@@ -77,7 +78,7 @@ def run_experiment(
             rpy = None if summary.task is None or summary.task.target_rpy is None else summary.task.target_rpy
             _, forces = push_wrenches(robot, summary.pushes, frame)
             written = write_recording(
-                robot, trajectory, record, png=png, target=task, frame=frame or robot.end_effector,
+                robot, trajectory, record, png=png, target=task, frame=frame,
                 target_rotation=None if rpy is None else target_rotation(np.asarray(rpy)), forces=tuple(forces),
             )  # fmt: skip
             summary = summary.with_file("recording", str(written))

@@ -16,7 +16,7 @@ CORE = ("pin", "yourdfpy", "numpy", "sympy")
 
 
 def test_require_names_the_extra():
-    with pytest.raises(MissingExtraError, match=r"pip install 'robodyn\[viewer\]'") as caught:
+    with pytest.raises(MissingExtraError, match=r"'robodyn\[viewer\]' extra \(pip install '\.\[viewer\]' in a clone") as caught:
         require("robodyn_no_such_module", extra="viewer", purpose="recordings")
     assert isinstance(caught.value, RobodynError) and caught.value.extra == "viewer"
     assert "\n" not in str(caught.value)

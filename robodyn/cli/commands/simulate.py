@@ -23,7 +23,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--frame",
-        help="controlled frame for task-space, osc, impedance (default: the end effector 'robodyn info' shows; it must move)",
+        help="controlled frame for task-space, osc, impedance (default: the end effector 'robodyn info' shows; it must move);"
+        " with any controller, the path --record and --plot draw",
     )
     parser.add_argument("--posture", type=vector, help="osc: a configuration drawn toward in the task's null space")
     parser.add_argument("--stiffness", type=vector, help="impedance: K, 3 values in [N/m] (or 6, then [N m/rad])")

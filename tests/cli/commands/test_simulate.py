@@ -62,11 +62,6 @@ FORK = """<robot name="fork">
     <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="50" velocity="3"/></joint>
 </robot>
 """
-PENDING = (
-    "needs the library change named in issue 29's follow-ups: sim/experiment.py lets `frame` through for every "
-    "controller (it names the drawn path) and viz/experiment.py records with `frame` (None: no path) instead of "
-    "`frame or robot.end_effector`"
-)
 
 
 def _simulate(tmp_path, *extra: str) -> list[str]:
@@ -75,13 +70,11 @@ def _simulate(tmp_path, *extra: str) -> list[str]:
             "--dt", "0.01", "--record", str(tmp_path / "m.html"), *extra]  # fmt: skip
 
 
-@pytest.mark.xfail(strict=True, reason=PENDING)
 def test_a_pd_recording_of_a_robot_with_several_chain_ends_draws_no_path(tmp_path, capsys):
     assert main(_simulate(tmp_path)) == 0, capsys.readouterr().err
     assert (tmp_path / "m.html").stat().st_size > 10_000
 
 
-@pytest.mark.xfail(strict=True, reason=PENDING)
 def test_frame_names_the_path_drawn_under_a_pd_controller(tmp_path, capsys):
     assert main(_simulate(tmp_path, "--frame", "left")) == 0, capsys.readouterr().err
     html = (tmp_path / "m.html").read_text()
