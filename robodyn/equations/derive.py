@@ -136,11 +136,16 @@ def _closed_form(
     rename, parameters, labels = _safe_parameters(closed.parameters, closed.labels, taken)
     if progress:
         progress("simplification", 1, 3)
-    tidy = lambda e: simplify.entry(e.xreplace(rename), q, qd)  # noqa: E731
-    M = closed.M.applyfunc(tidy)
-    C = closed.C.applyfunc(tidy)
-    Cv = (closed.C * sp.Matrix(qd)).applyfunc(tidy)
-    G = closed.G.applyfunc(tidy)
+    raw = {name: m.xreplace(rename) for name, m in (("M", closed.M), ("C", closed.C), ("G", closed.G))}
+    raw["Cv"] = raw["C"] * sp.Matrix(qd)
+    # Round-off floor of a matrix: RELATIVE_ROUND_OFF of its largest coefficient (C and C q̇
+    # are M's derivatives: at least M's), so an entry made of round-off alone goes too.
+    scale = {name: simplify.largest_coefficient(m) for name, m in raw.items()}
+    tidied = {}
+    for name, matrix in raw.items():
+        floor = simplify.RELATIVE_ROUND_OFF * max(scale[name], scale["M"] if name in ("C", "Cv") else 0.0)
+        tidied[name] = matrix.applyfunc(lambda e, f=floor: simplify.entry(e, q, qd, floor=f))
+    M, C, Cv, G = (tidied[name] for name in ("M", "C", "Cv", "G"))
     used = set().union(*(m.free_symbols for m in (M, C, G)))
     if progress:
         progress("simplification", 3, 3)
