@@ -27,16 +27,25 @@ import sympy as sp
 from robodyn import reference
 from robodyn.common.text import identifier
 from robodyn.equations import simplify
-from robodyn.equations.compact import derive_compact
+from robodyn.equations.compact import SNAP, derive_compact
 from robodyn.equations.model import EquationsData
 from robodyn.equations.output import FORMATS, render
 from robodyn.equations.render_latex import latex_math
 from robodyn.exceptions import DerivationTooExpensiveError, InputError
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.symbolic import derive, exact_number
+from robodyn.reference.symbolic import derive, exact_matrix, exact_number
+from robodyn.reference.tree import Body
 from robodyn.urdf.sources import resolve_source
 
-__all__ = ["CLOSED_FORM_JOINTS", "FORMATS", "Equations", "derive_equations", "estimate_closed_form_seconds", "render"]
+__all__ = [
+    "AUTO_CLOSED_FORM_S",
+    "CLOSED_FORM_JOINTS",
+    "FORMATS",
+    "Equations",
+    "derive_equations",
+    "estimate_closed_form_seconds",
+    "render",
+]
 
 Form = Literal["auto", "closed", "compact"]
 
@@ -44,6 +53,8 @@ Form = Literal["auto", "closed", "compact"]
 CLOSED_FORM_JOINTS = 3
 #: A closed-form derivation estimated to take longer than this is refused, in [s].
 CLOSED_FORM_LIMIT_S = 30.0
+#: ``form="auto"`` takes the compact form when the closed one is estimated longer, in [s].
+AUTO_CLOSED_FORM_S = 5.0
 
 
 class Equations(EquationsData):
@@ -55,17 +66,37 @@ class Equations(EquationsData):
         return latex_math(self)
 
 
+def _complexity(body: Body) -> float:
+    """How much a joint's frame multiplies the closed form's cost: 7 for an axis off the
+    joint frame's x, y, z; 2 for an origin turned by other than right angles (rotation
+    entries that are long rationals, not 0, ±1, ±½...); else 1."""
+    axis = exact_matrix(body.axis[:, None], SNAP)
+    if sum(x != 0 for x in axis) > 1:
+        return 7.0
+    rotation = exact_matrix(body.origin[:3, :3], SNAP)
+    return 2.0 if any(isinstance(x, sp.Rational) and x.q > 2 for x in rotation) else 1.0
+
+
 def estimate_closed_form_seconds(robot: ReferenceRobot, *, keep_params: bool = False) -> float:
     """A rough estimate of the closed form's derivation time, in [s].
 
-    The Lagrangian's expressions grow about tenfold with each revolute joint of a chain
-    and threefold with each prismatic one (CPU time measured: rp_arm 0.2 s, the double
-    pendulum 0.5 s, a revolute–revolute–prismatic arm 1.5 s, ur5's first four joints 52 s);
-    kept parameters cost about as much again.
+    The Lagrangian's expressions grow about tenfold with each revolute body of a chain
+    (a mimic joint's body included) and threefold with each prismatic one; a mimic joint
+    adds angles ``a q + b`` (1.5-fold more); an oblique axis sevenfold, an origin turned
+    by other than right angles twofold (:func:`_complexity`). CPU time measured (estimate):
+    rp_arm 0.2 s (0.15), the double pendulum 0.66 s (0.5), a revolute–revolute–prismatic
+    arm 1.5 s (1.5), the mimic arm (two coordinates, three bodies) 7.5 s (7.5), that
+    arm with a prismatic joint before the wrist 16 s (22.5), and with the wrist's origin
+    turned by 0.3 rad 30 s (45), a two-joint arm with one origin turned by 0.3 rad 1.1 s
+    (1.0), the oblique robot's first joint 0.28 s (0.35) and first two 28 s (24.5), ur5's
+    first four joints 52 s. Kept parameters cost about as much again.
     """
     bodies = robot.tree.bodies
     revolute = sum(body.revolute for body in bodies)
-    estimate = 0.005 * 10.0**revolute * 3.0 ** (len(bodies) - revolute)
+    mimic = len(bodies) - robot.nv
+    estimate = 0.005 * 10.0**revolute * 3.0 ** (len(bodies) - revolute) * 1.5**mimic
+    for body in bodies:
+        estimate *= _complexity(body)
     return estimate * (3.0 if keep_params else 1.0)
 
 
@@ -136,11 +167,16 @@ def _closed_form(
     rename, parameters, labels = _safe_parameters(closed.parameters, closed.labels, taken)
     if progress:
         progress("simplification", 1, 3)
-    tidy = lambda e: simplify.entry(e.xreplace(rename), q, qd)  # noqa: E731
-    M = closed.M.applyfunc(tidy)
-    C = closed.C.applyfunc(tidy)
-    Cv = (closed.C * sp.Matrix(qd)).applyfunc(tidy)
-    G = closed.G.applyfunc(tidy)
+    raw = {name: m.xreplace(rename) for name, m in (("M", closed.M), ("C", closed.C), ("G", closed.G))}
+    raw["Cv"] = raw["C"] * sp.Matrix(qd)
+    # Round-off floor of a matrix: RELATIVE_ROUND_OFF of its largest coefficient (C and C q̇
+    # are M's derivatives: at least M's), so an entry made of round-off alone goes too.
+    scale = {name: simplify.largest_coefficient(m) for name, m in raw.items()}
+    tidied = {}
+    for name, matrix in raw.items():
+        floor = simplify.RELATIVE_ROUND_OFF * max(scale[name], scale["M"] if name in ("C", "Cv") else 0.0)
+        tidied[name] = matrix.applyfunc(lambda e, f=floor: simplify.entry(e, q, qd, floor=f))
+    M, C, Cv, G = (tidied[name] for name in ("M", "C", "Cv", "G"))
     used = set().union(*(m.free_symbols for m in (M, C, G)))
     if progress:
         progress("simplification", 3, 3)
@@ -170,7 +206,9 @@ def derive_equations(
 
     Args:
         source: Anything :func:`robodyn.load` takes.
-        form: ``"closed"``, ``"compact"`` or ``"auto"`` (closed up to three joints).
+        form: ``"closed"``, ``"compact"`` or ``"auto"`` (closed up to three joints when
+            estimated to take at most :data:`AUTO_CLOSED_FORM_S`; see
+            :func:`estimate_closed_form_seconds`). The result's ``form`` says which.
         keep_params: Keep masses, centres of mass, inertias, joint offsets and gravity as
             symbols (both forms; code output then refuses, it needs numbers).
         gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
@@ -187,7 +225,8 @@ def derive_equations(
     _check_request(source, form, floating_base)
     model = reference.load(source, lock=lock, gravity=gravity)
     if form == "auto":
-        form = "closed" if model.nv <= CLOSED_FORM_JOINTS else "compact"
+        fast = estimate_closed_form_seconds(model, keep_params=keep_params) <= AUTO_CLOSED_FORM_S
+        form = "closed" if model.nv <= CLOSED_FORM_JOINTS and fast else "compact"
     if form == "closed":
         estimate = estimate_closed_form_seconds(model, keep_params=keep_params)
         if estimate > CLOSED_FORM_LIMIT_S:

@@ -8,8 +8,11 @@ form, factored — and the shortest kept; then the entry as a whole is tried fac
 ``C q̇`` groups velocity products sharing a coefficient. "Shortest" is
 :func:`robodyn.equations.model.operation_count`'s measure (numbers as floats).
 
-:func:`chop` is a safety net: a term whose coefficient is below 1e-12 of the entry's
-largest is round-off (exact inputs leave none) and is dropped.
+Round-off: a URDF's rotations enter as exact rationals that are orthonormal only to
+about 1e-16, so ``s² + c² = 1`` can leave ``3.8e-18 cos(q)²``. :func:`chop` drops every term
+whose numeric coefficient is below ``floor`` (:data:`RELATIVE_ROUND_OFF` of the largest
+coefficient of the matrix, see :func:`largest_coefficient`), at the start, after every
+``s² + c² = 1`` reduction, and no form that still carries such a term is chosen.
 """
 
 from __future__ import annotations
@@ -31,15 +34,30 @@ def size(expr: sp.Expr) -> int:
     return int(sp.count_ops(expr.xreplace(fractions) if fractions else expr))
 
 
-def chop(expr: sp.Expr) -> sp.Expr:
-    """``expr`` (expanded) without terms below :data:`RELATIVE_ROUND_OFF` of its largest."""
+def _weights(expr: sp.Expr) -> list[float]:
+    """The magnitude of each term's numeric coefficient (``expr`` expanded)."""
+    return [abs(float(t.as_coeff_Mul()[0])) for t in sp.Add.make_args(expr) if t != 0]
+
+
+def largest_coefficient(exprs: Iterable[sp.Expr]) -> float:
+    """The largest magnitude of a numeric coefficient of the expanded ``exprs`` (0 if none)."""
+    return max((w for e in exprs for w in _weights(sp.expand(e))), default=0.0)
+
+
+def chop(expr: sp.Expr, floor: float | None = None) -> sp.Expr:
+    """``expr`` (expanded) without terms whose numeric coefficient is below ``floor``
+    (default: :data:`RELATIVE_ROUND_OFF` of its own largest)."""
     expr = sp.expand(expr)
     if not expr.is_Add:
-        return expr
-    terms = expr.args
-    weights = [abs(float(t.as_coeff_Mul()[0])) if t.as_coeff_Mul()[0].is_number else 1.0 for t in terms]
-    largest = max(weights)
-    return sp.Add(*(t for t, w in zip(terms, weights, strict=True) if w >= RELATIVE_ROUND_OFF * largest))
+        return expr if floor is None or expr == 0 or _weights(expr)[0] >= floor else sp.Integer(0)
+    weights = _weights(expr)
+    floor = RELATIVE_ROUND_OFF * max(weights) if floor is None else floor
+    return sp.Add(*(t for t, w in zip(expr.args, weights, strict=True) if w >= floor))
+
+
+def clean(expr: sp.Expr, floor: float) -> bool:
+    """No term of ``expr`` (expanded) has a numeric coefficient below ``floor``."""
+    return all(w >= floor for w in _weights(sp.expand(expr)))
 
 
 def _horner(expr: sp.Expr, variables: Iterable[sp.Symbol]) -> sp.Expr:
@@ -84,15 +102,17 @@ def absorb(expr: sp.Expr) -> sp.Expr:
     return min(options, key=lambda e: len(str(e.evalf(6))))
 
 
-def _best(candidates: list[sp.Expr]) -> sp.Expr:
-    candidates = [absorb(c) for c in candidates]
-    return min(candidates, key=lambda e: (size(e), len(str(e))))
+def _best(candidates: list[sp.Expr], floor: float) -> sp.Expr:
+    """The shortest candidate without round-off (the first one is known to have none)."""
+    kept = [candidates[0]] + [c for c in candidates[1:] if floor <= 0 or clean(c, floor)]
+    return min((absorb(c) for c in kept), key=lambda e: (size(e), len(str(e))))
 
 
-def pythagoras(expr: sp.Expr) -> sp.Expr:
+def pythagoras(expr: sp.Expr, floor: float = 0.0) -> sp.Expr:
     """``expr`` expanded, reduced with ``sin² + cos² = 1`` of each angle (towards
-    whichever of ``sin²`` or ``cos²`` gives the shorter result)."""
-    expr = sp.expand(expr)
+    whichever of ``sin²`` or ``cos²`` gives the shorter result), terms below ``floor``
+    dropped."""
+    expr = chop(expr, floor)
     angles = {f.args[0] for f in expr.atoms(sp.sin)} & {f.args[0] for f in expr.atoms(sp.cos)}
     for angle in sorted(angles, key=sp.default_sort_key):
         s, c = sp.sin(angle), sp.cos(angle)
@@ -104,7 +124,7 @@ def pythagoras(expr: sp.Expr) -> sp.Expr:
                     lambda e, sq=square, ot=other: sq ** (e.exp - 2) * (1 - ot**2),
                 )
             )
-            options.append(sp.expand(reduced))
+            options.append(chop(reduced, floor))
         expr = min(options, key=size)
     return expr
 
@@ -128,31 +148,36 @@ def completed_square(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
     return expr
 
 
-def coefficient(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
-    """The shortest of several equivalent forms of a function of ``q``."""
-    reduced = pythagoras(expr)
+def coefficient(expr: sp.Expr, q: list[sp.Symbol], floor: float = 0.0) -> sp.Expr:
+    """The shortest of several equivalent forms of a function of ``q`` (terms below
+    ``floor`` dropped)."""
+    reduced = pythagoras(expr, floor)
     if reduced.is_number:
         return reduced
-    merged = pythagoras(TR10i(reduced))  # cos a cos b - sin a sin b = cos(a + b), ...
+    merged = pythagoras(TR10i(reduced), floor)  # cos a cos b - sin a sin b = cos(a + b), ...
     candidates = [reduced, _collected(reduced, q), merged, sp.factor_terms(merged), _collected(merged, q)]
     candidates += [completed_square(reduced, q), completed_square(merged, q)]
     if sp.count_ops(reduced) < 200:
         with contextlib.suppress(sp.PolynomialError):
             candidates.append(sp.factor(reduced))
-    return _best(candidates)
+    return _best(candidates, floor)
 
 
-def entry(expr: sp.Expr, q: list[sp.Symbol], qd: list[sp.Symbol]) -> sp.Expr:
-    """One entry of ``M``, ``C q̇`` or ``G``, chopped and simplified (see the module)."""
-    expr = chop(expr)
+def entry(expr: sp.Expr, q: list[sp.Symbol], qd: list[sp.Symbol], *, floor: float | None = None) -> sp.Expr:
+    """One entry of ``M``, ``C q̇`` or ``G``, chopped and simplified (see the module).
+
+    ``floor``: terms whose numeric coefficient is below it are dropped (default
+    :data:`RELATIVE_ROUND_OFF` of the entry's largest)."""
+    expr = chop(expr, floor)
+    floor = RELATIVE_ROUND_OFF * largest_coefficient([expr]) if floor is None else floor
     speeds = [v for v in qd if expr.has(v)]
     if not speeds:
-        return coefficient(expr, q)
+        return coefficient(expr, q, floor)
     terms = sp.Poly(expr, *speeds).terms()
     by_product = sp.Add(
-        *(coefficient(c, q) * sp.Mul(*(v**k for v, k in zip(speeds, powers, strict=True))) for powers, c in terms)
+        *(coefficient(c, q, floor) * sp.Mul(*(v**k for v, k in zip(speeds, powers, strict=True))) for powers, c in terms)
     )
     candidates = [by_product, sp.factor_terms(by_product)]
     with contextlib.suppress(sp.PolynomialError):
         candidates.append(sp.factor(by_product))
-    return _best(candidates)
+    return _best(candidates, floor)

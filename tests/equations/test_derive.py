@@ -190,3 +190,73 @@ def test_floating_robots_need_an_explicit_fixed_base(capsys):
     assert "symbolic equations model fixed bases (--fixed-base)" in capsys.readouterr().err
     assert main(["equations", "solo12", "--symbolic", "--fixed-base", "--format", "json"]) == 0
     assert len(json.loads(capsys.readouterr().out)["joint_names"]) == 12
+
+
+# A 3-DoF arm (revolute, revolute, prismatic) whose wrist mimics the elbow, its origin
+# turned by 0.3 rad: estimated 15 s before issue 29, its closed form takes minutes.
+SLOW_MIMIC_ARM = """<?xml version="1.0"?>
+<robot name="slow_mimic">
+  <link name="base"/>
+  <link name="upper"><inertial><origin xyz="0.1 0 0.05" rpy="0 0 0"/><mass value="1.5"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.009" iyz="0" izz="0.008"/></inertial></link>
+  <link name="middle"><inertial><origin xyz="0.15 0.01 0" rpy="0 0 0"/><mass value="0.8"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.009" iyz="0" izz="0.008"/></inertial></link>
+  <link name="ram"><inertial><origin xyz="0.05 0 0" rpy="0 0 0"/><mass value="0.5"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.009" iyz="0" izz="0.008"/></inertial></link>
+  <link name="tip"><inertial><origin xyz="0.05 0 0.02" rpy="0 0 0"/><mass value="0.3"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.009" iyz="0" izz="0.008"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="20" velocity="2"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="middle"/>
+    <origin xyz="0.2 0 0.05" rpy="0 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="20" velocity="2"/></joint>
+  <joint name="extend" type="prismatic"><parent link="middle"/><child link="ram"/>
+    <origin xyz="0.3 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="-0.1" upper="0.1" effort="20" velocity="2"/></joint>
+  <joint name="wrist" type="revolute"><parent link="ram"/><child link="tip"/>
+    <origin xyz="0.1 0 0" rpy="0.3 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="20" velocity="2"/>
+    <mimic joint="elbow" multiplier="-1.5" offset="0.2"/></joint>
+</robot>
+"""
+
+
+def _never_closed(*args, **kwargs):
+    raise AssertionError("the closed-form Lagrangian was derived")
+
+
+def test_a_slow_mimic_arm_in_auto_form_is_derived_compact_and_says_so(tmp_path, monkeypatch, rng):
+    import time
+
+    from robodyn.equations import derive as derive_module
+
+    path = tmp_path / "slow_mimic.urdf"
+    path.write_text(SLOW_MIMIC_ARM)
+    monkeypatch.setattr(derive_module, "derive", _never_closed)
+    start = time.perf_counter()
+    equations = derive_equations(path)
+    assert time.perf_counter() - start < 30
+    assert equations.form == "compact"
+    robot = robodyn.load(path)
+    namespace: dict = {}
+    exec(render(equations, "python"), namespace)
+    q = robot.random_configuration(rng, 5)
+    v, a = rng.normal(size=(2, 5, robot.nv))
+    tau = robot.inverse_dynamics(q, v, a)
+    assert np.max(np.abs(namespace["inverse_dynamics"](q, v, a) - tau)) < 1e-9 * max(1.0, np.max(np.abs(tau)))
+
+
+def test_a_slow_closed_form_is_refused_in_one_line_before_any_work(tmp_path, monkeypatch, capsys):
+    from robodyn.equations import derive as derive_module
+    from robodyn.exceptions import DerivationTooExpensiveError
+
+    path = tmp_path / "slow_mimic.urdf"
+    path.write_text(SLOW_MIMIC_ARM)
+    monkeypatch.setattr(derive_module, "derive", _never_closed)
+    with pytest.raises(DerivationTooExpensiveError, match="form='compact'") as refused:
+        derive_equations(path, form="closed")
+    assert refused.value.estimate_s > refused.value.limit_s and "\n" not in str(refused.value)
+    assert main(["equations", str(path), "--symbolic", "--form", "closed"]) == 2
+    err = capsys.readouterr().err
+    assert "--form compact" in err and len(err.strip().splitlines()) == 1

@@ -122,3 +122,60 @@ def test_christoffel_symbols_rebuild_the_coriolis_matrix(name, capsys):
     assert "Gamma[1," in capsys.readouterr().out
     with pytest.raises(InputError, match="closed"):
         christoffel_symbols(derive_equations(name, form="compact"))
+
+
+ROTATED_ARM = """<?xml version="1.0"?>
+<robot name="rotated_arm">
+  <link name="base"/>
+  <link name="upper"><inertial><origin xyz="0.1 0 0.05" rpy="0 0 0"/><mass value="1.5"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.012" iyz="0" izz="0.008"/></inertial></link>
+  <link name="fore"><inertial><origin xyz="0.15 {offset} 0" rpy="0 0 0"/><mass value="0.8"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.009" iyz="0" izz="0.009"/></inertial></link>
+  <joint name="shoulder_pan" type="revolute"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="20" velocity="2"/></joint>
+  <joint name="shoulder_pitch" type="revolute"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0.2 0 0.05" rpy="0.3 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-2" upper="2" effort="10" velocity="2"/></joint>
+</robot>
+"""
+
+
+def _matrix_coefficients(equations) -> dict[str, list[float]]:
+    return {name: [c for e in getattr(equations, name) for c in coefficients(e)] for name in ("M", "C", "Cv", "G")}
+
+
+@pytest.mark.parametrize("offset", ["0", "1e-9"], ids=["round_off_only", "genuine_small_term"])
+def test_a_rotated_joint_origin_leaves_no_round_off_and_keeps_real_small_terms(offset, tmp_path, rng):
+    """The rationals of a 0.3 rad rotation are orthonormal to ~1e-16 only: sin² + cos² = 1
+    left ``3.8e-18 cos(q)²`` in M[2,2] and a C[2,2] of round-off alone. A centre of mass
+    1e-9 m off the plane is a real term ~1e-9 of the largest and stays."""
+    path = tmp_path / "rotated_arm.urdf"
+    path.write_text(ROTATED_ARM.format(offset=offset))
+    equations = derive_equations(path)
+    assert equations.form == "closed"
+    sizes = _matrix_coefficients(equations)
+    for name, found in sizes.items():
+        largest = max(found + (sizes["M"] if name in ("C", "Cv") else []))
+        assert min(found) >= 1e-12 * largest, name
+    smallest = min(sizes["M"]) / max(sizes["M"])
+    assert (smallest < 1e-6) == (offset != "0")  # the genuine term is kept
+    assert equations.M[1, 1].free_symbols == set() and equations.C[1, 1] == 0
+    robot = robodyn.load(path)
+    namespace: dict = {}
+    exec(render(equations, "python"), namespace)
+    q = robot.random_configuration(rng, 10)
+    v, a = rng.normal(size=(2, 10, robot.nv))
+    assert relative(namespace["inverse_dynamics"](q, v, a), robot.inverse_dynamics(q, v, a)) < 1e-9
+    for k in range(3):
+        assert relative(numeric_matrix(equations.M, equations.q, q[k]), robot.mass_matrix(q[k])) < 1e-9
+
+
+def numeric_matrix(matrix: sp.Matrix, symbols, values) -> np.ndarray:
+    return np.array(sp.lambdify(symbols, matrix, "numpy")(*values), dtype=float)
+
+
+def test_chop_with_a_floor_drops_only_what_is_below_it():
+    x = sp.Symbol("x")
+    assert chop(sp.Rational(1, 10**17) * sp.cos(x) ** 2, 1e-14) == 0
+    assert chop(sp.Rational(1, 10**13) * sp.cos(x) ** 2 + 2, 1e-14) == sp.Rational(1, 10**13) * sp.cos(x) ** 2 + 2
