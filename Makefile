@@ -46,8 +46,8 @@ test: $(STAMP) chromium tex
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/lint-imports
 	$(BIN)/mypy
-	$(BIN)/python -m pytest -m "not slow"
-	$(BIN)/python -m pytest -m slow
+	$(BIN)/python -m pytest -m "not slow" --durations=15
+	$(BIN)/python -m pytest -m slow --durations=15
 
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -m "not slow" -x -q
