@@ -169,6 +169,7 @@ def test_out_file_is_written_only_on_success(tmp_path, capsys):
     assert "def inverse_dynamics" in target.read_text()
 
 
+@pytest.mark.slow  # a property over random trees, 7 s
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(random_urdfs)
 def test_compact_form_of_random_trees_agrees_with_pinocchio(urdf):

@@ -9,6 +9,7 @@ import pytest
 from tests.conftest import ROOT
 
 
+@pytest.mark.slow  # like the lecture's notebook: a whole story, 6 s
 def test_the_sequel_notebook_runs_and_reaches_deflects_and_observes_as_it_says():
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
