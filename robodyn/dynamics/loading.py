@@ -25,7 +25,7 @@ import copyreg
 import os
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -69,6 +69,9 @@ def load(
     threads: int | None = None,
     max_dof: int | None = None,
     max_bytes: int | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+    packages: Mapping[str, str | os.PathLike] | None = None,
+    armature: Mapping[str, float] | None = None,
 ) -> Robot:
     """Load a robot.
 
@@ -93,6 +96,12 @@ def load(
             the cube of the size: about 1.8 GB a thread at 300).
         max_bytes: Largest URDF accepted, in bytes; default 64 MiB or
             ``$ROBODYN_MAX_URDF_BYTES``.
+        xacro_args: Arguments of a ``.xacro`` source, ``{name: value}`` (its ``<xacro:arg>``
+            defaults otherwise).
+        packages: Package folders, ``{package name: folder}``: where ``package://`` paths
+            and ``$(find name)`` resolve, before ``$ROS_PACKAGE_PATH`` and the zoo's folders.
+        armature: Rotor inertia reflected to joints, ``{joint name: value in [kg m²] or
+            [kg]}``, added to what the file says.
 
     Returns:
         The robot.
@@ -106,7 +115,8 @@ def load(
     Warns:
         RobodynWarning: For what ``strict=True`` refuses.
     """
-    resolved = resolve_source(source, max_bytes=max_bytes)
+    folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
+    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders)
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
@@ -119,6 +129,9 @@ def load(
         threads=threads,
         max_dof=max_dof,
         max_bytes=max_bytes,
+        xacro_args=xacro_args,
+        packages=folders,
+        armature=armature,
     )
     return build_robot(resolved, options)
 

@@ -39,6 +39,12 @@ class LoadOptions:
         max_dof: Most degrees of freedom accepted (:data:`MAX_DOF` by default).
         max_bytes: Largest URDF accepted when it was read, in bytes (the source, read
             once, carries the text: building from it reads no file).
+        xacro_args: Arguments a ``.xacro`` source was expanded with, as ``(name, value)``
+            pairs (the source carries the expanded text).
+        packages: Package folders ``package://`` and ``$(find …)`` resolved through, as
+            ``(package name, folder)`` pairs, before ``$ROS_PACKAGE_PATH`` and the zoo's.
+        armature: Rotor inertia added at joints, as ``(joint name, value in [kg m²] or
+            [kg])`` pairs (on top of what the file says).
     """
 
     floating_base: bool
@@ -49,6 +55,9 @@ class LoadOptions:
     lock: tuple[tuple[str, float], ...] = ()
     max_dof: int = MAX_DOF
     max_bytes: int | None = None
+    xacro_args: tuple[tuple[str, str], ...] = ()
+    packages: tuple[tuple[str, str], ...] = ()
+    armature: tuple[tuple[str, float], ...] = ()
 
 
 def load_options(
@@ -61,6 +70,9 @@ def load_options(
     threads: int | None = None,
     max_dof: int | None = None,
     max_bytes: int | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+    packages: Mapping[str, str] | None = None,
+    armature: Mapping[str, float] | None = None,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 
@@ -79,6 +91,9 @@ def load_options(
         lock=tuple((name, float(position)) for name, position in (lock or {}).items()),
         max_dof=MAX_DOF if max_dof is None else max_dof,
         max_bytes=max_urdf_bytes(max_bytes),
+        xacro_args=tuple((str(name), str(value)) for name, value in (xacro_args or {}).items()),
+        packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
+        armature=tuple((str(name), float(value)) for name, value in (armature or {}).items()),
     )
 
 

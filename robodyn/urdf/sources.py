@@ -12,6 +12,7 @@ import difflib
 import os
 import stat
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -127,7 +128,13 @@ def _read_file(path: Path, max_bytes: int) -> URDFSource:
     return URDFSource(text, path.stem, str(path), path.resolve(), False, ())
 
 
-def resolve_source(source: str | os.PathLike, *, max_bytes: int | None = None) -> URDFSource:
+def resolve_source(
+    source: str | os.PathLike,
+    *,
+    max_bytes: int | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+    packages: Mapping[str, str] | None = None,
+) -> URDFSource:
     """Find the URDF a source names.
 
     Args:
@@ -135,6 +142,8 @@ def resolve_source(source: str | os.PathLike, *, max_bytes: int | None = None) -
             generated robot's name (``"rp_arm"``).
         max_bytes: Largest URDF accepted, in bytes (files and text); default
             ``$ROBODYN_MAX_URDF_BYTES`` or :data:`MAX_URDF_BYTES` (64 MiB).
+        xacro_args: Arguments of a ``.xacro`` source (not yet expanded: see issue 24).
+        packages: Package folders by package name (not yet used: see issue 24).
 
     Raises:
         URDFError: If a file cannot be read, is not a regular file or is too large.

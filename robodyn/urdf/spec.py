@@ -74,6 +74,12 @@ class JointSpec:
         lower, upper: Position limits in [rad] or [m] (±inf for continuous joints).
         effort, velocity: Effort limit in [N m] or [N], velocity limit in [rad/s] or [m/s].
         mimic: The mimic relation, or ``None``.
+        damping: Viscous damping b (``<dynamics damping>``, MJCF ``damping``): the joint
+            torque −b q̇, in [N m s/rad] or [N s/m].
+        friction: Coulomb friction f (``<dynamics friction>``, MJCF ``frictionloss``): the
+            largest torque the joint's friction resists with, in [N m] or [N].
+        armature: Rotor inertia reflected to the joint (MJCF ``armature``, ``load(armature=)``),
+            added to the diagonal of M, in [kg m²] or [kg].
     """
 
     name: str
@@ -88,6 +94,9 @@ class JointSpec:
     effort: float = math.inf
     velocity: float = math.inf
     mimic: Mimic | None = None
+    damping: float = 0.0
+    friction: float = 0.0
+    armature: float = 0.0
 
 
 @dataclass
