@@ -46,6 +46,9 @@ class Dof:
         lower, upper: Position limits in [rad] or [m] (±inf when unlimited).
         velocity_limit: Velocity limit in [rad/s] or [m/s] (inf when not given).
         effort_limit: Effort limit in [N m] or [N] (inf when not given).
+        damping: Viscous damping b of the joint, in [N m s/rad] or [N s/m] (0: none).
+        friction: Coulomb friction f of the joint, in [N m] or [N] (0: none).
+        armature: Rotor inertia reflected to the joint, in [kg m²] or [kg] (0: none).
     """
 
     name: str
@@ -57,6 +60,9 @@ class Dof:
     upper: float
     velocity_limit: float
     effort_limit: float
+    damping: float = 0.0
+    friction: float = 0.0
+    armature: float = 0.0
 
     @property
     def linear(self) -> bool:
