@@ -41,16 +41,18 @@ demo: $(STAMP) chromium
 		--out out/rp_arm.csv --plot out/rp_arm.png --record out/rp_arm.html \
 		$$(command -v chromium >/dev/null 2>&1 && echo --png out/rp_arm_poster.png)
 
-# Everything CI runs: lint, the fast tier, then the slow tier.
+# Everything CI runs: lint, the fast tier, then the slow tier. Both tiers run on
+# TEST_WORKERS processes (pytest-xdist; default 2, the CI machine's cores; 0 runs in-process).
+TEST_WORKERS ?= 2
 test: $(STAMP) chromium tex
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/lint-imports
 	$(BIN)/mypy
-	$(BIN)/python -m pytest -m "not slow" --durations=15
-	$(BIN)/python -m pytest -m slow --durations=15
+	$(BIN)/python -m pytest -m "not slow" -n $(TEST_WORKERS) --durations=15
+	$(BIN)/python -m pytest -m slow -n $(TEST_WORKERS) --durations=15
 
 test-fast: $(STAMP)
-	$(BIN)/python -m pytest -m "not slow" -x -q
+	$(BIN)/python -m pytest -m "not slow" -n $(TEST_WORKERS) -x -q
 
 lint: $(STAMP)
 	$(BIN)/ruff check robodyn tests scripts
