@@ -25,6 +25,7 @@ Conventions:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -35,6 +36,8 @@ from robodyn.exceptions import NonFiniteResultError, SingularMassMatrixError
 
 #: Three derivative matrices: (nv, nv) each for one state, (N, nv, nv) each for a batch.
 Derivatives = tuple[np.ndarray, np.ndarray, np.ndarray]
+_isfinite = math.isfinite
+_FLOAT = np.dtype(np.float64)
 
 
 def inverse_dynamics_derivatives(handle: ModelHandle, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
@@ -88,15 +91,14 @@ def forward_dynamics_derivatives(handle: ModelHandle, q: np.ndarray, v: np.ndarr
 def rnea_derivatives(handle: ModelHandle) -> Callable[[np.ndarray, np.ndarray, np.ndarray], Derivatives]:
     """The unchecked one-state function ``(q, v, a) -> (∂τ/∂q, ∂τ/∂v, M)`` of a handle
     (float64 1-D arrays of the right sizes)."""
-    mimic, lower = handle.mimic, np.tri(handle.nv, handle.nv, -1, dtype=bool)
+    mimic = handle.mimic
     if mimic is None:
         model = handle.model
 
         def derivatives(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+            # Pinocchio 4 returns its data's matrices (copied here), M with both triangles
             dq, dv, mass = pin.computeRNEADerivatives(model, handle.data, q, v, a)
-            mass = mass.copy()
-            np.copyto(mass, mass.T, where=lower)  # Pinocchio fills the upper triangle only
-            return dq.copy(), dv.copy(), mass
+            return dq.copy(), dv.copy(), mass.copy()
 
         return derivatives
     selection = mimic.selection
@@ -104,7 +106,6 @@ def rnea_derivatives(handle: ModelHandle) -> Callable[[np.ndarray, np.ndarray, n
     def expanded(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         full = mimic.model
         dq, dv, mass = pin.computeRNEADerivatives(full, mimic.data, mimic.q(q), selection @ v, selection @ a)
-        mass = np.triu(mass) + np.triu(mass, 1).T
         return selection.T @ dq @ selection, selection.T @ dv @ selection, selection.T @ mass @ selection
 
     return expanded
@@ -117,15 +118,13 @@ def aba_derivatives(handle: ModelHandle) -> Callable[[np.ndarray, np.ndarray, np
     docstring): ``q̈`` by a linear solve, then ``−M⁻¹ ∂τ/∂(q, v)`` at ``a = q̈``.
     A singular ``M`` gives non-finite values.
     """
-    lower = np.tri(handle.nv, handle.nv, -1, dtype=bool)
     if handle.mimic is None:
         model = handle.model
 
         def derivatives(q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> Derivatives:
+            # Pinocchio 4 returns its data's matrices (copied here), M⁻¹ with both triangles
             dq, dv, inverse = pin.computeABADerivatives(model, handle.data, q, v, tau)
-            inverse = inverse.copy()
-            np.copyto(inverse, inverse.T, where=lower)  # Pinocchio fills the upper triangle only
-            return dq.copy(), dv.copy(), inverse
+            return dq.copy(), dv.copy(), inverse.copy()
 
         return derivatives
     inverse_dynamics, forward = rnea_derivatives(handle), handle.kernels.a.single
@@ -158,9 +157,11 @@ def _evaluate(
         InputError: For arguments :meth:`ModelHandle.validate` refuses.
         NonFiniteResultError: For a non-finite result of finite inputs.
     """
-    if all(type(x) is np.ndarray and x.ndim == 1 and x.dtype == np.float64 for x in values):
+    q, v, third = values
+    arrays_1d = type(q) is np.ndarray and type(v) is np.ndarray and type(third) is np.ndarray
+    if arrays_1d and q.ndim == v.ndim == third.ndim == 1 and q.dtype == v.dtype == third.dtype == _FLOAT:
         try:
-            result = single(*values)
+            result = single(q, v, third)
             if _fine(handle, values, result):
                 return result
         except PINOCCHIO_ERRORS:
@@ -179,9 +180,17 @@ def _evaluate(
 
 def _fine(handle: ModelHandle, values: tuple[np.ndarray, ...], result: Derivatives) -> bool:
     """Whether a fast-path result may be returned: finite, of finite inputs with a unit
-    base quaternion (anything else goes through the checks, which name the argument)."""
-    if not (all(np.isfinite(value).all() for value in values) and all(np.isfinite(part).all() for part in result)):
+    base quaternion (anything else goes through the checks, which name the argument).
+
+    A NaN or inf anywhere makes a sum (the inputs) or a sum of squares (the results)
+    non-finite; a finite sum that overflows only sends the caller to the exact checks.
+    """
+    if not _isfinite(sum(values[0].tolist()) + sum(values[1].tolist()) + sum(values[2].tolist())):
         return False
+    for part in result:
+        flat = part.ravel()
+        if not _isfinite(flat.dot(flat)):
+            return False
     if handle.floating_base:
         quaternion = values[0][3:7]
         return abs(quaternion.dot(quaternion) - 1.0) < QUATERNION_TOLERANCE
