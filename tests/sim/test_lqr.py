@@ -79,6 +79,12 @@ def test_a_discrete_design_balances_at_a_coarse_held_step(double):
     assert np.abs(np.linalg.eigvals(A - B @ lqr.gain)).max() < 1.0
     error, peak = balance(double, lqr, UP + np.array([0.15, 0.0]), duration=4.0, dt=dt, hold=True)
     assert error < 1e-5 and (peak <= EFFORT).all(), (error, peak)
+    continuous = LQR(double, UP, np.zeros(2), Q_WEIGHT, R_WEIGHT)  # negative control: designed on another system
+    try:
+        error, _ = balance(double, continuous, UP + np.array([0.15, 0.0]), duration=4.0, dt=dt, hold=True)
+    except robodyn.SimulationError:
+        error = np.inf
+    assert error > 0.5, error
 
 
 def test_lqr_balances_an_acrobot_by_its_elbow_alone():
