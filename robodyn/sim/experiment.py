@@ -287,24 +287,35 @@ def _control_law(
     return law, task, controlled
 
 
-def lqr_weights(robot: Robot, actuated: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+#: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.
+LQR_ACCELERATION = 100.0
+
+
+def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The LQR weights ``simulate --controller lqr`` uses (Bryson's rule): ``Q`` with
     1 / (0.3 rad)² per position and 1 / (1 rad/s)² per velocity (prismatic: 0.03 m,
-    0.1 m/s), ``R`` with 1 / effort limit² per actuated joint (1 / (100 N m)² without one)."""
+    0.1 m/s); ``R`` with 1 / u_j² per actuated joint, ``u_j`` the smaller of its effort
+    limit and ``M_jj(q_eq)`` × :data:`LQR_ACCELERATION` (so light distal joints are not
+    given gains too stiff for a millisecond step).
+    """
     positions = [1 / 0.03**2 if dof.linear else 1 / 0.3**2 for dof in robot.dofs]
     velocities = [100.0 if dof.linear else 1.0 for dof in robot.dofs]
     chosen = robot.joint_names if actuated is None else actuated
-    efforts = [
-        dof.effort_limit if np.isfinite(dof.effort_limit) and dof.effort_limit > 0 else 100.0
+    inertia = np.diag(robot.mass_matrix(q_eq))
+    scales = [
+        min(
+            dof.effort_limit if np.isfinite(dof.effort_limit) and dof.effort_limit > 0 else np.inf,
+            inertia[dof.index] * LQR_ACCELERATION,
+        )
         for dof in robot.dofs
         if dof.joint in chosen
     ]
-    return np.diag(positions + velocities), np.diag(1.0 / np.square(efforts))
+    return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))
 
 
 def _lqr_law(robot: Robot, target: np.ndarray, actuated: list[str] | None) -> LQR:
     """The LQR controller about ``target`` held still (on its own model)."""
-    Q, R = lqr_weights(robot, actuated)
+    Q, R = lqr_weights(robot, target, actuated)
     return LQR(controller_model(robot), target, np.zeros(robot.nv), Q, R, actuated=actuated)
 
 

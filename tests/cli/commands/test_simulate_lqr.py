@@ -35,3 +35,12 @@ def test_an_unheld_target_and_a_misplaced_actuated_flag_are_one_line_errors(tmp_
         assert main([*common, *arguments]) == 2
         error = capsys.readouterr().err.strip()
         assert error.count("\n") == 0 and flag in error, error
+
+
+def test_the_default_weights_suit_a_light_zoo_pendulum(capsys):
+    """double_pendulum_continuous (0.7 kg, no effort limits, upright at q = 0): gains bounded
+    by its inertia, so a millisecond RK4 step stays stable and it balances."""
+    arguments = ["simulate", "double_pendulum_continuous", "--controller", "lqr", "--target", "0,0", "--q0", "0.15,0"]
+    assert main([*arguments, "--duration", "4", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["final_joint_error"] < 1e-5
