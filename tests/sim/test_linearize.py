@@ -61,7 +61,7 @@ def test_the_integrators_are_the_simulators():
 
 
 @pytest.mark.parametrize("integrator", ["rk4", "semi-implicit-euler"])
-@pytest.mark.parametrize("name", ["gripper", "oblique_floating", "double_pendulum_continuous"])
+@pytest.mark.parametrize("name", ["gripper", "oblique_floating", "mimic_tree_floating", "double_pendulum_continuous"])
 def test_one_step_matches_central_differences_of_the_simulator(name, integrator, rng):
     robot = load_case(name)
     q, v, tau = (x[0] for x in random_states(robot, rng, 1))
