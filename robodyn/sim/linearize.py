@@ -82,7 +82,7 @@ class Linearization:
         return {
             "q": [dof.position_unit for dof in self.dofs],
             "v": [dof.velocity_unit for dof in self.dofs],
-            "u": [dof.effort_unit for dof in self.dofs if dof.name in self.inputs],
+            "u": [_input_unit(self.dofs, column) for column in self.actuation.T],
             "A": "SI: entry (i, j) in units of x_i per unit of x_j" + ("" if self.dt is not None else " per second"),
             "B": "SI: entry (i, k) in units of x_i per unit of u_k" + ("" if self.dt is not None else " per second"),
         }
@@ -118,6 +118,12 @@ class Linearization:
         lines += ["", f"B (columns: {', '.join(self.inputs)}):"]
         lines += _rows(names, self.B, precision)
         return "\n".join(printable(line) for line in lines)
+
+
+def _input_unit(dofs: tuple[Dof, ...], column: np.ndarray) -> str:
+    """The unit of an input: its degrees of freedom's effort unit, or "SI" when they differ."""
+    units = {dofs[int(k)].effort_unit for k in np.flatnonzero(column)}
+    return units.pop() if len(units) == 1 else "SI (N m and N)"
 
 
 def _rows(names: list[str], matrix: np.ndarray, precision: int) -> list[str]:
