@@ -51,7 +51,6 @@ class Linearization:
     Attributes:
         robot: The robot's name.
         dofs: Its degrees of freedom (names, units), length nv.
-        inputs: The names of the inputs (columns of ``B``): the actuated degrees of freedom.
         q: Configuration, shape (nq,); ``v``: velocity, (nv,); ``tau``: torques, (nv,), in
             [N m] / [N] (the holding torque when none was given).
         dt: The step in [s], or ``None`` for continuous time.
@@ -63,7 +62,6 @@ class Linearization:
 
     robot: str
     dofs: tuple[Dof, ...]
-    inputs: tuple[str, ...]
     q: np.ndarray
     v: np.ndarray
     tau: np.ndarray
@@ -72,6 +70,16 @@ class Linearization:
     A: np.ndarray
     B: np.ndarray
     actuation: np.ndarray
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """A name per input (column of ``B``): the degree of freedom its actuation column
+        selects, else ``u<k>``."""
+        names = []
+        for k, column in enumerate(self.actuation.T):
+            hits = np.flatnonzero(column)
+            names.append(self.dofs[int(hits[0])].name if hits.size == 1 and column[hits[0]] == 1.0 else f"u{k}")
+        return tuple(names)
 
     def state_names(self) -> list[str]:
         """Names of the rows of ``A`` and ``B``: ``q[<dof>]`` then ``v[<dof>]``."""
@@ -196,10 +204,8 @@ def linearization(
     dt: float | None = None,
     integrator: StepIntegrator = "rk4",
     actuation: np.ndarray | None = None,
-    inputs: Sequence[str] | None = None,
 ) -> Linearization:
-    """:func:`linearize` with the state, names and units (a :class:`Linearization`);
-    ``inputs`` names the columns of ``actuation`` (default: the degrees of freedom it selects)."""
+    """:func:`linearize` with the state, names and units (a :class:`Linearization`)."""
     q, v, tau = _state(robot, q, v, tau)
     selection = _actuation(robot, actuation)
     if dt is not None and not (isinstance(dt, int | float) and np.isfinite(dt) and dt > 0):
@@ -210,9 +216,8 @@ def linearization(
         A, B = _continuous(robot, q, v, tau, selection)
     else:
         A, B = _Step(robot, tau, selection).jacobians(q, v, float(dt), integrator)
-    names = tuple(inputs) if inputs is not None else _input_names(robot, selection)
     return Linearization(
-        robot.name, robot.dofs, names, q, v, tau, None if dt is None else float(dt),
+        robot.name, robot.dofs, q, v, tau, None if dt is None else float(dt),
         None if dt is None else integrator, A, B, selection,
     )  # fmt: skip
 
@@ -236,15 +241,6 @@ def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
     if matrix.ndim != 2 or matrix.shape[0] != robot.nv or matrix.shape[1] < 1 or not np.isfinite(matrix).all():
         raise InputError("actuation", f"a finite matrix of shape ({robot.nv}, nu), nu >= 1", f"shape {matrix.shape}")
     return matrix
-
-
-def _input_names(robot: Robot, selection: np.ndarray) -> tuple[str, ...]:
-    """A name per input: the degree of freedom a column selects, else ``u<k>``."""
-    names = []
-    for k, column in enumerate(selection.T):
-        hits = np.flatnonzero(column)
-        names.append(robot.dofs[int(hits[0])].name if hits.size == 1 and column[hits[0]] == 1.0 else f"u{k}")
-    return tuple(names)
 
 
 def _continuous(robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray):
