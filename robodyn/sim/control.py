@@ -26,6 +26,7 @@ import numpy as np
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.linearize import StepIntegrator, actuation_matrix, linearize
 
 #: A joint reference: time in [s] -> (q_d, v_d, a_d).
 JointReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -192,7 +193,7 @@ class LQR:
     R: float | np.ndarray
     dt: float | None = None
     actuated: list[str] | None = None
-    integrator: str = "rk4"
+    integrator: StepIntegrator = "rk4"
 
     def __post_init__(self) -> None:
         self.gain, self.u_eq, self.actuation = lqr_gain(
@@ -214,13 +215,11 @@ def lqr_gain(
     *,
     dt: float | None = None,
     actuated: list[str] | None = None,
-    integrator: str = "rk4",
+    integrator: StepIntegrator = "rk4",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The gain ``K`` (nu, 2 nv), the holding input ``u_eq`` (nu,) and ``S_act`` (nv, nu) of
     :class:`LQR` (its attributes are the arguments; same errors)."""
     import scipy.linalg
-
-    from robodyn.sim.linearize import actuation_matrix, linearize
 
     if model.floating_base:
         raise InputError("model", "a fixed-base robot (LQR about a floating base's pose is not supported)", "a floating base")
@@ -235,7 +234,7 @@ def lqr_gain(
     if np.abs(missing).max() > 1e-6 * scale:  # [N m] / [N]: a target typed to 8 digits holds
         unheld = ", ".join(f"{x:.3g}" for x in missing)
         raise InputError("q_eq", "an equilibrium the actuated joints can hold", f"gravity torques left unheld [{unheld}]")
-    A, B = linearize(model, q_eq, v_eq, holding, dt=dt, integrator=integrator, actuation=selection)  # type: ignore[arg-type]
+    A, B = linearize(model, q_eq, v_eq, holding, dt=dt, integrator=integrator, actuation=selection)
     weights = _weight(Q, 2 * model.nv, "Q"), _weight(R, selection.shape[1], "R")
     try:
         if dt is None:
