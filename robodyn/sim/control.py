@@ -251,7 +251,10 @@ def lqr_gain(
 def _weight(value: float | np.ndarray, size: int, name: str) -> np.ndarray:
     """A weight matrix from a scalar, a diagonal (size,) or a matrix (size, size): symmetric,
     finite, positive semi-definite (``R``: definite)."""
-    array = np.asarray(value, dtype=float)
+    try:
+        array = np.asarray(value, dtype=float) if not np.iscomplexobj(value) else np.array([])
+    except (TypeError, ValueError):  # text: refused below
+        array = np.array([])
     matrix = array * np.eye(size) if array.ndim == 0 else (np.diag(array) if array.shape == (size,) else array)
     smallest = np.linalg.eigvalsh(matrix)[0] if matrix.shape == (size, size) and np.isfinite(matrix).all() else -np.inf
     symmetric = matrix.shape == (size, size) and np.allclose(matrix, matrix.T)

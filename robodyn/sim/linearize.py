@@ -25,6 +25,7 @@ in the tangent space at ``q⁺``.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -128,6 +129,17 @@ class Linearization:
         return "\n".join(printable(line) for line in lines)
 
 
+def _real_array(value: Any) -> np.ndarray:
+    """``value`` as a float array, or an empty one for anything not real numbers (complex
+    values, text), for the caller's check to refuse."""
+    if np.iscomplexobj(value):
+        return np.array([])
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return np.array([])
+
+
 def _input_unit(dofs: tuple[Dof, ...], column: np.ndarray) -> str:
     """The unit of an input: its degrees of freedom's effort unit, or "SI" when they differ."""
     units = {dofs[int(k)].effort_unit for k in np.flatnonzero(column)}
@@ -208,7 +220,7 @@ def linearization(
     """:func:`linearize` with the state, names and units (a :class:`Linearization`)."""
     q, v, tau = _state(robot, q, v, tau)
     selection = _actuation(robot, actuation)
-    if dt is not None and not (isinstance(dt, int | float) and np.isfinite(dt) and dt > 0):
+    if dt is not None and not (isinstance(dt, numbers.Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0):
         raise InputError("dt", "a finite step > 0 in [s] (or None for continuous time)", repr(dt))
     if integrator not in STEP_INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(STEP_INTEGRATORS)}", repr(integrator))
@@ -237,7 +249,7 @@ def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
     """The actuation matrix, checked: (nv, nu) finite, nu ≥ 1; the identity for ``None``."""
     if actuation is None:
         return np.eye(robot.nv)
-    matrix = np.asarray(actuation, dtype=float) if not np.iscomplexobj(actuation) else np.array([])
+    matrix = _real_array(actuation)
     if matrix.ndim != 2 or matrix.shape[0] != robot.nv or matrix.shape[1] < 1 or not np.isfinite(matrix).all():
         raise InputError("actuation", f"a finite matrix of shape ({robot.nv}, nu), nu >= 1", f"shape {matrix.shape}")
     return matrix

@@ -114,8 +114,10 @@ def test_the_default_torque_holds_the_state_and_actuation_selects_columns(rng):
     [
         ({"dt": 0.0}, "dt"),
         ({"dt": float("nan")}, "dt"),
+        ({"dt": True}, "dt"),
         ({"integrator": "euler"}, "integrator"),
         ({"actuation": np.ones((3, 1))}, "actuation"),
+        ({"actuation": [["a", "b"]]}, "actuation"),
     ],
 )
 def test_bad_options_are_refused_naming_them(options, argument, rng):

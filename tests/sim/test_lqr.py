@@ -122,6 +122,8 @@ def test_an_equilibrium_the_actuated_joints_cannot_hold_is_refused():
         ({"Q": -1.0}, "Q"),
         ({"R": np.zeros((2, 2))}, "R"),
         ({"Q": np.ones(3)}, "Q"),
+        ({"Q": "heavy"}, "Q"),
+        ({"R": 1.0 + 2.0j}, "R"),
         ({"v_eq": np.ones(2)}, "v_eq"),
         ({"actuated": ["elbow"]}, "actuated"),
     ],
