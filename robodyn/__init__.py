@@ -64,6 +64,7 @@ _LAZY = {
     "excite": "robodyn.ident",
     "identify": "robodyn.ident",
     "Recording": "robodyn.viz.recording",
+    "linearize": "robodyn.sim.linearize",
 }
 
 __all__ = [
@@ -103,6 +104,7 @@ __all__ = [
     "estimate_external_torques",
     "excite",
     "identify",
+    "linearize",
     "load",
     "record",
     "recording",

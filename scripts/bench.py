@@ -17,6 +17,7 @@ Sections:
     compiled-batch       100 000 states, compiled vs rneaInParallel / abaInParallel / a Python loop
     compiled-compile     cold and cached compile times
     compiled-simulation  panda-arm real-time factor: compiled RK4 / Euler vs Python engine vs MuJoCo
+    derivatives  Robot.*_derivatives single calls vs pin.computeRNEADerivatives / computeABADerivatives
 """
 
 from __future__ import annotations
@@ -561,6 +562,34 @@ def bench_compiled_simulation(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_derivatives(quick: bool) -> list[dict]:
+    """Robot.*_derivatives single calls vs the raw Pinocchio analytical derivatives (panda arm, ur5)."""
+    rows = []
+    for name, options in (("ur5", {}), ("panda", PANDA_ARM)):
+        robot = robodyn.load(name, **options)
+        model, data = robot.model, robot.model.createData()
+        rng = np.random.default_rng(0)
+        q = robot.random_configuration(rng).copy()
+        v, a = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+        tau = robot.inverse_dynamics(q, v, a)
+        cases = {
+            "inverse_dynamics_derivatives": (
+                lambda: robot.inverse_dynamics_derivatives(q, v, a),
+                lambda: pin.computeRNEADerivatives(model, data, q, v, a),
+            ),
+            "forward_dynamics_derivatives": (
+                lambda: robot.forward_dynamics_derivatives(q, v, tau),
+                lambda: pin.computeABADerivatives(model, data, q, v, tau),
+            ),
+        }
+        for method, (ours, raw) in cases.items():
+            ours_s, raw_s, ratio = paired(ours, raw, repeats=5 if quick else 15)
+            rows.append(
+                {"robot": name, "method": method, "robodyn_us": ours_s * 1e6, "pinocchio_us": raw_s * 1e6, "ratio": ratio}
+            )
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -573,6 +602,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-batch": bench_compiled_batch,
     "compiled-compile": bench_compiled_compile,
     "compiled-simulation": bench_compiled_simulation,
+    "derivatives": bench_derivatives,
 }
 
 

@@ -39,6 +39,8 @@ FLAGS: dict[str, str] = {
     "threshold": "--threshold",
     "torque": "--torque",
     "plot": "--plot",
+    "actuated": "--actuated",
+    "q_eq": "--target",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

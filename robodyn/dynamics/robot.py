@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics import configurations, energies, frames, kinematics
+from robodyn.dynamics import configurations, derivatives, energies, frames, kinematics
 from robodyn.dynamics import regressor as identification
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
@@ -309,6 +309,51 @@ class Robot:
         """
         handle = self.handle
         return handle.evaluate(handle.kernels.nle, q, v)
+
+    # ----------------------------------------------------------------------------------
+    # Derivatives (robodyn.dynamics.derivatives): q columns in the tangent space
+    # ----------------------------------------------------------------------------------
+    def inverse_dynamics_derivatives(
+        self, q: np.ndarray, v: np.ndarray, a: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M)`` of inverse dynamics (Pinocchio's analytical RNEA
+        derivatives; :func:`robodyn.dynamics.derivatives.inverse_dynamics_derivatives`).
+
+        Derivatives in ``q`` are along :meth:`integrate` (Pinocchio's convention: the
+        floating base's six columns are its displacements in the base frame).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+            a: Acceleration, shape (nv,) or (N, nv).
+
+        Returns:
+            Three arrays of shape (nv, nv) or (N, nv, nv), in SI units (torque per unit of
+            the coordinate).
+        """
+        return derivatives.inverse_dynamics_derivatives(self.handle, q, v, a)
+
+    def forward_dynamics_derivatives(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹)`` of forward dynamics (Pinocchio's analytical ABA
+        derivatives; :func:`robodyn.dynamics.derivatives.forward_dynamics_derivatives`).
+
+        Derivatives in ``q`` are along :meth:`integrate`, as for
+        :meth:`inverse_dynamics_derivatives`.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+            tau: Torques in [N m] / [N], shape (nv,) or (N, nv).
+
+        Returns:
+            Three arrays of shape (nv, nv) or (N, nv, nv), in SI units.
+
+        Raises:
+            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
+        """
+        return derivatives.forward_dynamics_derivatives(self.handle, q, v, tau)
 
     # ----------------------------------------------------------------------------------
     # Energies (robodyn.dynamics.energies)

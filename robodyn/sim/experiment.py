@@ -30,7 +30,7 @@ import pinocchio as pin
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
-from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
+from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, quintic_reference
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
@@ -40,8 +40,8 @@ from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
-ControllerName = Literal["passive", "pd", "computed-torque", "task-space", "osc", "impedance"]
-CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space", "osc", "impedance")
+ControllerName = Literal["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr"]
+CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr")
 #: The controllers of a frame's pose (position, or position and attitude).
 POSE_CONTROLLERS = ("osc", "impedance")
 #: The controllers that drive a frame (``frame`` applies to them).
@@ -131,6 +131,7 @@ def run_simulation(
     damping: list[float] | None = None,
     force_at: Sequence[str | Push] = (),
     observer_gain: float | None = None,
+    actuated: list[str] | None = None,
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -140,7 +141,9 @@ def run_simulation(
             ``"computed-torque"`` (quintic from ``q0`` to a joint target in half the
             duration), ``"task-space"`` (drive ``frame`` to a position target), ``"osc"``
             (operational-space control of ``frame``'s position or pose) or
-            ``"impedance"`` (Cartesian impedance about the target pose).
+            ``"impedance"`` (Cartesian impedance about the target pose) or ``"lqr"``
+            (:class:`~robodyn.sim.control.LQR` about the joint target held still, gain of
+            the continuous Riccati equation, weights :func:`lqr_weights`).
         target: Joint target (nq values), task target (X,Z or X,Y,Z in [m]) or, for osc
             and impedance, X,Y,Z in [m] with optionally ROLL,PITCH,YAW in [rad].
         frame: Controlled frame for task-space, osc and impedance control (default the
@@ -156,6 +159,7 @@ def run_simulation(
         force_at: Pushes, each a :class:`~robodyn.sim.report.Push` or ``T:FX,FY,FZ[@FRAME]``
             (default frame: the controlled frame, or the end effector).
         observer_gain: ``K_O`` in [1/s]: run a momentum observer along (``None``: none).
+        actuated: lqr only: the actuated joints (default all; the others get zero torque).
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -169,7 +173,10 @@ def run_simulation(
     if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
         raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
-    options = {"posture": posture, "stiffness": stiffness, "damping": damping}
+    options: dict[str, Any] = {"posture": posture, "stiffness": stiffness, "damping": damping}
+    if actuated is not None and controller != "lqr":
+        raise InputError("actuated", "given only with the lqr controller", f"{len(actuated)} joints")
+    options["actuated"] = actuated
     law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
     pushes, external = push_wrenches(robot, force_at, controlled or None)
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
@@ -251,10 +258,10 @@ def _control_law(
     start: np.ndarray,
     duration: float,
     options: dict[str, Any],
-) -> tuple[PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | None, np.ndarray | None, str]:
+) -> tuple[PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | LQR | None, np.ndarray | None, str]:
     """The controller (on its own model), the task target in [m] and the controlled frame
     (task-space, osc and impedance control only: ``None`` and ``""`` otherwise)."""
-    law: PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | None = None
+    law: PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | LQR | None = None
     task, controlled = None, ""
     if controller == "pd":
         law = PDGravity(controller_model(robot), np.asarray(target, float))
@@ -273,9 +280,43 @@ def _control_law(
         check_reach(robot, controlled, task, parameter="target")
         law = _pose_law(robot, controller, controlled, task, rpy, options)
     given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
-    if controller in ("pd", "computed-torque") and given != robot.nq:
+    if controller == "lqr" and given == robot.nq:
+        law = _lqr_law(robot, np.asarray(target, float), options["actuated"])
+    if controller in ("pd", "computed-torque", "lqr") and given != robot.nq:
         raise InputError("target", f"{robot.nq} joint values for the {controller} controller", f"{given} values")
     return law, task, controlled
+
+
+#: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.
+LQR_ACCELERATION = 100.0
+
+
+def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The LQR weights ``simulate --controller lqr`` uses (Bryson's rule): ``Q`` with
+    1 / (0.3 rad)² per position and 1 / (1 rad/s)² per velocity (prismatic: 0.03 m,
+    0.1 m/s); ``R`` with 1 / u_j² per actuated joint, ``u_j`` the smaller of its effort
+    limit and ``M_jj(q_eq)`` × :data:`LQR_ACCELERATION` (so light distal joints are not
+    given gains too stiff for a millisecond step).
+    """
+    positions = [1 / 0.03**2 if dof.linear else 1 / 0.3**2 for dof in robot.dofs]
+    velocities = [100.0 if dof.linear else 1.0 for dof in robot.dofs]
+    chosen = robot.joint_names if actuated is None else actuated
+    inertia = np.diag(robot.mass_matrix(q_eq))
+    scales = [
+        min(
+            dof.effort_limit if np.isfinite(dof.effort_limit) and dof.effort_limit > 0 else np.inf,
+            inertia[dof.index] * LQR_ACCELERATION,
+        )
+        for dof in robot.dofs
+        if dof.joint in chosen
+    ]
+    return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))
+
+
+def _lqr_law(robot: Robot, target: np.ndarray, actuated: list[str] | None) -> LQR:
+    """The LQR controller about ``target`` held still (on its own model)."""
+    Q, R = lqr_weights(robot, target, actuated)
+    return LQR(controller_model(robot), target, np.zeros(robot.nv), Q, R, actuated=actuated)
 
 
 def _pose_law(

@@ -13,13 +13,13 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
     add_model_arguments(parser)
     parser.add_argument(
-        "--controller", choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance"], default="passive"
+        "--controller", choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr"], default="passive"
     )
     parser.add_argument(
         "--target",
         type=vector,
         help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
-        "pd / computed-torque: joint target",
+        "pd / computed-torque: joint target; lqr: the equilibrium (joint values) to balance at",
     )
     parser.add_argument(
         "--frame",
@@ -43,6 +43,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         type=float,
         help="run a momentum observer of this gain [1/s]; --out then has tau_ext[<joint>] columns",
     )
+    parser.add_argument("--actuated", help="lqr: the actuated joints, comma-separated (default all; the others get no torque)")
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
     parser.add_argument("--dt", type=float, default=1e-3, help=f"step, {RANGES['dt'].text()}, at most --duration (default 0.001)")
@@ -86,6 +87,7 @@ def run(arguments: argparse.Namespace) -> int:
         damping=arguments.damping,
         force_at=arguments.force_at,
         observer_gain=arguments.observer_gain,
+        actuated=None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")],
         out=arguments.out,
         plot=arguments.plot,
         record=arguments.record,

@@ -1,0 +1,46 @@
+"""`robodyn linearize`: (A, B) of a robot's dynamics about one state, continuous or one step."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from robodyn.cli.common import RANGES, add_model_arguments, load_robot, state, vector
+from robodyn.common.text import json_text
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the command to the ``robodyn`` parser."""
+    parser = commands.add_parser(
+        "linearize",
+        help="(A, B) of the dynamics about a state: continuous time, or the exact Jacobians of one simulator step",
+        description="Linearise x = (q, v), input u (torques of the actuated joints): continuous time "
+        "(dx/dt = A dx + B du) or, with --dt, one step of robodyn's integrator (dx+ = A dx + B du), "
+        "by Pinocchio's analytical derivatives. A floating base's q perturbations are in the tangent space.",
+    )
+    add_model_arguments(parser)
+    parser.add_argument("--q", type=vector, help="configuration, comma-separated, in [rad] / [m] (default: neutral)")
+    parser.add_argument("--v", type=vector, help="velocity in [rad/s] / [m/s] (default: zeros)")
+    parser.add_argument("--tau", type=vector, help="torques in [N m] / [N] (default: the holding torque C(q, v) v + G(q))")
+    parser.add_argument("--dt", type=float, help=f"step, {RANGES['dt'].text()}: the Jacobians of one step (default: continuous)")
+    parser.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], default="rk4", help="with --dt (default rk4)")
+    parser.add_argument("--actuated", help="actuated joints, comma-separated (default: all): the columns of B")
+    parser.add_argument("--json", action="store_true", help="print JSON (keys A, B, state, inputs, units, ...)")
+    parser.add_argument("--precision", type=int, default=6, choices=range(1, 18), metavar="1..17", help="significant digits")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    from robodyn.sim.linearize import actuation_matrix, linearization
+
+    robot = load_robot(arguments)
+    q = state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
+    v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
+    tau = None if arguments.tau is None else state(robot, arguments.tau, "tau", robot.nv, np.zeros(robot.nv))
+    actuated = None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")]
+    result = linearization(
+        robot, q, v, tau, dt=arguments.dt, integrator=arguments.integrator, actuation=actuation_matrix(robot, actuated)
+    )
+    print(json_text(result.to_dict()) if arguments.json else result.text(precision=arguments.precision))
+    return 0

@@ -1,0 +1,319 @@
+"""Linearisation of a robot's dynamics about a state: ``(A, B)`` in continuous time, or
+the exact Jacobians of one step of robodyn's integrators.
+
+The state is ``x = (q, v)`` and the input ``u`` with joint torques ``τ = S_act u``
+(``S_act``, shape (nv, nu), the actuation matrix: the identity by default, or the columns
+of the actuated joints, :func:`actuation_matrix`).
+
+- Continuous time (``dt=None``): ``ẋ = f(x, u)``, ``A = ∂f/∂x = [[A_qq, I], [∂q̈/∂q, ∂q̈/∂v]]``
+  and ``B = [[0], [M⁻¹ S_act]]``, with ``A_qq = 0`` for a fixed base.
+- Discrete time (``dt`` in [s]): ``x⁺ = step(x, u)``, one step of
+  :func:`robodyn.simulate` with the torque held over the step (``"rk4"`` or
+  ``"semi-implicit-euler"``, stage by stage as :mod:`robodyn.sim.simulation` does it),
+  and ``(A, B)`` its exact Jacobians: the chain rule through every stage with the
+  analytical derivatives of forward dynamics
+  (:meth:`robodyn.Robot.forward_dynamics_derivatives`), not finite differences. A
+  controller designed on them is designed on the simulator that runs it.
+
+Floating base: ``q`` perturbations are in the tangent space (Pinocchio's convention,
+``q ⊕ δq = robot.integrate(q, δq)``: the base's six entries are its displacement in the
+base frame, linear then angular), so ``A`` is (2 nv, 2 nv), not (nq + nv)². In continuous
+time the base's ``A_qq`` block is then ``−ad(v_base)`` (the twist's motion action: a
+tangent vector carried along a moving base), zero at rest. In discrete time, ``δq⁺`` is
+in the tangent space at ``q⁺``.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+import pinocchio as pin
+
+from robodyn.common.text import printable
+from robodyn.dynamics.dofs import Dof
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
+
+#: The integrators of :func:`robodyn.simulate` (the same names as
+#: :data:`robodyn.sim.simulation.INTEGRATORS`, not imported: the simulator imports the
+#: controllers, which import this module).
+StepIntegrator = Literal["rk4", "semi-implicit-euler"]
+STEP_INTEGRATORS: tuple[StepIntegrator, ...] = ("rk4", "semi-implicit-euler")
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """A linearisation ``δẋ = A δx + B δu`` (continuous) or ``δx⁺ = A δx + B δu`` (one step).
+
+    Attributes:
+        robot: The robot's name.
+        dofs: Its degrees of freedom (names, units), length nv.
+        q: Configuration, shape (nq,); ``v``: velocity, (nv,); ``tau``: torques, (nv,), in
+            [N m] / [N] (the holding torque when none was given).
+        dt: The step in [s], or ``None`` for continuous time.
+        integrator: The step's integrator, or ``None`` for continuous time.
+        A: Shape (2 nv, 2 nv): rows and columns ``(δq, δv)``, ``δq`` in the tangent space.
+        B: Shape (2 nv, nu): columns per unit of input, [N m] or [N].
+        actuation: ``S_act``, shape (nv, nu).
+    """
+
+    robot: str
+    dofs: tuple[Dof, ...]
+    q: np.ndarray
+    v: np.ndarray
+    tau: np.ndarray
+    dt: float | None
+    integrator: StepIntegrator | None
+    A: np.ndarray
+    B: np.ndarray
+    actuation: np.ndarray
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """A name per input (column of ``B``): the degree of freedom its actuation column
+        selects, else ``u<k>``."""
+        names = []
+        for k, column in enumerate(self.actuation.T):
+            hits = np.flatnonzero(column)
+            names.append(self.dofs[int(hits[0])].name if hits.size == 1 and column[hits[0]] == 1.0 else f"u{k}")
+        return tuple(names)
+
+    def state_names(self) -> list[str]:
+        """Names of the rows of ``A`` and ``B``: ``q[<dof>]`` then ``v[<dof>]``."""
+        return [f"q[{dof.name}]" for dof in self.dofs] + [f"v[{dof.name}]" for dof in self.dofs]
+
+    def units(self) -> dict[str, Any]:
+        """Units of the state and of the input, by entry."""
+        return {
+            "q": [dof.position_unit for dof in self.dofs],
+            "v": [dof.velocity_unit for dof in self.dofs],
+            "u": [_input_unit(self.dofs, column) for column in self.actuation.T],
+            "A": "SI: entry (i, j) in units of x_i per unit of x_j" + ("" if self.dt is not None else " per second"),
+            "B": "SI: entry (i, k) in units of x_i per unit of u_k" + ("" if self.dt is not None else " per second"),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (the ``robodyn linearize --json`` output)."""
+        return {
+            "robot": self.robot,
+            "time": "continuous" if self.dt is None else "discrete",
+            "dt": self.dt,
+            "integrator": self.integrator,
+            "state": self.state_names(),
+            "inputs": list(self.inputs),
+            "units": self.units(),
+            "tangent_space": "q perturbations along robot.integrate (a floating base: base-frame displacement)",
+            "q": self.q.tolist(),
+            "v": self.v.tolist(),
+            "tau": self.tau.tolist(),
+            "A": self.A.tolist(),
+            "B": self.B.tolist(),
+        }
+
+    def text(self, *, precision: int = 6) -> str:
+        """Readable text: the state, the matrices with their row and column names."""
+        if self.dt is None:
+            head = f"{self.robot}: continuous time, d(dx)/dt = A dx + B du"
+        else:
+            head = f"{self.robot}: one {self.integrator} step of dt = {self.dt:g} s, dx+ = A dx + B du"
+        names = self.state_names()
+        lines = [head, "state x = (q, v) in [rad] [m] and [rad/s] [m/s], input u in [N m] [N]"]
+        lines += [f"tau (holding or given): {' '.join(f'{x:.{precision}g}' for x in self.tau)}", "", "A:"]
+        lines += _rows(names, self.A, precision)
+        lines += ["", f"B (columns: {', '.join(self.inputs)}):"]
+        lines += _rows(names, self.B, precision)
+        return "\n".join(printable(line) for line in lines)
+
+
+def _real_array(value: Any) -> np.ndarray:
+    """``value`` as a float array, or an empty one for anything not real numbers (complex
+    values, text), for the caller's check to refuse."""
+    if np.iscomplexobj(value):
+        return np.array([])
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return np.array([])
+
+
+def _input_unit(dofs: tuple[Dof, ...], column: np.ndarray) -> str:
+    """The unit of an input: its degrees of freedom's effort unit, or "SI" when they differ."""
+    units = {dofs[int(k)].effort_unit for k in np.flatnonzero(column)}
+    return units.pop() if len(units) == 1 else "SI (N m and N)"
+
+
+def _rows(names: list[str], matrix: np.ndarray, precision: int) -> list[str]:
+    width = max(len(name) for name in names)
+    return [
+        f"  {name:{width}s} [" + " ".join(f"{x:{precision + 7}.{precision}g}" for x in row) + " ]"
+        for name, row in zip(names, matrix, strict=True)
+    ]
+
+
+def actuation_matrix(robot: Robot, actuated: Sequence[str] | None) -> np.ndarray:
+    """``S_act``, shape (nv, nu): one column a degree of freedom of the ``actuated`` joints
+    (in the robot's order), or the identity for ``None``.
+
+    Raises:
+        InputError: For an unknown joint name, a repeated one or none at all.
+    """
+    if actuated is None:
+        return np.eye(robot.nv)
+    names = [actuated] if isinstance(actuated, str) else list(actuated)
+    unknown = [name for name in names if name not in robot.joint_names]
+    if unknown or not names or len(set(names)) != len(names):
+        received = f"unknown {unknown}" if unknown else repr(names)
+        raise InputError("actuated", f"distinct joint names of {robot.name} ({', '.join(robot.joint_names)})", received)
+    columns = [dof.index for dof in robot.dofs if dof.joint in names]
+    return np.eye(robot.nv)[:, columns]
+
+
+def linearize(
+    robot: Robot,
+    q: np.ndarray,
+    v: np.ndarray,
+    tau: np.ndarray | None = None,
+    *,
+    dt: float | None = None,
+    integrator: StepIntegrator = "rk4",
+    actuation: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, B)`` of the dynamics about ``(q, v, tau)``: continuous, or one step of ``dt``.
+
+    Args:
+        robot: The robot.
+        q: Configuration, shape (nq,).
+        v: Velocity, shape (nv,).
+        tau: Torques in [N m] / [N], shape (nv,); ``None``: the torque that holds
+            ``(q, v)`` at zero acceleration, ``C(q, v) v + G(q)``.
+        dt: Step in [s] for the Jacobians of one integrator step; ``None``: continuous time.
+        integrator: With ``dt``: ``"rk4"`` or ``"semi-implicit-euler"`` (as :func:`robodyn.simulate`).
+        actuation: ``S_act`` of shape (nv, nu), torques ``τ = S_act u``; default the identity.
+
+    Returns:
+        ``A`` of shape (2 nv, 2 nv) and ``B`` of shape (2 nv, nu) (module docstring:
+        conventions, the floating base's tangent space).
+
+    Raises:
+        InputError: For a state that is not one valid state, a bad step, integrator or
+            actuation matrix.
+        SingularMassMatrixError: If ``M(q)`` is singular.
+    """
+    result = linearization(robot, q, v, tau, dt=dt, integrator=integrator, actuation=actuation)
+    return result.A, result.B
+
+
+def linearization(
+    robot: Robot,
+    q: np.ndarray,
+    v: np.ndarray,
+    tau: np.ndarray | None = None,
+    *,
+    dt: float | None = None,
+    integrator: StepIntegrator = "rk4",
+    actuation: np.ndarray | None = None,
+) -> Linearization:
+    """:func:`linearize` with the state, names and units (a :class:`Linearization`)."""
+    q, v, tau = _state(robot, q, v, tau)
+    selection = _actuation(robot, actuation)
+    if dt is not None and not (isinstance(dt, numbers.Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0):
+        raise InputError("dt", "a finite step > 0 in [s] (or None for continuous time)", repr(dt))
+    if integrator not in STEP_INTEGRATORS:
+        raise InputError("integrator", f"one of {', '.join(STEP_INTEGRATORS)}", repr(integrator))
+    if dt is None:
+        A, B = _continuous(robot, q, v, tau, selection)
+    else:
+        A, B = _Step(robot, tau, selection).jacobians(q, v, float(dt), integrator)
+    return Linearization(
+        robot.name, robot.dofs, q, v, tau, None if dt is None else float(dt),
+        None if dt is None else integrator, A, B, selection,
+    )  # fmt: skip
+
+
+def _state(robot: Robot, q: Any, v: Any, tau: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One checked state; the holding torque ``C v + G`` for ``tau=None``."""
+    named = {"q": q, "v": v} if tau is None else {"q": q, "v": v, "tau": tau}
+    arrays, batch = robot.validate(**named)
+    if batch:
+        raise InputError("q", "one state (1-D arrays): a linearisation is about one state", f"shape {arrays[0].shape}")
+    if tau is None:
+        arrays.append(robot.nonlinear_effects(arrays[0], arrays[1]))
+    return arrays[0], arrays[1], arrays[2]
+
+
+def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
+    """The actuation matrix, checked: (nv, nu) finite, nu ≥ 1; the identity for ``None``."""
+    if actuation is None:
+        return np.eye(robot.nv)
+    matrix = _real_array(actuation)
+    if matrix.ndim != 2 or matrix.shape[0] != robot.nv or matrix.shape[1] < 1 or not np.isfinite(matrix).all():
+        raise InputError("actuation", f"a finite matrix of shape ({robot.nv}, nu), nu >= 1", f"shape {matrix.shape}")
+    return matrix
+
+
+def _continuous(robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray):
+    """Continuous-time ``(A, B)``."""
+    nv = robot.nv
+    dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau)
+    velocity_block = np.zeros((nv, nv))
+    if robot.floating_base:  # the tangent space moves with the base: −ad(v_base)
+        velocity_block[:6, :6] = -pin.Motion(v[:6]).action
+    A = np.block([[velocity_block, np.eye(nv)], [dq, dv]])
+    B = np.vstack([np.zeros((nv, selection.shape[1])), inverse @ selection])
+    return A, B
+
+
+class _Step:
+    """One integrator step and the Jacobians of its quantities with respect to
+    ``z = (δq, δv, δu)`` (each a matrix with 2 nv + nu columns), stage by stage as
+    :mod:`robodyn.sim.simulation` computes the step (torque held over the step)."""
+
+    def __init__(self, robot: Robot, tau: np.ndarray, selection: np.ndarray) -> None:
+        self.robot, self.tau, nv, nu = robot, tau, robot.nv, selection.shape[1]
+        self.dq0 = np.hstack([np.eye(nv), np.zeros((nv, nv + nu))])
+        self.dv0 = np.hstack([np.zeros((nv, nv)), np.eye(nv), np.zeros((nv, nu))])
+        self.dtau = np.hstack([np.zeros((nv, 2 * nv)), selection])
+
+    def configuration(self, q: np.ndarray, w: np.ndarray, dw: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+        """``q ⊕ h w`` (the step's start ``q``) and its Jacobian, in the tangent space there."""
+        robot = self.robot
+        if not robot.floating_base:
+            return q + h * w, self.dq0 + h * dw
+        step = h * w
+        by_q = pin.dIntegrate(robot.model, q, step, pin.ArgumentPosition.ARG0)
+        by_step = pin.dIntegrate(robot.model, q, step, pin.ArgumentPosition.ARG1)
+        return robot.integrate(q, step), by_q @ self.dq0 + h * by_step @ dw
+
+    def acceleration(self, q: np.ndarray, dq: np.ndarray, v: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Forward dynamics at a stage and its Jacobian by the chain rule."""
+        robot, tau = self.robot, self.tau
+        by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, tau)
+        return robot.forward_dynamics(q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
+
+    def jacobians(self, q: np.ndarray, v: np.ndarray, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, B)`` of one step of ``dt`` from ``(q, v)``."""
+        dq0, dv0, nv = self.dq0, self.dv0, self.robot.nv
+        a1, da1 = self.acceleration(q, dq0, v, dv0)
+        if integrator == "semi-implicit-euler":
+            v_next, dv_next = v + dt * a1, dv0 + dt * da1
+            _, dq_next = self.configuration(q, v_next, dv_next, dt)
+        else:
+            half, sixth = 0.5 * dt, dt / 6.0
+            v2, dv2 = v + half * a1, dv0 + half * da1
+            a2, da2 = self.acceleration(*self.configuration(q, v, dv0, half), v2, dv2)
+            v3, dv3 = v + half * a2, dv0 + half * da2
+            a3, da3 = self.acceleration(*self.configuration(q, v2, dv2, half), v3, dv3)
+            v4, dv4 = v + dt * a3, dv0 + dt * da3
+            _, da4 = self.acceleration(*self.configuration(q, v3, dv3, dt), v4, dv4)
+            mean, dmean = v + v4 + 2.0 * (v2 + v3), dv0 + dv4 + 2.0 * (dv2 + dv3)
+            _, dq_next = self.configuration(q, mean, dmean, sixth)
+            dv_next = dv0 + sixth * (da1 + da4 + 2.0 * (da2 + da3))
+        jacobian = np.vstack([dq_next, dv_next])
+        return jacobian[:, : 2 * nv], jacobian[:, 2 * nv :]
+
+
+__all__ = ["STEP_INTEGRATORS", "Linearization", "StepIntegrator", "actuation_matrix", "linearization", "linearize"]

@@ -1,0 +1,189 @@
+"""Linearisation (robodyn.sim.linearize): continuous (A, B) from the derivatives, the exact
+Jacobians of one simulator step against central differences of robodyn.simulate itself,
+and against MuJoCo's mjd_transitionFD (semi-implicit Euler)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robodyn
+from robodyn.sim.linearize import STEP_INTEGRATORS, actuation_matrix, linearization, linearize
+from robodyn.sim.simulation import INTEGRATORS
+from tests.conftest import NONDEGENERATE_CASES, random_states
+
+GRAVITY = [0.8, 1.1, -9.3]
+
+
+def load_case(name: str) -> robodyn.Robot:
+    if name in NONDEGENERATE_CASES:
+        path, options = NONDEGENERATE_CASES[name]
+        return robodyn.load(path, gravity=GRAVITY, **options)
+    return robodyn.load(name, gravity=GRAVITY)
+
+
+def one_step(robot, q, v, tau, dt, integrator):
+    """(q, v) after one step of robodyn.simulate with ``tau`` held."""
+    run = robodyn.simulate(robot, q, v, dt, dt, controller=lambda t, q, v: tau, hold=True, integrator=integrator, limits="ignore")
+    return run.q[-1], run.v[-1]
+
+
+def difference(robot, q0, q1):
+    """``q1 ⊖ q0`` in the tangent space at ``q0``."""
+    return pin.difference(robot.model, q0, q1) if robot.floating_base else q1 - q0
+
+
+def step_differences(robot, q, v, tau, dt, integrator, eps=1e-6):
+    """Central differences of one simulator step: (A, B) with δq in the tangent space."""
+    nv = robot.nv
+    q_next, _ = one_step(robot, q, v, tau, dt, integrator)
+
+    def state(qi, vi, taui):
+        qn, vn = one_step(robot, qi, vi, taui, dt, integrator)
+        return np.concatenate([difference(robot, q_next, qn), vn])
+
+    A, B = np.zeros((2 * nv, 2 * nv)), np.zeros((2 * nv, nv))
+    for j in range(nv):
+        unit = np.eye(nv)[j] * eps
+        A[:, j] = (state(robot.integrate(q, unit), v, tau) - state(robot.integrate(q, -unit), v, tau)) / (2 * eps)
+        A[:, nv + j] = (state(q, v + unit, tau) - state(q, v - unit, tau)) / (2 * eps)
+        B[:, j] = (state(q, v, tau + unit) - state(q, v, tau - unit)) / (2 * eps)
+    return A, B
+
+
+def relative(a, b):
+    return float(np.abs(a - b).max() / max(1.0, np.abs(b).max()))
+
+
+def test_the_integrators_are_the_simulators():
+    assert STEP_INTEGRATORS == INTEGRATORS
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi-implicit-euler"])
+@pytest.mark.parametrize("name", ["gripper", "oblique_floating", "mimic_tree_floating", "double_pendulum_continuous"])
+def test_one_step_matches_central_differences_of_the_simulator(name, integrator, rng):
+    robot = load_case(name)
+    q, v, tau = (x[0] for x in random_states(robot, rng, 1))
+    dt = 0.02
+    A, B = linearize(robot, q, v, tau, dt=dt, integrator=integrator)
+    A_numeric, B_numeric = step_differences(robot, q, v, tau, dt, integrator)
+    assert relative(A, A_numeric) < 1e-6, relative(A, A_numeric)
+    assert relative(B, B_numeric) < 1e-6, relative(B, B_numeric)
+    other = "rk4" if integrator != "rk4" else "semi-implicit-euler"  # negative control
+    assert relative(linearize(robot, q, v, tau, dt=dt, integrator=other)[0], A_numeric) > 1e-5
+
+
+@pytest.mark.parametrize("name", ["gripper", "oblique_floating"])
+def test_continuous_time_is_the_limit_of_small_steps(name, rng):
+    """(A_d − I) / dt → A_c: the floating base's −ad(v) block included (v ≠ 0 here)."""
+    robot = load_case(name)
+    q, v, tau = (x[0] for x in random_states(robot, rng, 1))
+    A, B = linearize(robot, q, v, tau)
+    dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau)
+    nv = robot.nv
+    np.testing.assert_array_equal(A[nv:, :nv], dq)
+    np.testing.assert_array_equal(A[nv:, nv:], dv)
+    np.testing.assert_array_equal(A[:nv, nv:], np.eye(nv))
+    np.testing.assert_array_equal(B[nv:], inverse)
+    dt = 1e-6
+    A_d, B_d = linearize(robot, q, v, tau, dt=dt, integrator="rk4")
+    assert relative(A, (A_d - np.eye(2 * nv)) / dt) < 1e-4
+    assert relative(B, B_d / dt) < 1e-4
+    if robot.floating_base:  # negative control: without the moving tangent space it fails
+        naive = A.copy()
+        naive[:6, :6] = 0.0
+        assert relative(naive, (A_d - np.eye(2 * nv)) / dt) > 1e-3
+
+
+def test_the_default_torque_holds_the_state_and_actuation_selects_columns(rng):
+    robot = load_case("double_pendulum_continuous")
+    q, v, _ = (x[0] for x in random_states(robot, rng, 1))
+    result = linearization(robot, q, v, actuation=actuation_matrix(robot, [robot.joint_names[1]]))
+    np.testing.assert_allclose(robot.forward_dynamics(q, v, result.tau), 0.0, atol=1e-9)
+    full = linearize(robot, q, v)[1]
+    np.testing.assert_array_equal(result.B, full[:, 1:])
+    assert result.inputs == (robot.dofs[1].name,)
+    document = result.to_dict()
+    assert document["inputs"] == [robot.dofs[1].name] and len(document["A"]) == 2 * robot.nv
+    assert "A:" in result.text()
+
+
+@pytest.mark.parametrize(
+    ("options", "argument"),
+    [
+        ({"dt": 0.0}, "dt"),
+        ({"dt": float("nan")}, "dt"),
+        ({"dt": True}, "dt"),
+        ({"integrator": "euler"}, "integrator"),
+        ({"actuation": np.ones((3, 1))}, "actuation"),
+        ({"actuation": [["a", "b"]]}, "actuation"),
+    ],
+)
+def test_bad_options_are_refused_naming_them(options, argument, rng):
+    robot = load_case("double_pendulum_continuous")
+    q, v, _ = (x[0] for x in random_states(robot, rng, 1))
+    with pytest.raises(robodyn.InputError) as error:
+        linearize(robot, q, v, **options)
+    assert error.value.argument == argument
+
+
+def test_a_batch_and_unknown_joints_are_refused(rng):
+    robot = load_case("double_pendulum_continuous")
+    q, v, _ = random_states(robot, rng, 2)
+    with pytest.raises(robodyn.InputError, match="one state"):
+        linearize(robot, q, v)
+    with pytest.raises(robodyn.InputError) as error:
+        actuation_matrix(robot, ["no_such_joint"])
+    assert error.value.argument == "actuated"
+
+
+# --------------------------------------------------------------------------------------
+# MuJoCo's transition Jacobians: its Euler integrator is semi-implicit, like robodyn's
+# --------------------------------------------------------------------------------------
+mujoco = pytest.importorskip("mujoco")
+
+
+def mujoco_with_motors(robot, dt):
+    """MuJoCo's model of the URDF (contacts, limits, damping off) with a motor on every joint."""
+    spec = mujoco.MjSpec.from_string(_urdf_for_mujoco(robot))
+    for name in robot.joint_names:
+        actuator = spec.add_actuator()
+        actuator.name, actuator.target, actuator.trntype = f"motor_{name}", name, mujoco.mjtTrn.mjTRN_JOINT
+    model = spec.compile()
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
+    model.opt.gravity[:] = robot.gravity_vector
+    model.dof_damping[:] = model.dof_armature[:] = model.dof_frictionloss[:] = 0.0
+    model.opt.timestep = dt
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    return model
+
+
+def _urdf_for_mujoco(robot):
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(robot.urdf)
+    for element in [*root.iter("link"), *root.iter("joint")]:
+        for child in [c for c in element if c.tag in ("visual", "collision", "dynamics", "safety_controller", "calibration")]:
+            element.remove(child)
+    extension = ET.SubElement(root, "mujoco")
+    ET.SubElement(extension, "compiler", {"discardvisual": "true", "fusestatic": "false", "balanceinertia": "false"})
+    return ET.tostring(root, encoding="unicode")
+
+
+@pytest.mark.parametrize("name", ["ur5", "double_pendulum_continuous"])
+def test_one_euler_step_matches_mujocos_transition_jacobians(name, rng):
+    robot = load_case(name)
+    dt = 2e-3
+    model = mujoco_with_motors(robot, dt)
+    data = mujoco.MjData(model)
+    q, v, tau = (x[0] for x in random_states(robot, rng, 1))
+    data.qpos[:], data.qvel[:], data.ctrl[:] = q, v, tau
+    nv = robot.nv
+    A_mj, B_mj = np.zeros((2 * nv, 2 * nv)), np.zeros((2 * nv, nv))
+    mujoco.mjd_transitionFD(model, data, 1e-7, 1, A_mj, B_mj, None, None)
+    A, B = linearize(robot, q, v, tau, dt=dt, integrator="semi-implicit-euler")
+    assert relative(A, A_mj) < 1e-5, relative(A, A_mj)
+    assert relative(B, B_mj) < 1e-5, relative(B, B_mj)
+    rk4 = linearize(robot, q, v, tau, dt=dt, integrator="rk4")[0]
+    assert relative(rk4, A_mj) > 10 * relative(A, A_mj)  # negative control: another integrator
