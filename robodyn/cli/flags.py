@@ -39,6 +39,8 @@ FLAGS: dict[str, str] = {
     "threshold": "--threshold",
     "torque": "--torque",
     "plot": "--plot",
+    "xacro_args": "--xacro-arg",
+    "packages": "--package",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.
