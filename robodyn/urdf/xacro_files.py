@@ -113,10 +113,13 @@ def _reason(xacro: Any, error: Exception) -> str:
     """One sentence for a xacro failure, with the file it happened in."""
     from xacro.substitution_args import ArgException
 
-    inner = getattr(error, "exc", None)
-    if isinstance(error, ArgException) or isinstance(inner, ArgException):
-        name = str(inner if isinstance(inner, ArgException) else error)
-        return f"xacro: undefined argument {name!r} (xacro_args= gives its value)"
+    inner: BaseException | None = error
+    for _ in range(10):  # xacro wraps an exception in its own, sometimes twice
+        if inner is None or isinstance(inner, ArgException):
+            break
+        inner = getattr(inner, "exc", None) or inner.__context__
+    if isinstance(inner, ArgException):
+        return f"xacro: undefined argument {str(inner)!r} (xacro_args= gives its value)"
     message = " ".join((str(error) or repr(error)).split())
     stack = [str(item) for item in (xacro.filestack or []) if item]
     where = f" (in {stack[-1]})" if stack else ""
