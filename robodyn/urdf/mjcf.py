@@ -18,13 +18,15 @@ The reading, as MuJoCo's compiler does it:
   everything in the body is placed relative to it; a body without joints is welded;
 - joints ``hinge`` (revolute / continuous), ``slide`` (prismatic), ``free`` (on the one
   top body only: a floating base); ``range`` with ``limited`` / ``autolimits``;
-- ``<inertial>`` (``diaginertia`` or ``fullinertia``, with its own frame);
+- ``<inertial>`` (``diaginertia`` or ``fullinertia``, with its own frame), or, where
+  MuJoCo's ``inertiafromgeom`` would, the inertia of the body's solid geoms (sphere,
+  capsule, cylinder, ellipsoid, box; ``density`` / ``mass``; :mod:`robodyn.urdf.geom_inertia`);
 - ``<site>`` s become frames (massless links on fixed joints, named as the site);
 - ``box``, ``sphere``, ``capsule``, ``cylinder``, ``ellipsoid`` and ``mesh`` geoms become
   visuals (drawings only).
 
 Refused with one sentence: ``ball`` joints, a ``free`` joint below the top, a nonzero joint
-``ref``, a body that needs MuJoCo to compute its inertia from geoms, ``<include>``,
+``ref``, a body whose inertia would come from a mesh geom or a shell, ``<include>``,
 ``<frame>``, ``<replicate>``, ``<attach>``, compiler options that rescale masses. Reported
 in one :class:`~robodyn.exceptions.RobodynWarning` line per kind (``strict=True`` refuses):
 tendons, equality constraints, actuators, contact pairs / excludes, joint stiffness,
@@ -45,6 +47,7 @@ import numpy as np
 from robodyn.common.rotations import axis_rotation, matrix_rpy
 from robodyn.common.text import printable
 from robodyn.exceptions import RobodynWarning, URDFError
+from robodyn.urdf.geom_inertia import SOLIDS, combine, solid_properties
 from robodyn.urdf.xmltext import parse_number, parse_xml, split_numbers
 
 if TYPE_CHECKING:
@@ -72,6 +75,7 @@ class Compiler:
     autolimits: bool = True
     inertiafromgeom: str = "auto"
     meshdir: Path | None = None
+    inertiagroups: str = "0 5"
 
 
 @dataclass
@@ -181,7 +185,12 @@ def _compiler(root: ET.Element, label: str, base_dir: Path | None) -> Compiler:
     meshdir = settings.get("meshdir", settings.get("assetdir"))
     folder = None if base_dir is None else (base_dir / meshdir if meshdir else base_dir)
     return Compiler(
-        angle == "degree", sequence, settings.get("autolimits", "true") == "true", settings.get("inertiafromgeom", "auto"), folder
+        angle == "degree",
+        sequence,
+        settings.get("autolimits", "true") == "true",
+        settings.get("inertiafromgeom", "auto"),
+        folder,
+        settings.get("inertiagrouprange", "0 5"),
     )
 
 
@@ -432,12 +441,8 @@ def _write_link(robot: _Robot, body: ET.Element, name: str, link: ET.Element, of
     geoms = body.findall("geom")
     needs_geoms = robot.compiler.inertiafromgeom == "true" or (inertial is None and robot.compiler.inertiafromgeom == "auto")
     if geoms and needs_geoms:
-        raise URDFError(
-            robot.label,
-            f'body "{name}" has no <inertial> (or inertiafromgeom="true"): robodyn does not compute inertia from '
-            "geoms; add <inertial> (MuJoCo's compiled model gives the values: mj_saveLastXML)",
-        )
-    if inertial is not None:
+        _write_geom_inertial(robot, geoms, name, link, shift, childclass)
+    elif inertial is not None:
         _write_inertial(robot, inertial, name, link, shift)
     for index, geom in enumerate(geoms):
         _write_visual(robot, geom, f'geom #{index + 1} of body "{name}"', link, shift, childclass)
@@ -470,6 +475,65 @@ def _write_inertial(robot: _Robot, node: ET.Element, name: str, link: ET.Element
     ET.SubElement(element, "mass", value=repr(_number(robot.label, where, node.attrib["mass"])))
     values = {"ixx": ixx, "iyy": iyy, "izz": izz, "ixy": ixy, "ixz": ixz, "iyz": iyz}
     ET.SubElement(element, "inertia", {key: repr(float(value)) for key, value in values.items()})
+
+
+def _write_geom_inertial(
+    robot: _Robot, geoms: list[ET.Element], name: str, link: ET.Element, shift: np.ndarray, childclass: str
+) -> None:
+    """The body's inertia from its geoms, as MuJoCo's compiler computes it (uniform solids)."""
+    parts = []
+    for index, geom in enumerate(geoms):
+        where = f'geom #{index + 1} of body "{name}"'
+        attributes = _attributes(robot, geom, childclass)
+        kind = attributes.get("type", "sphere")
+        low, high = (int(value) for value in _floats(robot.label, where, robot.compiler.inertiagroups, 2))
+        if not low <= int(_number(robot.label, where, attributes.get("group", "0"))) <= high or kind in ("plane", "hfield"):
+            continue
+        if kind not in SOLIDS or attributes.get("shellinertia", "false") == "true":
+            raise URDFError(
+                robot.label,
+                f'body "{name}" has no <inertial> and a {kind} geom robodyn does not compute inertia from '
+                "(solid sphere, capsule, cylinder, ellipsoid, box): add <inertial>",
+            )
+        size, pose = _geom_size_and_pose(robot, where, attributes, kind)
+        given = attributes.get("mass")
+        mass, principal = solid_properties(
+            kind,
+            size,
+            density=_number(robot.label, where, attributes.get("density", "1000")),
+            mass=None if given is None else _number(robot.label, where, given),
+        )
+        placed = shift @ pose
+        parts.append((mass, placed[:3, 3], placed[:3, :3], principal))
+    mass, centre, inertia = combine(parts)
+    if mass <= 0:
+        return
+    element = ET.SubElement(link, "inertial")
+    ET.SubElement(element, "origin", xyz=_text(centre), rpy="0 0 0")
+    ET.SubElement(element, "mass", value=repr(mass))
+    values = {"ixx": (0, 0), "iyy": (1, 1), "izz": (2, 2), "ixy": (0, 1), "ixz": (0, 2), "iyz": (1, 2)}
+    ET.SubElement(element, "inertia", {key: repr(float(inertia[i, j])) for key, (i, j) in values.items()})
+
+
+def _geom_size_and_pose(robot: _Robot, where: str, attributes: dict[str, str], kind: str) -> tuple[list[float], np.ndarray]:
+    """A geom's ``size`` and pose in its body's frame (``fromto`` for capsules and cylinders)."""
+    size = [_number(robot.label, where, token) for token in split_numbers(attributes.get("size", ""))]
+    needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}.get(kind, 0)
+    if "fromto" not in attributes:
+        if len(size) < needed:
+            raise URDFError(robot.label, f"{where}: a {kind} needs {needed} size numbers")
+        return size, _pose(robot, where, attributes)
+    if kind not in ("capsule", "cylinder"):
+        raise URDFError(robot.label, f"{where}: fromto on a {kind} is not read by robodyn")
+    ends = _floats(robot.label, where, attributes["fromto"], 6)
+    pose = np.eye(4)
+    pose[:3, 3] = (ends[:3] + ends[3:]) / 2
+    length = float(np.linalg.norm(ends[3:] - ends[:3]))
+    if length > 1e-12:
+        pose[:3, :3] = _zaxis((ends[3:] - ends[:3]) / length)
+    if not size:
+        raise URDFError(robot.label, f"{where}: a {kind} needs a radius")
+    return [size[0], length / 2], pose
 
 
 def _write_visual(robot: _Robot, geom: ET.Element, where: str, link: ET.Element, shift: np.ndarray, childclass: str) -> None:

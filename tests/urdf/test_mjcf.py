@@ -23,7 +23,7 @@ from robodyn.exceptions import RobodynWarning, URDFError
 from tests.conftest import ROOT
 
 DATA = ROOT / "tests" / "data" / "mjcf"
-FILES = ["arm.xml", "floating.xml"]
+FILES = ["arm.xml", "floating.xml", "geoms.xml"]
 
 
 def mujoco_model(text: str) -> mujoco.MjModel:
@@ -135,9 +135,7 @@ def test_the_arm_reads_every_joint_and_its_armature_damping_and_friction_as_mujo
             assert (joint.lower, joint.upper) == pytest.approx(tuple(model.jnt_range[index]), abs=1e-12)
         else:
             assert np.isinf(joint.lower) and np.isinf(joint.upper)
-    assert sorted(robot.joint_names) == sorted(
-        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)
-    )
+    assert sorted(robot.joint_names) == sorted(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt))
 
 
 def test_sites_are_frames_where_mujoco_puts_them():
@@ -192,6 +190,12 @@ def test_a_quaternion_written_w_last_is_caught():
     assert max(largest_differences(robodyn.load(text), path.read_text())) > 1e-3
 
 
+def test_a_geom_class_left_out_is_caught():
+    path = DATA / "geoms.xml"
+    text = path.read_text().replace('size="0.06" class="light"', 'size="0.06"')
+    assert largest_differences(robodyn.load(text), path.read_text())[1] > 1e-6  # far above the 1e-10 tolerance
+
+
 def test_degrees_read_as_radians_are_caught():
     path = DATA / "arm.xml"
     text = path.read_text().replace('angle="degree"', 'angle="radian"')
@@ -221,7 +225,8 @@ INERTIAL = '<inertial pos="0 0 -0.1" mass="1" diaginertia="0.01 0.01 0.01"/>'
     ("joint", "inside", "message"),
     [
         ('type="ball"', INERTIAL, 'joint "j": ball joints are not read'),
-        ("", '<geom type="box" size="0.1 0.1 0.1"/>', 'body "b" has no <inertial>'),
+        ("", '<geom type="mesh" mesh="m"/>', 'body "b" has no <inertial> and a mesh geom'),
+        ("", '<geom type="box" fromto="0 0 0 0 0 1" size="0.1 0.1"/>', "fromto on a box"),
         ('ref="0.3"', INERTIAL, "nonzero ref"),
         ('axis="0 0 0"', INERTIAL, "must not be zero"),
         ('range="0.5 0.1"', INERTIAL, "lower < upper"),

@@ -105,7 +105,7 @@ def test_the_reference_reads_the_same_expansion():
         (('x="0.04" y="0.06" z="0.1"', 'x="0.04" y="0.06"'), "xacro: "),
         (("$(arg prefix)", "$(arg no_such_arg)"), "undefined argument 'no_such_arg'"),
         (("${-pi/2}", "${__import__('os')}"), "xacro: "),
-        (("<link name=\"${prefix}base\"/>", "<link name=\"${prefix}base\">"), "xacro: "),
+        (('<link name="${prefix}base"/>', '<link name="${prefix}base">'), "xacro: "),
     ],
 )
 def test_a_xacro_that_does_not_expand_is_one_line_naming_why(tmp_path, capsys, edit, message):
