@@ -3,7 +3,6 @@ then the zoo; drawings, lint and loading all use it."""
 
 from __future__ import annotations
 
-import os
 import pickle
 import shutil
 import warnings
@@ -50,7 +49,7 @@ def test_a_missing_package_names_the_places_looked_in(monkeypatch):
 
 @pytest.mark.parametrize("packages", [{"a/b": str(PACKAGE)}, {"robodyn_test_arm": "/no/such/folder"}])
 def test_a_bad_packages_argument_is_one_input_error(packages):
-    with pytest.raises(InputError, match="^packages must be"):
+    with pytest.raises(InputError, match=r"^packages must be"):
         robodyn.load(URDF, packages=packages)
 
 

@@ -127,11 +127,11 @@ def test_an_include_that_is_a_fifo_or_too_large_is_refused(tmp_path):
     (tmp_path / "top.xacro").write_text(
         '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:include filename="fifo.xacro"/></robot>'
     )
-    with pytest.raises(URDFError, match="fifo.xacro: is not a regular file"):
+    with pytest.raises(URDFError, match=r"fifo\.xacro: is not a regular file"):
         robodyn.load(tmp_path / "top.xacro")
     (tmp_path / "big.xacro").write_text("<robot>" + " " * 5000 + "</robot>")
     (tmp_path / "top.xacro").write_text((tmp_path / "top.xacro").read_text().replace("fifo", "big"))
-    with pytest.raises(URDFError, match="big.xacro: is 5015 bytes, more than the limit of 1000"):
+    with pytest.raises(URDFError, match=r"big\.xacro: is 5015 bytes, more than the limit of 1000"):
         robodyn.load(tmp_path / "top.xacro", max_bytes=1000)
 
 
