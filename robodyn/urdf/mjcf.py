@@ -27,7 +27,8 @@ The reading, as MuJoCo's compiler does it:
 
 Refused with one sentence: ``ball`` joints, a ``free`` joint below the top, a nonzero joint
 ``ref``, a body whose inertia would come from a mesh geom or a shell, ``<include>``,
-``<frame>``, ``<replicate>``, ``<attach>``, compiler options that rescale masses. Reported
+``<frame>``, ``<replicate>``, ``<attach>``, ``boundmass`` / ``boundinertia``
+(``settotalmass`` is read: masses and inertias scaled as MuJoCo does). Reported
 in one :class:`~robodyn.exceptions.RobodynWarning` line per kind (``strict=True`` refuses):
 tendons, equality constraints, actuators, contact pairs / excludes, joint stiffness,
 ``gravcomp``, a non-default ``<option gravity>``.
@@ -76,6 +77,7 @@ class Compiler:
     inertiafromgeom: str = "auto"
     meshdir: Path | None = None
     inertiagroups: str = "0 5"
+    total_mass: float = -1.0
 
 
 @dataclass
@@ -164,14 +166,29 @@ def read_mjcf(root: ET.Element, label: str, base_dir: Path | None) -> _Robot:
         ET.SubElement(urdf, "link", name="world")
         for body in bodies:
             _read_body(robot, body, "world", np.eye(4), "main")
+    if compiler.total_mass > 0:
+        _set_total_mass(urdf, compiler.total_mass)
     return robot
+
+
+def _set_total_mass(urdf: ET.Element, total: float) -> None:
+    """Scale every mass and inertia so that they add up to ``total`` (``<compiler settotalmass>``)."""
+    inertials = urdf.findall("link/inertial")
+    current = sum(float(mass.get("value", "0")) for mass in urdf.findall("link/inertial/mass"))
+    if current <= 0:
+        return
+    for node in inertials:
+        for element in (node.find("mass"), node.find("inertia")):
+            assert element is not None  # written by this module
+            for key, value in element.attrib.items():
+                element.set(key, repr(float(value) * total / current))
 
 
 def _compiler(root: ET.Element, label: str, base_dir: Path | None) -> Compiler:
     settings: dict[str, str] = {}
     for node in root.findall("compiler"):
         settings.update(node.attrib)
-    for option in ("settotalmass", "boundmass", "boundinertia"):
+    for option in ("boundmass", "boundinertia"):
         if option in settings and _number(label, "compiler", settings[option]) > 0:
             raise URDFError(label, f"<compiler {option}> rescales masses or inertias: robodyn does not read it")
     if settings.get("balanceinertia", "false") == "true" or settings.get("coordinate", "local") != "local":
@@ -191,6 +208,7 @@ def _compiler(root: ET.Element, label: str, base_dir: Path | None) -> Compiler:
         settings.get("inertiafromgeom", "auto"),
         folder,
         settings.get("inertiagrouprange", "0 5"),
+        _number(label, "compiler settotalmass", settings.get("settotalmass", "-1")),
     )
 
 

@@ -190,6 +190,13 @@ def test_a_quaternion_written_w_last_is_caught():
     assert max(largest_differences(robodyn.load(text), path.read_text())) > 1e-3
 
 
+def test_settotalmass_scales_masses_and_inertias_as_mujoco_does():
+    text = (DATA / "geoms.xml").read_text().replace('<compiler angle="radian"/>', '<compiler angle="radian" settotalmass="7.5"/>')
+    robot = robodyn.load(text)
+    assert robot.total_mass == pytest.approx(7.5, abs=1e-12)
+    assert max(largest_differences(robot, text)) < 1e-10
+
+
 def test_a_geom_class_left_out_is_caught():
     path = DATA / "geoms.xml"
     text = path.read_text().replace('size="0.06" class="light"', 'size="0.06"')
