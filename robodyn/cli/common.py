@@ -48,6 +48,56 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
         dest="max_dof",
         help="largest number of degrees of freedom to build (Pinocchio's memory grows as nv²; default 300)",
     )
+    add_file_arguments(parser)
+
+
+def add_file_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable)."""
+    parser.add_argument(
+        "--xacro-arg",
+        dest="xacro_arg",
+        action="append",
+        metavar="NAME:=VALUE",
+        help="a xacro argument of a .xacro model (repeatable)",
+    )
+    parser.add_argument(
+        "--package",
+        dest="package",
+        action="append",
+        metavar="NAME=DIR",
+        help="where ROS package NAME is, for package:// paths and $(find NAME) (repeatable; "
+        "then $ROS_PACKAGE_PATH, then the zoo's folders)",
+    )
+
+
+def xacro_arguments(values: Sequence[str] | None) -> dict[str, str]:
+    """Parse ``--xacro-arg NAME:=VALUE`` options into ``{NAME: VALUE}``.
+
+    Raises:
+        InputError: For a value without ``:=`` or with an empty name.
+    """
+    arguments = {}
+    for item in values or []:
+        name, separator, value = item.partition(":=")
+        if not separator or not name.strip():
+            raise InputError("--xacro-arg", "NAME:=VALUE", repr(item))
+        arguments[name.strip()] = value
+    return arguments
+
+
+def package_arguments(values: Sequence[str] | None) -> dict[str, str]:
+    """Parse ``--package NAME=DIR`` options into ``{NAME: DIR}``.
+
+    Raises:
+        InputError: For a value without ``=``, with an empty name or folder.
+    """
+    packages = {}
+    for item in values or []:
+        name, separator, folder = item.partition("=")
+        if not separator or not name.strip() or not folder.strip() or "/" in name:
+            raise InputError("--package", "NAME=DIR (a package name and its folder)", repr(item))
+        packages[name.strip()] = folder.strip()
+    return packages
 
 
 def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
@@ -60,6 +110,8 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
         strict=arguments.strict,
         max_dof=arguments.max_dof,
         lock=lock_values(getattr(arguments, "lock", None)),
+        xacro_args=xacro_arguments(getattr(arguments, "xacro_arg", None)) or None,
+        packages=package_arguments(getattr(arguments, "package", None)) or None,
     )
 
 

@@ -41,6 +41,8 @@ FLAGS: dict[str, str] = {
     "plot": "--plot",
     "actuated": "--actuated",
     "q_eq": "--target",
+    "xacro_args": "--xacro-arg",
+    "packages": "--package",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

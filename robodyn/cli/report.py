@@ -37,6 +37,9 @@ def info_dict(robot: Robot) -> dict:
     limited = [False] * offset + [bool(np.isfinite(lo) or np.isfinite(up)) for lo, up in zip(lower, upper, strict=True)]
     return {
         "name": robot.name,
+        "robot_name": robot.spec.name,
+        "file_format": robot.source.file_format,
+        "source": robot.source.label if len(robot.source.label) < 300 else "<text>",
         "nq": robot.nq,
         "nv": robot.nv,
         "floating_base": robot.floating_base,
@@ -57,14 +60,42 @@ def info_dict(robot: Robot) -> dict:
         ],
         "link_masses_kg": robot.link_masses,
         "total_mass_kg": robot.total_mass,
+        "mimic_joints": mimic_joints(robot),
+        "joint_dynamics": [
+            {"joint": dof.joint, "damping": dof.damping, "friction": dof.friction, "armature": dof.armature}
+            for dof in robot.dofs
+            if not dof.is_base
+        ],
+        "package_paths": package_paths(robot),
     }
+
+
+def mimic_joints(robot: Robot) -> list[dict]:
+    """The robot's mimic joints: ``q = multiplier * q_source + offset``, in document order."""
+    return [
+        {"joint": joint.name, "source": joint.mimic.joint, "multiplier": joint.mimic.multiplier, "offset": joint.mimic.offset}
+        for joint in robot.spec.joints.values()
+        if joint.mimic is not None
+    ]
+
+
+def package_paths(robot: Robot) -> dict[str, list[str]]:
+    """Where the robot's ``package://`` paths resolve: ``packages=``, ``$ROS_PACKAGE_PATH``, the zoo."""
+    from robodyn.urdf.packages import PackageLookup
+
+    dirs = robot.source.package_dirs
+    if isinstance(dirs, PackageLookup):
+        return dirs.as_dict()
+    return {"packages": [], "ros_package_path": [], "zoo": [str(folder) for folder in dirs]}
 
 
 def info_text(robot: Robot) -> str:
     """A readable description of a robot: joints with types and limits, link masses."""
     end_effector, reason = end_effector_text(robot)
+    also = f' ("{printable(robot.name)}")' if robot.name != robot.spec.name else ""
+    kind = {"xacro": ", expanded from xacro", "mjcf": ", read from MJCF"}.get(robot.source.file_format, "")
     lines = [
-        f"robot {printable(robot.name)}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
+        f"robot {printable(robot.spec.name)}{also}{kind}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
         f"{'floating' if robot.floating_base else 'fixed'} base, gravity {_vector(robot.gravity_vector, 4)} m/s²",
         f"end effector (default task frame): {printable(end_effector) if end_effector else reason}",
         "",
@@ -88,10 +119,47 @@ def info_text(robot: Robot) -> str:
         )
     if open_limits:
         lines.append("* a placeholder (|limit| ≥ 1e3, lower = upper, or 0 effort / velocity): treated as no limit")
+    lines += _dynamics_lines(robot) + _mimic_lines(robot) + _package_lines(robot)
     lines += ["", f"{'link':30s} {'mass':>12s}"]
     lines += [f"{printable(name):30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
     lines.append(f"{'total':30s} {robot.total_mass:>9.4g} kg")
     return "\n".join(lines)
+
+
+def _dynamics_lines(robot: Robot) -> list[str]:
+    """Damping, friction and armature of each joint, when any joint has one."""
+    dofs = [dof for dof in robot.dofs if not dof.is_base]
+    if not any(dof.damping or dof.friction or dof.armature for dof in dofs):
+        return ["", "joint damping, friction, armature: none"]
+    lines = ["", f"{'joint':30s} {'damping b':>16s} {'friction f':>12s} {'armature':>14s}"]
+    for dof in dofs:
+        inertia = "kg m²" if dof.kind == "angular" else "kg"
+        damping = f"{dof.damping:.4g} {dof.effort_unit} s/{dof.position_unit}"
+        lines.append(
+            f"{printable(dof.joint):30s} {damping:>16s} {f'{dof.friction:.4g} {dof.effort_unit}':>12s} "
+            f"{f'{dof.armature:.4g} {inertia}':>14s}"
+        )
+    return lines
+
+
+def _mimic_lines(robot: Robot) -> list[str]:
+    mimics = mimic_joints(robot)
+    if not mimics:
+        return []
+    lines = ["", "mimic joints (q = multiplier × q_source + offset):"]
+    for mimic in mimics:
+        lines.append(
+            f"  {printable(mimic['joint'])} = {mimic['multiplier']:.6g} × {printable(mimic['source'])} + {mimic['offset']:.6g}"
+        )
+    return lines
+
+
+def _package_lines(robot: Robot) -> list[str]:
+    paths = package_paths(robot)
+    shown = [f"{item} (--package)" for item in paths["packages"]]
+    shown += [f"{item} ($ROS_PACKAGE_PATH)" for item in paths["ros_package_path"]]
+    shown += [f"{item} (zoo)" for item in paths["zoo"]]
+    return ["", "package paths: " + ("; ".join(printable(item) for item in shown) if shown else "none")]
 
 
 def _limit(value: float, unit: str) -> str:

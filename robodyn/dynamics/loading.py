@@ -38,7 +38,7 @@ from robodyn.dynamics.options import MAX_DOF, LoadOptions, load_options
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import URDFError
 from robodyn.urdf.normalised import normalised_urdf
-from robodyn.urdf.sources import URDFSource, locked_source, resolve_source
+from robodyn.urdf.sources import URDFSource, locked_source, resolve_source, with_file_dynamics
 from robodyn.urdf.validation import URDFSpec, parse_urdf
 
 
@@ -76,9 +76,9 @@ def load(
     """Load a robot.
 
     Args:
-        source: A URDF file path, URDF XML text, a zoo robot name (``"panda"``,
-            ``"ur5"``, ...) or a generated robot's name (``"rp_arm"``); ``robodyn list``
-            prints the names.
+        source: A URDF, ``.xacro`` or MJCF (``<mujoco>``) file path, such XML text, a zoo
+            robot name (``"panda"``, ``"ur5"``, ...) or a generated robot's name
+            (``"rp_arm"``); ``robodyn list`` prints the names. See docs/robot-files.md.
         floating_base: Give the root link a free-flyer joint. ``None``: true for zoo
             robots that walk, swim or fly, false otherwise.
         gravity: Gravity acceleration in the world frame, in [m/s²]; default
@@ -116,7 +116,7 @@ def load(
         RobodynWarning: For what ``strict=True`` refuses.
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
-    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders)
+    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict)
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
@@ -216,6 +216,7 @@ def build_robot(resolved: URDFSource, options: LoadOptions) -> Robot:
         strict=options.strict,
         **resolved.mesh_context,
     )
+    spec = with_file_dynamics(spec, resolved.label)
     _check_size(spec, resolved.label, floating, options.max_dof)
     model = build_model(spec, resolved.label, floating=floating, mimic=True)
     mimic = None

@@ -14,7 +14,7 @@ package imports it, and a test runs it in a process where Pinocchio cannot be im
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -22,7 +22,7 @@ from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.tree import KinematicTree, build_tree
-from robodyn.urdf.sources import locked_source, resolve_source
+from robodyn.urdf.sources import locked_source, resolve_source, with_file_dynamics
 from robodyn.urdf.validation import parse_urdf
 
 
@@ -33,6 +33,8 @@ def load(
     check_inertia: bool = True,
     lock: dict[str, float] | None = None,
     floating_base: bool = False,
+    xacro_args: Mapping[str, str] | None = None,
+    packages: Mapping[str, str] | None = None,
 ) -> ReferenceRobot:
     """Load the reference model of a robot.
 
@@ -44,16 +46,19 @@ def load(
         floating_base: Give the root six degrees of freedom (Pinocchio's free-flyer
             convention for ``q`` and ``v``); unlike :func:`robodyn.load` the default is
             a fixed base whatever the source.
+        xacro_args, packages: As for :func:`robodyn.load` (a xacro or MJCF source is read
+            by robodyn's own readers, never by Pinocchio).
 
     Raises:
         UnknownRobotError, URDFError: As :func:`robodyn.load`.
     """
-    resolved = resolve_source(source)
+    resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating_base, check_inertia=check_inertia)
     spec = parse_urdf(
         resolved.text, resolved.label, floating_base=floating_base, check_inertia=check_inertia, **resolved.mesh_context
     )
+    spec = with_file_dynamics(spec, resolved.label)
     tree = build_tree(spec, resolved.text, floating_base=floating_base)
     name = spec.name if resolved.name == "robot" else resolved.name
     gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)

@@ -20,6 +20,27 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from robodyn.exceptions import MeshPathError
+from robodyn.urdf.packages import PackageLookup
+
+
+def _roots(package_dirs: Sequence[Path] | PackageLookup) -> tuple[Path, ...]:
+    return package_dirs.roots() if isinstance(package_dirs, PackageLookup) else tuple(Path(d) for d in package_dirs)
+
+
+def _package_folders(package: str, package_dirs: Sequence[Path] | PackageLookup) -> list[Path]:
+    """The folders package ``package`` may be: the lookup's one, or ``NAME`` under each folder."""
+    if isinstance(package_dirs, PackageLookup):
+        found = package_dirs.find(package)
+        return [found] if found is not None else []
+    return [Path(folder) / package for folder in package_dirs]
+
+
+def looked_in(filename: str, package_dirs: Sequence[Path] | PackageLookup) -> str:
+    """Where a missing ``package://`` mesh was looked for, for a message."""
+    package = filename[len("package://") :].lstrip("/").partition("/")[0]
+    if isinstance(package_dirs, PackageLookup):
+        return "; ".join(package_dirs.places(package))
+    return "; ".join(str(Path(folder) / package) for folder in package_dirs) or "no package folder given"
 
 
 def _inside(path: Path, folder: Path) -> bool:
@@ -30,25 +51,27 @@ def _inside(path: Path, folder: Path) -> bool:
     return True
 
 
-def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> Path | None:
+def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence[Path] | PackageLookup) -> Path | None:
     """The file a mesh path names (which may not be a regular file: see
     :func:`is_regular_file`), or ``None`` if it cannot be found.
 
     Args:
         filename: The ``filename`` attribute of a ``<mesh>``.
         base_dir: Folder of the URDF file (``None`` for URDF text).
-        package_dirs: Folders holding the packages ``package://`` names.
+        package_dirs: The package lookup (:class:`~robodyn.urdf.packages.PackageLookup`:
+            ``packages=``, ``$ROS_PACKAGE_PATH``, the zoo), or folders holding the
+            packages ``package://`` names.
 
     Raises:
         MeshPathError: If the path leaves the URDF's folder or the package folders.
     """
-    roots = [Path(d) for d in package_dirs] + ([Path(base_dir)] if base_dir is not None else [])
+    roots = list(_roots(package_dirs)) + ([Path(base_dir)] if base_dir is not None else [])
     if filename.startswith("package://"):
         relative = filename[len("package://") :].lstrip("/")
-        package = relative.split("/", 1)[0]
-        for folder in package_dirs:
-            candidate = Path(folder) / relative
-            if not _inside(candidate, Path(folder) / package):
+        package, _, rest = relative.partition("/")
+        for folder in _package_folders(package, package_dirs):
+            candidate = folder / rest
+            if not _inside(candidate, folder):
                 raise MeshPathError(filename, f"leaves its package {package!r}")
             if _exists(candidate):
                 return candidate
@@ -88,7 +111,9 @@ def is_regular_file(path: Path) -> bool:
     return mode is not None and stat.S_ISREG(mode)
 
 
-def mesh_problems(root: ET.Element, *, base_dir: Path | None, package_dirs: Sequence[Path]) -> list[tuple[str, str, str]]:
+def mesh_problems(
+    root: ET.Element, *, base_dir: Path | None, package_dirs: Sequence[Path] | PackageLookup
+) -> list[tuple[str, str, str]]:
     """Problems of every ``<mesh>``: ``(element, rule, severity)`` tuples."""
     problems = []
     for link in root.findall("link"):
@@ -105,7 +130,10 @@ def mesh_problems(root: ET.Element, *, base_dir: Path | None, package_dirs: Sequ
                     problems.append((where, str(error), "error"))
                     continue
                 if found is None:
-                    problems.append((where, f"{kind} mesh {filename!r} not found (the model loads without it)", "warning"))
+                    places = looked_in(filename, package_dirs) if filename.startswith("package://") else str(base_dir)
+                    problems.append(
+                        (where, f"{kind} mesh {filename!r} not found (looked in {places}; the model loads without it)", "warning")
+                    )
                 elif not is_regular_file(found):
                     problems.append(
                         (where, f"{kind} mesh {filename!r} is not a regular file (a FIFO, device or directory): "

@@ -9,7 +9,9 @@ messages, the folder its relative mesh paths start from and the package folders 
 from __future__ import annotations
 
 import difflib
+import math
 import os
+import re
 import stat
 import warnings
 from collections.abc import Mapping
@@ -20,7 +22,10 @@ from robodyn.exceptions import RobodynWarning, UnknownRobotError, URDFError
 from robodyn.urdf import zoo
 from robodyn.urdf.edit import lock_joints
 from robodyn.urdf.models import GENERATED
-from robodyn.urdf.validation import Problem, lint_urdf, parse_urdf
+from robodyn.urdf.packages import PackageLookup, package_lookup
+from robodyn.urdf.validation import Problem, URDFSpec, lint_urdf, parse_urdf
+from robodyn.urdf.xacro_files import expand_xacro, is_xacro_text
+from robodyn.urdf.xmltext import parse_number
 
 
 @dataclass(frozen=True)
@@ -33,7 +38,11 @@ class URDFSource:
         label: Where it came from, for messages: a path, a robot name or ``"<string>"``.
         path: The file it was read from, if any.
         floating_base: Whether the robot is floating by default (zoo robots that walk or fly).
-        package_dirs: Folders under which ``package://`` paths resolve.
+        package_dirs: Where ``package://`` paths resolve: the zoo's folders, or (files
+            and text) the package lookup (:class:`~robodyn.urdf.packages.PackageLookup`,
+            a tuple of folders that also knows ``packages=`` and ``$ROS_PACKAGE_PATH``).
+        file_format: What the user's file was: ``"urdf"``, ``"xacro"`` (``text`` is its
+            expansion) or ``"mjcf"`` (``text`` is the URDF robodyn's MJCF reader wrote).
     """
 
     text: str
@@ -42,6 +51,7 @@ class URDFSource:
     path: Path | None = None
     floating_base: bool = False
     package_dirs: tuple[Path, ...] = field(default_factory=tuple)
+    file_format: str = "urdf"
 
     @property
     def mesh_context(self) -> dict:
@@ -119,13 +129,74 @@ def _kind(mode: int) -> str:
     return "a special file"
 
 
-def _read_file(path: Path, max_bytes: int) -> URDFSource:
-    data = read_regular_file(path, max_bytes)
+def read_text(path: Path, max_bytes: int, label: str | None = None) -> str:
+    """The UTF-8 text of a regular file of at most ``max_bytes`` bytes (see
+    :func:`read_regular_file`).
+
+    Raises:
+        URDFError: As :func:`read_regular_file`, or if the file is not UTF-8 text.
+    """
+    data = read_regular_file(path, max_bytes, label)
     try:
-        text = data.decode("utf-8")
+        return data.decode("utf-8")
     except UnicodeDecodeError as error:
-        raise URDFError(str(path), f"is not UTF-8 text (byte {error.start})") from None
-    return URDFSource(text, path.stem, str(path), path.resolve(), False, ())
+        raise URDFError(str(path) if label is None else label, f"is not UTF-8 text (byte {error.start})") from None
+
+
+def _read_file(path: Path, max_bytes: int, reading: _Reading | None = None) -> URDFSource:
+    text = read_text(path, max_bytes)
+    source = URDFSource(text, path.stem, str(path), path.resolve(), False, ())
+    return _interpret(source, reading) if reading is not None else source
+
+
+@dataclass(frozen=True)
+class _Reading:
+    """How a file or text is read: its limit, xacro arguments, package lookup, strictness."""
+
+    limit: int
+    xacro_args: Mapping[str, str] | None
+    lookup: PackageLookup
+    strict: bool
+
+
+_ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
+_PROLOG = re.compile(r"<\?.*?\?>|<!--.*?-->", re.DOTALL)
+
+
+def root_tag(text: str) -> str | None:
+    """The name of the first element of XML text (after its declaration and comments)."""
+    head = _PROLOG.sub("", text[: 1 << 20])
+    match = _ROOT_TAG.search(head)
+    return match.group(1) if match else None
+
+
+def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
+    """A source read as what it is: xacro expanded, MJCF converted, SDF refused."""
+    tag = root_tag(source.text)
+    if tag == "sdf":
+        raise URDFError(
+            source.label,
+            "the root element must be <robot>, not <sdf>: robodyn does not read SDF; convert it to URDF "
+            "first (e.g. 'gz sdf -p model.sdf > model.urdf')",
+        )
+    if tag == "mujoco":
+        from robodyn.urdf.mjcf import mjcf_source
+
+        return mjcf_source(source, strict=reading.strict, lookup=reading.lookup)
+    source = replace(source, package_dirs=reading.lookup)
+    is_xacro = source.path is not None and source.path.suffix == ".xacro"
+    if is_xacro or (tag == "robot" and is_xacro_text(source.text)):
+        text = expand_xacro(
+            path=source.path if source.path is not None else None,
+            text=source.text,
+            label=source.label,
+            args=reading.xacro_args,
+            lookup=reading.lookup,
+            read_file=lambda path: read_text(path, reading.limit),
+        )
+        name = source.name.removesuffix(".urdf") if is_xacro else source.name
+        return replace(source, text=text, name=name, file_format="xacro")
+    return source
 
 
 def resolve_source(
@@ -134,31 +205,36 @@ def resolve_source(
     max_bytes: int | None = None,
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
+    strict: bool = False,
 ) -> URDFSource:
     """Find the URDF a source names.
 
     Args:
-        source: A path to a URDF file, URDF XML text, a zoo robot name (``"panda"``) or a
-            generated robot's name (``"rp_arm"``).
-        max_bytes: Largest URDF accepted, in bytes (files and text); default
-            ``$ROBODYN_MAX_URDF_BYTES`` or :data:`MAX_URDF_BYTES` (64 MiB).
-        xacro_args: Arguments of a ``.xacro`` source (not yet expanded: see issue 24).
-        packages: Package folders by package name (not yet used: see issue 24).
+        source: A path to a URDF, ``.xacro`` or MJCF file, URDF / xacro / MJCF text, a zoo
+            robot name (``"panda"``) or a generated robot's name (``"rp_arm"``).
+        max_bytes: Largest file accepted, in bytes (files, text and each file a xacro
+            includes); default ``$ROBODYN_MAX_URDF_BYTES`` or :data:`MAX_URDF_BYTES` (64 MiB).
+        xacro_args: Arguments of a xacro source, ``{name: value}``.
+        packages: Package folders by package name, searched before ``$ROS_PACKAGE_PATH``
+            and the zoo (:mod:`robodyn.urdf.packages`) for ``$(find)`` and ``package://``.
+        strict: Refuse MJCF elements robodyn cannot take instead of warning.
 
     Raises:
-        URDFError: If a file cannot be read, is not a regular file or is too large.
+        URDFError: If a file cannot be read, is not a regular file or is too large, a
+            xacro does not expand, an MJCF cannot be read, or the file is SDF.
         UnknownRobotError: If a name is neither a robot nor an existing file.
     """
     limit = max_urdf_bytes(max_bytes)
+    reading = _Reading(limit, xacro_args, package_lookup(packages), strict)
     if isinstance(source, os.PathLike):
-        return _read_file(Path(source), limit)
+        return _read_file(Path(source), limit, reading)
     if not isinstance(source, str):
         raise UnknownRobotError(f"{type(source).__name__} {source!r:.60}")
     text = source.lstrip("\ufeff \t\r\n").strip()
     if text.startswith("<"):
         if len(source) > limit:  # characters: a lower bound of the UTF-8 size
             raise URDFError("<string>", f"is more than the limit of {limit} bytes ({_OVERRIDE})")
-        return URDFSource(source, "robot", "<string>")
+        return _interpret(URDFSource(source, "robot", "<string>"), reading)
     if text in GENERATED:
         return URDFSource(GENERATED[text](), text, text)
     if text in zoo.ZOO:
@@ -171,10 +247,10 @@ def resolve_source(
         exists = path.exists()
     except (OSError, ValueError):  # a name too long for the file system, a NUL byte
         exists = False
-    if exists or os.sep in text or text.endswith((".urdf", ".xml")):
+    if exists or os.sep in text or text.endswith((".urdf", ".xml", ".xacro", ".mjcf", ".sdf")):
         if "\x00" in text:
             raise URDFError(text, "a file name cannot contain a NUL character")
-        return _read_file(path, limit)
+        return _read_file(path, limit, reading)
     raise UnknownRobotError(text, difflib.get_close_matches(text, list(GENERATED) + list(zoo.ZOO), n=3))
 
 
@@ -195,15 +271,52 @@ def locked_source(
     return replace(resolved, text=text, label=f"{resolved.label} (locked {', '.join(lock)})")
 
 
-def lint_source(source: str | os.PathLike, *, floating_base: bool | None = None) -> list[Problem]:
-    """Every problem of a URDF (a path, text or robot name), errors and warnings.
+def with_file_dynamics(spec: URDFSpec, label: str) -> URDFSpec:
+    """The spec with each joint's ``<dynamics armature=...>`` (robodyn's extension of URDF,
+    what its MJCF reader writes for MuJoCo's ``armature``), and ``damping`` / ``friction``
+    where the spec has none, read from the spec's XML.
 
-    A document that is not even well-formed XML gives one error problem.
+    Raises:
+        URDFError: If a value is not a finite number ≥ 0.
+    """
+    joints = dict(spec.joints)
+    for node in spec.xml.findall("joint"):
+        name, dynamics = node.get("name"), node.find("dynamics")
+        if dynamics is None or name not in joints:
+            continue
+        values: dict[str, float] = {}
+        for attribute in ("damping", "friction", "armature"):
+            text = dynamics.get(attribute)
+            value = None if text is None else parse_number(text)
+            if text is not None and (value is None or not math.isfinite(value) or value < 0):
+                raise URDFError(label, f"joint {name!r}: <dynamics {attribute}={text!r}> must be a finite number >= 0")
+            if value is not None and getattr(joints[name], attribute) == 0:
+                values[attribute] = value
+        joints[name] = replace(
+            joints[name],
+            damping=values.get("damping", joints[name].damping),
+            friction=values.get("friction", joints[name].friction),
+            armature=values.get("armature", joints[name].armature),
+        )
+    return URDFSpec(spec.name, spec.root, spec.links, joints, spec.xml)
+
+
+def lint_source(
+    source: str | os.PathLike,
+    *,
+    floating_base: bool | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+    packages: Mapping[str, str] | None = None,
+) -> list[Problem]:
+    """Every problem of a robot file (a path, text or robot name), errors and warnings.
+
+    A document that is not even well-formed XML gives one error problem. A xacro is
+    linted as its expansion, an MJCF file as the URDF robodyn reads it into.
 
     Raises:
         UnknownRobotError, URDFError: If the source cannot be found or read.
     """
-    resolved = resolve_source(source)
+    resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
     floating = resolved.floating_base if floating_base is None else floating_base
     try:
         _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, strict=True, **resolved.mesh_context)

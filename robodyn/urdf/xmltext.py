@@ -17,8 +17,9 @@ MAX_XML_DEPTH = 100
 _FORBIDDEN_XML = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
 
 
-def parse_xml(text: str, source: str) -> ET.Element:
-    """Parse URDF text strictly and return its ``<robot>`` element.
+def parse_xml(text: str, source: str, *, root: str = "robot") -> ET.Element:
+    """Parse URDF text strictly and return its ``<robot>`` element (``root``: the
+    root element expected instead, e.g. MJCF's ``"mujoco"``).
 
     Whitespace (and a byte-order mark) before the XML declaration is accepted, as urdfdom
     does. Elements nested deeper than :data:`MAX_XML_DEPTH` are refused while parsing
@@ -33,7 +34,7 @@ def parse_xml(text: str, source: str) -> ET.Element:
     text = text.lstrip(" \t\r\n\ufeff")
     parser: ET.XMLPullParser[ET.Element] = ET.XMLPullParser(events=("start", "end"))
     depth = 0
-    root: ET.Element | None = None
+    top: ET.Element | None = None
     try:
         for start in range(0, max(len(text), 1), 1 << 16):
             parser.feed(text[start : start + (1 << 16)])
@@ -41,16 +42,16 @@ def parse_xml(text: str, source: str) -> ET.Element:
                 # only "start"/"end" events were asked for: each is an (event, Element) pair
                 event, element = cast("tuple[str, ET.Element]", item)
                 depth += 1 if event == "start" else -1
-                root = element if root is None else root
+                top = element if top is None else top
                 if depth > MAX_XML_DEPTH:
                     raise URDFError(source, f"XML elements are nested deeper than {MAX_XML_DEPTH} levels (<{element.tag}>)")
         parser.close()
     except ET.ParseError as error:
         raise URDFError(source, f"not well-formed XML ({error})") from None
-    assert root is not None  # parser.close() refuses a document without an element
-    if root.tag != "robot":
-        raise URDFError(source, f"the root element must be <robot>, not <{root.tag}>")
-    return root
+    assert top is not None  # parser.close() refuses a document without an element
+    if top.tag != root:
+        raise URDFError(source, f"the root element must be <{root}>, not <{top.tag}>")
+    return top
 
 
 #: The number grammar of a URDF attribute, the only one robodyn accepts: an optional sign,

@@ -1,10 +1,11 @@
-"""`robodyn lint`: every problem of a URDF."""
+"""`robodyn lint`: every problem of a URDF (a xacro as its expansion, an MJCF file as robodyn reads it)."""
 
 from __future__ import annotations
 
 import argparse
 import json
 
+from robodyn.cli.common import add_file_arguments, package_arguments, xacro_arguments
 from robodyn.common.text import printable
 
 
@@ -16,13 +17,19 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--floating-base", dest="floating_base", action="store_true", default=None, help="check as a floating-base robot"
     )
     parser.add_argument("--json", action="store_true", help="print JSON")
+    add_file_arguments(parser)
     parser.set_defaults(run=run)
 
 
 def run(arguments: argparse.Namespace) -> int:
     from robodyn.urdf.sources import lint_source
 
-    problems = lint_source(arguments.model, floating_base=arguments.floating_base)
+    problems = lint_source(
+        arguments.model,
+        floating_base=arguments.floating_base,
+        xacro_args=xacro_arguments(arguments.xacro_arg) or None,
+        packages=package_arguments(arguments.package) or None,
+    )
     errors = sum(problem.severity == "error" for problem in problems)
     if arguments.json:
         print(
