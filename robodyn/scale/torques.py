@@ -266,7 +266,9 @@ def _results(robot: Robot, dataset: Dataset, client, *, gravity: bool, mass_matr
             chunk.trajectory = trajectory
             yield chunk, chunk_dynamics(robot, trajectory.q, trajectory.v, trajectory.a, first_row=chunk.first_row, **options)
         return
-    [remote_robot] = client.scatter([robot], broadcast=True, hash=False)
+    # The robot travels with each task (it pickles by its source and options and is built once
+    # per worker process): scattered data has no lineage, so a worker killed mid-run could
+    # take the only copy the scheduler knew of with it and cancel every later chunk.
     window = 2 * max(1, len(client.nthreads()))
     pending: deque = deque()
     try:
@@ -275,7 +277,7 @@ def _results(robot: Robot, dataset: Dataset, client, *, gravity: bool, mass_matr
             chunk.trajectory = trajectory
             future = client.submit(
                 chunk_dynamics,
-                remote_robot,
+                robot,
                 trajectory.q,
                 trajectory.v,
                 trajectory.a,
