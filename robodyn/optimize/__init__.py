@@ -1,0 +1,1 @@
+"""Optimal motions on robodyn's exported dynamics (CasADi and IPOPT)."""
