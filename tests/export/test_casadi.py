@@ -16,54 +16,7 @@ from robodyn.export import FUNCTIONS, casadi_functions, module_source
 from robodyn.export.functions import _run
 from tests.conftest import FAST_ZOO, NONDEGENERATE_CASES, random_states
 from tests.equations.test_output import CANARY, hostile_urdf
-
-#: Test robots (mimic with multipliers and offsets, oblique axes, prismatic joints, locked
-#: joints) and one with gravity off the z axis.
-CASES = {
-    name: NONDEGENERATE_CASES[name]
-    for name in ("oblique", "oblique_locked", "gripper", "gripper_locked_prismatic", "mimic_tree", "mimic_tree_locked")
-}
-CASES["gripper_tilted_gravity"] = (
-    NONDEGENERATE_CASES["gripper_locked_prismatic"][0],
-    {**NONDEGENERATE_CASES["gripper_locked_prismatic"][1], "gravity": (1.3, -2.1, -9.3)},
-)
-#: The fast tier's share (the derivation of an oblique or branching robot takes seconds).
-FAST_CASES = ("oblique_locked", "gripper_locked_prismatic", "gripper_tilted_gravity")
-
-_SOURCES: dict[str, tuple[robodyn.Robot, str]] = {}
-
-
-def exported(case: str) -> tuple[robodyn.Robot, str]:
-    """The robot of a case and its CasADi module (derived once per test run)."""
-    if case not in _SOURCES:
-        path, options = CASES.get(case, (case, {}))
-        robot = robodyn.load(path, **options)
-        _SOURCES[case] = (robot, module_source(robot, "casadi"))
-    return _SOURCES[case]
-
-
-def column(x) -> np.ndarray:
-    return np.array(x, dtype=float).ravel()
-
-
-def differences(robot: robodyn.Robot, functions: dict, q, v, a) -> dict[str, float]:
-    """Largest relative difference of every exported function from the engine at one state."""
-
-    def relative(ours, theirs) -> float:
-        ours, theirs = np.asarray(ours, float).reshape(np.shape(theirs)), np.asarray(theirs)
-        return float(np.max(np.abs(ours - theirs)) / max(1.0, float(np.max(np.abs(theirs)))))
-
-    result = {
-        "inverse_dynamics": relative(functions["inverse_dynamics"](q, v, a), robot.inverse_dynamics(q, v, a)),
-        "mass_matrix": relative(functions["mass_matrix"](q), robot.mass_matrix(q)),
-        "nonlinear_effects": relative(functions["nonlinear_effects"](q, v), robot.nonlinear_effects(q, v)),
-        "gravity": relative(functions["gravity"](q), robot.gravity(q)),
-        "forward_dynamics": relative(functions["forward_dynamics"](q, v, a), robot.forward_dynamics(q, v, a)),
-    }
-    for frame in robot.frame_names:
-        result["frame_position:" + frame] = relative(functions["frame_position:" + frame](q), robot.frame_position(q, frame))
-        result["frame_jacobian:" + frame] = relative(functions["frame_jacobian:" + frame](q), robot.frame_jacobian(q, frame))
-    return result
+from tests.export.cases import CASES, FAST_CASES, column, differences, exported
 
 
 @pytest.mark.parametrize(
