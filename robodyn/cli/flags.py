@@ -39,6 +39,10 @@ FLAGS: dict[str, str] = {
     "threshold": "--threshold",
     "torque": "--torque",
     "plot": "--plot",
+    "start": "--start",
+    "goal": "--goal",
+    "intervals": "--intervals",
+    "cost": "--cost",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.
