@@ -64,6 +64,9 @@ _LAZY = {
     "excite": "robodyn.ident",
     "identify": "robodyn.ident",
     "Recording": "robodyn.viz.recording",
+    "casadi_functions": "robodyn.export",
+    "jax_functions": "robodyn.export",
+    "point_to_point": "robodyn.optimize",
 }
 
 __all__ = [
@@ -97,13 +100,16 @@ __all__ = [
     "__version__",
     "attach_payload",
     "base_parameters",
+    "casadi_functions",
     "check_robot",
     "compile",
     "derive_equations",
     "estimate_external_torques",
     "excite",
     "identify",
+    "jax_functions",
     "load",
+    "point_to_point",
     "record",
     "recording",
     "robot_names",

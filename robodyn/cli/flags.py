@@ -43,6 +43,7 @@ FLAGS: dict[str, str] = {
     "goal": "--goal",
     "intervals": "--intervals",
     "cost": "--cost",
+    "reference": "--reference",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import time
 
 import numpy as np
@@ -118,3 +119,20 @@ def test_a_weak_double_pendulum_swings_up_within_a_minute():
     print(
         f"swing-up: {elapsed:.2f} s in all, solve {motion.solve_time:.2f} s, cost {motion.cost:.4f}, peaks {motion.peak_torque}"
     )
+
+
+def test_simulate_tracks_the_motion_with_computed_torque_to_the_goal(tmp_path, capsys):
+    path = tmp_path / "motion.npz"
+    arguments = ["optimize", "rp_arm", "--start", "0,0.05", "--goal", "1.2,0.25", "--duration", "2", "--intervals", "20"]
+    assert main([*arguments, "--out", str(path)]) == 0
+    capsys.readouterr()
+    command = ["simulate", "rp_arm", "--controller", "computed-torque", "--reference", str(path), "--duration", "2.5"]
+    assert main([*command, "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["final_joint_error"] < 1e-6 and summary["limit_violations"] == []
+    # Negative control: the quintic to the same goal in half the time breaks the arm's velocity limit.
+    assert (
+        main(["simulate", "rp_arm", "--controller", "computed-torque", "--target", "1.2,0.25", "--duration", "1", "--json"]) == 0
+    )
+    assert json.loads(capsys.readouterr().out)["limit_violations"] != []
+    assert main([*command[:3], "pd", *command[4:]]) == 2  # a reference is for computed torque only
