@@ -230,7 +230,7 @@ class TrajectoryReference:
         t = max(float(t), float(self.t[0]))
         k = int(np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.t) - 2))
         s = (t - self.t[k]) / (self.t[k + 1] - self.t[k])
-        return tuple((1 - s) * x[k] + s * x[k + 1] for x in (self.q, self.v, self.a))  # type: ignore[return-value]
+        return tuple((1 - s) * x[k] + s * x[k + 1] for x in (self.q, self.v, self.a))
 
 
 def _tracked(
