@@ -78,6 +78,7 @@ def test_without_float64_jax_functions_are_refused_in_one_line():
         jax_functions(robot)
 
 
+@pytest.mark.slow  # the CasADi module's test runs the same CLI path in the fast tier
 def test_the_cli_writes_a_standalone_module_that_imports_only_jax(tmp_path, rng, x64):
     path = tmp_path / "dyn_jax.py"
     urdf, options = NONDEGENERATE_CASES["oblique_locked"]

@@ -103,6 +103,7 @@ def test_the_cli_writes_a_trajectory_file(tmp_path, capsys):
     trajectory = Trajectory.load(path)
     robot = robodyn.load("rp_arm")
     check_motion(robot, trajectory, RP_START, RP_GOAL)
+    assert main(["record", "rp_arm", "--trajectory", str(path), "--out", str(tmp_path / "motion.html")]) == 0
     assert main([*arguments[:-2], "--intervals", "1", "--out", str(path)]) == 2
     assert "--intervals" in capsys.readouterr().err
 
