@@ -117,8 +117,14 @@ def _export(arguments: argparse.Namespace) -> int:
     from robodyn.export import module_source
 
     given = [f"--{name}" for name in ("q", "v", "a", "kinematics") if getattr(arguments, name) is not None]
+    given += [f"--{name}" for name in ("christoffel", "lecture", "derivation") if getattr(arguments, name)]
+    given += ["--form"] if arguments.form != "auto" else []
     if given:
-        raise InputError(", ".join(given), f"left out with --format {arguments.format} (every frame is exported)", "given")
+        raise InputError(
+            ", ".join(given),
+            f"left out with --format {arguments.format} (the module holds the compact equations and every frame)",
+            "given",
+        )
     robot = load_robot(arguments)
     source = module_source(robot, arguments.format, keep_params=arguments.keep_params)
     return _emit(arguments, source, f"{arguments.format} module, {robot.nv} joints, {len(robot.frame_names)} frames")
