@@ -20,7 +20,14 @@ from robodyn.export.source import Backend, module_text
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "nonlinear_effects", "gravity", "forward_dynamics")
 
 
-def module_source(robot: Robot, backend: Backend, *, frames: Sequence[str] | None = None, keep_params: bool = False) -> str:
+def module_source(
+    robot: Robot,
+    backend: Backend,
+    *,
+    frames: Sequence[str] | None = None,
+    keep_params: bool = False,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> str:
     """A standalone Python module (imports only ``casadi``, or only ``jax``) whose
     ``functions()`` returns what :func:`casadi_functions` / :func:`jax_functions` return.
 
@@ -30,6 +37,7 @@ def module_source(robot: Robot, backend: Backend, *, frames: Sequence[str] | Non
         frames: Frames to export (``None``: every frame of :attr:`robodyn.Robot.frame_names`).
         keep_params: Masses, centres of mass, inertias, joint offsets and gravity as a last
             input ``p`` (``PARAMETER_NAMES``, ``PARAMETER_VALUES`` in the module).
+        progress: Called as ``progress(stage, done, total)`` during the derivation.
 
     Raises:
         InputError: For an unknown backend, a floating base or a robot without moving joints.
@@ -37,7 +45,7 @@ def module_source(robot: Robot, backend: Backend, *, frames: Sequence[str] | Non
     """
     if backend not in ("casadi", "jax"):
         raise InputError("backend", "casadi or jax", repr(backend))
-    return module_text(export_programs(robot, frames=frames, keep_params=keep_params), backend)
+    return module_text(export_programs(robot, frames=frames, keep_params=keep_params, progress=progress), backend)
 
 
 def _run(source: str) -> dict[str, Any]:

@@ -19,7 +19,7 @@ Jacobians are the ones :meth:`robodyn.Robot.frame_position` and
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -87,7 +87,13 @@ def check_exportable(robot: Robot) -> None:
         raise InputError("robot", "a robot with moving joints", f"{robot.name} with none")
 
 
-def export_programs(robot: Robot, *, frames: Sequence[str] | None = None, keep_params: bool = False) -> ExportPrograms:
+def export_programs(
+    robot: Robot,
+    *,
+    frames: Sequence[str] | None = None,
+    keep_params: bool = False,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> ExportPrograms:
     """Derive the programs of a fixed-base robot's exported functions (a sympy derivation:
     seconds for a 7-joint arm).
 
@@ -96,6 +102,7 @@ def export_programs(robot: Robot, *, frames: Sequence[str] | None = None, keep_p
         frames: Frames to export (names of :attr:`robodyn.Robot.frame_names`); ``None``: all.
         keep_params: Masses, centres of mass, inertias, joint offsets and gravity as an
             extra input (see :class:`robodyn.reference.symbolic.Parameters`).
+        progress: Called as ``progress(stage, done, total)`` during the derivation.
 
     Raises:
         InputError: For a floating base or a robot without moving joints.
@@ -111,8 +118,10 @@ def export_programs(robot: Robot, *, frames: Sequence[str] | None = None, keep_p
     free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
     reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
     symbols = joint_symbols(free.joint_names)
-    dynamics = derive_compact(reference, snap=SNAP, keep_params=keep_params, symbols=symbols).program()
+    dynamics = derive_compact(reference, snap=SNAP, keep_params=keep_params, symbols=symbols, progress=progress).program()
     tau = derive_newton_euler(reference, snap=SNAP, keep_params=keep_params, symbols=symbols)
+    if progress:
+        progress("Newton-Euler", 0, 1)
     still = {symbol: sp.Integer(0) for symbol in symbols[2]}
     nle = shortened(
         Program(

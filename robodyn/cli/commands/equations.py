@@ -114,6 +114,7 @@ def _base_parameters(arguments: argparse.Namespace) -> int:
 
 
 def _export(arguments: argparse.Namespace) -> int:
+    from robodyn.common.text import printable
     from robodyn.export import module_source
 
     given = [f"--{name}" for name in ("q", "v", "a", "kinematics") if getattr(arguments, name) is not None]
@@ -126,7 +127,11 @@ def _export(arguments: argparse.Namespace) -> int:
             "given",
         )
     robot = load_robot(arguments)
-    source = module_source(robot, arguments.format, keep_params=arguments.keep_params)
+    progress = Progress(f"exporting {printable(robot.name)[:60]}")
+    try:
+        source = module_source(robot, arguments.format, keep_params=arguments.keep_params, progress=progress)
+    finally:
+        progress.close()
     return _emit(arguments, source, f"{arguments.format} module, {robot.nv} joints, {len(robot.frame_names)} frames")
 
 
