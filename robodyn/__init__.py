@@ -65,6 +65,9 @@ _LAZY = {
     "identify": "robodyn.ident",
     "Recording": "robodyn.viz.recording",
     "linearize": "robodyn.sim.linearize",
+    "casadi_functions": "robodyn.export",
+    "jax_functions": "robodyn.export",
+    "point_to_point": "robodyn.optimize",
 }
 
 __all__ = [
@@ -98,14 +101,17 @@ __all__ = [
     "__version__",
     "attach_payload",
     "base_parameters",
+    "casadi_functions",
     "check_robot",
     "compile",
     "derive_equations",
     "estimate_external_torques",
     "excite",
     "identify",
+    "jax_functions",
     "linearize",
     "load",
+    "point_to_point",
     "record",
     "recording",
     "robot_names",

@@ -18,6 +18,8 @@ Sections:
     compiled-compile     cold and cached compile times
     compiled-simulation  panda-arm real-time factor: compiled RK4 / Euler vs Python engine vs MuJoCo
     derivatives  Robot.*_derivatives single calls vs pin.computeRNEADerivatives / computeABADerivatives
+    export     CasADi instruction counts of M + C v + G vs adam's (bench-only), forward dynamics
+               through CasADi's generated C vs pin.aba
 """
 
 from __future__ import annotations
@@ -587,6 +589,81 @@ def bench_derivatives(quick: bool) -> list[dict]:
             rows.append(
                 {"robot": name, "method": method, "robodyn_us": ours_s * 1e6, "pinocchio_us": raw_s * 1e6, "ratio": ratio}
             )
+
+
+def _adam_counts(robot) -> list[int] | None:
+    """adam's CasADi instruction counts of M, bias forces and G (base fixed by substituting
+    the identity pose), or None when adam-robotics is not installed (a bench-only tool)."""
+    try:
+        import casadi as ca
+        from adam.casadi import KinDynComputations
+    except ImportError:
+        return None
+    import tempfile
+
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as file:
+        file.write(robot.urdf)
+    kinematics = KinDynComputations(file.name, list(robot.joint_names))
+    os.unlink(file.name)
+    H, s, ds, rest = ca.DM.eye(4), ca.SX.sym("s", robot.nv), ca.SX.sym("ds", robot.nv), ca.DM.zeros(6)
+    terms = (
+        ca.Function("M", [s], [kinematics.mass_matrix(H, s)[6:, 6:]]),
+        ca.Function("h", [s, ds], [kinematics.bias_force(H, s, rest, ds)[6:]]),
+        ca.Function("G", [s], [kinematics.gravity_term(H, s)[6:]]),
+    )
+    return [function.n_instructions() for function in terms]
+
+
+def _generated_c(function, folder: Path):
+    """A casadi Function through its generated C, compiled with the system compiler (-O2)."""
+    import subprocess
+
+    import casadi as ca
+
+    source = folder / f"{function.name()}.c"
+    function.generate(str(source.name), {"with_header": False})
+    Path(source.name).replace(source)
+    library = folder / f"{function.name()}.so"
+    subprocess.run(["cc", "-O2", "-fPIC", "-shared", str(source), "-o", str(library)], check=True)
+    return ca.external(function.name(), str(library))
+
+
+def bench_export(quick: bool) -> list[dict]:
+    """CasADi graph sizes (M + C v + G) against adam's, and forward dynamics through CasADi's
+    generated C against pin.aba (10 000 states in one mapped call, per state)."""
+    import tempfile
+
+    from robodyn.export import casadi_functions
+
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        robot = robodyn.load(name, **options)
+        functions = casadi_functions(robot, frames=())
+        ours = [functions[key].n_instructions() for key in ("mass_matrix", "nonlinear_effects", "gravity")]
+        adam = _adam_counts(robot)
+        rng = np.random.default_rng(0)
+        count = 1000 if quick else 10_000
+        Q = robot.random_configuration(rng, count)
+        V, TAU = rng.normal(size=(2, count, robot.nv))
+        with tempfile.TemporaryDirectory() as folder:
+            mapped = _generated_c(functions["forward_dynamics"], Path(folder)).map(count, "serial")
+            arguments = (Q.T.copy(), V.T.copy(), TAU.T.copy())
+            casadi_s = median_once(lambda: mapped(*arguments), repeats=3 if quick else 7) / count
+            error = float(np.max(np.abs(np.array(mapped(*arguments)).T - robot.forward_dynamics(Q, V, TAU))))
+        model, data = robot.model, robot.model.createData()
+        q, v, tau = Q[0], V[0], TAU[0]
+        aba_s = min(timeit.repeat(lambda: pin.aba(model, data, q, v, tau), number=2000, repeat=5)) / 2000
+        rows.append(
+            {
+                "robot": label,
+                "robodyn M+h+G": f"{sum(ours)} ({' + '.join(map(str, ours))})",
+                "adam M+h+G": "adam not installed" if adam is None else f"{sum(adam)} ({' + '.join(map(str, adam))})",
+                "ratio": None if adam is None else sum(ours) / sum(adam),
+                "fd casadi C us/state": casadi_s * 1e6,
+                "pin.aba us/call": aba_s * 1e6,
+                "fd max error vs pin": error,
+            }
+        )
     return rows
 
 
@@ -603,6 +680,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-compile": bench_compiled_compile,
     "compiled-simulation": bench_compiled_simulation,
     "derivatives": bench_derivatives,
+    "export": bench_export,
 }
 
 

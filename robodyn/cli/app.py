@@ -27,6 +27,7 @@ from robodyn.cli.commands import (
     lint,
     listing,
     observe,
+    optimize,
     record,
     simulate,
     torques,
@@ -38,7 +39,10 @@ from robodyn.cli.flags import error_text
 from robodyn.exceptions import RobodynError, one_line_warnings
 
 #: The commands, in the order ``robodyn --help`` lists them.
-COMMANDS = (listing, info, equations, check, lint, simulate, observe, record, view, torques, whatif, excite, identify, linearize)
+COMMANDS = (
+    listing, info, equations, check, lint, simulate, observe, record, view, torques, whatif, excite, identify, linearize,
+    optimize,
+)  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -43,6 +43,11 @@ FLAGS: dict[str, str] = {
     "q_eq": "--target",
     "xacro_args": "--xacro-arg",
     "packages": "--package",
+    "start": "--start",
+    "goal": "--goal",
+    "intervals": "--intervals",
+    "cost": "--cost",
+    "reference": "--reference",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

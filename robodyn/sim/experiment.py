@@ -132,6 +132,7 @@ def run_simulation(
     force_at: Sequence[str | Push] = (),
     observer_gain: float | None = None,
     actuated: list[str] | None = None,
+    reference: Trajectory | None = None,
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -160,6 +161,9 @@ def run_simulation(
             (default frame: the controlled frame, or the end effector).
         observer_gain: ``K_O`` in [1/s]: run a momentum observer along (``None``: none).
         actuated: lqr only: the actuated joints (default all; the others get zero torque).
+        reference: computed-torque only: a motion to track instead of the quintic
+            (:class:`TrajectoryReference`; e.g. ``robodyn optimize``'s); it starts at its first
+            sample (unless ``q0`` is given) and its last configuration is the target.
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -168,6 +172,8 @@ def run_simulation(
     Raises:
         InputError: Naming the parameter (``controller``, ``target``, ``frame``, ...).
     """
+    if reference is not None:
+        reference, target, q0 = _tracked(robot, controller, reference, target, q0)
     _check_request(robot, controller, target, frame, limits)
     _check_pose_options(controller, posture, stiffness, damping)
     if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
@@ -178,6 +184,8 @@ def run_simulation(
         raise InputError("actuated", "given only with the lqr controller", f"{len(actuated)} joints")
     options["actuated"] = actuated
     law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
+    if reference is not None:
+        law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
     pushes, external = push_wrenches(robot, force_at, controlled or None)
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
     began = time.perf_counter()
@@ -207,6 +215,44 @@ def run_simulation(
         error = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
         return trajectory, replace(summary, final_joint_error=error)
     return trajectory, summary
+
+
+class TrajectoryReference:
+    """A recorded motion as a joint reference ``t -> (q_d, v_d, a_d)`` for computed torque:
+    each column interpolated linearly between samples; before the first sample its state,
+    after the last one at rest there.
+
+    Args:
+        trajectory: The motion (fixed base: ``q`` and ``v`` of the same size), in the
+            robot's joint order.
+    """
+
+    def __init__(self, trajectory: Trajectory) -> None:
+        self.t, self.q, self.v, self.a = trajectory.t, trajectory.q, trajectory.v, trajectory.a
+        self.rest = np.zeros(trajectory.v.shape[1])
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if t >= self.t[-1]:
+            return self.q[-1], self.rest, self.rest
+        t = max(float(t), float(self.t[0]))
+        k = int(np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.t) - 2))
+        s = (t - self.t[k]) / (self.t[k + 1] - self.t[k])
+        return tuple((1 - s) * x[k] + s * x[k + 1] for x in (self.q, self.v, self.a))
+
+
+def _tracked(
+    robot: Robot, controller: str, reference: Trajectory, target: list[float] | None, q0: list[float] | None
+) -> tuple[Trajectory, list[float], list[float]]:
+    """The reference in the robot's joint order, its goal as the target and its start as ``q0``
+    (unless given); refused with another controller, a target, a floating base or one sample."""
+    if controller != "computed-torque":
+        raise InputError("reference", "given only with the computed-torque controller", repr(controller))
+    if target is not None:
+        raise InputError("target", "left out with a reference (its last sample is the target)", f"{np.size(target)} values")
+    reference = reference.for_robot(robot)
+    if robot.floating_base or len(reference) < 2:
+        raise InputError("reference", "a fixed-base robot's motion of at least two samples", f"{len(reference)} samples")
+    return reference, list(reference.q[-1]), list(reference.q[0]) if q0 is None else q0
 
 
 def _summary(robot: Robot, trajectory: Trajectory, settings: dict[str, Any], elapsed: float) -> SimulationSummary:

@@ -50,3 +50,15 @@ def test_the_sequel_notebook_runs_and_reaches_deflects_and_observes_as_it_says()
     assert "last significant joint: joint2" in text
     assert sum("image/png" in d for d in data) == 1  # estimated vs applied
     assert any("<iframe" in d.get("text/html", "") for d in data)  # the recording inline
+
+
+@pytest.mark.slow  # two IPOPT solves and an animation, about 10 s
+def test_the_optimization_notebook_solves_both_motions_within_the_limits():
+    text, data = run_notebook("optimization.ipynb")
+    assert text.count("Solve_Succeeded") == 2
+    assert float(re.search(r"largest RNEA residual: (\S+)", text).group(1)) < 1e-9
+    assert text.count("limits broken: 0") == 2
+    shoulder = float(re.search(r"peak torques: shoulder (\S+) N m", text).group(1))
+    assert shoulder <= 5.0 + 1e-6  # weaker than the 9.2 N m that would lift it directly
+    assert sum("<iframe" in d.get("text/html", "") for d in data) == 1  # the RP arm's recording
+    assert any("animation" in d.get("text/html", "").lower() for d in data)  # the swing-up

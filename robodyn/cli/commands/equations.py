@@ -24,9 +24,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--symbolic", action="store_true", help="closed-form equations from the reference's symbolic Lagrangian")
     parser.add_argument(
         "--format",
-        choices=["text", "latex", "pdf", "json", "python", "c"],
+        choices=["text", "latex", "pdf", "json", "python", "c", "casadi", "jax"],
         default="text",
-        help="with --symbolic (pdf needs pdflatex and --out)",
+        help="with --symbolic (pdf needs pdflatex and --out); casadi, jax: a standalone module whose functions() "
+        "returns the robot's dynamics and frames (robodyn.export)",
     )
     parser.add_argument("--out", help="with --symbolic: write to this file instead of stdout")
     parser.add_argument(
@@ -112,9 +113,33 @@ def _base_parameters(arguments: argparse.Namespace) -> int:
     return 0
 
 
+def _export(arguments: argparse.Namespace) -> int:
+    from robodyn.common.text import printable
+    from robodyn.export import module_source
+
+    given = [f"--{name}" for name in ("q", "v", "a", "kinematics") if getattr(arguments, name) is not None]
+    given += [f"--{name}" for name in ("christoffel", "lecture", "derivation") if getattr(arguments, name)]
+    given += ["--form"] if arguments.form != "auto" else []
+    if given:
+        raise InputError(
+            ", ".join(given),
+            f"left out with --format {arguments.format} (the module holds the compact equations and every frame)",
+            "given",
+        )
+    robot = load_robot(arguments)
+    progress = Progress(f"exporting {printable(robot.name)[:60]}")
+    try:
+        source = module_source(robot, arguments.format, keep_params=arguments.keep_params, progress=progress)
+    finally:
+        progress.close()
+    return _emit(arguments, source, f"{arguments.format} module, {robot.nv} joints, {len(robot.frame_names)} frames")
+
+
 def run(arguments: argparse.Namespace) -> int:
     if arguments.base_parameters:
         return _base_parameters(arguments)
+    if arguments.format in ("casadi", "jax"):
+        return _export(arguments)
     if arguments.symbolic or arguments.lecture or arguments.derivation:
         return _symbolic(arguments)
     from robodyn.dynamics.terms import dynamics_terms

@@ -61,11 +61,24 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too",
     )
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
+    parser.add_argument(
+        "--reference",
+        help="computed-torque: track this trajectory file (e.g. robodyn optimize's) instead of the quintic; no --target",
+    )
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
     parser.add_argument("--record", help="HTML animation (meshcat, self-contained, plays on open)")
     parser.add_argument("--png", help="with --record: a still of the first frame (needs Chromium)")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.set_defaults(run=run)
+
+
+def _reference(arguments: argparse.Namespace) -> dict:
+    """``reference=`` the trajectory of ``--reference`` (nothing when not given)."""
+    if not getattr(arguments, "reference", None):
+        return {}
+    from robodyn.trajectory import Trajectory
+
+    return {"reference": Trajectory.load(arguments.reference)}
 
 
 def run(arguments: argparse.Namespace) -> int:
@@ -92,6 +105,7 @@ def run(arguments: argparse.Namespace) -> int:
         plot=arguments.plot,
         record=arguments.record,
         png=arguments.png,
+        **_reference(arguments),
     )
     warn(summary.warnings())
     if summary.task is not None and not summary.task.reached and summary.task.deflection is None:
