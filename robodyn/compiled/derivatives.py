@@ -79,6 +79,24 @@ def bodies_program(robot: Robot, snap: float) -> tuple[Program, np.ndarray, np.n
     return derive_newton_euler(reference, snap=snap), selection, np.asarray(tree.offset, float)
 
 
+def _diff(expr: sp.Expr, symbol: sp.Symbol) -> sp.Expr:
+    """``∂expr/∂symbol``: by hand for the program's sums of products of symbols and whole
+    powers (fast), by ``sympy.diff`` for anything else."""
+    if expr == symbol:
+        return sp.Integer(1)
+    if expr.is_Add:
+        return sp.Add(*(_diff(term, symbol) for term in expr.args if symbol in term.free_symbols))
+    if expr.is_Mul:
+        inside = [i for i, factor in enumerate(expr.args) if symbol in factor.free_symbols]
+        if len(inside) == 1:
+            i = inside[0]
+            rest = expr.args[:i] + expr.args[i + 1 :]
+            return sp.Mul(*rest, _diff(expr.args[i], symbol))
+    if expr.is_Pow and expr.base == symbol and expr.exp.is_Integer:
+        return expr.exp * symbol ** (expr.exp - 1)
+    return sp.diff(expr, symbol)
+
+
 def _term(expr: sp.Expr, names: dict[sp.Symbol, str]) -> Term | None:
     """``expr`` as ``coefficient * name`` if it is that simple (a number, a symbol, or
     number × symbol), else None."""
@@ -139,7 +157,7 @@ class TangentWriter:
 
     def _partial(self, expr: sp.Expr, symbol: sp.Symbol) -> Term | None:
         """``∂expr/∂symbol`` as a term (named by a new statement when not simple), None if 0."""
-        partial = sp.diff(expr, symbol).xreplace(self._known)
+        partial = _diff(expr, symbol).xreplace(self._known)
         if partial == 0:
             return None
         simple = _term(partial, self.names)
