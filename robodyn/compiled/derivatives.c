@@ -27,23 +27,46 @@ static int rdd_factor(double *M) {
     return 0;
 }
 
-/* B <- M⁻¹ B for a factored M and B of shape (RD_NV, m), row-major (row operations). */
-static void rdd_solve(const double *L, double *B, int m) {
+/* B_k <- M⁻¹ B_k for a factored M and three (RD_NV, RD_NV) row-major matrices, by row
+ * operations (one pass over the factor for the three). */
+static void rdd_solve3(const double *L, double *B0, double *B1, double *B2) {
     const int n = RD_NV;
     for (int i = n - 1; i >= 0; --i)
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
             const double l = L[i * n + j];
-            for (int c = 0; c < m; ++c) B[j * m + c] -= l * B[i * m + c];
+            for (int c = 0; c < RD_NV; ++c) {
+                B0[j * n + c] -= l * B0[i * n + c];
+                B1[j * n + c] -= l * B1[i * n + c];
+                B2[j * n + c] -= l * B2[i * n + c];
+            }
         }
     for (int i = 0; i < n; ++i) {
         const double d = 1.0 / L[i * n + i];
-        for (int c = 0; c < m; ++c) B[i * m + c] *= d;
+        for (int c = 0; c < RD_NV; ++c) {
+            B0[i * n + c] *= d;
+            B1[i * n + c] *= d;
+            B2[i * n + c] *= d;
+        }
     }
     for (int i = 0; i < n; ++i)
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
             const double l = L[i * n + j];
-            for (int c = 0; c < m; ++c) B[i * m + c] -= l * B[j * m + c];
+            for (int c = 0; c < RD_NV; ++c) {
+                B0[i * n + c] -= l * B0[j * n + c];
+                B1[i * n + c] -= l * B1[j * n + c];
+                B2[i * n + c] -= l * B2[j * n + c];
+            }
         }
+}
+
+/* b <- M⁻¹ b for a factored M (the runtime's substitutions). */
+static void rdd_solve(const double *L, double *b) {
+    const int n = RD_NV;
+    for (int i = n - 1; i >= 0; --i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= L[i * n + j] * b[i];
+    for (int i = 0; i < n; ++i) b[i] /= L[i * n + i];
+    for (int i = 0; i < n; ++i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= L[i * n + j] * b[j];
 }
 
 typedef int (*rdd_row)(const double *const *in, double *const *out);
@@ -65,10 +88,10 @@ static int rdd_row_fd(const double *const *in, double *const *out) {
     rd_mass_nle(in[0], in[1], M, a);
     for (int i = 0; i < n; ++i) a[i] = in[2][i] - a[i];
     if (rdd_factor(M)) return 3;
-    rdd_solve(M, a, 1);
+    rdd_solve(M, a);
     rdd_tau_derivatives(in[0], in[1], a, out[0], out[1]);
     for (int i = 0; i < n * n; ++i) out[2][i] = (i % (n + 1)) == 0 ? 1.0 : 0.0;
-    for (int k = 0; k < 3; ++k) rdd_solve(M, out[k], n);
+    rdd_solve3(M, out[0], out[1], out[2]);
     for (int i = 0; i < n * n; ++i) {
         out[0][i] = -out[0][i];
         out[1][i] = -out[1][i];

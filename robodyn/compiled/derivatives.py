@@ -217,8 +217,9 @@ class TangentWriter:
         tau = list(self.program.outputs["tau"])
         values = needed(self.program.assignments, tau)
         used = set().union(*(sp.sympify(e).free_symbols for e in tau), *(e.free_symbols for _, e in values))
-        head = self._coordinates(used) + self.printer.statements(values)
-        for symbol, expr in values:
+        head = self._coordinates(used)
+        for symbol, expr in values:  # each value, then its derivatives (short live ranges)
+            self.lines += self.printer.statements([(symbol, expr)])
             self.differentiate(symbol, expr, self.names[symbol])
         outputs = [sp.Dummy(f"tau_body{b}") for b in range(self.bodies)]
         for b, (symbol, expr) in enumerate(zip(outputs, tau, strict=True)):

@@ -234,15 +234,16 @@ class CompiledRobot:
         return self._checked("fd", self._fd, result, q=q, v=v, tau=tau)
 
     # ---- derivatives (issue 25): kernels of their own, generated and built on first use ----
-    _derivative_module: ModuleType | None = None
-
     def _derivatives(self) -> ModuleType:
-        """The derivative module (:mod:`robodyn.compiled.derivatives`), built on first use."""
-        if self._derivative_module is None:
+        """The derivative module (:mod:`robodyn.compiled.derivatives`), built on first use
+        and kept in the instance's ``__dict__`` (so a call costs one dictionary look-up)."""
+        module = self.__dict__.get("_derivative_module")
+        if module is None:
             key = robot_key(self.robot)
             kernels = build.cached_kernels(key) or generate_kernels(self.robot)
-            self._derivative_module = derivatives.derivative_module(self.robot, key=key, kernels=kernels, snap=SNAP)
-        return self._derivative_module
+            module = derivatives.derivative_module(self.robot, key=key, kernels=kernels, snap=SNAP)
+            self.__dict__["_derivative_module"] = module
+        return module
 
     def inverse_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, a: np.ndarray
@@ -261,10 +262,10 @@ class CompiledRobot:
             ``(dtau_dq, dtau_dv, M)``, each (nv, nv) or (N, nv, nv); entry ``[i, j]`` is
             ``∂τ_i/∂x_j`` (in [N m/rad], [N m s/rad], [kg m²], or per [m] for prismatic joints).
         """
-        function = self._derivatives().tau_derivatives
+        function = (self.__dict__.get("_derivative_module") or self._derivatives()).tau_derivatives
         result = function(q, v, a, self.threads)
         if result.__class__ is tuple:
-            return cast(tuple[np.ndarray, np.ndarray, np.ndarray], result)
+            return result  # type: ignore[no-any-return]
         return derivatives.checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
 
     def forward_dynamics_derivatives(
@@ -286,8 +287,8 @@ class CompiledRobot:
         Raises:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
-        function = self._derivatives().fd_derivatives
+        function = (self.__dict__.get("_derivative_module") or self._derivatives()).fd_derivatives
         result = function(q, v, tau, self.threads)
         if result.__class__ is tuple:
-            return cast(tuple[np.ndarray, np.ndarray, np.ndarray], result)
+            return result  # type: ignore[no-any-return]
         return derivatives.checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
