@@ -33,6 +33,7 @@ loops; docs/compiled.md has the numbers.
 from __future__ import annotations
 
 import dataclasses
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
@@ -140,26 +141,29 @@ class TangentWriter:
         self._partials: dict[sp.Expr, str] = {}
         self.lines: list[str] = []
 
-    def _coordinates(self, used: set[sp.Basic]) -> list[str]:
-        """``th``/``thd``/``thdd`` declarations for the body coordinates the values use."""
-        lines = []
+    def _coordinates(self, used: set[sp.Basic], suffix: str = "") -> list[str]:
+        """``th``/``thd``/``thdd`` values of the body coordinates the program uses, as
+        ``(name, C expression in q{suffix}, v{suffix}, a{suffix})``."""
+        values = []
         inputs = (self.program.inputs["q"], self.program.inputs["qd"], self.program.inputs["qdd"])
         for b in range(self.bodies):
             for symbols, (local, array) in zip(inputs, (("th", "q"), ("thd", "v"), ("thdd", "a")), strict=True):
                 if symbols[b] not in used:
                     continue
-                terms = [(self.selection[b, j], f"{array}[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
+                terms = [(self.selection[b, j], f"{array}{suffix}[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
                 value = c_combination(terms)
                 if local == "th" and self.offset[b] != 0:
                     value += f" + {c_number(self.offset[b])}"
-                lines.append(f"    const double {local}{b} = {value};")
-        return lines
+                values.append(f"    const double {local}{b} = {value};")
+        return values
 
     def _partial(self, expr: sp.Expr, symbol: sp.Symbol) -> Term | None:
         """``∂expr/∂symbol`` as a term (named by a new statement when not simple), None if 0."""
         partial = _diff(expr, symbol).xreplace(self._known)
         if partial == 0:
             return None
+        if not partial.free_symbols:  # a constant such as √2/2: folded like a number
+            return float(partial), None
         simple = _term(partial, self.names)
         if simple is not None:
             return simple
@@ -181,7 +185,7 @@ class TangentWriter:
         if not products:
             return (constant, None) if constant != 0.0 else None
         if constant == 0.0 and len(products) == 1:
-            (key, c), = products.items()
+            ((key, c),) = products.items()
             if "*" not in key:
                 return c, key
         value = c_combination(list((c, k) for k, c in products.items()))
@@ -213,11 +217,11 @@ class TangentWriter:
             self.tangents[symbol] = result
 
     def source(self) -> str:
-        """The C function ``rdd_tau_derivatives`` (see the module)."""
+        """The C functions ``rdd_tau_derivatives`` and, where the program allows it, the same
+        on two states at once in SIMD lanes (``rdd_tau_derivatives2``, ``RDD_PAIRS`` 1)."""
         tau = list(self.program.outputs["tau"])
         values = needed(self.program.assignments, tau)
         used = set().union(*(sp.sympify(e).free_symbols for e in tau), *(e.free_symbols for _, e in values))
-        head = self._coordinates(used)
         for symbol, expr in values:  # each value, then its derivatives (short live ranges)
             self.lines += self.printer.statements([(symbol, expr)])
             self.differentiate(symbol, expr, self.names[symbol])
@@ -225,15 +229,51 @@ class TangentWriter:
         for b, (symbol, expr) in enumerate(zip(outputs, tau, strict=True)):
             self.names[symbol] = f"tb{b}"
             self.differentiate(symbol, sp.sympify(expr), f"tb{b}")
-        return "\n".join(self._function(head, outputs))
-
-    def _function(self, head: list[str], outputs: Sequence[sp.Symbol]) -> list[str]:
-        n, S = self.nv, self.selection
-        lines = [
+        results = self._outputs(outputs)
+        scalar = [
             "static void rdd_tau_derivatives(const double *q, const double *v, const double *a, double *dq, double *dv) {",
-            *head,
+            *self._coordinates(used),
             *self.lines,
+            *(f"    {out}[{index}] = {value};" for out, index, value in results),
+            "}",
+            "",
         ]
+        return "\n".join(scalar + self._pairs(used, results))
+
+    def _pairs(self, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
+        """``rdd_tau_derivatives2``: the same statements on two states, one a SIMD lane
+        (GCC/Clang vector extension; the same IEEE operations, so bit-identical results)."""
+        pattern = re.compile(r"= (cos|sin)\((\w+)\);$")
+        body = [pattern.sub(r"= rdd_\1_2(\2);", line).replace("const double ", "const rdd_v2 ") for line in self.lines]
+        if any(call in line for line in body for call in ("cos(", "sin(", "pow(")):
+            return ["#define RDD_PAIRS 0", ""]
+        lanes = zip(self._coordinates(used, "0"), self._coordinates(used, "1"), strict=True)
+        head = [f"{one.split(' = ')[0].replace('double', 'rdd_v2')} = {{{one.split(' = ')[1][:-1]}, {two.split(' = ')[1][:-1]}}};" for one, two in lanes]
+        tail = []
+        for out, index, value in results:
+            try:  # a constant: the same in both lanes
+                tail.append(f"    {out}0[{index}] = {out}1[{index}] = {c_number(float(value))};")
+            except ValueError:
+                tail.append(f"    {{ const rdd_v2 o = {value}; {out}0[{index}] = o[0]; {out}1[{index}] = o[1]; }}")
+        return [
+            "#define RDD_PAIRS 1",
+            "typedef double rdd_v2 __attribute__((vector_size(16)));",
+            "static inline rdd_v2 rdd_cos_2(rdd_v2 x) { const rdd_v2 r = {cos(x[0]), cos(x[1])}; return r; }",
+            "static inline rdd_v2 rdd_sin_2(rdd_v2 x) { const rdd_v2 r = {sin(x[0]), sin(x[1])}; return r; }",
+            "static void rdd_tau_derivatives2(const double *q0, const double *v0, const double *a0, const double *q1,",
+            "                                 const double *v1, const double *a1, double *dq0, double *dv0, double *dq1, double *dv1) {",
+            *head,
+            *body,
+            *tail,
+            "}",
+            "",
+        ]
+
+    def _outputs(self, outputs: Sequence[sp.Symbol]) -> list[tuple[str, int, str]]:
+        """``(array, index, C value)`` of every entry of ``dq`` and ``dv``: ``Sᵀ`` times the
+        bodies' derivatives."""
+        n, S = self.nv, self.selection
+        results = []
         for j in range(n):
             for k in range(2 * n):
                 terms = []
@@ -246,9 +286,8 @@ class TangentWriter:
                 value = c_combination(named) if named else ""
                 if constant != 0.0 or not named:
                     value = f"{value} + {c_number(constant)}" if named else c_number(constant)
-                out = "dq" if k < n else "dv"
-                lines.append(f"    {out}[{j * n + k % n}] = {value};")
-        return [*lines, "}", ""]
+                results.append(("dq" if k < n else "dv", j * n + k % n, value))
+        return results
 
 
 def derivative_key(robot_key: str) -> str:

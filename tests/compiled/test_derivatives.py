@@ -58,7 +58,9 @@ def pinocchio_tau_derivatives(robot, q, v, a):
     else:
         model, selection, offset = robot.mimic.model, robot.mimic.selection, robot.mimic.offset
     data = model.createData()  # kept alive: Pinocchio returns views of its arrays
-    dq, dv, mass = (np.array(m) for m in pin.computeRNEADerivatives(model, data, selection @ q + offset, selection @ v, selection @ a))
+    dq, dv, mass = (
+        np.array(m) for m in pin.computeRNEADerivatives(model, data, selection @ q + offset, selection @ v, selection @ a)
+    )
     mass = np.triu(mass) + np.triu(mass, 1).T  # Pinocchio fills the upper triangle
     return tuple(selection.T @ m @ selection for m in (dq, dv, mass))
 
