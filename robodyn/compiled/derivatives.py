@@ -133,7 +133,7 @@ class TangentWriter:
         self.tangents: dict[sp.Symbol, dict[int, Term]] = {}
         for b in range(self.bodies):
             for symbols, shift in ((program.inputs["q"], 0), (program.inputs["qd"], self.nv)):
-                seeds = {shift + j: (float(s), None) for j, s in enumerate(self.selection[b]) if s != 0}
+                seeds: dict[int, Term] = {shift + j: (float(s), None) for j, s in enumerate(self.selection[b]) if s != 0}
                 if seeds:
                     self.tangents[symbols[b]] = seeds
         trig = (sp.sin, sp.cos)
@@ -248,7 +248,10 @@ class TangentWriter:
         if any(call in line for line in body for call in ("cos(", "sin(", "pow(")):
             return ["#define RDD_PAIRS 0", ""]
         lanes = zip(self._coordinates(used, "0"), self._coordinates(used, "1"), strict=True)
-        head = [f"{one.split(' = ')[0].replace('double', 'rdd_v2')} = {{{one.split(' = ')[1][:-1]}, {two.split(' = ')[1][:-1]}}};" for one, two in lanes]
+        head = [
+            f"{one.split(' = ')[0].replace('double', 'rdd_v2')} = {{{one.split(' = ')[1][:-1]}, {two.split(' = ')[1][:-1]}}};"
+            for one, two in lanes
+        ]
         tail = []
         for out, index, value in results:
             try:  # a constant: the same in both lanes

@@ -265,7 +265,7 @@ class CompiledRobot:
         function = (self.__dict__.get("_derivative_module") or self._derivatives()).tau_derivatives
         result = function(q, v, a, self.threads)
         if result.__class__ is tuple:
-            return result  # type: ignore[no-any-return]
+            return result
         return derivatives.checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
 
     def forward_dynamics_derivatives(
@@ -290,5 +290,5 @@ class CompiledRobot:
         function = (self.__dict__.get("_derivative_module") or self._derivatives()).fd_derivatives
         result = function(q, v, tau, self.threads)
         if result.__class__ is tuple:
-            return result  # type: ignore[no-any-return]
+            return result
         return derivatives.checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
