@@ -9,9 +9,10 @@ import pytest
 
 import robodyn
 from robodyn.compiled import compile
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, SingularMassMatrixError
 from tests.compiled_helpers import shared_cache
 from tests.conftest import NONDEGENERATE_CASES
+from tests.random_robots import urdf_from_seed
 
 #: The issue's bar: the compiled derivatives within 1e-10 of Pinocchio's, relative to their size.
 RTOL = 1e-10
@@ -180,6 +181,29 @@ def test_derivative_inputs_are_checked_like_every_method(mimic_tree, rng):
         compiled.inverse_dynamics_derivatives(q[None], v, a)  # a batch of one q with one v
     listed = compiled.inverse_dynamics_derivatives(list(q), list(v), [float(x) for x in a])  # the checked path
     assert all(np.array_equal(x, y) for x, y in zip(listed, compiled.inverse_dynamics_derivatives(q, v, a), strict=True))
+
+
+def test_a_nan_in_one_row_of_a_batch_is_refused_naming_the_argument(mimic_tree, rng):
+    robot, compiled = mimic_tree
+    q, v, _, tau = states(robot, rng, 129)
+    v[100, 1] = np.nan
+    with pytest.raises(InputError, match=r"^v "):
+        compiled.forward_dynamics_derivatives(q, v, tau)
+
+
+def test_a_singular_mass_matrix_is_refused_like_the_forward_dynamics():
+    """The last link massless (the singular robot of the compiled engine's tests)."""
+    text = urdf_from_seed(3, 2, ["revolute"])
+    head, _, _ = text.rpartition("<inertial>")
+    text = (
+        head + '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>\n</robot>'
+    )
+    robot = robodyn.load(text, check_inertia=False)
+    compiled = compile(robot)
+    with pytest.raises(SingularMassMatrixError):
+        compiled.forward_dynamics_derivatives(*np.zeros((3, robot.nv)))
+    with pytest.raises(SingularMassMatrixError):
+        compiled.forward_dynamics_derivatives(*np.zeros((3, 129, robot.nv)))
 
 
 @pytest.mark.slow
