@@ -20,6 +20,9 @@ Sections:
     derivatives  Robot.*_derivatives single calls vs pin.computeRNEADerivatives / computeABADerivatives
     export     CasADi instruction counts of M + C v + G vs adam's (bench-only), forward dynamics
                through CasADi's generated C vs pin.aba
+    compiled-derivatives-single  compiled ∂τ / ∂q̈ vs pin.computeRNEADerivatives / computeABADerivatives
+    compiled-derivatives-batch   100 000 states on 2 threads vs a 2-thread loop of Pinocchio's
+    compiled-derivatives-build   the derivative module's cold build (on first use)
 """
 
 from __future__ import annotations
@@ -667,6 +670,130 @@ def bench_export(quick: bool) -> list[dict]:
     return rows
 
 
+def _derivative_cases(robot, compiled, q, v, a, tau):
+    """(method, compiled call, Pinocchio's call maker) for both kinds of derivatives."""
+    return (
+        (
+            "inverse_dynamics_derivatives vs pin.computeRNEADerivatives",
+            compiled.inverse_dynamics_derivatives,
+            pin.computeRNEADerivatives,
+            a,
+        ),
+        (
+            "forward_dynamics_derivatives vs pin.computeABADerivatives",
+            compiled.forward_dynamics_derivatives,
+            pin.computeABADerivatives,
+            tau,
+        ),
+    )
+
+
+def bench_compiled_derivatives_single(quick: bool) -> list[dict]:
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        robot, compiled = _compiled(name, options)
+        model, data = robot.model, robot.model.createData()
+        rng = np.random.default_rng(0)
+        q = robot.random_configuration(rng).copy()
+        v, a = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+        tau = robot.inverse_dynamics(q, v, a)
+        for method, ours, theirs, third in _derivative_cases(robot, compiled, q, v, a, tau):
+            ours(q, v, third)  # builds the derivative module (first use), not timed
+            ours_s, raw_s, ratio = paired(
+                lambda: ours(q, v, third), lambda: theirs(model, data, q, v, third), repeats=7 if quick else 15
+            )
+            cpu_ours, cpu_raw = (
+                min(timeit.Timer(call, timer=time.thread_time).repeat(7, 5000)) / 5000
+                for call in (lambda: ours(q, v, third), lambda: theirs(model, data, q, v, third))
+            )
+            rows.append(
+                {
+                    "robot": label,
+                    "method": method,
+                    "compiled_us": ours_s * 1e6,
+                    "pinocchio_us": raw_s * 1e6,
+                    "ratio": ratio,
+                    "ratio_cpu_time": cpu_ours / cpu_raw,
+                    "load_average": os.getloadavg()[0],
+                }
+            )
+    return rows
+
+
+def bench_compiled_derivatives_batch(quick: bool) -> list[dict]:
+    """100 000 states on two native threads vs Pinocchio's analytical derivatives in a Python
+    loop; the loop's time halved is a 2-thread loop at perfect scaling (Pinocchio's favour).
+    ``speedup_cpu_time``: the same ratio in CPU time (ours summed over both threads), which a
+    loaded machine disturbs less than wall time."""
+    count = 20_000 if quick else 100_000
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        robot, compiled = _compiled(name, options)
+        compiled.threads = 2
+        model, data = robot.model, robot.model.createData()
+        rng = np.random.default_rng(1)
+        q = robot.random_configuration(rng, count)
+        v, a = rng.normal(size=(2, count, robot.nv))
+        tau = robot.inverse_dynamics(q, v, a)
+        for method, ours, theirs, third in _derivative_cases(robot, compiled, q, v, a, tau):
+            ours(q[:1], v[:1], third[:1])  # builds the derivative module (first use), not timed
+            ours_s = median_once(lambda: ours(q, v, third), repeats=5)
+            ours_cpu = median_once(lambda: ours(q, v, third), repeats=5, clock=time.process_time)  # both threads
+            loop = lambda: [theirs(model, data, q[i], v[i], third[i]) for i in range(count)]  # noqa: E731
+            loop_s = median_once(loop, repeats=1)
+            loop_cpu = median_once(loop, repeats=1, clock=time.process_time)
+            rows.append(
+                {
+                    "robot": label,
+                    "method": method.split(" vs ")[0],
+                    "states": count,
+                    "threads": 2,
+                    "compiled_states_per_s": count / ours_s,
+                    "python_loop_states_per_s": count / loop_s,
+                    "speedup_vs_2_thread_loop": loop_s / 2 / ours_s,
+                    "speedup_cpu_time": loop_cpu / ours_cpu,
+                    "load_average": os.getloadavg()[0],
+                }
+            )
+    return rows
+
+
+_DERIVATIVE_BUILD = """
+import os, sys, time, robodyn
+from robodyn.compiled import compile
+robot = robodyn.load(sys.argv[1], **eval(sys.argv[2]))
+compiled = compile(robot)
+start, before = time.perf_counter(), os.times()
+compiled._derivatives()
+after = os.times()
+cpu = after.user + after.system + after.children_user + after.children_system - sum(before[:4])
+print(time.perf_counter() - start, cpu)
+"""
+
+
+def bench_compiled_derivatives_build(quick: bool) -> list[dict]:
+    """The derivative module's cold build (after the robot's own compile, in a fresh cache)."""
+    import subprocess
+    import tempfile
+
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        with tempfile.TemporaryDirectory() as folder:
+            env = os.environ | {"ROBODYN_CACHE": folder}
+            run = [sys.executable, "-c", _DERIVATIVE_BUILD, name, repr(options)]
+            wall, cpu = map(float, subprocess.run(run, env=env, capture_output=True, text=True, check=True).stdout.split())
+        rows.append(
+            {
+                "robot": label,
+                "derivative_build_s": wall,
+                "derivative_build_cpu_s": cpu,
+                "load_average": os.getloadavg()[0],
+                "note": "on first use: Newton-Euler program, forward-mode tangents (sympy), cc -O1 of its own module",
+            }
+        )
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -681,6 +808,9 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-simulation": bench_compiled_simulation,
     "derivatives": bench_derivatives,
     "export": bench_export,
+    "compiled-derivatives-single": bench_compiled_derivatives_single,
+    "compiled-derivatives-batch": bench_compiled_derivatives_batch,
+    "compiled-derivatives-build": bench_compiled_derivatives_build,
 }
 
 

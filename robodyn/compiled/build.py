@@ -204,3 +204,24 @@ def _import(name: str, path: Path) -> ModuleType:
     loader.exec_module(module)
     sys.modules[name] = module
     return module
+
+
+def build_extension(kernels: str, runtime: str, *, init: str, label: str) -> ModuleType:
+    """Like :func:`build_module`, for a module of its own: ``runtime`` (more C, with its own
+    method table) follows ``runtime.c``, and the module is made by the C function ``init``
+    (``PyObject *init(const char *name)``). Used by the derivative kernels
+    (:mod:`robodyn.compiled.derivatives`), built only when first asked for.
+
+    Raises:
+        CompilerNotFoundError: No C compiler.
+        CompileError: The compiler failed (its first error line is quoted).
+    """
+    compiler = find_compiler()
+    base = _RUNTIME.read_text(encoding="utf-8")
+    name = "rd_" + digest(kernels, base, runtime, init, toolchain_key(compiler))
+    target = cache_dir() / f"{name}{sysconfig.get_config_var('EXT_SUFFIX') or '.so'}"
+    if not target.exists():
+        entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
+        source = _PRELUDE + kernels + "\n" + base + "\n" + runtime + "\n" + entry
+        _compile(compiler, source, cache_dir(), target, label)
+    return _import(name, target)

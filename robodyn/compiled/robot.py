@@ -24,7 +24,7 @@ from typing import cast
 
 import numpy as np
 
-from robodyn.compiled import build, codegen
+from robodyn.compiled import build, codegen, derivatives
 from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
@@ -232,3 +232,63 @@ class CompiledRobot:
         if result.__class__ is _ndarray:
             return result
         return self._checked("fd", self._fd, result, q=q, v=v, tau=tau)
+
+    # ---- derivatives (issue 25): kernels of their own, generated and built on first use ----
+    def _derivatives(self) -> ModuleType:
+        """The derivative module (:mod:`robodyn.compiled.derivatives`), built on first use
+        and kept in the instance's ``__dict__`` (so a call costs one dictionary look-up)."""
+        module = self.__dict__.get("_derivative_module")
+        if module is None:
+            key = robot_key(self.robot)
+            kernels = build.cached_kernels(key) or generate_kernels(self.robot)
+            module = derivatives.derivative_module(self.robot, key=key, kernels=kernels, snap=SNAP)
+            self.__dict__["_derivative_module"] = module
+        return module
+
+    def inverse_dynamics_derivatives(
+        self, q: np.ndarray, v: np.ndarray, a: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``∂τ/∂q``, ``∂τ/∂v`` and ``∂τ/∂a = M`` of the inverse dynamics (generated C).
+
+        The first call on a robot generates and builds its derivative kernels (seconds; then
+        cached like the robot's kernels).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv).
+            a: Acceleration, shape (nv,) or (N, nv).
+
+        Returns:
+            ``(dtau_dq, dtau_dv, M)``, each (nv, nv) or (N, nv, nv); entry ``[i, j]`` is
+            ``∂τ_i/∂x_j`` (in [N m/rad], [N m s/rad], [kg m²], or per [m] for prismatic joints).
+        """
+        function = (self.__dict__.get("_derivative_module") or self._derivatives()).tau_derivatives
+        result = function(q, v, a, self.threads)
+        if result.__class__ is tuple:
+            return result
+        return derivatives.checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
+
+    def forward_dynamics_derivatives(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``∂q̈/∂q``, ``∂q̈/∂v`` and ``∂q̈/∂τ = M⁻¹`` of the forward dynamics (generated C).
+
+        ``∂q̈/∂x = −M⁻¹ ∂τ/∂x`` at ``a = q̈``, with one LDLᵀ of ``M``. The first call on a
+        robot builds its derivative kernels (see :meth:`inverse_dynamics_derivatives`).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq).
+            v: Velocity, shape (nv,) or (N, nv).
+            tau: Torques in [N m] / [N], shape (nv,) or (N, nv).
+
+        Returns:
+            ``(dqdd_dq, dqdd_dv, Minv)``, each (nv, nv) or (N, nv, nv).
+
+        Raises:
+            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
+        """
+        function = (self.__dict__.get("_derivative_module") or self._derivatives()).fd_derivatives
+        result = function(q, v, tau, self.threads)
+        if result.__class__ is tuple:
+            return result
+        return derivatives.checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
