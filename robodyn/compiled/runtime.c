@@ -279,20 +279,27 @@ static void rdc_ldl_apply(const double *M, double *b) {
 
 /* Eigen-decomposition of a symmetric m×m matrix (cyclic Jacobi): A -> values on its
  * diagonal, V (row-major) the eigenvectors as columns. */
-static void rdc_jacobi(double *A, double *V, int m) {
+#if defined(__GNUC__) && !defined(__clang__)
+#define RD_HOT __attribute__((optimize("O2", "unroll-loops")))
+#else
+#define RD_HOT
+#endif
+static inline void rdc_jacobi_m(double *A, double *V, const int m) {
     for (int i = 0; i < m; ++i)
         for (int j = 0; j < m; ++j) V[i * m + j] = i == j;
     for (int sweep = 0; sweep < 60; ++sweep) {
-        double off = 0.0, diag = 0.0;
-        for (int i = 0; i < m; ++i) {
-            diag += A[i * m + i] * A[i * m + i];
-            for (int j = i + 1; j < m; ++j) off += A[i * m + j] * A[i * m + j];
-        }
-        if (off <= 1e-36 * diag || off == 0.0) return;
+        double off = 0.0;
+        for (int i = 0; i < m; ++i)
+            for (int j = i + 1; j < m; ++j) off += fabs(A[i * m + j]);
+        if (off == 0.0) return;
         for (int p = 0; p < m; ++p)
             for (int r = p + 1; r < m; ++r) {
-                const double apr = A[p * m + r];
+                const double apr = A[p * m + r], g = 100.0 * fabs(apr);
                 if (apr == 0.0) continue;
+                if (sweep > 3 && fabs(A[p * m + p]) + g == fabs(A[p * m + p]) && fabs(A[r * m + r]) + g == fabs(A[r * m + r])) {
+                    A[p * m + r] = A[r * m + p] = 0.0; /* below rounding of both diagonal entries */
+                    continue;
+                }
                 const double theta = (A[r * m + r] - A[p * m + p]) / (2.0 * apr);
                 const double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
                 const double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
@@ -306,6 +313,7 @@ static void rdc_jacobi(double *A, double *V, int m) {
                     A[p * m + k] = c * apk - s * ark;
                     A[r * m + k] = s * apk + c * ark;
                 }
+                A[p * m + r] = A[r * m + p] = 0.0; /* zeroed by the rotation: exactly, not to rounding */
                 for (int k = 0; k < m; ++k) {
                     const double vkp = V[k * m + p], vkr = V[k * m + r];
                     V[k * m + p] = c * vkp - s * vkr;
@@ -313,6 +321,14 @@ static void rdc_jacobi(double *A, double *V, int m) {
                 }
             }
     }
+}
+
+/* The loops' trip count a constant (3 or 6), so that the compiler unrolls them. */
+static RD_HOT void rdc_jacobi(double *A, double *V, int m) {
+    if (m == 6)
+        rdc_jacobi_m(A, V, 6);
+    else
+        rdc_jacobi_m(A, V, 3);
 }
 
 /* Λ from Λ⁻¹ = A (m×m, destroyed), damped as operational_space.damped_task_inertia. */
