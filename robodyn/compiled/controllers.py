@@ -136,5 +136,12 @@ class CompiledImpedance(CompiledFrameController):
         stiffness[:rows] = _vector(self.stiffness, "stiffness", rows)
         damping[:rows] = _vector(self.damping, "damping", rows)
         return np.concatenate(
-            [[rows], _vector(self.position, "position", 3), rotation, stiffness, damping, [_scalar(self.null_damping, "null_damping")]]
+            [
+                [rows],
+                _vector(self.position, "position", 3),
+                rotation,
+                stiffness,
+                damping,
+                [_scalar(self.null_damping, "null_damping")],
+            ]
         )

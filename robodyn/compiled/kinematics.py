@@ -103,23 +103,26 @@ def frame_source(program: Program) -> str:
     return "\n".join(lines)
 
 
-def frame_key(robot: Robot, frame: str) -> str:
-    """The cache key of a frame's kernels: the robot's URDF, the frame and the generator."""
-    from robodyn.compiled.robot import robot_key
-
+def frame_key(robot_key: str, frame: str) -> str:
+    """The cache key of a frame's kernels: the robot's key (its URDF, gravity, the dynamics
+    generator), the frame and this generator."""
     generator = "".join(Path(module).read_text(encoding="utf-8") for module in (__file__, frame_program.__code__.co_filename))
-    return build.digest(robot_key(robot), frame, FRAME_VERSION, CODEGEN_VERSION, generator)
+    return build.digest(robot_key, frame, FRAME_VERSION, CODEGEN_VERSION, generator)
 
 
-def build_frame(robot: Robot, frame: str) -> ModuleType:
+def build_frame(robot: Robot, frame: str, robot_key: str) -> ModuleType:
     """Generate (or find cached), compile and load the frame's extension module.
+
+    Args:
+        robot: The robot; frame: one of its frames; robot_key: its
+            :func:`robodyn.compiled.robot.robot_key`.
 
     Raises:
         FrameError: Unknown frame. CompileError, CompilerNotFoundError: As :func:`robodyn.compile`.
     """
     robot.frame_id(frame)  # refuse an unknown frame before any work
     compiler = build.find_compiler()
-    key = "frame-" + frame_key(robot, frame)
+    key = "frame-" + frame_key(robot_key, frame)
     with build.locked(key):
         kernels = build.cached_kernels(key)
         if kernels is None:

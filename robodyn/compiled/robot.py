@@ -26,6 +26,7 @@ import numpy as np
 
 from robodyn.compiled import build, codegen
 from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
+from robodyn.compiled.kinematics import build_frame
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
 from robodyn.equations import c_printer, compact, newton_euler, program, sharing
@@ -243,9 +244,7 @@ class CompiledRobot:
         """
         modules = self.__dict__.setdefault("_frames", {})
         if frame not in modules:
-            from robodyn.compiled.kinematics import build_frame
-
-            modules[frame] = build_frame(self.robot, frame)
+            modules[frame] = build_frame(self.robot, frame, robot_key(self.robot))
         return modules[frame]
 
     def _frame_call(self, kind: str, frame: str, **named: np.ndarray) -> np.ndarray:

@@ -11,7 +11,7 @@ like the dynamics (:mod:`robodyn.equations.simplify`). No Pinocchio here.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Literal
 
 import numpy as np
@@ -182,5 +182,10 @@ def frame_program(
         w, dw = motion.angular_velocity[body], motion.angular_acceleration[body]
         local = motion.acceleration[body] + dw.cross(offset) + w.cross(w.cross(offset))
         bias = (world_rotation[body] * local).col_join(world_rotation[body] * dw)
-    outputs = {"position": list(position), "rotation": list(frame_rotation), "jacobian": list(jacobian), "bias": list(bias)}
+    outputs: dict[str, Sequence[sp.Expr]] = {
+        "position": list(position),
+        "rotation": list(frame_rotation),
+        "jacobian": list(jacobian),
+        "bias": list(bias),
+    }
     return builder.program({"q": tuple(q), "qd": tuple(qd)}, outputs)

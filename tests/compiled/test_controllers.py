@@ -53,14 +53,18 @@ def deviation(python, compiled) -> float:
 
 
 def runs(robot, controller, q0, duration, dt=1e-3, integrator="rk4", twin=None):
-    python = robodyn.simulate(robot, q0, np.zeros(robot.nv), duration, dt, controller=controller, integrator=integrator, limits="ignore")
+    python = robodyn.simulate(
+        robot, q0, np.zeros(robot.nv), duration, dt, controller=controller, integrator=integrator, limits="ignore"
+    )
     law = twin if twin is not None else compiled_controller(controller)
     compiled = simulate_compiled(compile(robot), q0, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator)
     return python, compiled
 
 
 @pytest.mark.parametrize("kind", ["pd", "computed-torque", "task-space", "operational-space", "impedance"])
-@pytest.mark.parametrize(("source", "options", "duration"), [("rp_arm", {}, 1.0), ("panda", PANDA_ARM, 0.3)], ids=["rp_arm", "panda_arm"])
+@pytest.mark.parametrize(
+    ("source", "options", "duration"), [("rp_arm", {}, 1.0), ("panda", PANDA_ARM, 0.3)], ids=["rp_arm", "panda_arm"]
+)
 def test_each_compiled_controller_follows_the_python_engine_over_the_whole_run(kind, source, options, duration, rng):
     robot = robodyn.load(source, **options)
     law = controllers(robot, rng)[kind]
@@ -92,6 +96,8 @@ def test_a_controller_without_a_twin_is_refused_in_one_sentence():
     robot = robodyn.load("rp_arm")
     with pytest.raises(CompileError, match="no compiled twin"):
         compiled_controller(lambda t, q, v: np.zeros(robot.nv))
-    path = OperationalSpace(robot, None, lambda t: (robot.frame_position(np.zeros(robot.nv), robot.end_effector), np.zeros(3), np.zeros(3)))
+    path = OperationalSpace(
+        robot, None, lambda t: (robot.frame_position(np.zeros(robot.nv), robot.end_effector), np.zeros(3), np.zeros(3))
+    )
     with pytest.raises(CompileError, match="fixed target"):
         compiled_controller(path)
