@@ -212,8 +212,15 @@ CompiledController = CompiledPDGravity | CompiledComputedTorque | CompiledFrameC
 
 
 def has_twin(controller: object) -> bool:
-    """Whether :func:`compiled_controller` maps this controller's class (its parameters may still be refused)."""
-    return f"{type(controller).__module__}.{type(controller).__qualname__}" in _TWINS
+    """Whether :func:`compiled_controller` has a twin for this controller (its class and, for
+    computed torque, its reference; for operational space, a fixed target)."""
+    kind = _TWINS.get(f"{type(controller).__module__}.{type(controller).__qualname__}")
+    c: Any = controller
+    if kind == "computed-torque":
+        return type(c.reference).__qualname__ == "QuinticReference"
+    if kind == "operational-space":
+        return not callable(c.position)
+    return kind is not None
 
 
 def compiled_controller(controller: object) -> CompiledController:

@@ -9,7 +9,7 @@ import pytest
 
 import robodyn
 from robodyn.compiled import compile
-from robodyn.compiled.simulation import compiled_controller, simulate_compiled
+from robodyn.compiled.simulation import compiled_controller, has_twin, simulate_compiled
 from robodyn.exceptions import CompileError
 from robodyn.sim.control import ComputedTorque, Impedance, OperationalSpace, PDGravity, TaskSpace, quintic_reference
 from tests.compiled_helpers import shared_cache
@@ -101,3 +101,4 @@ def test_a_controller_without_a_twin_is_refused_in_one_sentence():
     )
     with pytest.raises(CompileError, match="fixed target"):
         compiled_controller(path)
+    assert not has_twin(path) and has_twin(TaskSpace(robot, None, [0.7, 0.0, 0.7]))
