@@ -63,7 +63,8 @@ def runs(robot, controller, q0, duration, dt=1e-3, integrator="rk4", twin=None):
 
 @pytest.mark.parametrize("kind", ["pd", "computed-torque", "task-space", "operational-space", "impedance"])
 @pytest.mark.parametrize(
-    ("source", "options", "duration"), [("rp_arm", {}, 1.0), ("panda", PANDA_ARM, 0.3)], ids=["rp_arm", "panda_arm"]
+    ("source", "options", "duration"),
+    [pytest.param("rp_arm", {}, 1.0, id="rp_arm"), pytest.param("panda", PANDA_ARM, 0.3, id="panda_arm", marks=pytest.mark.slow)],
 )
 def test_each_compiled_controller_follows_the_python_engine_over_the_whole_run(kind, source, options, duration, rng):
     robot = robodyn.load(source, **options)
@@ -74,6 +75,7 @@ def test_each_compiled_controller_follows_the_python_engine_over_the_whole_run(k
     assert np.abs(python.q[-1] - python.q[0]).max() > 1e-3  # the controller moved the arm
 
 
+@pytest.mark.slow
 def test_a_mismatched_model_non_default_gravity_and_semi_implicit_euler_still_agree(rng):
     """The controller's model carries a payload the plant does not; gravity is tilted."""
     plant = robodyn.load("panda", **PANDA_ARM, gravity=[0.4, -0.3, -9.7])

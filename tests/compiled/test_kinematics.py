@@ -53,16 +53,22 @@ def errors(compiled, robot, frame: str, rng: np.random.Generator) -> dict[str, f
     return worst
 
 
+SLOW = pytest.mark.slow
 CASES = [
-    # oblique non-unit axes, six-valued origins, a fixed joint mid-chain, a prismatic joint
-    (NONDEGENERATE_CASES["oblique"], ["end_effector", "bracket_link", "j_extend", "base"]),
-    (NONDEGENERATE_CASES["mimic_tree"], ["hand", "finger"]),  # mimic joints: J = J_bodies S
-    ((TWO_BRANCHES, {}), ["a_tip", "z_slider"]),  # a tree
-    (("panda", {"lock": {"panda_finger_joint1": 0.0}}), ["panda_hand_tcp", "panda_link4", "panda_rightfinger"]),  # fixed chains
+    # oblique non-unit axes, six-valued origins, a fixed joint mid-chain (its link), the base
+    pytest.param(NONDEGENERATE_CASES["oblique"], ["end_effector", "bracket_link", "base"], id="oblique"),
+    pytest.param((TWO_BRANCHES, {}), ["a_tip", "z_slider"], id="two_branches"),  # a tree, a prismatic tip
+    pytest.param(NONDEGENERATE_CASES["oblique"], ["j_extend", "j_tool"], id="oblique_joint_frames", marks=SLOW),
+    pytest.param(NONDEGENERATE_CASES["mimic_tree"], ["hand", "finger"], id="mimic_tree", marks=SLOW),  # J = J_bodies S
+    pytest.param(
+        ("panda", {"lock": {"panda_finger_joint1": 0.0}}),
+        ["panda_hand_tcp", "panda_link4", "panda_rightfinger"],
+        id="panda_arm",
+        marks=SLOW,
+    ),  # fixed chains
 ]
 
 
-@pytest.mark.parametrize(("case", "frames"), CASES, ids=["oblique", "mimic_tree", "two_branches", "panda_arm"])
 def test_compiled_frame_kinematics_match_pinocchio(case, frames, rng):
     source, options = case
     robot = robodyn.load(source, **options)
