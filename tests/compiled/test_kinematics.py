@@ -69,6 +69,7 @@ CASES = [
 ]
 
 
+@pytest.mark.parametrize(("case", "frames"), CASES)
 def test_compiled_frame_kinematics_match_pinocchio(case, frames, rng):
     source, options = case
     robot = robodyn.load(source, **options)
