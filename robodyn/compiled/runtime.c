@@ -277,66 +277,118 @@ static void rdc_ldl_apply(const double *M, double *b) {
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
 }
 
-/* Eigen-decomposition of a symmetric m×m matrix (cyclic Jacobi): A -> values on its
- * diagonal, V (row-major) the eigenvectors as columns. */
-#if defined(__GNUC__) && !defined(__clang__)
-#define RD_HOT __attribute__((optimize("O2", "unroll-loops")))
-#else
-#define RD_HOT
-#endif
-static inline void rdc_jacobi_m(double *A, double *V, const int m) {
-    for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j) V[i * m + j] = i == j;
-    for (int sweep = 0; sweep < 60; ++sweep) {
-        double off = 0.0;
-        for (int i = 0; i < m; ++i)
-            for (int j = i + 1; j < m; ++j) off += fabs(A[i * m + j]);
-        if (off == 0.0) return;
-        for (int p = 0; p < m; ++p)
-            for (int r = p + 1; r < m; ++r) {
-                const double apr = A[p * m + r], g = 100.0 * fabs(apr);
-                if (apr == 0.0) continue;
-                if (sweep > 3 && fabs(A[p * m + p]) + g == fabs(A[p * m + p]) && fabs(A[r * m + r]) + g == fabs(A[r * m + r])) {
-                    A[p * m + r] = A[r * m + p] = 0.0; /* below rounding of both diagonal entries */
-                    continue;
+/* Eigen-decomposition of a symmetric m×m matrix (its lower triangle, as numpy's eigh): Householder
+ * tridiagonalisation + implicit QL (EISPACK tred2/tql2, as in Numerical Recipes). */
+static void rdc_tred2(double *a, int n, double *d, double *e) {
+    for (int i = n - 1; i > 0; --i) {
+        const int l = i - 1;
+        double h = 0.0, scale = 0.0;
+        if (l > 0) {
+            for (int k = 0; k <= l; ++k) scale += fabs(a[i * n + k]);
+            if (scale == 0.0) {
+                e[i] = a[i * n + l];
+            } else {
+                for (int k = 0; k <= l; ++k) {
+                    a[i * n + k] /= scale;
+                    h += a[i * n + k] * a[i * n + k];
                 }
-                const double theta = (A[r * m + r] - A[p * m + p]) / (2.0 * apr);
-                const double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
-                const double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
-                for (int k = 0; k < m; ++k) {
-                    const double akp = A[k * m + p], akr = A[k * m + r];
-                    A[k * m + p] = c * akp - s * akr;
-                    A[k * m + r] = s * akp + c * akr;
+                double f = a[i * n + l];
+                double g = f >= 0.0 ? -sqrt(h) : sqrt(h);
+                e[i] = scale * g;
+                h -= f * g;
+                a[i * n + l] = f - g;
+                f = 0.0;
+                for (int j = 0; j <= l; ++j) {
+                    a[j * n + i] = a[i * n + j] / h;
+                    g = 0.0;
+                    for (int k = 0; k <= j; ++k) g += a[j * n + k] * a[i * n + k];
+                    for (int k = j + 1; k <= l; ++k) g += a[k * n + j] * a[i * n + k];
+                    e[j] = g / h;
+                    f += e[j] * a[i * n + j];
                 }
-                for (int k = 0; k < m; ++k) {
-                    const double apk = A[p * m + k], ark = A[r * m + k];
-                    A[p * m + k] = c * apk - s * ark;
-                    A[r * m + k] = s * apk + c * ark;
-                }
-                A[p * m + r] = A[r * m + p] = 0.0; /* zeroed by the rotation: exactly, not to rounding */
-                for (int k = 0; k < m; ++k) {
-                    const double vkp = V[k * m + p], vkr = V[k * m + r];
-                    V[k * m + p] = c * vkp - s * vkr;
-                    V[k * m + r] = s * vkp + c * vkr;
+                const double hh = f / (h + h);
+                for (int j = 0; j <= l; ++j) {
+                    f = a[i * n + j];
+                    e[j] = g = e[j] - hh * f;
+                    for (int k = 0; k <= j; ++k) a[j * n + k] -= f * e[k] + g * a[i * n + k];
                 }
             }
+        } else {
+            e[i] = a[i * n + l];
+        }
+        d[i] = h;
+    }
+    d[0] = 0.0;
+    e[0] = 0.0;
+    for (int i = 0; i < n; ++i) {
+        const int l = i - 1;
+        if (d[i] != 0.0) {
+            for (int j = 0; j <= l; ++j) {
+                double g = 0.0;
+                for (int k = 0; k <= l; ++k) g += a[i * n + k] * a[k * n + j];
+                for (int k = 0; k <= l; ++k) a[k * n + j] -= g * a[k * n + i];
+            }
+        }
+        d[i] = a[i * n + i];
+        a[i * n + i] = 1.0;
+        for (int j = 0; j <= l; ++j) a[j * n + i] = a[i * n + j] = 0.0;
     }
 }
 
-/* The loops' trip count a constant (3 or 6), so that the compiler unrolls them. */
-static RD_HOT void rdc_jacobi(double *A, double *V, int m) {
-    if (m == 6)
-        rdc_jacobi_m(A, V, 6);
-    else
-        rdc_jacobi_m(A, V, 3);
+static void rdc_tqli(double *d, double *e, int n, double *z) {
+    for (int i = 1; i < n; ++i) e[i - 1] = e[i];
+    e[n - 1] = 0.0;
+    for (int l = 0; l < n; ++l) {
+        int iter = 0, m;
+        do {
+            for (m = l; m < n - 1; ++m) {
+                const double dd = fabs(d[m]) + fabs(d[m + 1]);
+                if (fabs(e[m]) <= 2.220446049250313e-16 * dd) break;
+            }
+            if (m != l) {
+                if (iter++ == 60) break;
+                double g = (d[l + 1] - d[l]) / (2.0 * e[l]);
+                double r = hypot(g, 1.0);
+                g = d[m] - d[l] + e[l] / (g + (g >= 0.0 ? fabs(r) : -fabs(r)));
+                double s = 1.0, c = 1.0, p = 0.0;
+                int i;
+                for (i = m - 1; i >= l; --i) {
+                    double f = s * e[i], b = c * e[i];
+                    e[i + 1] = (r = hypot(f, g));
+                    if (r == 0.0) {
+                        d[i + 1] -= p;
+                        e[m] = 0.0;
+                        break;
+                    }
+                    s = f / r;
+                    c = g / r;
+                    g = d[i + 1] - p;
+                    r = (d[i] - g) * s + 2.0 * c * b;
+                    d[i + 1] = g + (p = s * r);
+                    g = c * r - b;
+                    for (int k = 0; k < n; ++k) {
+                        f = z[k * n + i + 1];
+                        z[k * n + i + 1] = s * z[k * n + i] + c * f;
+                        z[k * n + i] = c * z[k * n + i] - s * f;
+                    }
+                }
+                if (r == 0.0 && i >= l) continue;
+                d[l] -= p;
+                e[l] = g;
+                e[m] = 0.0;
+            }
+        } while (m != l);
+    }
 }
 
 /* Λ from Λ⁻¹ = A (m×m, destroyed), damped as operational_space.damped_task_inertia. */
 static void rdc_task_inertia(double *A, double damping, int m, double *L) {
-    double V[36], s[6], top = 0.0;
-    rdc_jacobi(A, V, m);
+    double V[36], s[6], d[6], e[6], top = 0.0;
+    memcpy(V, A, sizeof(double) * m * m); /* eigenvectors as the columns of V, values in d */
+    rdc_tred2(V, m, d, e);
+    rdc_tqli(d, e, m, V);
     for (int i = 0; i < m; ++i) {
-        s[i] = A[i * m + i] > 0.0 ? A[i * m + i] : 0.0;
+        s[i] = d[i] > 0.0 ? d[i] : 0.0;
         if (s[i] > top) top = s[i];
     }
     const double floor = (damping * top) * (damping * top);
