@@ -23,6 +23,8 @@ Sections:
     compiled-derivatives-single  compiled ∂τ / ∂q̈ vs pin.computeRNEADerivatives / computeABADerivatives
     compiled-derivatives-batch   100 000 states on 2 threads vs a 2-thread loop of Pinocchio's
     compiled-derivatives-build   the derivative module's cold build (on first use)
+    compiled-control     compiled controllers in the C loop: the demo's task-space run, panda-arm
+                         task space / OSC / impedance vs MuJoCo's passive RK4, frame kernels vs Pinocchio
 """
 
 from __future__ import annotations
@@ -794,6 +796,106 @@ def bench_compiled_derivatives_build(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_compiled_control(quick: bool) -> list[dict]:
+    """Compiled controllers (every RK4 stage, in C): the loop's real-time factor (start-up and
+    compile excluded), against the Python engine and MuJoCo's passive RK4 loop on the same robot."""
+    from robodyn.compiled.simulation import compiled_controller, simulate_compiled
+    from robodyn.sim.control import Impedance, OperationalSpace, TaskSpace
+
+    rows = []
+    # The demo (Makefile): rp_arm, task space, --q0 0,0.1 --target 0.7,0.7 --duration 3.
+    robot, compiled = _compiled("rp_arm", {})
+    law = TaskSpace(robot, None, [0.7, 0.0, 0.7])
+    twin, q0, v0 = compiled_controller(law), np.array([0.0, 0.1]), np.zeros(2)
+    run = lambda: simulate_compiled(compiled, q0, v0, 3.0, 1e-3, controller=twin)  # noqa: E731
+    python = simulate(robot, q0, v0, 3.0, 1e-3, controller=law)
+    rows.append(
+        {
+            "robot": "rp_arm (the demo)",
+            "controller": "task-space",
+            "duration_s": 3.0,
+            "compiled_loop_rtf": 3.0 / median_once(run, 7),
+            "compiled_loop_rtf_cpu": 3.0 / median_cpu(run, 7),
+            "python_engine_rtf": 3.0 / median_once(lambda: simulate(robot, q0, v0, 3.0, 1e-3, controller=law), 1),
+            "max_q_difference": float(np.abs(run().q - python.q).max()),
+            "mujoco_passive_rk4_rtf": float("nan"),
+            "mujoco_passive_rk4_rtf_cpu": float("nan"),
+            "compiled_vs_mujoco_passive_cpu": float("nan"),
+            "target": "compiled_loop_rtf >= 200",
+        }
+    )
+    robot, compiled = _compiled("panda", PANDA_ARM)
+    duration, q0 = (1.0 if quick else 5.0), robot.neutral_configuration() + 0.3
+    goal = robot.frame_position(q0 - 0.2, robot.end_effector)
+    laws = {
+        "task-space": TaskSpace(robot, None, goal),
+        "osc (position)": OperationalSpace(robot, None, goal),
+        "osc (pose)": OperationalSpace(robot, None, goal, orientation=[3.0, 0.2, 0.1]),
+        "impedance (pose)": Impedance(robot, None, goal, orientation=[3.0, 0.2, 0.1]),
+    }
+    mj_rtf = mj_rtf_cpu = float("nan")
+    try:
+        import mujoco
+
+        model = _mujoco_model(robot)
+        model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+
+        def mj_loop() -> None:
+            data = mujoco.MjData(model)
+            data.qpos[:] = q0
+            for _ in range(round(duration / 1e-3)):
+                mujoco.mj_step(model, data)
+
+        mj_rtf, mj_rtf_cpu = duration / median_once(mj_loop), duration / median_cpu(mj_loop)
+    except ImportError:
+        pass
+    for name, law in laws.items():
+        twin = compiled_controller(law)
+        run = lambda twin=twin: simulate_compiled(compiled, q0, np.zeros(robot.nv), duration, 1e-3, controller=twin)  # noqa: E731
+        row = {"robot": "panda (arm, fingers locked)", "controller": name, "duration_s": duration}
+        row["compiled_loop_rtf"] = duration / median_once(run)
+        row["compiled_loop_rtf_cpu"] = duration / median_cpu(run)
+        row["python_engine_rtf"], row["max_q_difference"] = float("nan"), float("nan")
+        row["mujoco_passive_rk4_rtf"], row["mujoco_passive_rk4_rtf_cpu"] = mj_rtf, mj_rtf_cpu
+        row["compiled_vs_mujoco_passive_cpu"] = row["compiled_loop_rtf_cpu"] / mj_rtf_cpu
+        row["target"] = "compiled_vs_mujoco_passive >= 1"
+        rows.append(row)
+    return rows
+
+
+def bench_compiled_frames(quick: bool) -> list[dict]:
+    """Compiled frame kinematics (one call, through Python) vs the same quantity from Pinocchio."""
+    robot, compiled = _compiled("panda", PANDA_ARM)
+    frame, model, data = robot.end_effector, robot.model, robot.model.createData()
+    index = robot.frame_id(frame)
+    rng = np.random.default_rng(0)
+    q, v = robot.random_configuration(rng), rng.normal(size=robot.nv)
+    module = compiled.frame_module(frame)
+
+    def pin_bias() -> None:
+        pin.forwardKinematics(model, data, q, v, np.zeros(robot.nv))
+        pin.getFrameClassicalAcceleration(model, data, index, pin.LOCAL_WORLD_ALIGNED)
+
+    cases = {
+        "frame_position vs framesForwardKinematics": (
+            lambda: module.position(q),
+            lambda: pin.framesForwardKinematics(model, data, q),
+        ),
+        "frame_jacobian vs computeFrameJacobian": (
+            lambda: module.jacobian(q),
+            lambda: pin.computeFrameJacobian(model, data, q, index, pin.LOCAL_WORLD_ALIGNED),
+        ),
+        "frame_bias (all four) vs forwardKinematics + classical acceleration": (lambda: module.bias(q, v), pin_bias),
+    }
+    rows = []
+    for method, (ours, raw) in cases.items():
+        ours_s, raw_s, ratio = paired(ours, raw)
+        rows.append(
+            {"robot": "panda (arm)", "method": method, "compiled_us": ours_s * 1e6, "pinocchio_us": raw_s * 1e6, "ratio": ratio}
+        )
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -811,6 +913,8 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-derivatives-single": bench_compiled_derivatives_single,
     "compiled-derivatives-batch": bench_compiled_derivatives_batch,
     "compiled-derivatives-build": bench_compiled_derivatives_build,
+    "compiled-control": bench_compiled_control,
+    "compiled-frames": bench_compiled_frames,
 }
 
 

@@ -26,6 +26,7 @@ import numpy as np
 
 from robodyn.compiled import build, codegen, derivatives
 from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
+from robodyn.compiled.kinematics import build_frame
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
 from robodyn.equations import c_printer, compact, newton_euler, program, sharing
@@ -292,3 +293,50 @@ class CompiledRobot:
         if result.__class__ is tuple:
             return result
         return derivatives.checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
+
+    # ---- frame kinematics (robodyn.compiled.kinematics): one small module a frame ----------
+
+    def frame_module(self, frame: str) -> ModuleType:
+        """The compiled kinematics of a frame (built on first use, then cached on disk and here).
+
+        Raises:
+            FrameError: Unknown frame. CompileError: If the build fails.
+        """
+        modules = self.__dict__.setdefault("_frames", {})
+        if frame not in modules:
+            modules[frame] = build_frame(self.robot, frame, robot_key(self.robot))
+        return modules[frame]
+
+    def _frame_call(self, kind: str, frame: str, **named: np.ndarray) -> np.ndarray:
+        function = getattr(self.frame_module(frame), kind)
+        result = function(*named.values())
+        if result.__class__ is _ndarray:
+            return result
+        arrays, _ = self.robot.validate(**named)
+        result = function(*[np.ascontiguousarray(array, dtype=np.float64) for array in arrays])
+        if result.__class__ is not _ndarray:  # cannot happen after validate(): refuse rather than guess
+            raise CompileError(self.name, f"the compiled frame {kind} refused checked inputs (status {result})")
+        return result
+
+    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Position of a frame's origin in the world frame, shape (3,) or (N, 3), in [m]
+        (as :meth:`robodyn.Robot.frame_position`, in generated C)."""
+        return self._frame_call("position", frame, q=q)
+
+    def frame_rotation(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Rotation world <- frame, shape (3, 3) or (N, 3, 3)."""
+        return self._frame_call("rotation", frame, q=q)
+
+    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Frame Jacobian, shape (6, nv) or (N, 6, nv): linear rows then angular, world-aligned
+        axes at the frame's origin (Pinocchio's ``LOCAL_WORLD_ALIGNED``, as
+        :meth:`robodyn.Robot.frame_jacobian`)."""
+        return self._frame_call("jacobian", frame, q=q)
+
+    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str, *, angular: bool = False) -> np.ndarray:
+        """``J̇(q, v) v``: the classical acceleration of the frame's origin at zero joint
+        acceleration, world axes, shape (3,) or (N, 3), in [m/s²] (as
+        :meth:`robodyn.Robot.frame_bias_acceleration`); with ``angular=True`` the angular
+        acceleration in [rad/s²] follows, shape (6,) or (N, 6)."""
+        bias = self._frame_call("bias", frame, q=q, v=v)
+        return bias if angular else bias[..., :3].copy()

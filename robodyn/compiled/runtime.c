@@ -9,10 +9,12 @@
  * Batches run across rows on `threads` POSIX threads with the GIL released.
  *
  *   simulate(q0, v0, dt, steps, t0, rk4, kind, hold, params, controller, out_q, out_v,
- *            out_a, out_tau) -> -1, or the step after which the state stopped being finite
+ *            out_a, out_tau[, frame]) -> -1, or the step after which the state stopped being finite
  * integrates in C (RK4 or semi-implicit Euler); kind 0 holds params[0:n] as the torque,
  * 1 is PD + gravity, 2 computed torque along a quintic, both on the controller's model
- * (a capsule of another compiled robot's kernels, `_kernels`).
+ * (a capsule of another compiled robot's kernels, `_kernels`); 3 task space, 4 operational
+ * space, 5 impedance, on the controller's model and a frame's kernels (the capsule `_frame`
+ * of a frame module, robodyn/compiled/kinematics.py).
  */
 
 #define RD_CAPSULE "robodyn.compiled.kernels"
@@ -210,7 +212,425 @@ typedef struct {
     int kind, hold;
     const double *params;
     const rd_kernels *model;
+    const void *frame; /* kinds 3-5: the controlled frame's rd_frame_kernels */
 } rd_controller;
+
+/* ---- compiled frame controllers (task space, operational space, impedance) -------------
+ * Each is the Python controller of robodyn.sim (control.py, operational_space.py), formula
+ * for formula, on the controller's model (rd_kernels) and one frame's kinematics
+ * (rd_frame_kernels, the capsule `_frame` of a frame module, see kinematics.py). */
+
+#define RD_FRAME_CAPSULE "robodyn.compiled.frame"
+
+typedef struct {
+    int nv;
+    void (*pose)(const double *, double *, double *);
+    void (*jacobian)(const double *, double *);
+    void (*all)(const double *, const double *, double *, double *, double *, double *);
+} rd_frame_kernels;
+
+/* Solve A X = B in place (A m×m destroyed, B m×k, both row-major): Gaussian elimination with
+ * partial pivoting (numpy.linalg.solve's LU). */
+static void rdc_solve(double *A, double *B, int m, int k) {
+    for (int c = 0; c < m; ++c) {
+        int pivot = c;
+        for (int r = c + 1; r < m; ++r)
+            if (fabs(A[r * m + c]) > fabs(A[pivot * m + c])) pivot = r;
+        if (pivot != c) {
+            for (int j = 0; j < m; ++j) { const double x = A[c * m + j]; A[c * m + j] = A[pivot * m + j]; A[pivot * m + j] = x; }
+            for (int j = 0; j < k; ++j) { const double x = B[c * k + j]; B[c * k + j] = B[pivot * k + j]; B[pivot * k + j] = x; }
+        }
+        for (int r = c + 1; r < m; ++r) {
+            const double f = A[r * m + c] / A[c * m + c];
+            for (int j = c; j < m; ++j) A[r * m + j] -= f * A[c * m + j];
+            for (int j = 0; j < k; ++j) B[r * k + j] -= f * B[c * k + j];
+        }
+    }
+    for (int c = m - 1; c >= 0; --c)
+        for (int j = 0; j < k; ++j) {
+            double x = B[c * k + j];
+            for (int r = c + 1; r < m; ++r) x -= A[c * m + r] * B[r * k + j];
+            B[c * k + j] = x / A[c * m + c];
+        }
+}
+
+/* The tree LDLᵀ of runtime's rd_ldl_solve, split: factor once, then solve for several b. */
+static int rdc_ldl_factor(double *M) {
+    const int n = RD_NV;
+    for (int k = n - 1; k >= 0; --k) {
+        const double d = M[k * n + k];
+        if (!(d > 0.0) || !isfinite(d)) return 3;
+        for (int i = rd_parent[k]; i >= 0; i = rd_parent[i]) {
+            const double x = M[k * n + i] / d;
+            for (int j = i; j >= 0; j = rd_parent[j]) M[i * n + j] -= M[k * n + j] * x;
+            M[k * n + i] = x;
+        }
+    }
+    return 0;
+}
+static void rdc_ldl_apply(const double *M, double *b) {
+    const int n = RD_NV;
+    for (int i = n - 1; i >= 0; --i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= M[i * n + j] * b[i];
+    for (int i = 0; i < n; ++i) b[i] /= M[i * n + i];
+    for (int i = 0; i < n; ++i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
+}
+
+/* Eigen-decomposition of a symmetric m×m matrix (its lower triangle, as numpy's eigh): Householder
+ * tridiagonalisation + implicit QL (EISPACK tred2/tql2, as in Numerical Recipes). */
+static void rdc_tred2(double *a, int n, double *d, double *e) {
+    for (int i = n - 1; i > 0; --i) {
+        const int l = i - 1;
+        double h = 0.0, scale = 0.0;
+        if (l > 0) {
+            for (int k = 0; k <= l; ++k) scale += fabs(a[i * n + k]);
+            if (scale == 0.0) {
+                e[i] = a[i * n + l];
+            } else {
+                for (int k = 0; k <= l; ++k) {
+                    a[i * n + k] /= scale;
+                    h += a[i * n + k] * a[i * n + k];
+                }
+                double f = a[i * n + l];
+                double g = f >= 0.0 ? -sqrt(h) : sqrt(h);
+                e[i] = scale * g;
+                h -= f * g;
+                a[i * n + l] = f - g;
+                f = 0.0;
+                for (int j = 0; j <= l; ++j) {
+                    a[j * n + i] = a[i * n + j] / h;
+                    g = 0.0;
+                    for (int k = 0; k <= j; ++k) g += a[j * n + k] * a[i * n + k];
+                    for (int k = j + 1; k <= l; ++k) g += a[k * n + j] * a[i * n + k];
+                    e[j] = g / h;
+                    f += e[j] * a[i * n + j];
+                }
+                const double hh = f / (h + h);
+                for (int j = 0; j <= l; ++j) {
+                    f = a[i * n + j];
+                    e[j] = g = e[j] - hh * f;
+                    for (int k = 0; k <= j; ++k) a[j * n + k] -= f * e[k] + g * a[i * n + k];
+                }
+            }
+        } else {
+            e[i] = a[i * n + l];
+        }
+        d[i] = h;
+    }
+    d[0] = 0.0;
+    e[0] = 0.0;
+    for (int i = 0; i < n; ++i) {
+        const int l = i - 1;
+        if (d[i] != 0.0) {
+            for (int j = 0; j <= l; ++j) {
+                double g = 0.0;
+                for (int k = 0; k <= l; ++k) g += a[i * n + k] * a[k * n + j];
+                for (int k = 0; k <= l; ++k) a[k * n + j] -= g * a[k * n + i];
+            }
+        }
+        d[i] = a[i * n + i];
+        a[i * n + i] = 1.0;
+        for (int j = 0; j <= l; ++j) a[j * n + i] = a[i * n + j] = 0.0;
+    }
+}
+
+static void rdc_tqli(double *d, double *e, int n, double *z) {
+    for (int i = 1; i < n; ++i) e[i - 1] = e[i];
+    e[n - 1] = 0.0;
+    for (int l = 0; l < n; ++l) {
+        int iter = 0, m;
+        do {
+            for (m = l; m < n - 1; ++m) {
+                const double dd = fabs(d[m]) + fabs(d[m + 1]);
+                if (fabs(e[m]) <= 2.220446049250313e-16 * dd) break;
+            }
+            if (m != l) {
+                if (iter++ == 60) break;
+                double g = (d[l + 1] - d[l]) / (2.0 * e[l]);
+                double r = hypot(g, 1.0);
+                g = d[m] - d[l] + e[l] / (g + (g >= 0.0 ? fabs(r) : -fabs(r)));
+                double s = 1.0, c = 1.0, p = 0.0;
+                int i;
+                for (i = m - 1; i >= l; --i) {
+                    double f = s * e[i], b = c * e[i];
+                    e[i + 1] = (r = hypot(f, g));
+                    if (r == 0.0) {
+                        d[i + 1] -= p;
+                        e[m] = 0.0;
+                        break;
+                    }
+                    s = f / r;
+                    c = g / r;
+                    g = d[i + 1] - p;
+                    r = (d[i] - g) * s + 2.0 * c * b;
+                    d[i + 1] = g + (p = s * r);
+                    g = c * r - b;
+                    for (int k = 0; k < n; ++k) {
+                        f = z[k * n + i + 1];
+                        z[k * n + i + 1] = s * z[k * n + i] + c * f;
+                        z[k * n + i] = c * z[k * n + i] - s * f;
+                    }
+                }
+                if (r == 0.0 && i >= l) continue;
+                d[l] -= p;
+                e[l] = g;
+                e[m] = 0.0;
+            }
+        } while (m != l);
+    }
+}
+
+/* Λ from Λ⁻¹ = A (m×m, destroyed), damped as operational_space.damped_task_inertia. */
+static void rdc_task_inertia(double *A, double damping, int m, double *L) {
+    double V[36], s[6], d[6], e[6], top = 0.0;
+    memcpy(V, A, sizeof(double) * m * m); /* eigenvectors as the columns of V, values in d */
+    rdc_tred2(V, m, d, e);
+    rdc_tqli(d, e, m, V);
+    for (int i = 0; i < m; ++i) {
+        s[i] = d[i] > 0.0 ? d[i] : 0.0;
+        if (s[i] > top) top = s[i];
+    }
+    const double floor = (damping * top) * (damping * top);
+    for (int i = 0; i < m; ++i) s[i] = floor == 0.0 ? 1.0 / s[i] : s[i] / (s[i] * s[i] + floor);
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+            double x = 0.0;
+            for (int k = 0; k < m; ++k) x += V[i * m + k] * s[k] * V[j * m + k];
+            L[i * m + j] = x;
+        }
+}
+
+/* pin.log3 (Pinocchio's formulas: renormalised matrix, series near 0, axis near π). */
+static void rdc_log3_axis(int i0, const double *R, double val, double *angle, double *axis) {
+    const double eps = 2.220446049250313e-16;
+    const int i1 = (i0 + 1) % 3, i2 = (i0 + 2) % 3;
+    const double s = sqrt(val + eps + eps * eps) * (R[i2 * 3 + i1] >= R[i1 * 3 + i2] ? 1.0 : -1.0);
+    axis[i0] = s / 2.0;
+    axis[i1] = 1.0 / (2.0 * s) * (R[i1 * 3 + i0] + R[i0 * 3 + i1]);
+    axis[i2] = 1.0 / (2.0 * s) * (R[i2 * 3 + i0] + R[i0 * 3 + i2]);
+    const double w = 1.0 / (2.0 * s) * (R[i2 * 3 + i1] - R[i1 * 3 + i2]);
+    const double norm = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    *angle = 2.0 * atan2(norm, w);
+    for (int k = 0; k < 3; ++k) axis[k] /= norm;
+}
+static void rdc_log3(const double *R0, double *out) {
+    const double eps = 2.220446049250313e-16, prec = cbrt(eps), pi = 3.14159265358979323846;
+    double R[9], c0[3], c1[3];
+    const double n0 = sqrt(R0[0] * R0[0] + R0[3] * R0[3] + R0[6] * R0[6]), n1 = sqrt(R0[1] * R0[1] + R0[4] * R0[4] + R0[7] * R0[7]);
+    for (int k = 0; k < 3; ++k) c0[k] = R0[k * 3] / n0, c1[k] = R0[k * 3 + 1] / n1;
+    const double c2[3] = {c0[1] * c1[2] - c0[2] * c1[1], c0[2] * c1[0] - c0[0] * c1[2], c0[0] * c1[1] - c0[1] * c1[0]};
+    const double d0[3] = {c1[1] * c2[2] - c1[2] * c2[1], c1[2] * c2[0] - c1[0] * c2[2], c1[0] * c2[1] - c1[1] * c2[0]};
+    for (int k = 0; k < 3; ++k) R[k * 3] = d0[k], R[k * 3 + 1] = c1[k], R[k * 3 + 2] = c2[k];
+    const double tr = R[0] + R[4] + R[8], cos_value = (tr - 1.0) / 2.0;
+    if (cos_value < -1.0 + prec) { /* near π: Pinocchio's axis from the largest diagonal entry */
+        double val[3], angle, axis[3];
+        for (int k = 0; k < 3; ++k) val[k] = 2.0 * R[k * 4] - tr + 1.0;
+        const int i0 = val[0] >= val[1] ? (val[0] >= val[2] ? 0 : 2) : (val[1] >= val[2] ? 1 : 2);
+        rdc_log3_axis(i0, R, val[i0], &angle, axis);
+        for (int k = 0; k < 3; ++k) out[k] = angle * axis[k];
+        return;
+    }
+    const double expansion = sqrt(2.0 * (1.0 - cos_value) + eps * eps);
+    const double theta = tr <= 3.0 - prec ? (tr >= -1.0 + prec ? acos(cos_value) : pi - expansion) : expansion;
+    const double a[3] = {(R[7] - R[5]) / 2.0, (R[2] - R[6]) / 2.0, (R[3] - R[1]) / 2.0};
+    const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    const double t = theta >= prec ? theta / sin(theta) : 1.0 + a2 / 6.0 + a2 * a2 * 3.0 / 40.0;
+    for (int k = 0; k < 3; ++k) out[k] = t * a[k];
+}
+
+/* y = Rᵀ x (transpose) or R x, R row-major 3×3 */
+static void rdc_rot(const double *R, const double *x, double *y, int transpose) {
+    for (int i = 0; i < 3; ++i)
+        y[i] = transpose ? R[i] * x[0] + R[3 + i] * x[1] + R[6 + i] * x[2] : R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
+}
+static void rdc_skew(const double *w, double *S) {
+    S[0] = 0, S[1] = -w[2], S[2] = w[1], S[3] = w[2], S[4] = 0, S[5] = -w[0], S[6] = -w[1], S[7] = w[0], S[8] = 0;
+}
+static void rdc_mat3(const double *A, const double *B, double *C) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) C[i * 3 + j] = A[i * 3] * B[j] + A[i * 3 + 1] * B[3 + j] + A[i * 3 + 2] * B[6 + j];
+}
+
+/* operational_space._log_coefficients: c(θ) and c'(θ)/θ */
+static void rdc_log_coefficients(double theta, double *c, double *cp) {
+    if (theta < 0.05) {
+        *c = 1.0 / 12 + theta * theta / 720 + pow(theta, 4) / 30240;
+        *cp = 1.0 / 360 + theta * theta / 7560;
+        return;
+    }
+    const double cot = 1.0 / tan(theta / 2);
+    *c = 1.0 / (theta * theta) - cot / (2 * theta);
+    const double sh = sin(theta / 2);
+    *cp = (-2.0 / pow(theta, 3) + cot / (2 * theta * theta) + 1.0 / (4 * theta * (sh * sh))) / theta;
+}
+
+/* The angular part of OperationalSpace._error: the world angular acceleration command. */
+static void rdc_orientation_command(const double *R, const double *Rd, const double *omega, double kp, double kd, double *angular) {
+    double RtRd[9], e[3], phi[3], body[3], S[9], S2[9], Jinv[9], rate[3], pd[3], Sd[9], A[9], B[9], T[9], x[3];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) RtRd[i * 3 + j] = R[i] * Rd[j] + R[3 + i] * Rd[3 + j] + R[6 + i] * Rd[6 + j];
+    rdc_log3(RtRd, e);
+    for (int k = 0; k < 3; ++k) phi[k] = -e[k];
+    rdc_rot(R, omega, body, 1);
+    const double theta = sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]);
+    double c, cp;
+    rdc_log_coefficients(theta, &c, &cp);
+    rdc_skew(phi, S);
+    rdc_mat3(S, S, S2);
+    for (int k = 0; k < 9; ++k) Jinv[k] = (k % 4 == 0) + 0.5 * S[k] + c * S2[k];
+    rdc_rot(Jinv, body, rate, 0);
+    for (int k = 0; k < 3; ++k) rate[k] = -rate[k], pd[k] = -rate[k]; /* angle_rate, and φ̇ = −angle_rate */
+    rdc_skew(pd, Sd);
+    rdc_mat3(Sd, S, A);
+    rdc_mat3(S, Sd, B);
+    const double dot = phi[0] * pd[0] + phi[1] * pd[1] + phi[2] * pd[2];
+    for (int k = 0; k < 9; ++k) T[k] = 0.5 * Sd[k] + c * (A[k] + B[k]) + cp * dot * S2[k];
+    double rate_term[3];
+    rdc_rot(T, body, rate_term, 0);
+    for (int k = 0; k < 3; ++k) x[k] = -(-kd * rate[k] - kp * e[k]) - rate_term[k];
+    rdc_solve(Jinv, x, 3, 1);
+    rdc_rot(R, x, angular, 0);
+}
+
+/* params: target (3), kp, kd, damping, joint_damping  (robodyn.sim.control.TaskSpace) */
+static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
+                           const double *v, double *tau) {
+    const int n = RD_NV;
+    double x[3], R[9], J[6 * RD_NV], bias[6], desired[3], gram[9], pinv[3 * RD_NV], command[RD_NV], jv[RD_NV], Nv[RD_NV];
+    frame->all(q, v, x, R, J, bias);
+    for (int i = 0; i < 3; ++i) {
+        double velocity = 0.0;
+        for (int j = 0; j < n; ++j) velocity += J[i * n + j] * v[j];
+        desired[i] = p[3] * (p[i] - x[i]) - p[4] * velocity - bias[i];
+        for (int k = 0; k < 3; ++k) {
+            double g = 0.0;
+            for (int j = 0; j < n; ++j) g += J[i * n + j] * J[k * n + j];
+            gram[i * 3 + k] = g + (i == k) * p[5];
+        }
+    }
+    memcpy(pinv, J, sizeof(double) * 3 * n); /* gram⁻¹ J, then pinv = (gram⁻¹ J)ᵀ = Jᵀ gram⁻¹ */
+    rdc_solve(gram, pinv, 3, n);
+    for (int j = 0; j < n; ++j) jv[j] = p[6] * v[j];
+    for (int i = 0; i < n; ++i) { /* N = I - pinv J; command = pinv desired - N jv */
+        double Nrow = 0.0, pd = 0.0;
+        for (int j = 0; j < n; ++j) {
+            double pj = 0.0;
+            for (int k = 0; k < 3; ++k) pj += pinv[k * n + i] * J[k * n + j];
+            Nrow += ((i == j) - pj) * jv[j];
+        }
+        for (int k = 0; k < 3; ++k) pd += pinv[k * n + i] * desired[k];
+        Nv[i] = Nrow;
+        command[i] = pd - Nv[i];
+    }
+    model->tau(q, v, command, tau);
+}
+
+/* params: rows m, position (3), R_d (9), kp, kd, damping, posture_kp, posture_kd, has_posture,
+ * posture (n)  (robodyn.sim.operational_space.OperationalSpace, fixed target) */
+static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
+                                  const double *v, double *tau) {
+    const int n = RD_NV, m = (int)p[0];
+    double x[3], R[9], J[6 * RD_NV], bias[6], command[6], M[RD_NV * RD_NV], L[RD_NV * RD_NV], h[RD_NV];
+    double MiJt[6 * RD_NV], A[36], Lam[36], f[6], posture[RD_NV], y[6];
+    frame->all(q, v, x, R, J, bias);
+    double velocity[6];
+    for (int i = 0; i < 6; ++i) {
+        velocity[i] = 0.0;
+        for (int j = 0; j < n; ++j) velocity[i] += J[i * n + j] * v[j];
+    }
+    for (int i = 0; i < 3; ++i) command[i] = 0.0 + p[14] * (0.0 - velocity[i]) + p[13] * (p[1 + i] - x[i]);
+    if (m == 6) rdc_orientation_command(R, p + 4, velocity + 3, p[13], p[14], command + 3);
+    model->mass_nle(q, v, M, h);
+    memcpy(L, M, sizeof M);
+    if (rdc_ldl_factor(L)) {
+        for (int i = 0; i < n; ++i) tau[i] = NAN;
+        return;
+    }
+    for (int k = 0; k < m; ++k) { /* column k of M⁻¹ Jᵀ, stored as row k */
+        memcpy(MiJt + k * n, J + k * n, sizeof(double) * n);
+        rdc_ldl_apply(L, MiJt + k * n);
+    }
+    for (int i = 0; i < m; ++i)
+        for (int k = 0; k < m; ++k) {
+            double s = 0.0;
+            for (int j = 0; j < n; ++j) s += J[i * n + j] * MiJt[k * n + j];
+            A[i * m + k] = s;
+        }
+    rdc_task_inertia(A, p[15], m, Lam);
+    for (int i = 0; i < m; ++i) y[i] = command[i] - bias[i];
+    for (int i = 0; i < m; ++i) {
+        f[i] = 0.0;
+        for (int k = 0; k < m; ++k) f[i] += Lam[i * m + k] * y[k];
+    }
+    for (int i = 0; i < n; ++i) { /* posture = M (kp0 (q0 - q) - kd0 v) */
+        double s = 0.0;
+        for (int j = 0; j < n; ++j) s += M[i * n + j] * (p[16] * (p[18] ? p[19 + j] - q[j] : 0.0) - p[17] * v[j]);
+        posture[i] = s;
+    }
+    double JP[6] = {0}; /* Nᵀ posture = posture - Jᵀ Λ (M⁻¹Jᵀ)ᵀ posture */
+    for (int k = 0; k < m; ++k)
+        for (int j = 0; j < n; ++j) JP[k] += MiJt[k * n + j] * posture[j];
+    double LJP[6];
+    for (int i = 0; i < m; ++i) {
+        LJP[i] = 0.0;
+        for (int k = 0; k < m; ++k) LJP[i] += Lam[k * m + i] * JP[k];
+    }
+    for (int j = 0; j < n; ++j) {
+        double task = 0.0, back = 0.0;
+        for (int i = 0; i < m; ++i) task += J[i * n + j] * f[i], back += J[i * n + j] * LJP[i];
+        tau[j] = task + h[j] + (posture[j] - back);
+    }
+}
+
+/* params: rows m, position (3), R_d (9), stiffness (6), damping (6), null_damping
+ * (robodyn.sim.operational_space.Impedance) */
+static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
+                          const double *v, double *tau) {
+    const int n = RD_NV, m = (int)p[0];
+    double x[3], R[9], J[6 * RD_NV], bias[6], error[6], wrench[6], gram[36], GJ[6 * RD_NV], g[RD_NV], dv[RD_NV];
+    frame->all(q, v, x, R, J, bias);
+    for (int i = 0; i < 3; ++i) error[i] = p[1 + i] - x[i];
+    if (m == 6) {
+        double RtRd[9], e[3];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) RtRd[i * 3 + j] = R[i] * p[4 + j] + R[3 + i] * p[7 + j] + R[6 + i] * p[10 + j];
+        rdc_log3(RtRd, e);
+        rdc_rot(R, e, error + 3, 0);
+    }
+    for (int i = 0; i < m; ++i) {
+        double velocity = 0.0;
+        for (int j = 0; j < n; ++j) velocity += J[i * n + j] * v[j];
+        wrench[i] = p[13 + i] * error[i] - p[19 + i] * velocity;
+        for (int k = 0; k < m; ++k) {
+            double s = 0.0;
+            for (int j = 0; j < n; ++j) s += J[i * n + j] * J[k * n + j];
+            gram[i * m + k] = s + (i == k) * 1e-8;
+        }
+    }
+    memcpy(GJ, J, sizeof(double) * m * n);
+    rdc_solve(gram, GJ, m, n); /* gram⁻¹ J; N = I - Jᵀ gram⁻¹ J */
+    for (int j = 0; j < n; ++j) dv[j] = p[25] * v[j];
+    model->gravity(q, g);
+    for (int j = 0; j < n; ++j) { /* Nᵀ dv = dv - (gram⁻¹ J)ᵀ J dv: N is symmetric up to rounding; use Nᵀ */
+        double Jw = 0.0, Ntdv = dv[j];
+        for (int i = 0; i < m; ++i) Jw += J[i * n + j] * wrench[i];
+        for (int k = 0; k < n; ++k) {
+            double JtGJ = 0.0;
+            for (int i = 0; i < m; ++i) JtGJ += J[i * n + k] * GJ[i * n + j];
+            Ntdv -= JtGJ * dv[k];
+        }
+        tau[j] = g[j] + Jw - Ntdv;
+    }
+}
+
+static void rd_control_frame(const rd_controller *c, const double *q, const double *v, double *tau) {
+    const rd_frame_kernels *frame = (const rd_frame_kernels *)c->frame;
+    if (c->kind == 3) rdc_task_space(c->model, frame, c->params, q, v, tau);
+    if (c->kind == 4) rdc_operational_space(c->model, frame, c->params, q, v, tau);
+    if (c->kind == 5) rdc_impedance(c->model, frame, c->params, q, v, tau);
+}
+
 
 static void rd_control(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
     const int n = RD_NV;
@@ -221,6 +641,8 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
         double g[RD_NV];
         c->model->gravity(q, g);
         for (int i = 0; i < n; ++i) tau[i] = p[n + i] * (p[i] - q[i]) - p[2 * n + i] * v[i] + g[i];
+    } else if (c->kind >= 3) { /* task space, operational space, impedance */
+        rd_control_frame(c, q, v, tau);
     } else { /* params: q_start, q_end, kp, kd, duration */
         const double duration = p[4 * n];
         double s = t / duration;
@@ -312,8 +734,8 @@ static double *rd_array(PyObject *object, npy_intp size, int writable) {
 }
 
 static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 14) {
-        PyErr_SetString(PyExc_TypeError, "simulate takes 14 arguments");
+    if (nargs != 14 && nargs != 15) {
+        PyErr_SetString(PyExc_TypeError, "simulate takes 14 or 15 arguments");
         return NULL;
     }
     const double dt = PyFloat_AsDouble(args[2]);
@@ -322,8 +744,8 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
     const long rk4 = PyLong_AsLong(args[5]), kind = PyLong_AsLong(args[6]), hold = PyLong_AsLong(args[7]);
     if (PyErr_Occurred()) return NULL;
     const int n = RD_NV;
-    const npy_intp sizes[4] = {n, 3 * n, 4 * n + 1};
-    if (kind < 0 || kind > 2 || steps < 0) {
+    const npy_intp sizes[6] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26};
+    if (kind < 0 || kind > 5 || steps < 0) {
         PyErr_SetString(PyExc_ValueError, "bad controller kind or step count");
         return NULL;
     }
@@ -339,7 +761,16 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         PyErr_SetString(PyExc_ValueError, "simulate: arrays of the wrong type or size");
         return NULL;
     }
-    rd_controller controller = {(int)kind, (int)hold, params, model};
+    const rd_frame_kernels *frame = NULL; /* the 15th argument: the frame capsule of kinds 3-5 */
+    if (nargs == 15 && args[14] != Py_None) {
+        frame = (const rd_frame_kernels *)PyCapsule_GetPointer(args[14], RD_FRAME_CAPSULE);
+        if (!frame) return NULL;
+    }
+    if (kind >= 3 && (!frame || frame->nv != n)) {
+        PyErr_SetString(PyExc_ValueError, "simulate: a frame controller needs its frame's kernels");
+        return NULL;
+    }
+    rd_controller controller = {(int)kind, (int)hold, params, model, frame};
     double q[RD_NV], v[RD_NV];
     memcpy(q, q0, sizeof q);
     memcpy(v, v0, sizeof v);

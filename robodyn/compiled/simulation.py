@@ -20,13 +20,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from robodyn.common.inputs import as_state
-from robodyn.compiled.robot import CompiledRobot
-from robodyn.exceptions import InputError, SimulationError
+from robodyn.compiled.controllers import CompiledFrameController, CompiledImpedance, CompiledOperationalSpace, CompiledTaskSpace
+from robodyn.compiled.robot import CompiledRobot, compile
+from robodyn.exceptions import CompileError, InputError, SimulationError
 
 INTEGRATORS = ("rk4", "semi-implicit-euler")
 
@@ -109,7 +110,7 @@ def simulate_compiled(
     dt: float,
     *,
     integrator: str = "rk4",
-    controller: CompiledPDGravity | CompiledComputedTorque | PythonController | None = None,
+    controller: CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | PythonController | None = None,
     control_period: float | None = None,
     hold: bool = False,
 ) -> SimulationArrays:
@@ -120,7 +121,9 @@ def simulate_compiled(
         q0, v0: Initial state, shape (nv,).
         duration: Simulated time in [s]; dt: step in [s].
         integrator: ``"rk4"`` or ``"semi-implicit-euler"``.
-        controller: ``None`` (passive), a compiled controller, or a Python callable
+        controller: ``None`` (passive), a compiled controller (joint space, or a frame
+            controller of :mod:`robodyn.compiled.controllers`; :func:`compiled_controller`
+            makes one from a Python controller), or a Python callable
             ``controller(t, q, v) -> tau`` sampled every ``control_period``.
         control_period: For a Python controller, in [s], a whole number of steps
             (default ``dt``).
@@ -144,16 +147,18 @@ def simulate_compiled(
     rk4 = int(integrator == "rk4")
     out = [np.empty((steps + 1, nv)) for _ in range(4)]
     q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
-    if controller is None or isinstance(controller, CompiledPDGravity | CompiledComputedTorque):
+    if controller is None or isinstance(controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController):
         if control_period is not None:
             raise InputError("control_period", "used with a Python controller only", repr(control_period))
-        kind, params, model = 0, np.zeros(nv), None
+        kind, params, model, frame = 0, np.zeros(nv), None, None
         if controller is not None:
             if controller.model.nv != nv:
                 raise InputError("controller.model", f"a compiled robot with {nv} joints", f"{controller.model.nv}")
             kind = 1 if isinstance(controller, CompiledPDGravity) else 2
             params, model = controller.params(nv), controller.model.module._kernels
-        failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out)
+            if isinstance(controller, CompiledFrameController):
+                kind, frame = controller.kind, controller.frame_kernels()
+        failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out, frame)
         _raise_if_failed(compiled, failed, out, dt, 0)
     elif callable(controller):
         period = dt if control_period is None else control_period
@@ -190,3 +195,66 @@ def _raise_if_failed(compiled: CompiledRobot, failed: int, out: list[np.ndarray]
     bad = np.flatnonzero(~np.isfinite(v)) if not np.isfinite(v).all() else np.flatnonzero(~np.isfinite(q))
     joint = compiled.joint_names[int(bad[0]) if bad.size else 0]
     raise SimulationError(step * dt, step, joint)
+
+
+#: The Python controllers that have a compiled twin, by qualified class name (the compiled
+#: layer sits below robodyn.sim and does not import it; exact classes only: a subclass may
+#: change the law).
+_TWINS = {
+    "robodyn.sim.control.PDGravity": "pd",
+    "robodyn.sim.control.ComputedTorque": "computed-torque",
+    "robodyn.sim.control.TaskSpace": "task-space",
+    "robodyn.sim.operational_space.OperationalSpace": "operational-space",
+    "robodyn.sim.operational_space.Impedance": "impedance",
+}
+
+CompiledController = CompiledPDGravity | CompiledComputedTorque | CompiledFrameController
+
+
+def has_twin(controller: object) -> bool:
+    """Whether :func:`compiled_controller` has a twin for this controller (its class and, for
+    computed torque, its reference; for operational space, a fixed target)."""
+    kind = _TWINS.get(f"{type(controller).__module__}.{type(controller).__qualname__}")
+    c: Any = controller
+    if kind == "computed-torque":
+        return type(c.reference).__qualname__ == "QuinticReference"
+    if kind == "operational-space":
+        return not callable(c.position)
+    return kind is not None
+
+
+def compiled_controller(controller: object) -> CompiledController:
+    """The compiled twin of a Python controller of :mod:`robodyn.sim` (on its own model, compiled).
+
+    ``PDGravity``, ``ComputedTorque`` along a quintic (:func:`robodyn.sim.control.quintic_reference`),
+    ``TaskSpace``, ``OperationalSpace`` with a fixed target, ``Impedance``: the same law in C,
+    evaluated wherever the integrator evaluates the dynamics.
+
+    Raises:
+        CompileError: For any other controller (one sentence saying why), or a model that
+            does not compile (a floating base).
+    """
+    kind = _TWINS.get(f"{type(controller).__module__}.{type(controller).__qualname__}")
+    c: Any = controller
+    if kind is None:
+        raise CompileError(
+            getattr(getattr(c, "model", None), "name", "?"),
+            f"the controller {type(controller).__name__} has no compiled twin (run it on the Pinocchio engine)",
+        )
+    if kind == "pd":
+        return CompiledPDGravity(compile(c.model), c.target, c.kp, c.kd)
+    if kind == "computed-torque":
+        reference = c.reference
+        if type(reference).__qualname__ != "QuinticReference":
+            raise CompileError(c.model.name, "computed torque compiles along a quintic_reference only")
+        return CompiledComputedTorque(compile(c.model), reference.q_start, reference.q_end, reference.duration, c.kp, c.kd)
+    if kind == "task-space":
+        return CompiledTaskSpace(compile(c.model), c.frame, c.target, c.kp, c.kd, c.damping, c.joint_damping)
+    if callable(c.position):
+        raise CompileError(c.model.name, f"{type(controller).__name__} compiles with a fixed target, not a path")
+    rotation = c._rotation  # the validated target attitude (the orientation given in any form)
+    if kind == "operational-space":
+        return CompiledOperationalSpace(
+            compile(c.model), c.frame, c.position, rotation, c.kp, c.kd, c.posture, c.posture_kp, c.posture_kd, c.damping
+        )
+    return CompiledImpedance(compile(c.model), c.frame, c.position, rotation, c.stiffness, c.damping, c.null_damping)

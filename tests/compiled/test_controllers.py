@@ -1,0 +1,106 @@
+"""Compiled controllers against the Python engine: the same trajectory over the whole run."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn.compiled import compile
+from robodyn.compiled.simulation import compiled_controller, has_twin, simulate_compiled
+from robodyn.exceptions import CompileError
+from robodyn.sim.control import ComputedTorque, Impedance, OperationalSpace, PDGravity, TaskSpace, quintic_reference
+from tests.compiled_helpers import shared_cache
+
+#: The issue's bar: the two engines' trajectories agree to 1e-9 at every sample.
+TOLERANCE = 1e-9
+PANDA_ARM = {"lock": {"panda_finger_joint1": 0.0}}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def cache():
+    """The session's compile cache (never the user's)."""
+    with shared_cache() as folder:
+        yield folder
+
+
+def controllers(robot, rng: np.random.Generator) -> dict[str, object]:
+    """Each controller, aimed at a reachable pose, on the robot's own model."""
+    frame = robot.end_effector
+    goal = robot.random_configuration(rng)
+    target = robot.frame_position(goal, frame)
+    rotation = compile(robot).frame_rotation(goal, frame) if robot.nv >= 6 else None
+    posture = robot.random_configuration(rng) if robot.nv >= 6 else None
+    return {
+        "pd": PDGravity(robot, goal, kp=80.0, kd=15.0),
+        "computed-torque": ComputedTorque(robot, quintic_reference(np.zeros(robot.nv), goal, 0.3)),
+        "task-space": TaskSpace(robot, frame, target, kp=60.0, kd=14.0),
+        "operational-space": OperationalSpace(robot, frame, target, orientation=rotation, posture=posture, kp=60.0, kd=14.0),
+        "impedance": Impedance(robot, frame, target, orientation=rotation),
+    }
+
+
+def deviation(python, compiled) -> float:
+    """The largest difference of positions and velocities (absolute) and torques (relative) over the run."""
+    torque_scale = max(1.0, float(np.abs(python.tau).max()))
+    return max(
+        float(np.abs(python.q - compiled.q).max()),
+        float(np.abs(python.v - compiled.v).max()),
+        float(np.abs(python.tau - compiled.tau).max()) / torque_scale,
+    )
+
+
+def runs(robot, controller, q0, duration, dt=1e-3, integrator="rk4", twin=None):
+    python = robodyn.simulate(
+        robot, q0, np.zeros(robot.nv), duration, dt, controller=controller, integrator=integrator, limits="ignore"
+    )
+    law = twin if twin is not None else compiled_controller(controller)
+    compiled = simulate_compiled(compile(robot), q0, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator)
+    return python, compiled
+
+
+@pytest.mark.parametrize("kind", ["pd", "computed-torque", "task-space", "operational-space", "impedance"])
+@pytest.mark.parametrize(
+    ("source", "options", "duration"),
+    [pytest.param("rp_arm", {}, 1.0, id="rp_arm"), pytest.param("panda", PANDA_ARM, 0.3, id="panda_arm", marks=pytest.mark.slow)],
+)
+def test_each_compiled_controller_follows_the_python_engine_over_the_whole_run(kind, source, options, duration, rng):
+    robot = robodyn.load(source, **options)
+    law = controllers(robot, rng)[kind]
+    q0 = robot.random_configuration(rng)
+    python, compiled = runs(robot, law, q0, duration)
+    assert deviation(python, compiled) <= TOLERANCE
+    assert np.abs(python.q[-1] - python.q[0]).max() > 1e-3  # the controller moved the arm
+
+
+@pytest.mark.slow
+def test_a_mismatched_model_non_default_gravity_and_semi_implicit_euler_still_agree(rng):
+    """The controller's model carries a payload the plant does not; gravity is tilted."""
+    plant = robodyn.load("panda", **PANDA_ARM, gravity=[0.4, -0.3, -9.7])
+    model = robodyn.attach_payload(plant, "panda_link7", 1.5, com=[0.01, 0.02, 0.05])
+    for kind in ("operational-space", "impedance"):
+        law = controllers(model, rng)[kind]
+        python, compiled = runs(plant, law, plant.random_configuration(rng), 0.2, integrator="semi-implicit-euler")
+        assert deviation(python, compiled) <= TOLERANCE
+
+
+def test_negative_control_a_twin_with_another_gain_departs_from_the_python_run(rng):
+    robot = robodyn.load("rp_arm")
+    law = controllers(robot, rng)["task-space"]
+    twin = compiled_controller(law)
+    python, compiled = runs(robot, law, robot.random_configuration(rng), 0.5, twin=dataclasses.replace(twin, kp=twin.kp * 1.0001))
+    assert deviation(python, compiled) > TOLERANCE
+
+
+def test_a_controller_without_a_twin_is_refused_in_one_sentence():
+    robot = robodyn.load("rp_arm")
+    with pytest.raises(CompileError, match="no compiled twin"):
+        compiled_controller(lambda t, q, v: np.zeros(robot.nv))
+    path = OperationalSpace(
+        robot, None, lambda t: (robot.frame_position(np.zeros(robot.nv), robot.end_effector), np.zeros(3), np.zeros(3))
+    )
+    with pytest.raises(CompileError, match="fixed target"):
+        compiled_controller(path)
+    assert not has_twin(path) and has_twin(TaskSpace(robot, None, [0.7, 0.0, 0.7]))
