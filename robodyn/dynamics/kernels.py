@@ -70,7 +70,10 @@ def massless_joints(model: pin.Model) -> list[str]:
 def redundant_free_flyers(model: pin.Model) -> list[str]:
     """Free-flyer joints whose body has no mass and carries one moving joint: the body's six
     motions move that joint's whole subtree rigidly, as the joint does, so ``M(q)`` is
-    singular (a massless floating root with one child link)."""
+    singular (a massless floating root with one child link). Not claimed with mimic joints
+    (``nv = 0`` here): a mimic in the subtree breaks the rigid motion."""
+    if any(model.joints[j].nv == 0 for j in range(1, model.njoints)):
+        return []
     out = []
     for i in range(1, model.njoints):
         children = [j for j in range(i + 1, model.njoints) if model.parents[j] == i and model.joints[j].nv > 0]

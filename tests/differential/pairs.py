@@ -40,6 +40,8 @@ class Pair:
     fast_cases: int | None = None
     #: Cases with more degrees of freedom are left out (symbolic derivations grow fast).
     max_dof: int | None = None
+    #: In the slow sweep, only this many cases (the first drawn that fit ``max_dof``).
+    slow_cases: int | None = None
 
 
 # ----------------------------------------------------------------------------------------
@@ -680,13 +682,17 @@ def identification_recovers(case: Case, rng: np.random.Generator) -> None:
 
 PAIRS.update(
     {
-        "compiled_vs_robot": Pair("compiled_vs_robot", compiled_vs_robot, fixed_base, fast_cases=2, max_dof=4),
-        "compile_twice": Pair("compile_twice", compile_twice, fixed_base, fast_cases=1, max_dof=3),
-        "generated_python": Pair("generated_python", generated_python_vs_robot, fixed_base, fast_cases=2, max_dof=4),
-        "generated_c": Pair("generated_c", generated_c_vs_robot, fixed_base, fast_cases=1, max_dof=4),
-        "symbolic_kinematics": Pair("symbolic_kinematics", symbolic_kinematics_vs_frames, fixed_base, fast_cases=2, max_dof=4),
+        "compiled_vs_robot": Pair("compiled_vs_robot", compiled_vs_robot, fixed_base, fast_cases=2, max_dof=4, slow_cases=10),
+        "compile_twice": Pair("compile_twice", compile_twice, fixed_base, fast_cases=1, max_dof=3, slow_cases=5),
+        "generated_python": Pair(
+            "generated_python", generated_python_vs_robot, fixed_base, fast_cases=2, max_dof=4, slow_cases=8
+        ),
+        "generated_c": Pair("generated_c", generated_c_vs_robot, fixed_base, fast_cases=1, max_dof=4, slow_cases=5),
+        "symbolic_kinematics": Pair(
+            "symbolic_kinematics", symbolic_kinematics_vs_frames, fixed_base, fast_cases=2, max_dof=4, slow_cases=10
+        ),
         "simulation": Pair("simulation", simulation_energy),
-        "engines": Pair("engines", engines_agree, fixed_base, fast_cases=1, max_dof=4),
+        "engines": Pair("engines", engines_agree, fixed_base, fast_cases=1, max_dof=4, slow_cases=8),
         "files": Pair("files", file_round_trips),
         "cli_torques": Pair("cli_torques", cli_torques_columns),
         "cli_simulate": Pair("cli_simulate", cli_simulate_columns),

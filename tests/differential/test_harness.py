@@ -24,9 +24,10 @@ def _params(cases: list[Case], *, fast: bool):
     params = []
     for pair in PAIRS.values():
         chosen = [case for case in cases if pair.applies(case)]
-        if fast and pair.fast_cases is not None:  # (the sweep skips large robots when it runs)
+        limit = pair.fast_cases if fast else pair.slow_cases
+        if limit is not None:
             chosen = [case for case in chosen if pair.max_dof is None or case.robot().nv <= pair.max_dof]
-            chosen = sorted(chosen, key=lambda case: case.robot().nv)[: pair.fast_cases]
+            chosen = sorted(chosen, key=lambda case: case.robot().nv)[:limit] if fast else chosen[:limit]
         params += [pytest.param(pair, case, id=f"{pair.name}-{case.id}") for case in chosen]
     return params
 
