@@ -51,3 +51,21 @@ def random_state(robot, rng: np.random.Generator, count: int | None = None):
     q = robot.random_configuration(rng, count)
     shape = (robot.nv,) if count is None else (count, robot.nv)
     return q, rng.normal(size=shape), rng.normal(size=shape)
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    """``--differential-seed GENERATOR:SEED`` replays one case of the differential harness
+    (tests/differential; the same as ``ROBODYN_DIFFERENTIAL_SEED=GENERATOR:SEED``)."""
+    parser.addoption(
+        "--differential-seed",
+        metavar="GENERATOR:SEED",
+        help="run the differential harness on this one case only (e.g. random_tree:1002)",
+    )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    seed = config.getoption("--differential-seed", default=None)
+    if seed:
+        import os
+
+        os.environ["ROBODYN_DIFFERENTIAL_SEED"] = seed

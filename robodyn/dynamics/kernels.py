@@ -58,11 +58,28 @@ class DynamicsKernels(NamedTuple):
 
 
 def massless_joints(model: pin.Model) -> list[str]:
-    """Joints of ``model`` whose whole subtree has no mass: they make ``M(q)`` singular."""
+    """Joints of ``model`` whose whole subtree has no mass, and :func:`redundant_free_flyers`:
+    they make ``M(q)`` singular."""
     subtree_mass = [model.inertias[i].mass for i in range(model.njoints)]
     for joint_id in range(model.njoints - 1, 0, -1):
         subtree_mass[model.parents[joint_id]] += subtree_mass[joint_id]
-    return [model.names[i] for i in range(1, model.njoints) if subtree_mass[i] <= 0 and model.joints[i].nv > 0]
+    massless = [model.names[i] for i in range(1, model.njoints) if subtree_mass[i] <= 0 and model.joints[i].nv > 0]
+    return massless + [name for name in redundant_free_flyers(model) if name not in massless]
+
+
+def redundant_free_flyers(model: pin.Model) -> list[str]:
+    """Free-flyer joints whose body has no mass and carries one moving joint: the body's six
+    motions move that joint's whole subtree rigidly, as the joint does, so ``M(q)`` is
+    singular (a massless floating root with one child link). Not claimed with mimic joints
+    (``nv = 0`` here): a mimic in the subtree breaks the rigid motion."""
+    if any(model.joints[j].nv == 0 for j in range(1, model.njoints)):
+        return []
+    out = []
+    for i in range(1, model.njoints):
+        children = [j for j in range(i + 1, model.njoints) if model.parents[j] == i and model.joints[j].nv > 0]
+        if model.joints[i].nv == 6 and model.inertias[i].mass <= 0 and len(children) == 1:
+            out.append(model.names[i])
+    return out
 
 
 def dynamics_kernels(

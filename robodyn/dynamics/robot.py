@@ -204,7 +204,8 @@ class Robot:
 
     @cached_property
     def massless_joints(self) -> list[str]:
-        """Joints whose whole subtree has no mass: they make ``M(q)`` singular."""
+        """Joints whose whole subtree has no mass (and a massless floating root carrying one
+        joint): they make ``M(q)`` singular."""
         return massless_joints(self.model)
 
     @property
@@ -246,6 +247,8 @@ class Robot:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
         handle = self.handle
+        if self.massless_joints:  # M singular for every q: ABA's finite numbers would be wrong
+            raise SingularMassMatrixError(self.name, self.massless_joints)
         try:
             return handle.evaluate(handle.kernels.a, q, v, tau)
         except NonFiniteResultError:  # finite inputs, non-finite accelerations: only a singular M does that
