@@ -468,3 +468,17 @@ class TypesettingError(RobodynError):
     def __init__(self, reason: str):
         self.reason = reason
         super().__init__(f"pdflatex failed on the equations: {reason}")
+
+
+class OptimizationError(RobodynError):
+    """The optimiser found no motion: IPOPT's status and, when it can be told, the limiting constraint.
+
+    Attributes:
+        robot: Robot name. status: IPOPT's return status. limiting: e.g. ``"the effort limit
+        of 'shoulder'"`` ("" when it cannot be told).
+    """
+
+    def __init__(self, robot: str, status: str, limiting: str = ""):
+        self.robot, self.status, self.limiting = robot, status, limiting
+        because = f"; the limiting constraint is {limiting}" if limiting else ""
+        super().__init__(f"no motion found for {quoted(robot)}: IPOPT stopped with {status}{because}.")

@@ -4,6 +4,7 @@
 URDF's position, velocity and effort limits (``robodyn optimize``).
 """
 
-from robodyn.optimize.motion import COSTS, OptimalMotion, OptimizationError, point_to_point
+from robodyn.exceptions import OptimizationError
+from robodyn.optimize.motion import COSTS, OptimalMotion, point_to_point
 
 __all__ = ["COSTS", "OptimalMotion", "OptimizationError", "point_to_point"]

@@ -34,7 +34,7 @@ import numpy as np
 
 from robodyn.common.extras import require
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError, RobodynError
+from robodyn.exceptions import InputError, OptimizationError
 from robodyn.export import casadi_functions
 from robodyn.export.programs import check_exportable
 from robodyn.sim.limits import JointLimits
@@ -50,20 +50,6 @@ MAX_ITERATIONS = 1000
 TIME_REGULARISATION = 1e-3
 
 Progress = Callable[[str, int, int], None]
-
-
-class OptimizationError(RobodynError):
-    """The optimiser found no motion: IPOPT's status and, when it can be told, the limiting constraint.
-
-    Attributes:
-        robot: Robot name. status: IPOPT's return status. limiting: e.g. ``"the effort limit
-        of 'shoulder'"`` ("" when it cannot be told).
-    """
-
-    def __init__(self, robot: str, status: str, limiting: str = ""):
-        self.robot, self.status, self.limiting = robot, status, limiting
-        because = f"; the limiting constraint is {limiting}" if limiting else ""
-        super().__init__(f"no motion found for {robot!r}: IPOPT stopped with {status}{because}.")
 
 
 @dataclass(frozen=True)

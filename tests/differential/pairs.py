@@ -700,3 +700,103 @@ PAIRS.update(
         "identification": Pair("identification", identification_recovers),
     }
 )
+
+
+# ----------------------------------------------------------------------------------------
+# Derivatives (Robot vs central differences, compiled vs Robot) and CasADi export vs Robot
+# ----------------------------------------------------------------------------------------
+def _tangent_differences(robot, function, q, v, third, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Central differences of ``function(q, v, third)`` along ``integrate`` (q) and in v."""
+    by_q, by_v = np.empty((robot.nv, robot.nv)), np.empty((robot.nv, robot.nv))
+    for column in range(robot.nv):
+        e = np.zeros(robot.nv)
+        e[column] = step
+        ahead, behind = robot.integrate(q, e), robot.integrate(q, -e)
+        by_q[:, column] = (function(ahead, v, third) - function(behind, v, third)) / (2 * step)
+        by_v[:, column] = (function(q, v + e, third) - function(q, v - e, third)) / (2 * step)
+    return by_q, by_v
+
+
+def derivatives_vs_differences(case: Case, rng: np.random.Generator) -> None:
+    """Robot.*_derivatives against central differences of τ and q̈ (floating bases along
+    ``integrate``), the identities ∂τ/∂a = M and ∂q̈/∂τ·M = I, and one state vs a batch."""
+    robot = case.robot()
+    q, v, a = (x[0] for x in random_state_batch(robot, rng, 1))
+    test = "derivatives"
+    dq, dv, mass = robot.inverse_dynamics_derivatives(q, v, a)
+    by_q, by_v = _tangent_differences(robot, robot.inverse_dynamics, q, v, a)
+    floor = max(scale(by_q), scale(by_v))
+    agree(case, "dtau/dq vs central differences", dq, by_q, rtol=1e-6, floor=floor, test=test)
+    agree(case, "dtau/dv vs central differences", dv, by_v, rtol=1e-6, floor=floor, test=test)
+    agree(case, "dtau/da vs M", mass, robot.mass_matrix(q), rtol=1e-12, test=test)
+    tau = robot.inverse_dynamics(q, v, a)
+    fq, fv, inverse = robot.forward_dynamics_derivatives(q, v, tau)
+    by_q, by_v = _tangent_differences(robot, robot.forward_dynamics, q, v, tau)
+    condition = float(np.linalg.cond(mass))
+    tolerance = max(1e-6, 1e-9 * condition)
+    floor = max(scale(by_q), scale(by_v))
+    agree(case, "dqdd/dq vs central differences", fq, by_q, rtol=tolerance, floor=floor, test=test)
+    agree(case, "dqdd/dv vs central differences", fv, by_v, rtol=tolerance, floor=floor, test=test)
+    agree(case, "dqdd/dtau M vs I", inverse @ mass, np.eye(robot.nv), rtol=max(1e-10, 1e-14 * condition), test=test)
+    count = _batch_size(rng)
+    qs, vs, accelerations = random_state_batch(robot, rng, count)
+    batch = robot.inverse_dynamics_derivatives(qs, vs, accelerations)
+    row = int(rng.integers(count))
+    for name, stacked, single in zip(
+        ("dq", "dv", "da"), batch, robot.inverse_dynamics_derivatives(qs[row], vs[row], accelerations[row]), strict=True
+    ):
+        agree(case, f"batch row {row} of {count} dtau/{name} vs one state", stacked[row], single, rtol=0.0, test=test)
+
+
+def compiled_derivatives_vs_robot(case: Case, rng: np.random.Generator) -> None:
+    """Compiled ∂τ and ∂q̈ (generated C) against the Robot's (Pinocchio's analytical
+    derivatives), on a batch whose size is no multiple of the thread count."""
+    robot = case.robot()
+    compiled = compiled_of(robot, robot.threads)
+    count = _batch_size(rng)
+    q, v, a = random_state_batch(robot, rng, count)
+    test = "compiled_derivatives"
+    for label, ours, theirs in (
+        ("dtau", compiled.inverse_dynamics_derivatives(q, v, a), robot.inverse_dynamics_derivatives(q, v, a)),
+        ("dqdd", compiled.forward_dynamics_derivatives(q, v, a), robot.forward_dynamics_derivatives(q, v, a)),
+    ):
+        floor = max(scale(part) for part in theirs)
+        for name, mine, reference in zip(("dq", "dv", "third"), ours, theirs, strict=True):
+            agree(case, f"compiled {label}/{name} vs Robot", mine, reference, rtol=1e-9, floor=floor, test=test)
+
+
+def casadi_vs_robot(case: Case, rng: np.random.Generator) -> None:
+    """The exported CasADi functions against the Robot, and CasADi's own Jacobian of the
+    inverse dynamics against Robot.inverse_dynamics_derivatives."""
+    import casadi
+
+    from robodyn.export import casadi_functions
+
+    robot = case.robot()
+    functions = casadi_functions(robot, frames=[])
+    q, v, a = (x[0] for x in random_state_batch(robot, rng, 1))
+    test = "casadi"
+    tau = robot.inverse_dynamics(q, v, a)
+    agree(case, "casadi tau", functions["inverse_dynamics"](q, v, a).full().ravel(), tau, rtol=1e-11, test=test)
+    agree(case, "casadi M", functions["mass_matrix"](q).full(), robot.mass_matrix(q), rtol=1e-11, test=test)
+    agree(case, "casadi G", functions["gravity"](q).full().ravel(), robot.gravity(q), rtol=1e-11, floor=scale(tau), test=test)
+    fd = robot.forward_dynamics(q, v, tau)
+    agree(case, "casadi FD", functions["forward_dynamics"](q, v, tau).full().ravel(), fd, rtol=1e-9, floor=scale(a), test=test)
+    symbols = [casadi.SX.sym(name, robot.nv) for name in ("q", "v", "a")]
+    jacobian = casadi.Function("j", symbols, [casadi.jacobian(functions["inverse_dynamics"](*symbols), s) for s in symbols])
+    ours = [part.full() for part in jacobian(q, v, a)]
+    theirs = robot.inverse_dynamics_derivatives(q, v, a)
+    floor = max(scale(part) for part in theirs)
+    for name, mine, reference in zip(("dq", "dv", "da"), ours, theirs, strict=True):
+        agree(case, f"casadi jacobian dtau/{name} vs Robot", mine, reference, rtol=1e-10, floor=floor, test=test)
+
+
+PAIRS.update(
+    {
+        "derivatives": Pair("derivatives", derivatives_vs_differences),
+        "compiled_derivatives": Pair(
+            "compiled_derivatives", compiled_derivatives_vs_robot, fixed_base, fast_cases=1, max_dof=4, slow_cases=6
+        ),
+        "casadi": Pair("casadi", casadi_vs_robot, fixed_base, fast_cases=1, max_dof=4, slow_cases=6),
+    }
+)
