@@ -39,6 +39,8 @@ FLAGS: dict[str, str] = {
     "threshold": "--threshold",
     "torque": "--torque",
     "plot": "--plot",
+    "engine": "--engine",
+    "control_period": "--control-period",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

@@ -6,6 +6,7 @@ import argparse
 
 from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector, warn
 from robodyn.common.text import json_text, printable
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -57,7 +58,22 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--compiled",
         action="store_true",
-        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too",
+        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too"
+        " (the same as --engine compiled)",
+    )
+    parser.add_argument(
+        "--engine",
+        choices=["auto", "pinocchio", "compiled"],
+        default=None,
+        help="where the loop runs: auto (default: compiled when the whole loop runs in C and a C compiler exists, "
+        "else pinocchio; the summary says which and why), pinocchio (Python over Pinocchio), compiled (C)",
+    )
+    parser.add_argument(
+        "--control-period",
+        dest="control_period",
+        type=float,
+        help="sample the controller every this many seconds (a whole number of --dt) and hold its torque "
+        "(zero-order hold); default: evaluated at every integrator stage",
     )
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
@@ -68,10 +84,13 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    from robodyn.sim.report import seconds_since_process_start
     from robodyn.viz.experiment import run_experiment
 
+    robot = load_robot(arguments)
+    startup = seconds_since_process_start()  # interpreter, imports, loading the robot
     summary = run_experiment(
-        load_robot(arguments),
+        robot,
         controller=arguments.controller,
         target=arguments.target,
         frame=arguments.frame,
@@ -80,7 +99,8 @@ def run(arguments: argparse.Namespace) -> int:
         dt=arguments.dt,
         integrator=arguments.integrator,
         limits=arguments.limits,
-        engine="compiled" if arguments.compiled else "pinocchio",
+        engine=_engine(arguments),
+        control_period=arguments.control_period,
         posture=arguments.posture,
         stiffness=arguments.stiffness,
         damping=arguments.damping,
@@ -91,6 +111,7 @@ def run(arguments: argparse.Namespace) -> int:
         record=arguments.record,
         png=arguments.png,
     )
+    summary = summary.with_startup(startup)
     warn(summary.warnings())
     if summary.task is not None and not summary.task.reached and summary.task.deflection is None:
         warn([
@@ -99,3 +120,10 @@ def run(arguments: argparse.Namespace) -> int:
         ])  # fmt: skip
     print(json_text(summary.to_dict()) if arguments.json else summary.text())
     return 0
+
+
+def _engine(arguments: argparse.Namespace) -> str:
+    """``--engine`` (``--compiled`` is ``--engine compiled``; both at odds: one stderr line)."""
+    if arguments.compiled and arguments.engine not in (None, "compiled"):
+        raise InputError("--compiled", "not combined with another --engine", f"--engine {arguments.engine}")
+    return "compiled" if arguments.compiled else (arguments.engine or "auto")
