@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -153,65 +153,9 @@ class ModelHandle:
             # a floating base's quaternion needs its own check; with mimic joints, M and the
             # accelerations are not one Pinocchio call (kernels.py)
             return lambda *values: evaluate(kernel, *values)
-        isfinite = _isfinite
         if symmetric:
-            lower, copyto = np.tri(self.nv, self.nv, -1, dtype=bool), np.copyto
-            # CRBA never uses the placement of a joint attached to the world, so those
-            # joints' q (only) are checked besides M itself; every other q moves M.
-            roots = tuple(_root_coordinates(model))
-            root = roots[0] if len(roots) == 1 else None
-
-            def matrix(q: np.ndarray) -> np.ndarray:
-                try:
-                    result = raw(model, local.data, q)
-                    copyto(result, result.T, where=lower)
-                    flat = result.ravel()
-                    if isfinite(flat.dot(flat) + (q.item(root) if root is not None else sum(map(q.item, roots)))):
-                        return result
-                except PINOCCHIO_ERRORS:
-                    pass
-                return evaluate(kernel, q)
-
-            return matrix
-
-        # One state's q, v, a (tau) reach every entry of RNEA's and ABA's results (a NaN or
-        # inf in any of them makes the result non-finite: tests/dynamics/test_single_call.py), so
-        # the result alone is checked; CRBA does not use the root joints' q, so M checks q.
-        if len(kernel.names) == 1:
-
-            def vector1(q: np.ndarray) -> np.ndarray:
-                try:
-                    result = raw(model, local.data, q)
-                    if isfinite(sum(result.tolist())):
-                        return result
-                except PINOCCHIO_ERRORS:
-                    pass
-                return evaluate(kernel, q)
-
-            return vector1
-        if len(kernel.names) == 2:
-
-            def vector2(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-                try:
-                    result = raw(model, local.data, q, v)
-                    if isfinite(sum(result.tolist())):
-                        return result
-                except PINOCCHIO_ERRORS:
-                    pass
-                return evaluate(kernel, q, v)
-
-            return vector2
-
-        def vector3(q: np.ndarray, v: np.ndarray, third: np.ndarray) -> np.ndarray:
-            try:
-                result = raw(model, local.data, q, v, third)
-                if isfinite(sum(result.tolist())):
-                    return result
-            except PINOCCHIO_ERRORS:
-                pass
-            return evaluate(kernel, q, v, third)
-
-        return vector3
+            return _matrix_call(kernel, raw, model, local, evaluate)
+        return _vector_call(kernel, raw, model, local, evaluate)
 
     def evaluate(self, kernel: Kernel, *values: np.ndarray) -> np.ndarray:
         """Fast path, then checked path, for one quantity (a :class:`~robodyn.dynamics.kernels.Kernel`).
@@ -245,6 +189,78 @@ class ModelHandle:
         if batch is not None:
             return self.finite(batch(*arrays), what)
         return self.finite(per_state(single, *arrays), what)
+
+
+def _matrix_call(
+    kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
+) -> Callable[..., np.ndarray]:
+    """:meth:`ModelHandle.single_call` of CRBA: the upper triangle mirrored, ``M`` and the
+    world-attached joints' ``q`` checked."""
+    isfinite = _isfinite
+    lower, copyto = np.tri(model.nv, model.nv, -1, dtype=bool), np.copyto
+    # CRBA never uses the placement of a joint attached to the world, so those
+    # joints' q (only) are checked besides M itself; every other q moves M.
+    roots = tuple(_root_coordinates(model))
+    root = roots[0] if len(roots) == 1 else None
+
+    def matrix(q: np.ndarray) -> np.ndarray:
+        try:
+            result = raw(model, local.data, q)
+            copyto(result, result.T, where=lower)
+            flat = result.ravel()
+            if isfinite(flat.dot(flat) + (q.item(root) if root is not None else sum(map(q.item, roots)))):
+                return result
+        except PINOCCHIO_ERRORS:
+            pass
+        return evaluate(kernel, q)
+
+    return matrix
+
+
+def _vector_call(
+    kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
+) -> Callable[..., np.ndarray]:
+    """:meth:`ModelHandle.single_call` of a vector quantity of 1, 2 or 3 state arguments."""
+    isfinite = _isfinite
+
+    # One state's q, v, a (tau) reach every entry of RNEA's and ABA's results (a NaN or
+    # inf in any of them makes the result non-finite: tests/dynamics/test_single_call.py), so
+    # the result alone is checked; CRBA does not use the root joints' q, so M checks q.
+    if len(kernel.names) == 1:
+
+        def vector1(q: np.ndarray) -> np.ndarray:
+            try:
+                result = raw(model, local.data, q)
+                if isfinite(sum(result.tolist())):
+                    return result
+            except PINOCCHIO_ERRORS:
+                pass
+            return evaluate(kernel, q)
+
+        return vector1
+    if len(kernel.names) == 2:
+
+        def vector2(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+            try:
+                result = raw(model, local.data, q, v)
+                if isfinite(sum(result.tolist())):
+                    return result
+            except PINOCCHIO_ERRORS:
+                pass
+            return evaluate(kernel, q, v)
+
+        return vector2
+
+    def vector3(q: np.ndarray, v: np.ndarray, third: np.ndarray) -> np.ndarray:
+        try:
+            result = raw(model, local.data, q, v, third)
+            if isfinite(sum(result.tolist())):
+                return result
+        except PINOCCHIO_ERRORS:
+            pass
+        return evaluate(kernel, q, v, third)
+
+    return vector3
 
 
 def _root_coordinates(model: pin.Model) -> list[int]:

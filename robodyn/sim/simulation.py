@@ -292,10 +292,11 @@ def choose_engine(
     The compiled engine when the whole loop runs in C there: a fixed-base robot with
     moving mass, no external wrenches, no observer, limits not enforced, passive or under
     a controller with a compiled counterpart (PD + gravity, computed torque along a
-    quintic; evaluated at every stage or once a step), and a C compiler on the PATH
-    (compiling is cached: the first run of a robot derives and builds its kernels, later
-    ones load them in milliseconds). Otherwise the Pinocchio engine. Both give the same
-    trajectory to ~1e-12.
+    quintic; evaluated at every stage or once a step), a C compiler on the PATH, and the
+    robot compiled before (its kernels in the cache: loading them takes milliseconds,
+    while a cold compile derives the equations, seconds to minutes, so auto never starts
+    one; ``engine="compiled"`` or :func:`robodyn.compile` does). Otherwise the Pinocchio
+    engine. Both give the same trajectory to ~1e-12.
 
     Args:
         robot: The plant.
@@ -325,8 +326,24 @@ def choose_engine(
         find_compiler()
     except CompileError as error:
         return "pinocchio", f"no C compiler ({error})"
+    if not _compiled_before(robot, controller):
+        return "pinocchio", (
+            "not compiled yet (engine='compiled' builds it once, in seconds to minutes; auto uses it from then on)"
+        )
     what = "passive" if controller is None else f"{type(controller).__name__} in C"
-    return "compiled", f"fixed base, {what}, a C compiler found"
+    return "compiled", f"fixed base, {what}, compiled before (cached)"
+
+
+def _compiled_before(robot: Robot, controller: Controller | None) -> bool:
+    """Whether the plant's kernels, and the controller's model's, are in the cache (a cold
+    compile derives the equations: seconds for 2 joints, minutes for 7 oblique ones)."""
+    from robodyn.compiled.build import cached_kernels
+    from robodyn.compiled.robot import robot_key
+
+    model = getattr(controller, "model", None)
+    models = [robot] if not isinstance(model, Robot) else [robot, model]
+    keys = {robot_key(each) for each in models}
+    return all(cached_kernels(key) is not None for key in keys)
 
 
 def _check_modes(integrator: str, limits: str, engine: str) -> None:

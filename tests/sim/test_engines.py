@@ -88,8 +88,9 @@ def test_a_control_period_is_refused_unless_whole_steps_and_a_controller():
             simulate(robot, q0, np.zeros(2), 0.01, DT, control_period=DT, engine=engine)
 
 
-def test_auto_runs_the_compiled_engine_only_where_the_whole_loop_runs_in_c(monkeypatch):
+def test_auto_runs_the_compiled_engine_only_where_the_whole_loop_runs_in_c(monkeypatch, tmp_path):
     robot = robodyn.load("rp_arm")
+    robodyn.compile(robot)  # auto uses compiled robots, never starts a cold compile
     q0 = robot.default_configuration()
     pd = PDGravity(controller_model(robot), q0 + 0.2)
     task = TaskSpace(controller_model(robot), robot.end_effector, np.array([0.7, 0.0, 0.7]))
@@ -103,6 +104,9 @@ def test_auto_runs_the_compiled_engine_only_where_the_whole_loop_runs_in_c(monke
     monkeypatch.setenv("CC", "no-such-compiler-here")
     assert choose_engine(robot, pd)[0] == "pinocchio" and "compiler" in choose_engine(robot, pd)[1]
     monkeypatch.delenv("CC")
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))  # an empty cache: nothing compiled yet
+    assert choose_engine(robot, pd)[0] == "pinocchio" and "not compiled yet" in choose_engine(robot, pd)[1]
+    monkeypatch.undo()
     auto, run = simulate_run(robot, q0, np.zeros(2), 0.3, DT, controller=pd, limits="ignore")
     python = simulate(robot, q0, np.zeros(2), 0.3, DT, controller=pd, limits="ignore", engine="pinocchio")
     assert run.engine == "compiled" and run.controller_in_c

@@ -61,20 +61,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too"
         " (the same as --engine compiled)",
     )
-    parser.add_argument(
-        "--engine",
-        choices=["auto", "pinocchio", "compiled"],
-        default=None,
-        help="where the loop runs: auto (default: compiled when the whole loop runs in C and a C compiler exists, "
-        "else pinocchio; the summary says which and why), pinocchio (Python over Pinocchio), compiled (C)",
-    )
-    parser.add_argument(
-        "--control-period",
-        dest="control_period",
-        type=float,
-        help="sample the controller every this many seconds (a whole number of --dt) and hold its torque "
-        "(zero-order hold); default: evaluated at every integrator stage",
-    )
+    _add_engine_arguments(parser)
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
     parser.add_argument("--record", help="HTML animation (meshcat, self-contained, plays on open)")
@@ -127,3 +114,22 @@ def _engine(arguments: argparse.Namespace) -> str:
     if arguments.compiled and arguments.engine not in (None, "compiled"):
         raise InputError("--compiled", "not combined with another --engine", f"--engine {arguments.engine}")
     return "compiled" if arguments.compiled else (arguments.engine or "auto")
+
+
+def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--engine`` and ``--control-period``."""
+    parser.add_argument(
+        "--engine",
+        choices=["auto", "pinocchio", "compiled"],
+        default=None,
+        help="where the loop runs: auto (default: compiled when the whole loop runs in C, a C compiler exists and the "
+        "robot was compiled before (--engine compiled compiles it), "
+        "else pinocchio; the summary says which and why), pinocchio (Python over Pinocchio), compiled (C)",
+    )
+    parser.add_argument(
+        "--control-period",
+        dest="control_period",
+        type=float,
+        help="sample the controller every this many seconds (a whole number of --dt) and hold its torque "
+        "(zero-order hold); default: evaluated at every integrator stage",
+    )

@@ -7,6 +7,7 @@ import shutil
 
 import pytest
 
+import robodyn
 from robodyn.cli.app import main
 
 
@@ -30,8 +31,10 @@ def test_outputs_are_written_together_when_all_succeed(tmp_path, capsys):
     assert status == 0
     summary = json.loads(capsys.readouterr().out)
     assert (tmp_path / "m.npz").is_file() and (tmp_path / "m.png").is_file()
-    # --engine auto (default): a passive fixed-base run goes to C where a compiler exists
-    assert summary["engine"] == ("compiled" if shutil.which("cc") or shutil.which("gcc") else "pinocchio")
+    # --engine auto (default): the engine choose_engine names (compiled once rp_arm is in the cache)
+    from robodyn.sim.simulation import choose_engine
+
+    assert (summary["engine"], summary["engine_reason"]) == choose_engine(robodyn.load("rp_arm"), None)
 
 
 @pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
