@@ -50,6 +50,7 @@ from robodyn.exceptions import (
     ControllerFailedError,
     InputError,
     JointLimitWarning,
+    NonFiniteResultError,
     SimulationError,
     SingularMassMatrixError,
 )
@@ -470,7 +471,7 @@ def _integrate(
         except InputError:  # a non-finite state reached a controller's checked call
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
-        except (np.linalg.LinAlgError, FloatingPointError) as error:  # a controller's solve failed
+        except (np.linalg.LinAlgError, FloatingPointError, NonFiniteResultError) as error:  # a controller's numerics failed
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             fastest = int(np.argmax(np.abs(vs[-1])))
             joint = robot.joint_names[max(0, min(fastest - (robot.nv - len(robot.joint_names)), len(robot.joint_names) - 1))]

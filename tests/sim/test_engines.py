@@ -123,3 +123,14 @@ def test_the_real_time_factor_is_the_loops_and_start_up_is_reported_apart():
     assert "(loop only)" in summary.text() and "engine: compiled" in summary.text()
     assert summary.with_startup(1.25).to_dict()["startup_time_s"] == 1.25
     assert "start-up 1.25 s" in summary.with_startup(1.25).text()
+
+
+@pytest.mark.parametrize("engine", ["pinocchio", "compiled"])
+def test_a_controller_overflowing_on_a_blown_up_state_stops_the_run_in_one_sentence(engine):
+    """ur5 driven past a singular posture at dt = 1 ms: the task-space law's J̇ q̇ overflows
+    (a NonFiniteResultError inside the controller) and the run stops with ControllerFailedError."""
+    robot = robodyn.load("ur5")
+    q0 = robot.default_configuration()
+    target = (robot.frame_position(q0, robot.end_effector) + np.array([0.1, -0.1, -0.1])).tolist()
+    with pytest.raises(robodyn.exceptions.ControllerFailedError, match="the controller failed"):
+        run_simulation(robot, controller="task-space", target=target, duration=0.4, limits="ignore", engine=engine)
