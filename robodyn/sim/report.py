@@ -265,8 +265,10 @@ class SimulationSummary:
         if self.controller != "passive":
             lines.append(f"controller evaluated: {self._sampling()}{where}")
         times = [] if self.loop_time is None else [f"loop {_seconds(self.loop_time)}"]
-        if self.compile_time:
+        if self.compile_time and self.engine == "compiled":
             times.append(f"engine choice and compile {_seconds(self.compile_time)} (imports included; kernels cached)")
+        elif self.compile_time:
+            times.append(f"engine choice {_seconds(self.compile_time)}")
         if self.startup_time is not None:
             times.append(f"start-up {_seconds(self.startup_time)} (interpreter, imports, loading)")
         return lines + ([f"wall-clock time: {', '.join(times)}"] if times else [])

@@ -308,8 +308,6 @@ def choose_engine(
     Returns:
         ``"compiled"`` or ``"pinocchio"``, and the reason.
     """
-    from robodyn.compiled.build import find_compiler
-
     if robot.floating_base:
         return "pinocchio", "a floating base (the compiled engine models fixed-base robots)"
     refusals = [
@@ -323,6 +321,8 @@ def choose_engine(
             return "pinocchio", f"{what} (the compiled engine models none)"
     if controller is not None and not _runs_in_c(controller, every):
         return "pinocchio", "a Python controller (called from Python at every stage in either engine)"
+    from robodyn.compiled.build import find_compiler  # the code generator's imports: only when needed
+
     try:
         find_compiler()
     except CompileError as error:
