@@ -25,6 +25,9 @@ Sections:
     compiled-derivatives-build   the derivative module's cold build (on first use)
     compiled-control     compiled controllers in the C loop: the demo's task-space run, panda-arm
                          task space / OSC / impedance vs MuJoCo's passive RK4, frame kernels vs Pinocchio
+    single-thin          Robot single calls vs raw Pinocchio on a preallocated Data (CPU time; target 1.3)
+    compile-scaling      cold compile time against DoF, chains and trees: sympy derivation vs cc
+    engines              loop-only real-time factor per engine (demo, ur5 PD) and their agreement
 """
 
 from __future__ import annotations
@@ -896,6 +899,149 @@ def bench_compiled_frames(quick: bool) -> list[dict]:
     return rows
 
 
+def _cpu_paired(ours: Callable[[], object], raw: Callable[[], object], repeats: int = 21) -> tuple[float, float, float]:
+    """Median CPU times (this thread's) of two functions measured alternately, and the median
+    of their ratios: on a loaded machine a thread's CPU time is steadier than wall time."""
+    number = 2000
+    ours_times, raw_times = [], []
+    for _ in range(repeats):
+        ours_times.append(timeit.timeit(ours, number=number, timer=time.thread_time) / number)
+        raw_times.append(timeit.timeit(raw, number=number, timer=time.thread_time) / number)
+    ratios = [o / r for o, r in zip(ours_times, raw_times, strict=True)]
+    return statistics.median(ours_times), statistics.median(raw_times), statistics.median(ratios)
+
+
+def bench_single_thin(quick: bool) -> list[dict]:
+    """``Robot``'s single calls vs the raw Pinocchio call on a preallocated Data (M: CRBA
+    and the lower triangle mirrored, as ``Robot`` returns it); target: ratio <= 1.3."""
+    rows = []
+    for label, name, options in (("ur5", "ur5", {}), *[("panda (arm, fingers locked)", "panda", PANDA_ARM)]):
+        robot = robodyn.load(name, **options)
+        model, data = robot.model, robot.model.createData()
+        rng = np.random.default_rng(0)
+        q = robot.random_configuration(rng).copy()
+        v, a = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+        tau = robot.inverse_dynamics(q, v, a)
+        lower = np.tri(robot.nv, robot.nv, -1, dtype=bool)
+
+        def crba_mirrored(q=q, model=model, data=data, lower=lower):
+            mass = pin.crba(model, data, q)
+            np.copyto(mass, mass.T, where=lower)
+            return mass
+
+        cases = {
+            "inverse_dynamics vs pin.rnea": (lambda: robot.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a)),
+            "mass_matrix vs pin.crba + mirror": (lambda: robot.mass_matrix(q), crba_mirrored),
+            "gravity vs pin.computeGeneralizedGravity": (
+                lambda: robot.gravity(q),
+                lambda: pin.computeGeneralizedGravity(model, data, q),
+            ),
+            "forward_dynamics vs pin.aba": (lambda: robot.forward_dynamics(q, v, tau), lambda: pin.aba(model, data, q, v, tau)),
+            "nonlinear_effects vs pin.nonLinearEffects": (
+                lambda: robot.nonlinear_effects(q, v),
+                lambda: pin.nonLinearEffects(model, data, q, v),
+            ),
+        }
+        for method, (ours, raw) in cases.items():
+            ours_s, raw_s, ratio = _cpu_paired(ours, raw, repeats=7 if quick else 21)
+            rows.append(
+                {
+                    "robot": label, "method": method, "robodyn_us": ours_s * 1e6, "pinocchio_us": raw_s * 1e6,
+                    "ratio": ratio, "within_1.3": ratio <= 1.3, "load_average": os.getloadavg()[0],
+                }
+            )  # fmt: skip
+    return rows
+
+
+_COMPILE_PARTS = """
+import sys, time, robodyn
+from robodyn.compiled import build
+from robodyn.compiled.robot import generate_kernels
+robot = robodyn.load(sys.stdin.read())
+start = time.perf_counter()
+kernels = generate_kernels(robot)
+derived = time.perf_counter()
+build.build_module(kernels, label="scaling")
+print(derived - start, time.perf_counter() - derived, len(kernels))
+"""
+
+
+def _chain(urdf: str) -> str:
+    """The random tree made a chain: joint ``j<i>``'s parent becomes ``link<i-1>``."""
+    import re
+
+    return re.sub(
+        r'(<joint name="j(\d+)"[^>]*><parent link=")link\d+"',
+        lambda match: f'{match.group(1)}link{int(match.group(2)) - 1}"',
+        urdf,
+    )
+
+
+def bench_compile_scaling(quick: bool) -> list[dict]:
+    """Cold compile time against DoF, chains and trees of revolute and prismatic joints (a
+    new process, an empty cache): the sympy derivation and the C compiler apart."""
+    import subprocess
+    import tempfile
+
+    sys.path.insert(0, str(ROOT))
+    from tests.random_robots import urdf_from_seed
+
+    rows = []
+    for dof in (2, 4, 8) if quick else (2, 4, 8, 12, 16, 24, 30):
+        for shape in ("chain", "tree"):
+            urdf = urdf_from_seed(dof, dof, ["revolute", "revolute", "prismatic"])
+            urdf = _chain(urdf) if shape == "chain" else urdf
+            with tempfile.TemporaryDirectory() as folder:
+                env = os.environ | {"ROBODYN_CACHE": folder}
+                try:
+                    done = subprocess.run(
+                        [sys.executable, "-c", _COMPILE_PARTS], input=urdf, env=env, capture_output=True, text=True,
+                        check=True, timeout=600,
+                    )  # fmt: skip
+                except subprocess.TimeoutExpired:
+                    rows.append({"shape": shape, "dof": dof, "derive_s": None, "note": "over 600 s"})
+                    continue
+            derive, cc, size = done.stdout.split()
+            rows.append(
+                {
+                    "shape": shape, "dof": dof, "derive_s": float(derive), "cc_s": float(cc),
+                    "total_s": float(derive) + float(cc), "c_source_kB": int(size) / 1e3,
+                    "load_average": os.getloadavg()[0],
+                }
+            )  # fmt: skip
+            print(rows[-1], file=sys.stderr)
+    return rows
+
+
+def bench_engines(quick: bool) -> list[dict]:
+    """Real-time factor of the loop alone (start-up and compile apart), per engine: the demo
+    (rp_arm task space) and ur5 PD; and the agreement of the two engines."""
+    from robodyn.sim.experiment import run_simulation
+
+    duration = 1.0 if quick else 3.0
+    runs = (
+        ("rp_arm", {"controller": "task-space", "target": [0.7, 0.7]}),
+        ("ur5", {"controller": "pd", "target": [0.3, -1.2, 1.0, -0.5, 0.4, 0.2]}),
+    )
+    rows = []
+    for name, settings in runs:
+        robot = robodyn.load(name)
+        results = {}
+        for engine in ("pinocchio", "compiled", "auto"):
+            trajectory, summary = run_simulation(robot, duration=duration, engine=engine, limits="ignore", **settings)
+            results[engine] = trajectory
+            rows.append(
+                {
+                    "robot": name, "controller": settings["controller"], "asked": engine, "ran": summary.engine,
+                    "loop_rtf": summary.real_time_factor, "loop_ms": (summary.loop_time or 0.0) * 1e3,
+                    "compile_ms": summary.compile_time * 1e3,
+                    "max_abs_q_diff_vs_pinocchio": float(np.abs(trajectory.q - results["pinocchio"].q).max()),
+                    "load_average": os.getloadavg()[0],
+                }
+            )  # fmt: skip
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -915,6 +1061,9 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-derivatives-build": bench_compiled_derivatives_build,
     "compiled-control": bench_compiled_control,
     "compiled-frames": bench_compiled_frames,
+    "single-thin": bench_single_thin,
+    "compile-scaling": bench_compile_scaling,
+    "engines": bench_engines,
 }
 
 

@@ -48,6 +48,8 @@ FLAGS: dict[str, str] = {
     "intervals": "--intervals",
     "cost": "--cost",
     "reference": "--reference",
+    "engine": "--engine",
+    "control_period": "--control-period",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

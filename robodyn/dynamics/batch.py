@@ -46,6 +46,9 @@ class PerThreadData:
     def __init__(self, model: pin.Model) -> None:
         self._model = model
         self._local = threading.local()
+        #: This thread's data is ``local.data`` once :meth:`get` made it (an
+        #: ``AttributeError`` before): the hot path reads it without a call.
+        self.local = self._local
 
     def get(self) -> pin.Data:
         """This thread's data."""

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -73,6 +74,14 @@ class ModelHandle:
         self._data = PerThreadData(model)
         self.parallel = ParallelRunner(model, threads=threads)
         self.kernels = dynamics_kernels(model, self._data.get, self.parallel.run, mimic, name=name)
+        kernels = self.kernels
+        self.calls = SingleCalls(
+            tau=self.single_call(kernels.tau, pin.rnea),
+            a=self.single_call(kernels.a, pin.aba),
+            M=self.single_call(kernels.M, pin.crba, symmetric=True),
+            G=self.single_call(kernels.G, pin.computeGeneralizedGravity),
+            nle=self.single_call(kernels.nle, pin.nonLinearEffects),
+        )
 
     @property
     def data(self) -> pin.Data:
@@ -121,6 +130,33 @@ class ModelHandle:
             raise NonFiniteResultError(self.name, what)
         return result
 
+    def single_call(
+        self, kernel: Kernel, raw: Callable[..., np.ndarray], *, symmetric: bool = False
+    ) -> Callable[..., np.ndarray]:
+        """The thinnest checked call of a quantity: :meth:`evaluate` with its fast path fused.
+
+        On a fixed-base robot (with mimic joints: for tau, G and C v + G only),
+        ``raw(model, data, *values)`` runs on this
+        thread's data (read from a ``threading.local`` without a call: thread-safe) and its
+        result is returned when it and ``q`` are finite (one ``isfinite`` of two sums); a
+        ``symmetric`` result (CRBA's upper triangle) gets its lower triangle filled first.
+        Anything else (other inputs, a first call in a thread, a non-finite value, a floating
+        base, mimic joints) goes to :meth:`evaluate`, which checks and names the argument.
+
+        Args:
+            kernel: The quantity's kernel (the checked path).
+            raw: The Pinocchio function ``raw(model, data, *values)`` of one state.
+            symmetric: Whether ``raw`` returns an upper triangle to mirror.
+        """
+        evaluate, model, local = self.evaluate, self.model, self._data.local
+        if self.floating_base or (self.mimic is not None and (symmetric or raw is pin.aba)):
+            # a floating base's quaternion needs its own check; with mimic joints, M and the
+            # accelerations are not one Pinocchio call (kernels.py)
+            return lambda *values: evaluate(kernel, *values)
+        if symmetric:
+            return _matrix_call(kernel, raw, model, local, evaluate)
+        return _vector_call(kernel, raw, model, local, evaluate)
+
     def evaluate(self, kernel: Kernel, *values: np.ndarray) -> np.ndarray:
         """Fast path, then checked path, for one quantity (a :class:`~robodyn.dynamics.kernels.Kernel`).
 
@@ -153,6 +189,97 @@ class ModelHandle:
         if batch is not None:
             return self.finite(batch(*arrays), what)
         return self.finite(per_state(single, *arrays), what)
+
+
+def _matrix_call(
+    kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
+) -> Callable[..., np.ndarray]:
+    """:meth:`ModelHandle.single_call` of CRBA: the upper triangle mirrored, ``M`` and the
+    world-attached joints' ``q`` checked."""
+    isfinite = _isfinite
+    lower, copyto = np.tri(model.nv, model.nv, -1, dtype=bool), np.copyto
+    # CRBA never uses the placement of a joint attached to the world, so those
+    # joints' q (only) are checked besides M itself; every other q moves M.
+    roots = tuple(_root_coordinates(model))
+    root = roots[0] if len(roots) == 1 else None
+
+    def matrix(q: np.ndarray) -> np.ndarray:
+        try:
+            result = raw(model, local.data, q)
+            copyto(result, result.T, where=lower)
+            flat = result.ravel()
+            if isfinite(flat.dot(flat) + (q.item(root) if root is not None else sum(map(q.item, roots)))):
+                return result
+        except PINOCCHIO_ERRORS:
+            pass
+        return evaluate(kernel, q)
+
+    return matrix
+
+
+def _vector_call(
+    kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
+) -> Callable[..., np.ndarray]:
+    """:meth:`ModelHandle.single_call` of a vector quantity of 1, 2 or 3 state arguments."""
+    isfinite = _isfinite
+
+    # One state's q, v, a (tau) reach every entry of RNEA's and ABA's results (a NaN or
+    # inf in any of them makes the result non-finite: tests/dynamics/test_single_call.py), so
+    # the result alone is checked; CRBA does not use the root joints' q, so M checks q.
+    if len(kernel.names) == 1:
+
+        def vector1(q: np.ndarray) -> np.ndarray:
+            try:
+                result = raw(model, local.data, q)
+                if isfinite(sum(result.tolist())):
+                    return result
+            except PINOCCHIO_ERRORS:
+                pass
+            return evaluate(kernel, q)
+
+        return vector1
+    if len(kernel.names) == 2:
+
+        def vector2(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+            try:
+                result = raw(model, local.data, q, v)
+                if isfinite(sum(result.tolist())):
+                    return result
+            except PINOCCHIO_ERRORS:
+                pass
+            return evaluate(kernel, q, v)
+
+        return vector2
+
+    def vector3(q: np.ndarray, v: np.ndarray, third: np.ndarray) -> np.ndarray:
+        try:
+            result = raw(model, local.data, q, v, third)
+            if isfinite(sum(result.tolist())):
+                return result
+        except PINOCCHIO_ERRORS:
+            pass
+        return evaluate(kernel, q, v, third)
+
+    return vector3
+
+
+def _root_coordinates(model: pin.Model) -> list[int]:
+    """Indices in ``q`` of the joints attached to the world (the universe, joint 0)."""
+    return [
+        model.joints[j].idx_q + k for j in range(1, model.njoints) if model.parents[j] == 0 for k in range(model.joints[j].nq)
+    ]
+
+
+class SingleCalls(NamedTuple):
+    """The one-state calls of the equations of motion (:meth:`ModelHandle.single_call`):
+    ``tau(q, v, a)``, ``a(q, v, tau)``, ``M(q)``, ``G(q)``, ``nle(q, v)``; each also takes
+    a batch (through :meth:`ModelHandle.evaluate`)."""
+
+    tau: Callable[..., np.ndarray]
+    a: Callable[..., np.ndarray]
+    M: Callable[..., np.ndarray]
+    G: Callable[..., np.ndarray]
+    nle: Callable[..., np.ndarray]
 
 
 def _all_finite(array: np.ndarray) -> bool:

@@ -229,8 +229,7 @@ class Robot:
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
-        handle = self.handle
-        return handle.evaluate(handle.kernels.tau, q, v, a)
+        return self.handle.calls.tau(q, v, a)
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).
@@ -246,11 +245,10 @@ class Robot:
         Raises:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
-        handle = self.handle
         if self.massless_joints:  # M singular for every q: ABA's finite numbers would be wrong
             raise SingularMassMatrixError(self.name, self.massless_joints)
         try:
-            return handle.evaluate(handle.kernels.a, q, v, tau)
+            return self.handle.calls.a(q, v, tau)
         except NonFiniteResultError:  # finite inputs, non-finite accelerations: only a singular M does that
             raise SingularMassMatrixError(self.name, self.massless_joints) from None
 
@@ -272,8 +270,7 @@ class Robot:
         Returns:
             Shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
         """
-        handle = self.handle
-        return handle.evaluate(handle.kernels.M, q)
+        return self.handle.calls.M(q)
 
     def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Coriolis and centrifugal matrix ``C(q, v)``, with ``dM/dt = C + Cᵀ``.
@@ -297,8 +294,7 @@ class Robot:
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        handle = self.handle
-        return handle.evaluate(handle.kernels.G, q)
+        return self.handle.calls.G(q)
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``C(q, v) v + G(q)``: the torques at zero acceleration.
@@ -310,8 +306,7 @@ class Robot:
         Returns:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
-        handle = self.handle
-        return handle.evaluate(handle.kernels.nle, q, v)
+        return self.handle.calls.nle(q, v)
 
     # ----------------------------------------------------------------------------------
     # Derivatives (robodyn.dynamics.derivatives): q columns in the tangent space

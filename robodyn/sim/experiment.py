@@ -18,7 +18,6 @@ deflection against ``K⁻¹ F``. ``observer_gain`` runs a
 
 from __future__ import annotations
 
-import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
@@ -36,7 +35,7 @@ from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
 from robodyn.sim.reach import check_reach
 from robodyn.sim.report import ObserverOutcome, Push, SimulationSummary, TaskOutcome
-from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate
+from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate_run
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
@@ -125,7 +124,7 @@ def run_simulation(
     dt: float = 1e-3,
     integrator: Integrator = "rk4",
     limits: LimitMode = "warn",
-    engine: Engine = "pinocchio",
+    engine: Engine = "auto",
     posture: list[float] | None = None,
     stiffness: list[float] | None = None,
     damping: list[float] | None = None,
@@ -133,6 +132,7 @@ def run_simulation(
     observer_gain: float | None = None,
     actuated: list[str] | None = None,
     reference: Trajectory | None = None,
+    control_period: float | None = None,
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -152,8 +152,8 @@ def run_simulation(
             controllers it only names the path a recording draws.
         q0: Initial configuration; default :meth:`Robot.default_configuration` (the
             neutral one clipped into the joint limits).
-        duration, dt, integrator, limits, engine: As for :func:`robodyn.simulate` (with
-            ``engine="compiled"`` the task-space controllers are sampled every step).
+        duration, dt, integrator, limits, engine: As for :func:`robodyn.simulate` (the
+            controller is evaluated at every integrator stage in either engine).
         posture: osc only: a configuration (nq) drawn toward in the task's null space.
         stiffness: impedance only: ``K``, 3 values [N/m] (or 6, then [N m/rad]).
         damping: impedance only: ``D``, [N s/m] (then [N m s/rad]).
@@ -164,6 +164,8 @@ def run_simulation(
         reference: computed-torque only: a motion to track instead of the quintic
             (:class:`TrajectoryReference`; e.g. ``robodyn optimize``'s); it starts at its first
             sample (unless ``q0`` is given) and its last configuration is the target.
+        control_period: Sample the controller every ``control_period`` [s] and hold its
+            torque (zero-order hold; the summary says so); ``None``: every stage.
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -188,23 +190,25 @@ def run_simulation(
         law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
     pushes, external = push_wrenches(robot, force_at, controlled or None)
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
-    began = time.perf_counter()
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
-        trajectory = simulate(
+        trajectory, run = simulate_run(
             robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits,
-            engine=engine, external=external, observer=observer,
+            engine=engine, external=external, observer=observer, control_period=control_period,
         )  # fmt: skip
-    elapsed = time.perf_counter() - began
     settings = {
         "controller": controller,
         "integrator": integrator,
         "limits": limits,
-        "engine": engine,
+        "engine": run.engine,
         "duration": duration,
         "dt": dt,
     }
-    summary = replace(_summary(robot, trajectory, settings, elapsed), pushes=pushes)
+    summary = replace(
+        _summary(robot, trajectory, settings, run.loop_time), pushes=pushes, engine_reason=run.reason,
+        control_period=run.control_period, controller_in_c=run.controller_in_c, loop_time=run.loop_time,
+        compile_time=run.compile_time,
+    )  # fmt: skip
     if observer is not None:
         summary = replace(summary, observer=_observer_outcome(robot, trajectory, observer, external))
     if isinstance(law, OperationalSpace | Impedance):

@@ -160,6 +160,16 @@ class SimulationSummary:
         violations: Every limit the run broke (none with ``limits="ignore"``).
         files: Files written for the run, by kind (``trajectory``, ``plot``, ``recording``,
             ``poster``), in the order written.
+        engine_reason: Why ``engine`` ran (``engine="auto"``: why it was chosen).
+        control_period: The period in [s] at which the controller was sampled and its
+            torque held (zero-order hold); ``None``: evaluated at every integrator stage.
+        controller_in_c: Whether the controller ran in C.
+        loop_time: Wall-clock time of the integration loop alone in [s]
+            (``real_time_factor`` is ``duration / loop_time``).
+        compile_time: Wall-clock time choosing the engine and compiling, or loading the
+            cached, kernels in [s] (importing the code generator included).
+        startup_time: Wall-clock time from the process's start to the run in [s]
+            (interpreter, imports, loading the robot; ``robodyn simulate`` fills it in).
     """
 
     robot: str
@@ -183,6 +193,16 @@ class SimulationSummary:
     observer: ObserverOutcome | None = None
     violations: tuple[LimitViolation, ...] = ()
     files: tuple[tuple[str, str], ...] = field(default=())
+    engine_reason: str = ""
+    control_period: float | None = None
+    controller_in_c: bool = False
+    loop_time: float | None = None
+    compile_time: float = 0.0
+    startup_time: float | None = None
+
+    def with_startup(self, seconds: float | None) -> SimulationSummary:
+        """The same summary with the start-up time in [s] (process start to the run)."""
+        return replace(self, startup_time=seconds)
 
     def with_file(self, kind: str, path: str) -> SimulationSummary:
         """The same summary also naming a file written for the run."""
@@ -207,6 +227,7 @@ class SimulationSummary:
             "torque_units": list(self.torque_units),
             "energy_change_J": self.energy_change,
         }
+        data |= self._timing_dict()
         if self.task is not None:
             data |= self.task.to_dict()
         if self.final_joint_error is not None:
@@ -217,6 +238,40 @@ class SimulationSummary:
             data |= self.observer.to_dict()
         data["limit_violations"] = [violation.as_dict() for violation in self.violations]
         return data | dict(self.files)
+
+    def _timing_dict(self) -> dict[str, Any]:
+        """The engine's reason, the controller's sampling and the times, units in the keys."""
+        return {
+            "engine_reason": self.engine_reason,
+            "controller_sampling": self._sampling(),
+            "control_period_s": self.control_period,
+            "controller_in_c": self.controller_in_c,
+            "loop_time_s": self.loop_time,
+            "compile_time_s": self.compile_time,
+            "startup_time_s": self.startup_time,
+        }
+
+    def _sampling(self) -> str:
+        if self.controller == "passive":
+            return "none (passive)"
+        if self.control_period is None:
+            return "every integrator stage"
+        return f"sampled every {_number(self.control_period)} s and held (zero-order hold)"
+
+    def _timing_lines(self) -> list[str]:
+        """Which engine ran and why, how the controller was sampled, where the time went."""
+        where = " in C" if self.controller_in_c else (" in Python" if self.controller != "passive" else "")
+        lines = [f"engine: {self.engine}" + (f" ({self.engine_reason})" if self.engine_reason else "")]
+        if self.controller != "passive":
+            lines.append(f"controller evaluated: {self._sampling()}{where}")
+        times = [] if self.loop_time is None else [f"loop {_seconds(self.loop_time)}"]
+        if self.compile_time and self.engine == "compiled":
+            times.append(f"engine choice and compile {_seconds(self.compile_time)} (imports included; kernels cached)")
+        elif self.compile_time:
+            times.append(f"engine choice {_seconds(self.compile_time)}")
+        if self.startup_time is not None:
+            times.append(f"start-up {_seconds(self.startup_time)} (interpreter, imports, loading)")
+        return lines + ([f"wall-clock time: {', '.join(times)}"] if times else [])
 
     def __getitem__(self, key: str) -> Any:
         """A key of :meth:`to_dict` (for code that reads the summary as the JSON dict)."""
@@ -236,8 +291,9 @@ class SimulationSummary:
             f"robot: {printable(self.robot)}",
             f"controller: {self.controller} (integrator {self.integrator}, limits {self.limits})",
             f"simulated: {_number(self.duration)} s in {self.steps} steps of {_number(self.dt)} s"
-            + (f", {_number(self.real_time_factor, 3)}× real time" if self.real_time_factor else ""),
+            + (f", {_number(self.real_time_factor, 3)}× real time (loop only)" if self.real_time_factor else ""),
         ]
+        lines += self._timing_lines()
         lines += [
             f"push: {vector_text(push.force, 6)} N at {printable(push.frame or '(the end effector)')} from {_number(push.time)} s"
             for push in self.pushes
@@ -279,3 +335,22 @@ def _number(value: object, digits: int = 6) -> str:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return str(value)
     return "unlimited" if not np.isfinite(value) else f"{value:.{digits}g}"
+
+
+def _seconds(value: float) -> str:
+    """A duration in [s] as ``12.3 ms`` or ``1.23 s``."""
+    return f"{value * 1e3:.3g} ms" if value < 1.0 else f"{value:.3g} s"
+
+
+def seconds_since_process_start() -> float | None:
+    """Wall-clock time since this process started in [s] (Linux ``/proc``; ``None`` elsewhere)."""
+    import os
+
+    try:
+        with open("/proc/self/stat", encoding="ascii") as stat:
+            fields = stat.read().rsplit(")", 1)[1].split()
+        with open("/proc/uptime", encoding="ascii") as uptime:
+            now = float(uptime.read().split()[0])
+        return max(0.0, now - int(fields[19]) / os.sysconf("SC_CLK_TCK"))
+    except (OSError, ValueError, IndexError):
+        return None

@@ -10,8 +10,13 @@ error in the base's orientation falls as dt² (solo12, 1 s at 1 kHz: momentum dr
 relative); joints keep fourth order.
 
 The controller is a continuous-time law evaluated wherever the integrator evaluates the
-dynamics (every Runge–Kutta stage); with ``hold=True`` it is sampled once per step and its
-torque held during the step (zero-order hold, as on a digital controller). External
+dynamics (every Runge–Kutta stage), in either engine; with ``hold=True`` it is sampled once
+per step and its torque held during the step (zero-order hold, as on a digital controller),
+with ``control_period=`` every so many steps. Engines (``engine=``): ``"pinocchio"`` (this
+loop, ABA per stage), ``"compiled"`` (:mod:`robodyn.compiled`: passive runs and compiled
+controllers wholly in C; a Python controller called from Python at every stage around the
+compiled dynamics) and ``"auto"`` (:func:`choose_engine`); :func:`simulate_run` also says
+which ran, why, and the loop's and the compilation's times. External
 wrenches are evaluated at every stage. An ``observer=`` (a
 :class:`~robodyn.sim.observer.MomentumObserver`) is updated once per step, at the state
 actually reached, with the torque applied there; its ``residuals`` are then the external
@@ -33,16 +38,19 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from time import perf_counter
 from typing import Literal
 
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import (
+    CompileError,
     ControllerFailedError,
     InputError,
     JointLimitWarning,
+    NonFiniteResultError,
     SimulationError,
     SingularMassMatrixError,
 )
@@ -55,9 +63,10 @@ Controller = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 #: Integration schemes: classical Runge–Kutta, or semi-implicit (symplectic) Euler.
 Integrator = Literal["rk4", "semi-implicit-euler"]
 INTEGRATORS: tuple[Integrator, ...] = ("rk4", "semi-implicit-euler")
-#: Where the loop runs: Python over Pinocchio, or C (:mod:`robodyn.compiled`).
-Engine = Literal["pinocchio", "compiled"]
-ENGINES: tuple[Engine, ...] = ("pinocchio", "compiled")
+#: Where the loop runs: Python over Pinocchio, or C (:mod:`robodyn.compiled`); ``"auto"``
+#: chooses (see :func:`choose_engine`).
+Engine = Literal["auto", "pinocchio", "compiled"]
+ENGINES: tuple[Engine, ...] = ("auto", "pinocchio", "compiled")
 #: Most steps one run may take (a guard against durations like 1e9 s at 1 ms).
 MAX_STEPS = 10_000_000
 #: Steps between two finiteness checks of the state (a divergence is located exactly).
@@ -90,6 +99,31 @@ def external_torques(robot: Robot, q: np.ndarray, time: float, external: Sequenc
     return total
 
 
+@dataclass(frozen=True)
+class EngineRun:
+    """How a run went: the engine that ran, why, and where the time went.
+
+    Attributes:
+        engine: ``"pinocchio"`` or ``"compiled"``: the engine that ran.
+        reason: Why that engine, one sentence (with ``engine="auto"``: why it was chosen).
+        loop_time: Wall-clock time of the integration loop alone, in [s].
+        compile_time: Wall-clock time spent choosing the engine and compiling (or loading
+            the cached) kernels, importing the code generator included, in [s] (0 when
+            ``engine="pinocchio"`` was asked for).
+        control_period: The period in [s] at which the controller was sampled and its
+            torque held; ``None`` when it was evaluated at every integrator stage (or there
+            is none).
+        controller_in_c: Whether the controller ran in C (passive runs: ``False``).
+    """
+
+    engine: Literal["pinocchio", "compiled"]
+    reason: str
+    loop_time: float
+    compile_time: float = 0.0
+    control_period: float | None = None
+    controller_in_c: bool = False
+
+
 def simulate(
     robot: Robot,
     q0: np.ndarray,
@@ -102,11 +136,17 @@ def simulate(
     external: Sequence[ExternalWrench] = (),
     hold: bool = False,
     limits: LimitMode = "warn",
-    engine: Engine = "pinocchio",
+    engine: Engine = "auto",
     control_period: float | None = None,
     observer: MomentumObserver | None = None,
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
+
+    Both engines evaluate the controller at every integrator stage (a Python controller in
+    the compiled engine is called from Python at each stage, the dynamics in C) unless
+    ``hold`` or ``control_period`` asks for sampling and holding it; the two engines give
+    the same trajectory (to ~1e-12). :func:`simulate_run` also says which engine ran, why,
+    and how long the loop and the compilation took.
 
     Args:
         robot: The plant.
@@ -118,15 +158,17 @@ def simulate(
         integrator: ``"rk4"`` or ``"semi-implicit-euler"``.
         external: Wrenches the environment applies (constant or functions of time).
         hold: Sample the controller once per step and hold its torque (zero-order hold)
-            instead of evaluating it at every integration stage.
+            instead of evaluating it at every integration stage (``control_period=dt``).
         limits: ``"warn"``, ``"enforce"`` or ``"ignore"`` (see :mod:`robodyn.sim.limits`).
-        engine: ``"pinocchio"`` (this loop in Python, ABA per stage) or ``"compiled"`` (the
-            whole loop in C, :mod:`robodyn.compiled`; fixed-base robots, no external
-            wrenches, limits warned or ignored). PD + gravity and computed torque along a
-            quintic run in C on their own compiled models; any other controller is called
-            every ``control_period`` [s] and its torque held in between.
-        control_period: With ``engine="compiled"`` and a Python controller, in [s] (a whole
-            number of steps; default ``dt``).
+        engine: ``"auto"`` (default: see :func:`choose_engine`), ``"pinocchio"`` (this
+            loop in Python, ABA per stage) or ``"compiled"`` (:mod:`robodyn.compiled`;
+            fixed-base robots, no external wrenches, no observer, limits warned or
+            ignored). Passive runs, PD + gravity and computed torque along a quintic run
+            wholly in C on their own compiled models; any other controller is called from
+            Python at every stage around the compiled dynamics.
+        control_period: Sample the controller every ``control_period`` [s] (a whole
+            number of steps) and hold its torque in between (zero-order hold, as on a
+            digital controller), in either engine; ``None``: evaluate it continuously.
         observer: A momentum observer fed every sample (time, state, applied torque) as
             the run goes (Pinocchio engine); afterwards ``observer.residuals`` holds its
             estimate of the external torques at each sample. Give it ``torque="held"``
@@ -137,8 +179,10 @@ def simulate(
         the applied torque: saturated with ``limits="enforce"``).
 
     Raises:
-        InputError: For bad initial states, step, integrator or limits mode, or a
-            duration that is not a whole number of steps (to 1e-9 relative).
+        InputError: For bad initial states, step, integrator, limits mode, engine or
+            control period, or a duration that is not a whole number of steps (to 1e-9
+            relative); with ``engine="compiled"``, for what it does not model.
+        CompileError: With ``engine="compiled"``, for a floating base.
         FrameError: An external wrench on a frame that is unknown or that no joint moves.
         SingularMassMatrixError: If the mass matrix is singular (no motion is defined).
         SimulationError: If the state stops being finite (``ControllerFailedError``: if
@@ -147,38 +191,160 @@ def simulate(
     Warns:
         JointLimitWarning: With ``limits="warn"``, when a limit was broken.
     """
+    trajectory, _, violations = _simulate(
+        robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
+        limits=limits, engine=engine, control_period=control_period, observer=observer,
+    )  # fmt: skip
+    if violations:
+        warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
+    return trajectory
+
+
+def simulate_run(
+    robot: Robot,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    duration: float,
+    dt: float,
+    *,
+    controller: Controller | None = None,
+    integrator: Integrator = "rk4",
+    external: Sequence[ExternalWrench] = (),
+    hold: bool = False,
+    limits: LimitMode = "warn",
+    engine: Engine = "auto",
+    control_period: float | None = None,
+    observer: MomentumObserver | None = None,
+) -> tuple[Trajectory, EngineRun]:
+    """:func:`simulate`, also saying which engine ran, why, and the loop's and the
+    compilation's wall-clock times (:class:`EngineRun`). Arguments, errors and warnings
+    are :func:`simulate`'s."""
+    trajectory, run, violations = _simulate(
+        robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
+        limits=limits, engine=engine, control_period=control_period, observer=observer,
+    )  # fmt: skip
+    if violations:
+        warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
+    return trajectory, run
+
+
+def _simulate(
+    robot: Robot,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    duration: float,
+    dt: float,
+    *,
+    controller: Controller | None,
+    integrator: str,
+    external: Sequence[ExternalWrench],
+    hold: bool,
+    limits: str,
+    engine: str,
+    control_period: float | None,
+    observer: MomentumObserver | None,
+) -> tuple[Trajectory, EngineRun, list]:
+    """The run, how it went, and the limits it broke (none with ``limits="ignore"``)."""
     _check_modes(integrator, limits, engine)
-    if engine == "compiled":
-        if observer is not None:
-            raise InputError("observer", "none with engine='compiled' (use the Pinocchio engine)", "an observer")
-        return _simulate_compiled(
-            robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
-            limits=limits, control_period=control_period,
-        )  # fmt: skip
     steps = _step_count(duration, dt)
+    every = _period_steps(control_period, hold, dt, controller)
     (q, v), _ = robot.validate(q=q0, v=v0)
     if q.ndim != 1:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
-    for item in external:
-        robot.task_frame(item.frame, "an external wrench")
-    if robot.massless_joints or _singular(robot, q):
-        raise SingularMassMatrixError(robot.name, robot.massless_joints)
-    joint_limits = JointLimits(robot)
-    enforce = limits == "enforce"
-    if enforce and controller is not None:
-        commanded = controller
-        controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
-    stepper = _Stepper(robot, external, controller, hold=hold, rk4=integrator == "rk4", observer=observer)
-    qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, joint_limits if enforce else None)
-    trajectory = Trajectory(
-        np.arange(steps + 1) * dt, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques),
-        list(robot.joint_names), robot.name,
-    )  # fmt: skip
-    if limits != "ignore":
-        violations = joint_limits.violations(trajectory)
-        if violations:
-            warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
-    return trajectory
+    if engine == "compiled":
+        _check_compiled_applies(robot, external, limits, observer)
+    chosen, reason = ("pinocchio", "asked for (engine='pinocchio')") if engine == "pinocchio" else ("compiled", "")
+    began = perf_counter()  # choosing and compiling: importing the code generator counts here
+    if engine == "auto":
+        chosen, reason = choose_engine(robot, controller, external=external, limits=limits, observer=observer, every=every)
+    compiled = None
+    if chosen == "compiled":
+        try:
+            compiled = _prepare_compiled(robot, controller, every)
+        except CompileError as error:  # CompilerNotFoundError included
+            if engine == "compiled":
+                raise
+            chosen, reason = "pinocchio", f"the compiled engine does not apply: {error}"
+    compile_time = perf_counter() - began if chosen == "compiled" or engine != "pinocchio" else 0.0
+    if compiled is not None:
+        trajectory, run = _simulate_compiled(robot, q, v, steps, dt, controller, integrator, every, compiled)
+        run = replace(run, reason=reason or "asked for (engine='compiled')", compile_time=compile_time)
+    else:
+        trajectory, run = _simulate_pinocchio(
+            robot, q, v, steps, dt, controller=controller, integrator=integrator, external=external, every=every,
+            limits=limits, observer=observer,
+        )  # fmt: skip
+        run = replace(run, reason=reason, compile_time=compile_time)
+    violations = [] if limits == "ignore" else JointLimits(robot).violations(trajectory)
+    return trajectory, run, violations
+
+
+def choose_engine(
+    robot: Robot,
+    controller: Controller | None,
+    *,
+    external: Sequence[ExternalWrench] = (),
+    limits: str = "warn",
+    observer: MomentumObserver | None = None,
+    every: int | None = None,
+) -> tuple[Literal["pinocchio", "compiled"], str]:
+    """The engine ``engine="auto"`` runs, and why (one sentence).
+
+    The compiled engine when the whole loop runs in C there: a fixed-base robot with
+    moving mass, no external wrenches, no observer, limits not enforced, passive or under
+    a controller with a compiled counterpart (PD + gravity, computed torque along a
+    quintic; evaluated at every stage or once a step), a C compiler on the PATH, and the
+    robot compiled before (its kernels in the cache: loading them takes milliseconds,
+    while a cold compile derives the equations, seconds to minutes, so auto never starts
+    one; ``engine="compiled"`` or :func:`robodyn.compile` does). Otherwise the Pinocchio
+    engine. Both give the same trajectory to ~1e-12.
+
+    Args:
+        robot: The plant.
+        controller: The controller (``None``: passive).
+        external, limits, observer: As for :func:`simulate`.
+        every: Steps between two samples of a held controller (``None``: every stage).
+
+    Returns:
+        ``"compiled"`` or ``"pinocchio"``, and the reason.
+    """
+    if robot.floating_base:
+        return "pinocchio", "a floating base (the compiled engine models fixed-base robots)"
+    refusals = [
+        (bool(external), "external wrenches"),
+        (observer is not None, "a momentum observer"),
+        (limits == "enforce", "limits enforced"),
+        (bool(robot.massless_joints) or robot.nv == 0, "no moving mass to compile"),
+    ]
+    for refused, what in refusals:
+        if refused:
+            return "pinocchio", f"{what} (the compiled engine models none)"
+    if controller is not None and not _runs_in_c(controller, every):
+        return "pinocchio", "a Python controller (called from Python at every stage in either engine)"
+    from robodyn.compiled.build import find_compiler  # the code generator's imports: only when needed
+
+    try:
+        find_compiler()
+    except CompileError as error:
+        return "pinocchio", f"no C compiler ({error})"
+    if not _compiled_before(robot, controller):
+        return "pinocchio", (
+            "not compiled yet (engine='compiled' builds it once, in seconds to minutes; auto uses it from then on)"
+        )
+    what = "passive" if controller is None else f"{type(controller).__name__} in C"
+    return "compiled", f"fixed base, {what}, compiled before (cached)"
+
+
+def _compiled_before(robot: Robot, controller: Controller | None) -> bool:
+    """Whether the plant's kernels, and the controller's model's, are in the cache (a cold
+    compile derives the equations: seconds for 2 joints, minutes for 7 oblique ones)."""
+    from robodyn.compiled.build import cached_kernels
+    from robodyn.compiled.robot import robot_key
+
+    model = getattr(controller, "model", None)
+    models = [robot] if not isinstance(model, Robot) else [robot, model]
+    keys = {robot_key(each) for each in models}
+    return all(cached_kernels(key) is not None for key in keys)
 
 
 def _check_modes(integrator: str, limits: str, engine: str) -> None:
@@ -202,6 +368,20 @@ def _step_count(duration: float, dt: float) -> int:
     return steps
 
 
+def _period_steps(control_period: float | None, hold: bool, dt: float, controller: Controller | None) -> int | None:
+    """Steps between two samples of a held controller (``hold``: 1), ``None`` for a
+    controller evaluated at every stage; a period that is not a whole number of steps, or
+    one without a controller, is refused."""
+    if control_period is None:
+        return 1 if hold and controller is not None else None
+    if controller is None:
+        raise InputError("control_period", "given only with a controller (a passive run samples nothing)", repr(control_period))
+    every = round(control_period / dt) if math.isfinite(control_period) and control_period > 0 else 0
+    if every < 1 or abs(every * dt - control_period) > 1e-9 * control_period:
+        raise InputError("control_period", f"a whole number of steps of dt = {dt:g} s, in [s]", repr(control_period))
+    return every
+
+
 class _Stepper:
     """One integration step of ``(q, v)`` under a controller: RK4 or semi-implicit Euler."""
 
@@ -214,10 +394,13 @@ class _Stepper:
         hold: bool,
         rk4: bool,
         observer: MomentumObserver | None = None,
+        forward: Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
+        every: int = 1,
     ) -> None:
         self.controller = controller
         self.observer = observer
-        self.forward = _accelerator(robot, external)
+        self.forward = _accelerator(robot, external) if forward is None else forward
+        self.every = every  # steps between two samples of the controller at a step's start
         if controller is None or hold:  # the step's torque (zero when passive) holds
             self.accelerate = self.forward
         else:
@@ -267,14 +450,17 @@ def _integrate(
 ) -> tuple[list, list, list, list]:
     """The samples of ``steps`` steps from ``(q, v)``: positions, velocities, accelerations,
     torques (``stops``: joints stopped at their position limits after each step)."""
-    qs, vs, accelerations, torques = [], [], [], []
+    qs: list[np.ndarray] = []
+    vs: list[np.ndarray] = []
+    accelerations: list[np.ndarray] = []
+    torques: list[np.ndarray] = []
     q, v = q.copy(), v.copy()
     for step in range(steps):
         t = step * dt
         try:
             qs.append(q)
             vs.append(v)
-            tau = stepper.torque(t, q, v)
+            tau = stepper.torque(t, q, v) if step % stepper.every == 0 else torques[-1]
             torques.append(tau)
             stepper.observe(t, q, v, tau)
             a = stepper.forward(t, q, v, tau)
@@ -285,7 +471,7 @@ def _integrate(
         except InputError:  # a non-finite state reached a controller's checked call
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
-        except (np.linalg.LinAlgError, FloatingPointError) as error:  # a controller's solve failed
+        except (np.linalg.LinAlgError, FloatingPointError, NonFiniteResultError) as error:  # a controller's numerics failed
             _check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             fastest = int(np.argmax(np.abs(vs[-1])))
             joint = robot.joint_names[max(0, min(fastest - (robot.nv - len(robot.joint_names)), len(robot.joint_names) - 1))]
@@ -300,56 +486,146 @@ def _integrate(
     return qs, vs, accelerations, torques
 
 
-def _simulate_compiled(
+def _simulate_pinocchio(
     robot: Robot,
-    q0: np.ndarray,
-    v0: np.ndarray,
-    duration: float,
+    q: np.ndarray,
+    v: np.ndarray,
+    steps: int,
     dt: float,
     *,
     controller: Controller | None,
     integrator: str,
     external: Sequence[ExternalWrench],
-    hold: bool,
+    every: int | None,
     limits: str,
-    control_period: float | None,
-) -> Trajectory:
-    """:func:`simulate` with ``engine="compiled"``: the same trajectory, integrated in C."""
-    from robodyn.compiled import CompiledComputedTorque, CompiledPDGravity, compile, simulate_compiled
-    from robodyn.sim.control import ComputedTorque, PDGravity, QuinticReference
+    observer: MomentumObserver | None,
+) -> tuple[Trajectory, EngineRun]:
+    """The run in Python over Pinocchio's ABA (checked state ``q``, ``v``)."""
+    for item in external:
+        robot.task_frame(item.frame, "an external wrench")
+    if robot.massless_joints or _singular(robot, q):
+        raise SingularMassMatrixError(robot.name, robot.massless_joints)
+    joint_limits = JointLimits(robot)
+    enforce = limits == "enforce"
+    if enforce and controller is not None:
+        commanded = controller
+        controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
+    stepper = _Stepper(
+        robot, external, controller, hold=every is not None, rk4=integrator == "rk4", observer=observer, every=every or 1
+    )
+    began = perf_counter()
+    qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, joint_limits if enforce else None)
+    loop = perf_counter() - began
+    trajectory = Trajectory(
+        np.arange(steps + 1) * dt, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques),
+        list(robot.joint_names), robot.name,
+    )  # fmt: skip
+    return trajectory, EngineRun("pinocchio", "", loop, control_period=None if every is None else every * dt)
 
+
+def _check_compiled_applies(
+    robot: Robot, external: Sequence[ExternalWrench], limits: str, observer: MomentumObserver | None
+) -> None:
+    """Refuse, in one sentence, what ``engine="compiled"`` does not model."""
     if external:
         raise InputError("external", "no wrenches with engine='compiled' (use the Pinocchio engine)", f"{len(external)} wrenches")
     if limits == "enforce":
         raise InputError(
             "limits", "'warn' or 'ignore' with engine='compiled' (enforce runs on the Pinocchio engine)", "'enforce'"
         )
-    plant = compile(robot)
-    law: CompiledPDGravity | CompiledComputedTorque | Controller | None = controller
-    if isinstance(controller, PDGravity):
-        law = CompiledPDGravity(compile(controller.model), controller.target, controller.kp, controller.kd)
-    elif isinstance(controller, ComputedTorque) and isinstance(controller.reference, QuinticReference):
-        reference = controller.reference
-        law = CompiledComputedTorque(
-            compile(controller.model), reference.q_start, reference.q_end, reference.duration, controller.kp, controller.kd
-        )
-    run = simulate_compiled(
-        plant,
-        q0,
-        v0,
-        duration,
-        dt,
-        integrator=integrator,
-        controller=law,
-        control_period=control_period,
-        hold=hold,
+    if observer is not None:
+        raise InputError("observer", "none with engine='compiled' (use the Pinocchio engine)", "an observer")
+
+
+def _runs_in_c(controller: Controller, every: int | None) -> bool:
+    """Whether a controller has a compiled counterpart the C loop evaluates (at every
+    stage, or once a step)."""
+    from robodyn.sim.control import ComputedTorque, PDGravity, QuinticReference
+
+    if every not in (None, 1):
+        return False
+    return isinstance(controller, PDGravity) or (
+        isinstance(controller, ComputedTorque) and isinstance(controller.reference, QuinticReference)
     )
-    trajectory = Trajectory(run.t, run.q, run.v, run.a, run.tau, list(robot.joint_names), robot.name)
-    if limits != "ignore":
-        violations = JointLimits(robot).violations(trajectory)
-        if violations:
-            warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=3)
-    return trajectory
+
+
+@dataclass(frozen=True)
+class _Compiled:
+    """The compiled plant, the controller's compiled counterpart (``None``: Python or
+    passive) and the time compiling them took in [s]."""
+
+    plant: object
+    law: object | None
+    seconds: float
+
+
+def _prepare_compiled(robot: Robot, controller: Controller | None, every: int | None) -> _Compiled:
+    """Compile (or load from the cache) the plant and the controller's own model."""
+    from robodyn.compiled import CompiledComputedTorque, CompiledPDGravity, compile
+    from robodyn.sim.control import ComputedTorque, PDGravity, QuinticReference
+
+    began = perf_counter()
+    plant = compile(robot)
+    law: CompiledPDGravity | CompiledComputedTorque | None = None
+    if controller is not None and _runs_in_c(controller, every):
+        if isinstance(controller, PDGravity):
+            law = CompiledPDGravity(compile(controller.model), controller.target, controller.kp, controller.kd)
+        elif isinstance(controller, ComputedTorque):
+            reference = controller.reference
+            assert isinstance(reference, QuinticReference)  # _runs_in_c checked it
+            law = CompiledComputedTorque(
+                compile(controller.model), reference.q_start, reference.q_end, reference.duration, controller.kp, controller.kd
+            )
+    return _Compiled(plant, law, perf_counter() - began)
+
+
+def _simulate_compiled(
+    robot: Robot,
+    q: np.ndarray,
+    v: np.ndarray,
+    steps: int,
+    dt: float,
+    controller: Controller | None,
+    integrator: str,
+    every: int | None,
+    compiled: _Compiled,
+) -> tuple[Trajectory, EngineRun]:
+    """The run on compiled kernels: wholly in C when passive or under a compiled law, or a
+    Python controller sampled every ``every`` steps (C between samples); else stage by
+    stage from Python (the controller at every stage, the dynamics in C)."""
+    from robodyn.compiled import CompiledRobot, simulate_compiled
+
+    plant = compiled.plant
+    assert isinstance(plant, CompiledRobot)
+    began = perf_counter()
+    if controller is not None and compiled.law is None and every is None:
+        stepper = _Stepper(robot, (), controller, hold=False, rk4=integrator == "rk4", forward=_compiled_accelerator(plant))
+        qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, None)
+        arrays = (np.array(qs), np.array(vs), np.array(accelerations), np.array(torques))
+    else:
+        law = compiled.law if compiled.law is not None else controller
+        run = simulate_compiled(
+            plant, q, v, steps * dt, dt, integrator=integrator, controller=law,  # type: ignore[arg-type]
+            control_period=None if compiled.law is not None or controller is None else every * dt,  # type: ignore[operator]
+            hold=every is not None,
+        )  # fmt: skip
+        arrays = (run.q, run.v, run.a, run.tau)
+    loop = perf_counter() - began
+    trajectory = Trajectory(np.arange(steps + 1) * dt, *arrays, list(robot.joint_names), robot.name)
+    period = None if every is None else every * dt
+    return trajectory, EngineRun("compiled", "", loop, compiled.seconds, period, compiled.law is not None)
+
+
+def _compiled_accelerator(plant: object) -> Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+    """``a(t, q, v, tau)`` by the compiled forward dynamics: straight to C on float64
+    contiguous finite arrays, else the checked call (its errors)."""
+    fd, checked = plant.module.fd, plant.forward_dynamics  # type: ignore[attr-defined]
+
+    def forward(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        a = fd(q, v, tau, 1)
+        return a if a.__class__ is np.ndarray else checked(q, v, tau)
+
+    return forward
 
 
 def _check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: np.ndarray, v: np.ndarray, dt: float) -> None:

@@ -50,7 +50,7 @@ def run_experiment(
         png: With ``record``: a still of the first frame (needs Chromium).
         **settings: ``controller``, ``target``, ``frame``, ``q0``, ``duration``, ``dt``,
             ``integrator``, ``limits``, ``engine``, ``posture``, ``stiffness``,
-            ``damping``, ``force_at``, ``observer_gain``, ``actuated``.
+            ``damping``, ``force_at``, ``observer_gain``, ``actuated``, ``control_period``.
 
     Returns:
         The run's summary; its ``files`` name what was written (``trajectory``: with an

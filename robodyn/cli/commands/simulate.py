@@ -6,6 +6,7 @@ import argparse
 
 from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector, warn
 from robodyn.common.text import json_text, printable
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -58,8 +59,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--compiled",
         action="store_true",
-        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too",
+        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too"
+        " (the same as --engine compiled)",
     )
+    _add_engine_arguments(parser)
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
     parser.add_argument(
         "--reference",
@@ -82,10 +85,13 @@ def _reference(arguments: argparse.Namespace) -> dict:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    from robodyn.sim.report import seconds_since_process_start
     from robodyn.viz.experiment import run_experiment
 
+    robot = load_robot(arguments)
+    startup = seconds_since_process_start()  # interpreter, imports, loading the robot
     summary = run_experiment(
-        load_robot(arguments),
+        robot,
         controller=arguments.controller,
         target=arguments.target,
         frame=arguments.frame,
@@ -94,7 +100,8 @@ def run(arguments: argparse.Namespace) -> int:
         dt=arguments.dt,
         integrator=arguments.integrator,
         limits=arguments.limits,
-        engine="compiled" if arguments.compiled else "pinocchio",
+        engine=_engine(arguments),
+        control_period=arguments.control_period,
         posture=arguments.posture,
         stiffness=arguments.stiffness,
         damping=arguments.damping,
@@ -107,6 +114,7 @@ def run(arguments: argparse.Namespace) -> int:
         png=arguments.png,
         **_reference(arguments),
     )
+    summary = summary.with_startup(startup)
     warn(summary.warnings())
     if summary.task is not None and not summary.task.reached and summary.task.deflection is None:
         warn([
@@ -115,3 +123,29 @@ def run(arguments: argparse.Namespace) -> int:
         ])  # fmt: skip
     print(json_text(summary.to_dict()) if arguments.json else summary.text())
     return 0
+
+
+def _engine(arguments: argparse.Namespace) -> str:
+    """``--engine`` (``--compiled`` is ``--engine compiled``; both at odds: one stderr line)."""
+    if arguments.compiled and arguments.engine not in (None, "compiled"):
+        raise InputError("--compiled", "not combined with another --engine", f"--engine {arguments.engine}")
+    return "compiled" if arguments.compiled else (arguments.engine or "auto")
+
+
+def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--engine`` and ``--control-period``."""
+    parser.add_argument(
+        "--engine",
+        choices=["auto", "pinocchio", "compiled"],
+        default=None,
+        help="where the loop runs: auto (default: compiled when the whole loop runs in C, a C compiler exists and the "
+        "robot was compiled before (--engine compiled compiles it), "
+        "else pinocchio; the summary says which and why), pinocchio (Python over Pinocchio), compiled (C)",
+    )
+    parser.add_argument(
+        "--control-period",
+        dest="control_period",
+        type=float,
+        help="sample the controller every this many seconds (a whole number of --dt) and hold its torque "
+        "(zero-order hold); default: evaluated at every integrator stage",
+    )

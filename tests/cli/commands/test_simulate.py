@@ -7,6 +7,7 @@ import shutil
 
 import pytest
 
+import robodyn
 from robodyn.cli.app import main
 
 
@@ -30,13 +31,16 @@ def test_outputs_are_written_together_when_all_succeed(tmp_path, capsys):
     assert status == 0
     summary = json.loads(capsys.readouterr().out)
     assert (tmp_path / "m.npz").is_file() and (tmp_path / "m.png").is_file()
-    assert summary["engine"] == "pinocchio"
+    # --engine auto (default): the engine choose_engine names (compiled once rp_arm is in the cache)
+    from robodyn.sim.simulation import choose_engine
+
+    assert (summary["engine"], summary["engine_reason"]) == choose_engine(robodyn.load("rp_arm"), None)
 
 
 @pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
 def test_compiled_flag_gives_the_same_summary(capsys):
     arguments = ["simulate", "ur5", "--controller", "pd", "--target", "0.3,-1.2,1.0,-0.5,0.4,0.2", "--duration", "0.5", "--json"]
-    assert main(arguments) == 0
+    assert main([*arguments, "--engine", "pinocchio"]) == 0
     python = json.loads(capsys.readouterr().out)
     assert main([*arguments, "--compiled"]) == 0
     compiled = json.loads(capsys.readouterr().out)

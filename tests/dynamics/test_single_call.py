@@ -1,0 +1,103 @@
+"""The thin single calls (ModelHandle.single_call): Pinocchio's numbers, every bad entry refused, thread-safe.
+
+The fast path checks only the result (and, for M, the world-attached joints' q): a NaN or
+inf anywhere in q, v, a or tau must still come back as an InputError naming it.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robodyn
+from robodyn.exceptions import InputError
+from tests.conftest import FAST_ZOO, NONDEGENERATE_CASES
+
+FIXED = [*FAST_ZOO, "panda_mimic", "gripper", "rp_arm", "oblique", "oblique_locked"]
+
+
+def _load(name):
+    if name in NONDEGENERATE_CASES:
+        path, options = NONDEGENERATE_CASES[name]
+        return robodyn.load(str(path), **options)
+    if name == "panda_mimic":  # as loaded: a mimic finger
+        return robodyn.load("panda")
+    return robodyn.load(name, **({"lock": {"panda_finger_joint1": 0.0}} if name == "panda" else {}))
+
+
+def _calls(robot, q, v, a):
+    return {
+        "inverse_dynamics": lambda q=q, v=v, a=a: robot.inverse_dynamics(q, v, a),
+        "forward_dynamics": lambda q=q, v=v, a=a: robot.forward_dynamics(q, v, a),
+        "mass_matrix": lambda q=q, v=v, a=a: robot.mass_matrix(q),
+        "gravity": lambda q=q, v=v, a=a: robot.gravity(q),
+        "nonlinear_effects": lambda q=q, v=v, a=a: robot.nonlinear_effects(q, v),
+    }
+
+
+@pytest.mark.parametrize("name", FIXED)
+def test_a_nan_or_inf_in_any_entry_is_refused_by_every_single_call(name, rng):
+    robot = _load(name)
+    q, v, a = robot.random_configuration(rng), rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    for method, call in _calls(robot, q, v, a).items():
+        assert np.isfinite(call()).all(), method
+    for argument, size in (("q", robot.nq), ("v", robot.nv), ("a", robot.nv)):
+        for index in range(size):
+            for bad in (np.nan, np.inf):
+                values = {"q": q.copy(), "v": v.copy(), "a": a.copy()}
+                values[argument][index] = bad
+                for method, call in _calls(robot, values["q"], values["v"], values["a"]).items():
+                    uses = {"mass_matrix": "q", "gravity": "q", "nonlinear_effects": "qv"}.get(method, "qva")
+                    if argument in uses:
+                        with pytest.raises(InputError):
+                            call()
+
+
+def test_crba_ignores_the_root_joints_q_so_the_mass_matrix_checks_it():
+    """Negative control: raw CRBA returns a finite M for a NaN root q (what checking the
+    result alone would let through); the single call refuses it."""
+    robot = robodyn.load("ur5")
+    q = robot.neutral_configuration()
+    q[0] = np.nan
+    assert np.isfinite(pin.crba(robot.model, robot.model.createData(), q)).all()
+    with pytest.raises(InputError, match="q"):
+        robot.mass_matrix(q)
+
+
+@pytest.mark.parametrize("name", ["ur5", "oblique"])
+def test_single_calls_are_pinocchios_numbers(name, rng):
+    robot = _load(name)
+    model, data = robot.model, robot.model.createData()
+    q, v, a = robot.random_configuration(rng), rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    mass = pin.crba(model, data, q)
+    mass = np.triu(mass) + np.triu(mass, 1).T
+    assert np.array_equal(robot.inverse_dynamics(q, v, a), pin.rnea(model, data, q, v, a))
+    assert np.array_equal(robot.forward_dynamics(q, v, a), pin.aba(model, data, q, v, a))
+    assert np.array_equal(robot.mass_matrix(q), mass)
+    assert np.array_equal(robot.gravity(q), pin.computeGeneralizedGravity(model, data, q))
+    assert np.array_equal(robot.nonlinear_effects(q, v), pin.nonLinearEffects(model, data, q, v))
+
+
+def test_one_robot_used_from_several_threads_gives_each_its_own_results(rng):
+    robot = robodyn.load("ur5")
+    states = [(robot.random_configuration(rng), rng.normal(size=6), rng.normal(size=6)) for _ in range(7)]
+    expected = [(robot.inverse_dynamics(*s), robot.mass_matrix(s[0]), robot.forward_dynamics(*s)) for s in states]
+    failures = []
+
+    def work(index: int) -> None:
+        q, v, a = states[index]
+        for _ in range(300):
+            got = (robot.inverse_dynamics(q, v, a), robot.mass_matrix(q), robot.forward_dynamics(q, v, a))
+            if not all(np.array_equal(x, y) for x, y in zip(got, expected[index], strict=True)):
+                failures.append(index)
+                return
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(len(states))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert failures == []
