@@ -538,15 +538,12 @@ def _check_compiled_applies(
 
 
 def _runs_in_c(controller: Controller, every: int | None) -> bool:
-    """Whether a controller has a compiled counterpart the C loop evaluates (at every
-    stage, or once a step)."""
-    from robodyn.sim.control import ComputedTorque, PDGravity, QuinticReference
+    """Whether a controller has a compiled twin the C loop evaluates at every stage
+    (:func:`robodyn.compiled.has_twin`: PD, computed torque along a quintic, task space,
+    operational space with a fixed target, impedance)."""
+    from robodyn.compiled import has_twin
 
-    if every not in (None, 1):
-        return False
-    return isinstance(controller, PDGravity) or (
-        isinstance(controller, ComputedTorque) and isinstance(controller.reference, QuinticReference)
-    )
+    return every in (None, 1) and has_twin(controller)
 
 
 @dataclass(frozen=True)
@@ -560,22 +557,12 @@ class _Compiled:
 
 
 def _prepare_compiled(robot: Robot, controller: Controller | None, every: int | None) -> _Compiled:
-    """Compile (or load from the cache) the plant and the controller's own model."""
-    from robodyn.compiled import CompiledComputedTorque, CompiledPDGravity, compile
-    from robodyn.sim.control import ComputedTorque, PDGravity, QuinticReference
+    """Compile (or load from the cache) the plant and the controller's compiled twin."""
+    from robodyn.compiled import compile, compiled_controller
 
     began = perf_counter()
     plant = compile(robot)
-    law: CompiledPDGravity | CompiledComputedTorque | None = None
-    if controller is not None and _runs_in_c(controller, every):
-        if isinstance(controller, PDGravity):
-            law = CompiledPDGravity(compile(controller.model), controller.target, controller.kp, controller.kd)
-        elif isinstance(controller, ComputedTorque):
-            reference = controller.reference
-            assert isinstance(reference, QuinticReference)  # _runs_in_c checked it
-            law = CompiledComputedTorque(
-                compile(controller.model), reference.q_start, reference.q_end, reference.duration, controller.kp, controller.kd
-            )
+    law = compiled_controller(controller) if controller is not None and _runs_in_c(controller, every) else None
     return _Compiled(plant, law, perf_counter() - began)
 
 

@@ -28,6 +28,8 @@ def _target(robot, controller: str) -> list[float]:
     q0 = robot.default_configuration()
     if controller in ("pd", "computed-torque"):
         return (q0 + 0.3).tolist()
+    if controller == "lqr":
+        return (q0 + 0.05).tolist()
     return (robot.frame_position(q0, robot.end_effector) + np.array([0.05, -0.04, -0.06])).tolist()
 
 
@@ -97,7 +99,15 @@ def test_auto_runs_the_compiled_engine_only_where_the_whole_loop_runs_in_c(monke
     assert choose_engine(robot, None)[0] == "compiled"
     assert choose_engine(robot, pd)[0] == "compiled"
     assert choose_engine(robot, pd, every=5)[0] == "pinocchio"  # sampled every 5 steps: Python
-    assert choose_engine(robot, task) == ("pinocchio", "a Python controller (called from Python at every stage in either engine)")
+    assert choose_engine(robot, task)[0] == "compiled"  # task space has a compiled twin
+
+    def custom(t, q, v):
+        return -v
+
+    assert choose_engine(robot, custom) == (
+        "pinocchio",
+        "a Python controller (called from Python at every stage in either engine)",
+    )
     assert "external" in choose_engine(robot, None, external=[ExternalWrench(robot.end_effector, [1.0, 0, 0])])[1]
     assert "enforced" in choose_engine(robot, None, limits="enforce")[1]
     assert "floating" in choose_engine(robodyn.load("solo12"), None)[1]
@@ -125,12 +135,19 @@ def test_the_real_time_factor_is_the_loops_and_start_up_is_reported_apart():
     assert "start-up 1.25 s" in summary.with_startup(1.25).text()
 
 
-@pytest.mark.parametrize("engine", ["pinocchio", "compiled"])
-def test_a_controller_overflowing_on_a_blown_up_state_stops_the_run_in_one_sentence(engine):
-    """ur5 driven past a singular posture at dt = 1 ms: the task-space law's J̇ q̇ overflows
-    (a NonFiniteResultError inside the controller) and the run stops with ControllerFailedError."""
+@pytest.mark.parametrize(
+    ("engine", "error", "sentence"),
+    [
+        ("pinocchio", robodyn.exceptions.ControllerFailedError, "the controller failed"),
+        ("compiled", robodyn.exceptions.SimulationError, "diverged at t = .* is no longer finite"),
+    ],
+)
+def test_a_controller_overflowing_on_a_blown_up_state_stops_the_run_in_one_sentence(engine, error, sentence):
+    """ur5 driven past a singular posture at dt = 1 ms: the task-space law's J̇ q̇ overflows.
+    In Python that is a NonFiniteResultError inside the controller (ControllerFailedError);
+    its compiled twin runs in C, where the loop stops at the first non-finite state."""
     robot = robodyn.load("ur5")
     q0 = robot.default_configuration()
     target = (robot.frame_position(q0, robot.end_effector) + np.array([0.1, -0.1, -0.1])).tolist()
-    with pytest.raises(robodyn.exceptions.ControllerFailedError, match="the controller failed"):
+    with pytest.raises(error, match=sentence):
         run_simulation(robot, controller="task-space", target=target, duration=0.4, limits="ignore", engine=engine)
