@@ -14,14 +14,14 @@ package imports it, and a test runs it in a process where Pinocchio cannot be im
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.tree import KinematicTree, build_tree
+from robodyn.reference.tree import KinematicTree, build_tree, spec_with_armature
 from robodyn.urdf.sources import locked_source, resolve_source
 from robodyn.urdf.validation import parse_urdf
 
@@ -33,6 +33,7 @@ def load(
     check_inertia: bool = True,
     lock: dict[str, float] | None = None,
     floating_base: bool = False,
+    armature: Mapping[str, float] | None = None,
 ) -> ReferenceRobot:
     """Load the reference model of a robot.
 
@@ -44,6 +45,8 @@ def load(
         floating_base: Give the root six degrees of freedom (Pinocchio's free-flyer
             convention for ``q`` and ``v``); unlike :func:`robodyn.load` the default is
             a fixed base whatever the source.
+        armature: Rotor inertia added at joints, ``{joint name: value in [kg m²] or
+            [kg]}``, on top of the description's (as for :func:`robodyn.load`).
 
     Raises:
         UnknownRobotError, URDFError: As :func:`robodyn.load`.
@@ -54,6 +57,7 @@ def load(
     spec = parse_urdf(
         resolved.text, resolved.label, floating_base=floating_base, check_inertia=check_inertia, **resolved.mesh_context
     )
+    spec = spec_with_armature(spec, armature or {}, locked=lock or {})
     tree = build_tree(spec, resolved.text, floating_base=floating_base)
     name = spec.name if resolved.name == "robot" else resolved.name
     gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)
