@@ -23,6 +23,12 @@ every position, velocity and effort limit the run broke in one
 :class:`~robodyn.exceptions.JointLimitWarning`; ``"enforce"`` saturates the torques at
 the effort limits and stops joints at their position limits; ``"ignore"`` does neither.
 
+Joint damping and Coulomb friction (``<dynamics>``, :attr:`Robot.joint_damping`,
+:attr:`Robot.joint_friction`) act by default (``joint_friction=False``: the rigid-body
+motion): ``−b v``, and stick–slip friction with its events located inside the step
+(:mod:`robodyn.sim.joint_friction`, docs/joint-friction.md). The compiled engine has
+neither: it refuses a robot with either unless ``joint_friction=False``.
+
 A state that stops being finite ends the run with a :class:`SimulationError` saying when
 and which joint, or a :class:`SingularMassMatrixError` when the mass matrix is singular
 there (massless moving bodies: no step size helps).
@@ -38,6 +44,7 @@ from typing import Literal
 
 import numpy as np
 
+from robodyn.common.text import quoted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import (
     ControllerFailedError,
@@ -46,6 +53,7 @@ from robodyn.exceptions import (
     SimulationError,
     SingularMassMatrixError,
 )
+from robodyn.sim.joint_friction import JointFriction, has_joint_friction
 from robodyn.sim.limits import JointLimits, LimitMode, check_mode, warning_text
 from robodyn.sim.observer import MomentumObserver
 from robodyn.trajectory import Trajectory
@@ -105,6 +113,7 @@ def simulate(
     engine: Engine = "pinocchio",
     control_period: float | None = None,
     observer: MomentumObserver | None = None,
+    joint_friction: bool = True,
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
 
@@ -131,6 +140,10 @@ def simulate(
             the run goes (Pinocchio engine); afterwards ``observer.residuals`` holds its
             estimate of the external torques at each sample. Give it ``torque="held"``
             with ``hold=True``, ``"sampled"`` otherwise.
+        joint_friction: Honour the joints' damping and Coulomb friction
+            (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`: ``−b v``, and
+            stick–slip friction up to ``±f``, :mod:`robodyn.sim.joint_friction`); ``False``
+            gives the rigid-body motion. The ``tau`` column stays the applied torque.
 
     Returns:
         The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0`` (``tau`` is
@@ -148,6 +161,8 @@ def simulate(
         JointLimitWarning: With ``limits="warn"``, when a limit was broken.
     """
     _check_modes(integrator, limits, engine)
+    if engine == "compiled" and joint_friction:
+        _refuse_compiled_friction(robot)
     if engine == "compiled":
         if observer is not None:
             raise InputError("observer", "none with engine='compiled' (use the Pinocchio engine)", "an observer")
@@ -168,7 +183,10 @@ def simulate(
     if enforce and controller is not None:
         commanded = controller
         controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
-    stepper = _Stepper(robot, external, controller, hold=hold, rk4=integrator == "rk4", observer=observer)
+    friction = JointFriction(robot) if joint_friction and has_joint_friction(robot) else None
+    stepper = _Stepper(robot, external, controller, hold=hold, rk4=integrator == "rk4", observer=observer, friction=friction)
+    if friction is not None:
+        friction.start(stepper.accelerate, 0.0, q, v, stepper.torque(0.0, q, v))
     qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, joint_limits if enforce else None)
     trajectory = Trajectory(
         np.arange(steps + 1) * dt, np.array(qs), np.array(vs), np.array(accelerations), np.array(torques),
@@ -214,10 +232,14 @@ class _Stepper:
         hold: bool,
         rk4: bool,
         observer: MomentumObserver | None = None,
+        friction: JointFriction | None = None,
     ) -> None:
         self.controller = controller
         self.observer = observer
         self.forward = _accelerator(robot, external)
+        self.friction = friction
+        if friction is not None:  # the joints' damping and stick-slip friction
+            self.forward = friction.wrap(self.forward)
         if controller is None or hold:  # the step's torque (zero when passive) holds
             self.accelerate = self.forward
         else:
@@ -236,6 +258,12 @@ class _Stepper:
         """Feed the observer (if any) a sample and the torque applied there."""
         if self.observer is not None:
             self.observer.update(t, q, v, tau)
+
+    def advance(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
+        """:meth:`step`, cut at the joints' stick-slip events when there is joint friction."""
+        if self.friction is None:
+            return self.step(t, dt, q, v, tau, a)
+        return self.friction.step(self.step, self.accelerate, t, dt, q, v, tau, a)
 
     def step(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
         """``(q, v)`` after one step of ``dt`` from time ``t`` with acceleration ``a`` there."""
@@ -279,7 +307,7 @@ def _integrate(
             stepper.observe(t, q, v, tau)
             a = stepper.forward(t, q, v, tau)
             accelerations.append(a)
-            q, v = stepper.step(t, dt, q, v, tau, a)
+            q, v = stepper.advance(t, dt, q, v, tau, a)
             if stops is not None:
                 q, v = stops.stop(q, v)
         except InputError:  # a non-finite state reached a controller's checked call
@@ -400,3 +428,17 @@ def _accelerator(
             return lambda t, q, v, tau: aba(model, data, q, v, tau)
         return lambda t, q, v, tau: forward(q, v, tau)
     return lambda t, q, v, tau: forward(q, v, tau + external_torques(robot, q, t, external))
+
+
+def _refuse_compiled_friction(robot: Robot) -> None:
+    """Refuse the compiled engine for a robot whose joints have damping or friction (its
+    loop in C has neither; ``joint_friction=False`` asks for the rigid-body motion)."""
+    if has_joint_friction(robot):
+        joints = [dof.name for dof in robot.dofs if dof.damping or dof.friction]
+        listed = ", ".join(quoted(name) for name in joints[:8]) + (", …" if len(joints) > 8 else "")
+        raise InputError(
+            "engine",
+            "'pinocchio' for joint damping and friction (the compiled loop has neither; joint_friction=False "
+            "simulates the rigid-body motion compiled)",
+            f"'compiled' for {quoted(robot.name)}, whose joints {listed} have some",
+        )
