@@ -59,12 +59,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         action="store_true",
         help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too",
     )
-    parser.add_argument(
-        "--no-joint-friction",
-        dest="joint_friction",
-        action="store_false",
-        help="leave out the joints' damping and friction (<dynamics>): the rigid-body motion",
-    )
+    no_friction = "leave out the joints' damping and friction (<dynamics>): the rigid-body motion"
+    parser.add_argument("--no-joint-friction", dest="joint_friction", action="store_false", help=no_friction)
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
     parser.add_argument("--record", help="HTML animation (meshcat, self-contained, plays on open)")
