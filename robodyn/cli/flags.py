@@ -58,6 +58,7 @@ SWITCHES: dict[str, str] = {
     "floating_base=True": "--floating-base",
     "check_inertia=False": "--no-check-inertia",
     "strict=True": "--strict",
+    "joint_friction=False": "--no-joint-friction",
 }
 
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.

@@ -14,7 +14,7 @@ only) and ``base.rx, base.ry, base.rz`` (angular velocity in [rad/s], base frame
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 from robodyn.dynamics.joints import JointInfo
@@ -106,11 +106,23 @@ class Dof:
         return _UNITS[self.kind][aliases.get(quantity, quantity)]
 
 
-def robot_dofs(joints: Sequence[JointInfo]) -> tuple[Dof, ...]:
+def robot_dofs(
+    joints: Sequence[JointInfo],
+    *,
+    damping: Sequence[float] | None = None,
+    friction: Sequence[float] | None = None,
+    armature: Sequence[float] | None = None,
+) -> tuple[Dof, ...]:
     """The degrees of freedom of a robot's joints (``Robot.joints``, root joint first).
 
     A floating root joint gives six: three linear (``base.x``, ``base.y``, ``base.z``) and
     three angular (``base.rx``, ``base.ry``, ``base.rz``), unlimited.
+
+    Args:
+        joints: The joints with coordinates, root joint first.
+        damping, friction, armature: Per degree of freedom (length nv; default zeros): the
+            model's ``model.damping``, ``model.friction``, ``model.armature``
+            (:mod:`robodyn.dynamics.joint_dynamics`).
     """
     inf = float("inf")
     dofs: list[Dof] = []
@@ -124,7 +136,18 @@ def robot_dofs(joints: Sequence[JointInfo]) -> tuple[Dof, ...]:
         dofs.append(
             Dof(joint.name, joint.name, joint.type, kind, len(dofs), joint.lower, joint.upper, joint.velocity, joint.effort)
         )
-    return tuple(dofs)
+    return tuple(_with_dynamics(dof, damping, friction, armature) for dof in dofs)
+
+
+def _with_dynamics(
+    dof: Dof, damping: Sequence[float] | None, friction: Sequence[float] | None, armature: Sequence[float] | None
+) -> Dof:
+    """``dof`` with its entries of the per-degree-of-freedom arrays given (0 where none is)."""
+
+    def entry(array: Sequence[float] | None) -> float:
+        return 0.0 if array is None else float(array[dof.index])
+
+    return replace(dof, damping=entry(damping), friction=entry(friction), armature=entry(armature))
 
 
 def configuration_names(joints: Sequence[JointInfo]) -> list[str]:

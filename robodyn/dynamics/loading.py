@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.dynamics import pickling
+from robodyn.dynamics.joint_dynamics import apply_joint_dynamics
 from robodyn.dynamics.mimic import has_mimic, mimic_expansion
 from robodyn.dynamics.options import MAX_DOF, LoadOptions, load_options
 from robodyn.dynamics.robot import Robot
@@ -229,6 +230,7 @@ def build_robot(resolved: URDFSource, options: LoadOptions) -> Robot:
         raise URDFError(
             resolved.label, "the robot has no moving joint (floating_base=True gives its root six degrees of freedom)"
         )
+    spec = apply_joint_dynamics(spec, model, mimic, options, resolved.label)
     name = spec.name if resolved.name == "robot" else resolved.name
     return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
 

@@ -16,12 +16,19 @@ Conventions, stated once (they are Pinocchio's, ``pin.Inertia.toDynamicParameter
   of freedom (``fv``, torque ``fv·v`` in [N m s/rad] or [N s/m]), then one Coulomb
   coefficient a degree of freedom (``fc``, torque ``fc·sign(v)`` in [N m] or [N]), in the
   order of ``robot.dofs`` (named by them: ``fv[joint1]``, a floating base's ``fv[base.x]``).
-  The robot's own dynamics have no friction, so its friction parameters are zero.
+  They are the joints' damping ``b`` and Coulomb friction ``f`` of
+  :mod:`robodyn.dynamics.joint_dynamics` (``<dynamics damping friction>``): the robot's own
+  friction parameters are its :attr:`~robodyn.Robot.joint_damping` and
+  :attr:`~robodyn.Robot.joint_friction` (zero where the file gives none).
+- The joints' **armature** is no parameter of the regressor: it is a known torque
+  ``a ⊙ q̈`` (:attr:`~robodyn.Robot.joint_armature`), so that
+  ``Y π + armature ⊙ q̈ = robot.inverse_dynamics`` (``joint_friction=True`` with the
+  friction columns; ``sign(0) = 0`` in both).
 
 The columns for a body are exactly those of Pinocchio's ``computeJointTorqueRegressor``
 (``Y = Sᵀ Y_full`` through the mimic map for robots with mimic joints, where Pinocchio's
 regressor is evaluated on the expanded model; locked joints are fixed joints, so their
-links are welded). ``Y π = robot.inverse_dynamics`` to rounding.
+links are welded). ``Y π = robot.inverse_dynamics`` to rounding for a robot without armature.
 
 :func:`regressor` and :func:`inertial_parameters` are functions of the robot's
 :class:`~robodyn.dynamics.handle.ModelHandle` (a :class:`robodyn.Robot` is taken too, for
@@ -94,7 +101,8 @@ def inertial_parameters(model: ModelHandle | DescribedModel, *, friction: bool =
 
     Args:
         model: The robot's model handle (or the robot).
-        friction: Append the friction parameters (zeros: the model has no friction).
+        friction: Append the friction parameters: the joints' damping ``b`` then Coulomb
+            friction ``f`` (the model's ``model.damping``, ``model.friction``).
 
     Returns:
         Shape (10·n_bodies,) (``+ 2·nv`` with friction), units as in the module docstring.
@@ -102,7 +110,9 @@ def inertial_parameters(model: ModelHandle | DescribedModel, *, friction: bool =
     handle = _handle(model)
     bodies = _bodies(handle)
     values = np.concatenate([bodies.inertias[i].toDynamicParameters() for i in range(1, bodies.njoints)])
-    return np.concatenate([values, np.zeros(2 * handle.nv)]) if friction else values
+    if not friction:
+        return values
+    return np.concatenate([values, np.asarray(handle.model.damping, float), np.asarray(handle.model.friction, float)])
 
 
 def regressor(

@@ -35,6 +35,7 @@ from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
 from robodyn.dynamics.dofs import Dof, configuration_names, robot_dofs
 from robodyn.dynamics.handle import ModelHandle
+from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.joints import JointInfo
 from robodyn.dynamics.kernels import massless_joints
 from robodyn.dynamics.mimic import MimicExpansion
@@ -106,7 +107,9 @@ class Robot:
         self.nv: int = model.nv
         self.joints: list[JointInfo] = joint_infos(model, spec)
         self.joint_names: list[str] = [joint.name for joint in self.joints]
-        self.dofs: tuple[Dof, ...] = robot_dofs(self.joints)
+        self.dofs: tuple[Dof, ...] = robot_dofs(
+            self.joints, damping=model.damping, friction=model.friction, armature=model.armature
+        )
         self.configuration_names: list[str] = configuration_names(self.joints)
 
     @property
@@ -197,6 +200,26 @@ class Robot:
         frames.require_moving(self.model, self.name, name, self.frame_id(name), purpose)
         return name
 
+    @property
+    def joint_damping(self) -> np.ndarray:
+        """Viscous damping b per degree of freedom, shape (nv,), in [N m s/rad] or [N s/m]
+        (joint torque ``−b v``; 0 for a floating base's six; see
+        :mod:`robodyn.dynamics.joint_dynamics`)."""
+        return np.array([dof.damping for dof in self.dofs])
+
+    @property
+    def joint_friction(self) -> np.ndarray:
+        """Coulomb friction f per degree of freedom, shape (nv,), in [N m] or [N] (the
+        torque ``−f sign(v)`` while sliding, up to ``±f`` at rest; 0 for a floating base's six)."""
+        return np.array([dof.friction for dof in self.dofs])
+
+    @property
+    def joint_armature(self) -> np.ndarray:
+        """Armature (rotor inertia reflected to the joint) per degree of freedom, shape
+        (nv,), in [kg m²] or [kg]: on the diagonal of :meth:`mass_matrix` (0 for a
+        floating base's six)."""
+        return np.array([dof.armature for dof in self.dofs])
+
     @cached_property
     def link_masses(self) -> dict[str, float]:
         """Mass of every URDF link that has one, in [kg]."""
@@ -218,18 +241,26 @@ class Robot:
     # ModelHandle.evaluate runs on the raw arguments first; anything doubtful goes through
     # the full boundary check.
     # ----------------------------------------------------------------------------------
-    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA).
+    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, joint_friction: bool = False) -> np.ndarray:
+        """Joint torques ``tau = M(q) a + C(q, v) v + G(q)`` (RNEA; ``M`` includes the
+        joints' armature, :attr:`joint_armature`).
 
         Args:
             q: Configuration, shape (nq,) or (N, nq).
             v: Velocity, shape (nv,) or (N, nv).
             a: Acceleration, shape (nv,) or (N, nv).
+            joint_friction: Add the torques the joints' friction takes,
+                ``b v + f sign(v)`` (:attr:`joint_damping`, :attr:`joint_friction`), with
+                ``sign(0) = 0``: at rest the Coulomb part is left out, since what a joint at
+                rest needs is anything within ``±f``. Default: the rigid-body torques.
 
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
-        return self.handle.calls.tau(q, v, a)
+        tau = self.handle.calls.tau(q, v, a)
+        if joint_friction:
+            tau = tau - friction_torque(self.joint_damping, self.joint_friction, np.asarray(v, dtype=float))
+        return tau
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Joint accelerations ``a = M(q)⁻¹ (tau − C(q, v) v − G(q))`` (ABA).

@@ -114,11 +114,12 @@ class BaseParameters:
         return self.standard_regressor(q, v, a)[..., self.columns[self.independent]]
 
     def known_torque(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        """Torque of the parameters outside :attr:`columns` (held at the URDF's values),
-        shape (nv,) or (N, nv); zero when every parameter is included."""
+        """Torque of the parameters outside :attr:`columns` (held at the URDF's values) and
+        of the joints' armature (``armature ⊙ a``, no parameter of the regressor), shape
+        (nv,) or (N, nv); zero when every parameter is included and there is no armature."""
         full = self.standard_regressor(q, v, a)
         rest = np.setdiff1d(np.arange(full.shape[-1]), self.columns)
-        return full[..., rest] @ self._standard[rest]
+        return full[..., rest] @ self._standard[rest] + self.robot.joint_armature * np.asarray(a, dtype=float)
 
     def to_base(self, standard: np.ndarray) -> np.ndarray:
         """Base values of a standard parameter vector over :attr:`columns`, (p,) -> (r,)."""

@@ -88,13 +88,14 @@ class Excitation:
 
     def sample(self, robot: Robot, *, rate: float = 100.0, periods: int = 1) -> tuple[np.ndarray, ...]:
         """``t, q, v, a, tau`` sampled at ``rate`` [Hz] over ``periods`` periods, with
-        ``tau`` the robot's inverse dynamics along it (shapes (M,) and (M, nv)); the
-        columns of :class:`robodyn.trajectory.Trajectory`."""
+        ``tau`` the robot's inverse dynamics along it, its joints' damping and friction
+        included (``joint_friction=True``: what the robot needs to follow it), shapes (M,)
+        and (M, nv); the columns of :class:`robodyn.trajectory.Trajectory`."""
         if not (np.isfinite(rate) and rate > 0) or periods < 1:
             raise InputError("rate and periods", "a positive rate in [Hz] and at least one period", f"{rate!r}, {periods!r}")
         t = np.arange(0.0, periods * self.period, 1.0 / rate)
         q, v, a = self.evaluate(t)
-        return t, q, v, a, robot.inverse_dynamics(q, v, a)
+        return t, q, v, a, robot.inverse_dynamics(q, v, a, joint_friction=True)
 
 
 def _series(

@@ -163,7 +163,7 @@ def identify(
         raise InputError("base", f"base parameters of robot {robot.name!r}", f"those of {base.robot.name!r}")
     full = base.standard_regressor(q, v, a)
     rest = np.setdiff1d(np.arange(full.shape[-1]), base.columns)
-    target = measured - full[..., rest] @ base._standard[rest]
+    target = measured - full[..., rest] @ base._standard[rest] - robot.joint_armature * a  # known: held parameters, armature
     w = full[..., base.columns[base.independent]]  # (N, nv, r)
     n, nv, r = w.shape
     if n * nv <= r:

@@ -51,8 +51,9 @@ def identified_urdf(robot: Robot, standard: np.ndarray, columns: np.ndarray) -> 
 
     Args:
         robot: The nominal robot.
-        standard: Standard parameters over ``columns`` (friction entries are ignored: URDF
-            has no place the dynamics read them from).
+        standard: Standard parameters over ``columns``; identified friction entries are
+            written as the joints' ``<dynamics damping friction>`` (a mimic joint keeps
+            its own, the source gets the rest: :func:`_write_friction`).
         columns: Their indices in the full standard vector (10 a body).
 
     Returns:
@@ -72,14 +73,54 @@ def identified_urdf(robot: Robot, standard: np.ndarray, columns: np.ndarray) -> 
             for old in nodes[name].findall("inertial"):
                 nodes[name].remove(old)
         nodes[links[body]].insert(0, _inertial(full[10 * body : 10 * body + 10]))
+    friction = np.asarray(standard)[columns >= full.size]
+    if friction.size:
+        _write_friction(robot, root, friction)
     text = ET.tostring(root, encoding="unicode")
-    written = inertial_parameters(rebuild(robot, urdf=text, label=f"{robot.name} (identified)"))
+    rebuilt = rebuild(robot, urdf=text, label=f"{robot.name} (identified)")
+    written = inertial_parameters(rebuilt)
     if not np.allclose(written, full, rtol=1e-9, atol=1e-9 * np.abs(full).max()):
         worst = float(np.max(np.abs(written - full)))
         raise IdentificationError(
             robot.name, f"the written URDF does not reproduce the identified parameters (error {worst:.3g})"
         )
+    if friction.size and not np.allclose(np.concatenate([rebuilt.joint_damping, rebuilt.joint_friction]), friction, atol=1e-9):
+        raise IdentificationError(robot.name, "the written URDF's <dynamics> do not give the identified friction")
     return text
+
+
+def _write_friction(robot: Robot, root: ET.Element, friction: np.ndarray) -> None:
+    """Write identified damping and Coulomb friction (``friction``: all ``b`` then all
+    ``f``, one a degree of freedom) as each joint's ``<dynamics>``. A degree of freedom's
+    values include its mimic joints' (``k² b_m``, ``|k| f_m``), which stay as the file has
+    them: its own joint gets the rest.
+
+    Raises:
+        IdentificationError: For friction on a floating base's coordinates, or a source
+            joint's share that would be negative.
+    """
+    nv = robot.nv
+    damping, coulomb = friction[:nv].copy(), friction[nv:].copy()
+    index_of = {dof.name: dof.index for dof in robot.dofs if not dof.is_base}
+    for joint in robot.spec.joints.values():
+        if joint.mimic is not None and joint.type != "fixed" and joint.mimic.joint in index_of:
+            index = index_of[joint.mimic.joint]
+            damping[index] -= joint.mimic.multiplier**2 * joint.damping
+            coulomb[index] -= abs(joint.mimic.multiplier) * joint.friction
+    nodes = {node.get("name"): node for node in root.findall("joint")}
+    for dof in robot.dofs:
+        b, f = float(damping[dof.index]), float(coulomb[dof.index])
+        if dof.is_base:
+            if abs(b) > 1e-12 or abs(f) > 1e-12:
+                raise IdentificationError(robot.name, f"friction on the floating base's {dof.name} has no place in a URDF")
+            continue
+        if b < -1e-12 or f < -1e-12:
+            raise IdentificationError(
+                robot.name, f"joint {dof.joint!r}: its mimic joints' friction exceeds the identified b={b:.3g}, f={f:.3g}"
+            )
+        for old in nodes[dof.joint].findall("dynamics"):
+            nodes[dof.joint].remove(old)
+        ET.SubElement(nodes[dof.joint], "dynamics", damping=repr(max(b, 0.0)), friction=repr(max(f, 0.0)))
 
 
 __all__ = ["identified_urdf"]

@@ -21,7 +21,7 @@ import numpy as np
 from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.tree import KinematicTree, build_tree
+from robodyn.reference.tree import KinematicTree, build_tree, spec_with_armature
 from robodyn.urdf.sources import locked_source, resolve_source, with_file_dynamics
 from robodyn.urdf.validation import parse_urdf
 
@@ -35,6 +35,7 @@ def load(
     floating_base: bool = False,
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
+    armature: Mapping[str, float] | None = None,
 ) -> ReferenceRobot:
     """Load the reference model of a robot.
 
@@ -48,6 +49,8 @@ def load(
             a fixed base whatever the source.
         xacro_args, packages: As for :func:`robodyn.load` (a xacro or MJCF source is read
             by robodyn's own readers, never by Pinocchio).
+        armature: Rotor inertia added at joints, ``{joint name: value in [kg m²] or
+            [kg]}``, on top of the description's (as for :func:`robodyn.load`).
 
     Raises:
         UnknownRobotError, URDFError: As :func:`robodyn.load`.
@@ -59,6 +62,7 @@ def load(
         resolved.text, resolved.label, floating_base=floating_base, check_inertia=check_inertia, **resolved.mesh_context
     )
     spec = with_file_dynamics(spec, resolved.label)
+    spec = spec_with_armature(spec, armature or {}, locked=lock or {})
     tree = build_tree(spec, resolved.text, floating_base=floating_base)
     name = spec.name if resolved.name == "robot" else resolved.name
     gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)

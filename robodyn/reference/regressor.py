@@ -10,7 +10,9 @@ of two robots with a unit mass: ``Y[:, m] = tau(m = 1)`` and
 exact for any non-zero mass, physical or not, so each robot is τ of that π.)
 
 Bodies are the reference tree's bodies that carry a URDF link (a floating base's virtual
-joints carry none but the last, which carries the root link), named by their link.
+joints carry none but the last, which carries the root link), named by their link. Joints'
+rotors (armature) are no rigid-body parameters: the regressor leaves them out (its ``tau``
+is the robot's without the armature's ``a q̈``).
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ def _body_with(body: Body, parameters: np.ndarray) -> Body:
 def reference_bodies(reference: ReferenceRobot) -> list[int]:
     """Indices of the tree's bodies that carry a link (the regressor's bodies, in order)."""
     bodies = reference.tree.bodies
-    return [i for i, body in enumerate(bodies) if body.joint not in VIRTUAL_JOINTS[:5]]
+    return [i for i, body in enumerate(bodies) if body.joint not in VIRTUAL_JOINTS[:5] and not body.rotor]
 
 
 def reference_body_links(reference: ReferenceRobot) -> list[str]:

@@ -12,7 +12,15 @@ moving joint:
 - joint axes are normalised (as the validator requires of both implementations);
 - a ``<mimic>`` joint stays a body of its own; :attr:`KinematicTree.selection` maps the
   independent coordinates ``q`` onto the coordinate of every body
-  (``theta = selection @ q + offset``).
+  (``theta = selection @ q + offset``);
+- a joint's **armature** ``a`` (``JointSpec.armature``: rotor inertia reflected to the
+  joint) is a body of its own, after all the others: a massless rotor of inertia
+  ``diag(0, 0, a)`` spinning about a fixed ``z`` axis at the joint's rate (its selection
+  row is the joint's). Its kinetic energy is ``½ a θ̇²`` whatever the other joints do, it
+  has no weight and no Coriolis term, so every method that sums over bodies (Lagrangian,
+  Newton–Euler, composite bodies) gets ``M + Sᵀ diag(a) S`` and ``tau + Sᵀ(a θ̈)``, mimic
+  joints' rotors included, without knowing of armature. (For a prismatic joint the
+  rotor's "angle" is the joint's position in [m], ``a`` in [kg]: the same ``½ a ẋ²``.)
 
 Nothing here imports Pinocchio.
 """
@@ -20,11 +28,15 @@ Nothing here imports Pinocchio.
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, replace
 
 import numpy as np
 import yourdfpy
 
+from robodyn.common.text import quoted
+from robodyn.exceptions import InputError
 from robodyn.urdf.validation import URDFSpec
 
 #: The six virtual joints of a floating base: translations then rotations about the base
@@ -46,6 +58,7 @@ class Body:
         mass: Total mass in [kg] of the links welded together.
         com: Centre of mass in the body frame, in [m].
         inertia: 3×3 inertia about the centre of mass, body-frame axes, in [kg m²].
+        rotor: Whether it is the rotor of a joint's armature (see the module docstring).
     """
 
     joint: str
@@ -57,6 +70,7 @@ class Body:
     mass: float
     com: np.ndarray
     inertia: np.ndarray
+    rotor: bool = False
 
 
 @dataclass(frozen=True)
@@ -124,6 +138,7 @@ def build_tree(spec: URDFSpec, text: str, *, floating_base: bool = False) -> Kin
     bodies = _virtual_bodies(spec.root) if floating_base else []
     bodies = _moving_bodies(urdf, spec.root, bodies)
     independent, selection, offset = _mimic_map(spec, bodies)
+    bodies, selection, offset = _with_rotors(spec, bodies, selection, offset)
     ancestors = np.zeros((len(bodies), len(bodies)), dtype=bool)
     for index, body in enumerate(bodies):
         ancestors[index, index] = True
@@ -200,3 +215,48 @@ def _mimic_map(spec: URDFSpec, bodies: list[Body]) -> tuple[list[str], np.ndarra
             selection[index, column_of[mimic.joint]] = mimic.multiplier
             offset[index] = mimic.offset
     return independent, selection, offset
+
+
+def _with_rotors(
+    spec: URDFSpec, bodies: list[Body], selection: np.ndarray, offset: np.ndarray
+) -> tuple[list[Body], np.ndarray, np.ndarray]:
+    """``bodies`` and the map to them with one rotor body appended for every joint with
+    armature (see the module docstring), its selection row the joint's body's."""
+    rotors, rows = [], []
+    for index, body in enumerate(bodies):
+        joint = spec.joints.get(body.joint) if body.joint not in VIRTUAL_JOINTS else None
+        if joint is None or joint.armature == 0:
+            continue
+        link = f"armature of {body.joint}"
+        while link in spec.links:  # never a link of the robot's (kinematics look bodies up by link)
+            link += "'"
+        inertia = np.diag([0.0, 0.0, float(joint.armature)])
+        rotors.append(
+            Body(body.joint, link, -1, np.eye(4), np.array([0.0, 0.0, 1.0]), True, 0.0, np.zeros(3), inertia, rotor=True)
+        )
+        rows.append(selection[index])
+    if not rotors:
+        return bodies, selection, offset
+    return [*bodies, *rotors], np.vstack([selection, *rows]), np.concatenate([offset, np.zeros(len(rotors))])
+
+
+def spec_with_armature(spec: URDFSpec, armature: Mapping[str, float], *, locked: Iterable[str] = ()) -> URDFSpec:
+    """``spec`` with ``armature`` (``{joint name: value}``) added to its joints' armature
+    (a locked joint's is dropped with it).
+
+    Raises:
+        InputError: For a name that is no moving joint of ``spec``, or a value that is not a
+            finite number >= 0.
+    """
+    joints = dict(spec.joints)
+    moving = [name for name, joint in joints.items() if joint.type != "fixed"]
+    for name, value in armature.items():
+        if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+            raise InputError(f"armature[{quoted(name)}]", "a finite number >= 0", repr(value))
+        if name in locked and name not in moving:
+            continue
+        if name not in moving:
+            listed = ", ".join(quoted(joint) for joint in moving)
+            raise InputError("armature", f"keyed by moving joints of {quoted(spec.name)} ({listed})", quoted(name))
+        joints[name] = replace(joints[name], armature=joints[name].armature + float(value))
+    return replace(spec, joints=joints)

@@ -15,6 +15,18 @@ and holds its **own** model of the robot, which may differ from the simulated pl
 
 Gains are scalars or per-joint arrays, in SI units (``Kp`` in [1/s²], ``Kd`` in [1/s] for
 the computed-torque and task-space laws; [N m/rad] and [N m s/rad] for PD).
+
+Floating base (solo12, a1): a joint-space target (:class:`PDGravity`, :class:`ComputedTorque`)
+is the joints' positions only, ``nq − 7`` values (:func:`joint_target` checks it); the base
+stays free and gets no torque (computed torque solves for the base acceleration the joints'
+motion causes).
+
+What the models compensate: every controller here uses its own rigid-body model (armature
+included, :attr:`robodyn.Robot.joint_armature`); none compensates the joints' damping or
+Coulomb friction (:mod:`robodyn.dynamics.joint_dynamics`), which the simulation applies
+by default: with friction in the plant a PD or task-space law stops where its torque falls
+inside the stiction band, and computed torque tracks with an error the friction drives.
+The same holds for the operational-space and impedance controllers re-exported here.
 """
 
 from __future__ import annotations
@@ -24,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.common.text import quoted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.linearize import StepIntegrator, actuation_matrix, linearize
@@ -38,8 +51,9 @@ class PDGravity:
 
     Attributes:
         model: The controller's model of the robot.
-        target: Joint target, shape (nq,).
-        kp: Stiffness, in [N m/rad] or [N/m] (scalar or shape (nv,)).
+        target: Joint target, shape (nq,) (a floating base: its joints' only, (nq − 7,);
+            the base gets no torque).
+        kp: Stiffness, in [N m/rad] or [N/m] (scalar or shape (nv,); floating: (nv − 6,)).
         kd: Damping, in [N m s/rad] or [N s/m].
     """
 
@@ -49,6 +63,8 @@ class PDGravity:
     kd: float | np.ndarray = 20.0
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        if self.model.floating_base:
+            return _floating_pd(self, q, v)
         return self.kp * (self.target - q) - self.kd * v + self.model.gravity(q)
 
 
@@ -58,7 +74,9 @@ class ComputedTorque:
 
     Attributes:
         model: The controller's model of the robot.
-        reference: ``reference(t) -> (q_d, v_d, a_d)``.
+        reference: ``reference(t) -> (q_d, v_d, a_d)`` (a floating base: of its joints
+            only, each shape (nv − 6,); the base is free, its acceleration the one the
+            joints' motion causes, and gets no torque).
         kp: Position gain in [1/s²] (scalar or shape (nv,)).
         kd: Velocity gain in [1/s].
     """
@@ -70,6 +88,9 @@ class ComputedTorque:
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         q_d, v_d, a_d = self.reference(t)
+        if self.model.floating_base:
+            command = a_d + self.kd * (v_d - v[6:]) + self.kp * (q_d - q[7:])
+            return free_base_torques(self.model, q, v, command)
         command = a_d + self.kd * (v_d - v) + self.kp * (q_d - q)
         return self.model.inverse_dynamics(q, v, command)
 
@@ -151,6 +172,49 @@ class QuinticReference:
 def quintic_reference(q_start: np.ndarray, q_end: np.ndarray, duration: float) -> QuinticReference:
     """A rest-to-rest joint motion from ``q_start`` to ``q_end`` in ``duration`` [s] (:class:`QuinticReference`)."""
     return QuinticReference(np.asarray(q_start, float), np.asarray(q_end, float), float(duration))
+
+
+def joint_target(robot: Robot, target: np.ndarray | list[float], controller: str = "joint-space") -> np.ndarray:
+    """A joint-space target, checked: ``nq`` values, or for a floating base its joints'
+    ``nq − 7`` (the base is not a target of joint-space control).
+
+    Raises:
+        InputError: For another number of values (naming the count and the joints) or
+            values that are not finite.
+    """
+    values = np.asarray(target, dtype=float).reshape(-1)
+    names = [dof.name for dof in robot.dofs if not dof.is_base]
+    if values.size != len(names) or not np.isfinite(values).all():
+        listed = ", ".join(quoted(name) for name in names[:20]) + (", …" if len(names) > 20 else "")
+        base = " (the floating base stays free: its joints only)" if robot.floating_base else ""
+        received = f"{values.size} values" if values.size != len(names) else "values that are not finite"
+        raise InputError("target", f"{len(names)} joint values for the {controller} controller{base}: {listed}", received)
+    return values
+
+
+def free_base_torques(model: Robot, q: np.ndarray, v: np.ndarray, joint_accelerations: np.ndarray) -> np.ndarray:
+    """Joint torques giving a floating robot's joints the accelerations ``joint_accelerations``
+    (shape (nv − 6,)) with no torque on its free base, shape (nv,) (the first six zero).
+
+    The base's acceleration is the one that motion causes: the base rows of
+    ``M a + h = tau`` with ``tau_base = 0`` give ``a_base = −M_bb⁻¹ (M_bj a_j + h_b)``.
+    """
+    mass, effects = model.mass_matrix(q), model.nonlinear_effects(q, v)
+    base = -np.linalg.solve(mass[:6, :6], mass[:6, 6:] @ joint_accelerations + effects[:6])
+    torques = model.inverse_dynamics(q, v, np.concatenate([base, joint_accelerations]))
+    torques[:6] = 0.0
+    return torques
+
+
+def _floating_pd(law: PDGravity, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """PD + gravity on a floating robot's joints, none on its base. The gravity term is the
+    torque that holds the joints still under gravity with the base free
+    (:func:`free_base_torques` at rest): a free base falls with the whole robot, so it is
+    zero to rounding, not the joints' rows of ``G(q)`` (those hold a robot whose base is held)."""
+    holding = free_base_torques(law.model, q, np.zeros(len(v)), np.zeros(len(v) - 6))
+    torques = np.zeros(len(v))
+    torques[6:] = law.kp * (law.target - q[7:]) - law.kd * v[6:] + holding[6:]
+    return torques
 
 
 # Operational-space and impedance control live in their own module; re-exported here with

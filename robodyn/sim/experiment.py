@@ -29,7 +29,7 @@ import pinocchio as pin
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
-from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, quintic_reference
+from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
@@ -133,19 +133,22 @@ def run_simulation(
     actuated: list[str] | None = None,
     reference: Trajectory | None = None,
     control_period: float | None = None,
+    joint_friction: bool = True,
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
     Args:
         robot: The plant.
-        controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target),
+        controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target; a floating
+            robot's gains from its joints' inertia, :func:`free_base_gains`),
             ``"computed-torque"`` (quintic from ``q0`` to a joint target in half the
             duration), ``"task-space"`` (drive ``frame`` to a position target), ``"osc"``
             (operational-space control of ``frame``'s position or pose) or
             ``"impedance"`` (Cartesian impedance about the target pose) or ``"lqr"``
             (:class:`~robodyn.sim.control.LQR` about the joint target held still, gain of
             the continuous Riccati equation, weights :func:`lqr_weights`).
-        target: Joint target (nq values), task target (X,Z or X,Y,Z in [m]) or, for osc
+        target: Joint target (nq values; a floating base's joints only, nq − 7: the base
+            stays free and gets no torque), task target (X,Z or X,Y,Z in [m]) or, for osc
             and impedance, X,Y,Z in [m] with optionally ROLL,PITCH,YAW in [rad].
         frame: Controlled frame for task-space, osc and impedance control (default the
             robot's end effector; it must be a frame some joint moves); under the other
@@ -166,6 +169,8 @@ def run_simulation(
             sample (unless ``q0`` is given) and its last configuration is the target.
         control_period: Sample the controller every ``control_period`` [s] and hold its
             torque (zero-order hold; the summary says so); ``None``: every stage.
+        joint_friction: As for :func:`robodyn.simulate`: the joints' damping and friction
+            act (``False``: the rigid-body motion). The controllers' models are rigid-body.
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -195,6 +200,7 @@ def run_simulation(
         trajectory, run = simulate_run(
             robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits,
             engine=engine, external=external, observer=observer, control_period=control_period,
+            joint_friction=joint_friction,
         )  # fmt: skip
     settings = {
         "controller": controller,
@@ -216,7 +222,8 @@ def run_simulation(
     if task is not None:
         return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
     if controller != "passive":
-        error = float(np.abs(trajectory.q[-1] - np.asarray(target, float)).max())
+        joints = np.asarray(target, float)
+        error = float(np.abs(trajectory.q[-1][robot.nq - joints.size :] - joints).max())
         return trajectory, replace(summary, final_joint_error=error)
     return trajectory, summary
 
@@ -313,10 +320,17 @@ def _control_law(
     (task-space, osc and impedance control only: ``None`` and ``""`` otherwise)."""
     law: PDGravity | ComputedTorque | TaskSpace | OperationalSpace | Impedance | LQR | None = None
     task, controlled = None, ""
-    if controller == "pd":
-        law = PDGravity(controller_model(robot), np.asarray(target, float))
+    if controller in ("pd", "computed-torque", "lqr"):  # the joints' positions (a floating base stays free)
+        assert target is not None  # checked by _check_request
+        joints = joint_target(robot, target, controller)
+    if controller == "pd" and robot.floating_base:
+        law = PDGravity(controller_model(robot), joints, *free_base_gains(robot, start))
+    elif controller == "pd":
+        law = PDGravity(controller_model(robot), joints)
     elif controller == "computed-torque":
-        law = ComputedTorque(controller_model(robot), quintic_reference(start, np.asarray(target, float), duration / 2))
+        law = ComputedTorque(controller_model(robot), quintic_reference(start[robot.nq - joints.size :], joints, duration / 2))
+    elif controller == "lqr":
+        law = _lqr_law(robot, joints, options["actuated"])
     elif controller == "task-space":
         assert target is not None  # checked by _check_request
         task = task_target(target)
@@ -329,12 +343,18 @@ def _control_law(
         controlled = robot.task_frame(frame, f"{controller} control")
         check_reach(robot, controlled, task, parameter="target")
         law = _pose_law(robot, controller, controlled, task, rpy, options)
-    given = 0 if target is None else int(np.size(np.asarray(target, dtype=float)))
-    if controller == "lqr" and given == robot.nq:
-        law = _lqr_law(robot, np.asarray(target, float), options["actuated"])
-    if controller in ("pd", "computed-torque", "lqr") and given != robot.nq:
-        raise InputError("target", f"{robot.nq} joint values for the {controller} controller", f"{given} values")
     return law, task, controlled
+
+
+def free_base_gains(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """PD gains for a floating robot's joints: ``100 m`` and ``20 m`` (a critically damped
+    10 rad/s) with ``m`` each joint's inertia at ``q`` with the base free (the diagonal of
+    ``M_jj − M_jb M_bb⁻¹ M_bj``), in [N m/rad] and [N m s/rad]. A legged robot's light
+    legs (solo12's knees: 3e-4 kg m²) make the fixed-base defaults (100, 20) unstable at
+    any practical step."""
+    mass = robot.mass_matrix(q)
+    inertia = np.diag(mass[6:, 6:] - mass[6:, :6] @ np.linalg.solve(mass[:6, :6], mass[:6, 6:]))
+    return 100.0 * inertia, 20.0 * inertia
 
 
 #: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.

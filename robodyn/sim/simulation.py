@@ -28,6 +28,13 @@ every position, velocity and effort limit the run broke in one
 :class:`~robodyn.exceptions.JointLimitWarning`; ``"enforce"`` saturates the torques at
 the effort limits and stops joints at their position limits; ``"ignore"`` does neither.
 
+Joint damping and Coulomb friction (``<dynamics>``, :attr:`Robot.joint_damping`,
+:attr:`Robot.joint_friction`) act by default (``joint_friction=False``: the rigid-body
+motion): ``−b v``, and stick–slip friction with its events located inside the step
+(:mod:`robodyn.sim.joint_friction`, docs/joint-friction.md). The compiled engine has
+neither: it refuses a robot with either unless ``joint_friction=False`` (``engine="auto"``
+runs such a robot on the Pinocchio engine).
+
 A state that stops being finite ends the run with a :class:`SimulationError` saying when
 and which joint, or a :class:`SingularMassMatrixError` when the mass matrix is singular
 there (massless moving bodies: no step size helps).
@@ -44,6 +51,7 @@ from typing import Literal
 
 import numpy as np
 
+from robodyn.common.text import quoted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import (
     CompileError,
@@ -54,6 +62,7 @@ from robodyn.exceptions import (
     SimulationError,
     SingularMassMatrixError,
 )
+from robodyn.sim.joint_friction import JointFriction, has_joint_friction
 from robodyn.sim.limits import JointLimits, LimitMode, check_mode, warning_text
 from robodyn.sim.observer import MomentumObserver
 from robodyn.trajectory import Trajectory
@@ -139,6 +148,7 @@ def simulate(
     engine: Engine = "auto",
     control_period: float | None = None,
     observer: MomentumObserver | None = None,
+    joint_friction: bool = True,
 ) -> Trajectory:
     """Simulate a robot from ``(q0, v0)`` for ``duration`` seconds.
 
@@ -174,6 +184,11 @@ def simulate(
             estimate of the external torques at each sample. Give it ``torque="held"``
             with ``hold=True``, ``"sampled"`` otherwise.
 
+        joint_friction: Honour the joints' damping and Coulomb friction
+            (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`: ``−b v``, and
+            stick–slip friction up to ``±f``, :mod:`robodyn.sim.joint_friction`); ``False``
+            gives the rigid-body motion. The ``tau`` column stays the applied torque.
+
     Returns:
         The trajectory, ``round(duration / dt) + 1`` samples from ``t = 0`` (``tau`` is
         the applied torque: saturated with ``limits="enforce"``).
@@ -193,7 +208,7 @@ def simulate(
     """
     trajectory, _, violations = _simulate(
         robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
-        limits=limits, engine=engine, control_period=control_period, observer=observer,
+        limits=limits, engine=engine, control_period=control_period, observer=observer, joint_friction=joint_friction,
     )  # fmt: skip
     if violations:
         warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
@@ -215,13 +230,14 @@ def simulate_run(
     engine: Engine = "auto",
     control_period: float | None = None,
     observer: MomentumObserver | None = None,
+    joint_friction: bool = True,
 ) -> tuple[Trajectory, EngineRun]:
     """:func:`simulate`, also saying which engine ran, why, and the loop's and the
     compilation's wall-clock times (:class:`EngineRun`). Arguments, errors and warnings
     are :func:`simulate`'s."""
     trajectory, run, violations = _simulate(
         robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
-        limits=limits, engine=engine, control_period=control_period, observer=observer,
+        limits=limits, engine=engine, control_period=control_period, observer=observer, joint_friction=joint_friction,
     )  # fmt: skip
     if violations:
         warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
@@ -243,6 +259,7 @@ def _simulate(
     engine: str,
     control_period: float | None,
     observer: MomentumObserver | None,
+    joint_friction: bool,
 ) -> tuple[Trajectory, EngineRun, list]:
     """The run, how it went, and the limits it broke (none with ``limits="ignore"``)."""
     _check_modes(integrator, limits, engine)
@@ -251,12 +268,17 @@ def _simulate(
     (q, v), _ = robot.validate(q=q0, v=v0)
     if q.ndim != 1:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
+    friction = joint_friction and has_joint_friction(robot)
     if engine == "compiled":
         _check_compiled_applies(robot, external, limits, observer)
+        if friction:
+            _refuse_compiled_friction(robot)
     chosen, reason = ("pinocchio", "asked for (engine='pinocchio')") if engine == "pinocchio" else ("compiled", "")
     began = perf_counter()  # choosing and compiling: importing the code generator counts here
     if engine == "auto":
-        chosen, reason = choose_engine(robot, controller, external=external, limits=limits, observer=observer, every=every)
+        chosen, reason = choose_engine(
+            robot, controller, external=external, limits=limits, observer=observer, every=every, joint_friction=friction
+        )
     compiled = None
     if chosen == "compiled":
         try:
@@ -272,7 +294,7 @@ def _simulate(
     else:
         trajectory, run = _simulate_pinocchio(
             robot, q, v, steps, dt, controller=controller, integrator=integrator, external=external, every=every,
-            limits=limits, observer=observer,
+            limits=limits, observer=observer, friction=friction,
         )  # fmt: skip
         run = replace(run, reason=reason, compile_time=compile_time)
     violations = [] if limits == "ignore" else JointLimits(robot).violations(trajectory)
@@ -287,6 +309,7 @@ def choose_engine(
     limits: str = "warn",
     observer: MomentumObserver | None = None,
     every: int | None = None,
+    joint_friction: bool = False,
 ) -> tuple[Literal["pinocchio", "compiled"], str]:
     """The engine ``engine="auto"`` runs, and why (one sentence).
 
@@ -304,6 +327,7 @@ def choose_engine(
         controller: The controller (``None``: passive).
         external, limits, observer: As for :func:`simulate`.
         every: Steps between two samples of a held controller (``None``: every stage).
+        joint_friction: Whether the joints' damping and friction act in this run.
 
     Returns:
         ``"compiled"`` or ``"pinocchio"``, and the reason.
@@ -314,6 +338,7 @@ def choose_engine(
         (bool(external), "external wrenches"),
         (observer is not None, "a momentum observer"),
         (limits == "enforce", "limits enforced"),
+        (joint_friction, "joint damping and friction"),
         (bool(robot.massless_joints) or robot.nv == 0, "no moving mass to compile"),
     ]
     for refused, what in refusals:
@@ -396,11 +421,15 @@ class _Stepper:
         observer: MomentumObserver | None = None,
         forward: Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
         every: int = 1,
+        friction: JointFriction | None = None,
     ) -> None:
         self.controller = controller
         self.observer = observer
         self.forward = _accelerator(robot, external) if forward is None else forward
         self.every = every  # steps between two samples of the controller at a step's start
+        self.friction = friction
+        if friction is not None:  # the joints' damping and stick-slip friction
+            self.forward = friction.wrap(self.forward)
         if controller is None or hold:  # the step's torque (zero when passive) holds
             self.accelerate = self.forward
         else:
@@ -419,6 +448,12 @@ class _Stepper:
         """Feed the observer (if any) a sample and the torque applied there."""
         if self.observer is not None:
             self.observer.update(t, q, v, tau)
+
+    def advance(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
+        """:meth:`step`, cut at the joints' stick-slip events when there is joint friction."""
+        if self.friction is None:
+            return self.step(t, dt, q, v, tau, a)
+        return self.friction.step(self.step, self.accelerate, t, dt, q, v, tau, a)
 
     def step(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
         """``(q, v)`` after one step of ``dt`` from time ``t`` with acceleration ``a`` there."""
@@ -465,7 +500,7 @@ def _integrate(
             stepper.observe(t, q, v, tau)
             a = stepper.forward(t, q, v, tau)
             accelerations.append(a)
-            q, v = stepper.step(t, dt, q, v, tau, a)
+            q, v = stepper.advance(t, dt, q, v, tau, a)
             if stops is not None:
                 q, v = stops.stop(q, v)
         except InputError:  # a non-finite state reached a controller's checked call
@@ -499,8 +534,10 @@ def _simulate_pinocchio(
     every: int | None,
     limits: str,
     observer: MomentumObserver | None,
+    friction: bool = False,
 ) -> tuple[Trajectory, EngineRun]:
-    """The run in Python over Pinocchio's ABA (checked state ``q``, ``v``)."""
+    """The run in Python over Pinocchio's ABA (checked state ``q``, ``v``; ``friction``: the
+    joints' damping and stick-slip friction act)."""
     for item in external:
         robot.task_frame(item.frame, "an external wrench")
     if robot.massless_joints or _singular(robot, q):
@@ -510,9 +547,13 @@ def _simulate_pinocchio(
     if enforce and controller is not None:
         commanded = controller
         controller = lambda t, q, v: joint_limits.saturate(np.asarray(commanded(t, q, v), dtype=float))  # noqa: E731
+    joint_friction = JointFriction(robot) if friction else None
     stepper = _Stepper(
-        robot, external, controller, hold=every is not None, rk4=integrator == "rk4", observer=observer, every=every or 1
-    )
+        robot, external, controller, hold=every is not None, rk4=integrator == "rk4", observer=observer, every=every or 1,
+        friction=joint_friction,
+    )  # fmt: skip
+    if joint_friction is not None:
+        joint_friction.start(stepper.accelerate, 0.0, q, v, stepper.torque(0.0, q, v))
     began = perf_counter()
     qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, joint_limits if enforce else None)
     loop = perf_counter() - began
@@ -663,3 +704,17 @@ def _accelerator(
             return lambda t, q, v, tau: aba(model, data, q, v, tau)
         return lambda t, q, v, tau: forward(q, v, tau)
     return lambda t, q, v, tau: forward(q, v, tau + external_torques(robot, q, t, external))
+
+
+def _refuse_compiled_friction(robot: Robot) -> None:
+    """Refuse the compiled engine for a robot whose joints have damping or friction (its
+    loop in C has neither; ``joint_friction=False`` asks for the rigid-body motion)."""
+    if has_joint_friction(robot):
+        joints = [dof.name for dof in robot.dofs if dof.damping or dof.friction]
+        listed = ", ".join(quoted(name) for name in joints[:8]) + (", …" if len(joints) > 8 else "")
+        raise InputError(
+            "engine",
+            "'pinocchio' for joint damping and friction (the compiled loop has neither; joint_friction=False "
+            "simulates the rigid-body motion compiled)",
+            f"'compiled' for {quoted(robot.name)}, whose joints {listed} have some",
+        )

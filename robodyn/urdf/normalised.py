@@ -5,8 +5,9 @@ Pinocchio never reads the user's text: every number it gets was parsed by the va
 so robodyn's checks, :class:`~robodyn.dynamics.robot.Robot`, the reference and the viewer
 cannot disagree about a mass, an inertia, an origin, an axis, a limit or a mimic relation
 (``" 1.0 "``, ``"1_000"`` or ``"２"`` are either refused by the validator or read the
-same everywhere). What Pinocchio reads and robodyn does not use (``<dynamics>``
-damping and friction, visuals, collisions, gazebo tags) is left out.
+same everywhere). A moving joint's ``<dynamics damping friction>`` is written back (Pinocchio
+reads it into ``model.damping`` and ``model.friction``, as it would from the user's file);
+what Pinocchio reads and robodyn does not use (visuals, collisions, gazebo tags) is left out.
 
 The copy is also normalised:
 
@@ -142,6 +143,8 @@ def normalised_urdf(spec: URDFSpec) -> tuple[str, dict[str, str]]:
             effort=repr(float(joint.effort)) if math.isfinite(joint.effort) else "0.0",
             velocity=repr(float(joint.velocity)) if math.isfinite(joint.velocity) else "0.0",
         )
+        if joint.damping or joint.friction:  # Pinocchio reads them into model.damping, model.friction
+            ET.SubElement(node, "dynamics", damping=repr(float(joint.damping)), friction=repr(float(joint.friction)))
         if joint.mimic is not None and joint.mimic.joint in canonical:
             ET.SubElement(
                 node,

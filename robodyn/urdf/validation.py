@@ -16,6 +16,9 @@ Conventions enforced here and relied on downstream:
       the triangle inequality is a loud warning (:class:`~robodyn.exceptions.RobodynWarning`),
       an error with ``strict=True``;
     - a ``<mimic>`` of a joint that does not exist is dropped with a loud warning;
+    - a joint's ``<dynamics damping friction>`` (viscous damping b, Coulomb friction f) are
+      finite and non-negative (0 where not given); on a fixed joint they have no effect
+      (a warning ``lint`` shows);
     - a revolute or prismatic joint with ``lower > upper`` (Bullet's encoding of an
       unlimited joint, e.g. pybullet_data's cube_no_rotation.urdf) has no position limit,
       with a loud warning.
@@ -171,9 +174,10 @@ def _read_joint(reader: _Reader, node: ET.Element, index: int) -> JointSpec | No
     if placement is None or limits is None:
         return None
     readable, mimic = _read_mimic(reader, where, node)
-    if not readable:
+    dynamics = _read_dynamics(reader, where, node, joint_type)
+    if not readable or dynamics is None:
         return None
-    return JointSpec(name, joint_type, parent_link, child_link, *placement, *limits, mimic)
+    return JointSpec(name, joint_type, parent_link, child_link, *placement, *limits, mimic, *dynamics)
 
 
 def _read_placement(
@@ -241,6 +245,25 @@ def _read_mimic(reader: _Reader, where: str, node: ET.Element) -> tuple[bool, Mi
         reader.error(where, "mimic multiplier and offset must be finite")
         return False, None
     return True, mimic
+
+
+def _read_dynamics(reader: _Reader, where: str, node: ET.Element, joint_type: str) -> tuple[float, float] | None:
+    """A joint's ``<dynamics damping friction>``: viscous damping b in [N m s/rad] or [N s/m]
+    and Coulomb friction f in [N m] or [N] (0 where not given), or ``None`` if they are not
+    finite, non-negative numbers."""
+    dynamics = node.find("dynamics")
+    if dynamics is None:
+        return 0.0, 0.0
+    values = []
+    for attribute in ("damping", "friction"):
+        value = reader.number(where, dynamics, attribute, 0.0)
+        if not math.isfinite(value) or value < 0:
+            reader.error(where, f"<dynamics {attribute}={quoted(dynamics.get(attribute, ''))}> must be a finite number >= 0")
+            return None
+        values.append(value)
+    if joint_type == "fixed" and any(values):
+        reader.warn(where, "is fixed, so its <dynamics> has no effect")
+    return values[0], values[1]
 
 
 def _check_tree(reader: _Reader, links: dict, joints: dict[str, JointSpec]) -> str | None:

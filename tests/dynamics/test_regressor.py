@@ -12,7 +12,7 @@ import robodyn.reference as reference
 from robodyn.dynamics.regressor import body_links, inertial_parameters, parameter_names, regressor
 from robodyn.reference.regressor import reference_body_links, reference_parameters, reference_regressor
 from robodyn.urdf.zoo import zoo_names
-from tests.conftest import FAST_ZOO, random_state
+from tests.conftest import FAST_ZOO, NONDEGENERATE, random_state, random_states
 from tests.random_robots import random_urdfs
 
 #: A chain with a mimic joint (multiplier ≠ 1, an offset), non-unit axes and a welded link.
@@ -172,3 +172,20 @@ def test_every_fixed_base_zoo_robot(name, rng):
     except robodyn.RobodynError:
         return  # refused models are covered by the zoo tests
     assert_regressor_reproduces_tau(robot, rng, count=3)
+
+
+def test_the_friction_columns_are_the_joints_damping_and_friction_and_armature_a_known_torque(rng):
+    """oblique (``<dynamics damping friction>`` on j_twist), floating, with armature: the
+    robot's own friction parameters are its b and f, and ``Y π + armature ⊙ a`` is the
+    inverse dynamics with the joints' friction (7 states, one with j_twist at rest)."""
+    robot = robodyn.load(NONDEGENERATE / "oblique.urdf", floating_base=True, armature={"j_twist": 0.05, "j_extend": 0.3})
+    parameters = inertial_parameters(robot, friction=True)
+    nv = robot.nv
+    np.testing.assert_array_equal(parameters[-2 * nv :], np.concatenate([robot.joint_damping, robot.joint_friction]))
+    assert robot.joint_friction.any()
+    q, v, a = random_states(robot, rng, 7)
+    v[0, robot.joint_names.index("j_twist") + 5] = 0.0
+    Y = regressor(robot, q, v, a, friction=True)
+    expected = robot.inverse_dynamics(q, v, a, joint_friction=True)
+    np.testing.assert_allclose(Y @ parameters + robot.joint_armature * a, expected, atol=1e-10 * np.abs(expected).max())
+    assert np.abs(Y @ parameters - expected).max() > 1e-3  # negative control: the armature matters

@@ -220,3 +220,52 @@ def test_written_urdf_merges_welded_links_and_the_reference_agrees(rng):
     order = np.concatenate([10 * [lk for lk in ["l1", "l2", "l3"]].index(link) + np.arange(10) for link in links])
     np.testing.assert_allclose(reference_parameters(ref), result.standard[order], atol=1e-9)
     np.testing.assert_allclose(written.inverse_dynamics(q, v, a), data.tau, rtol=0, atol=1e-3 * np.abs(data.tau).max())
+
+
+def _with_dynamics(urdf: str, values: dict[str, str]) -> str:
+    import re
+
+    for joint, attributes in values.items():
+        urdf, count = re.subn(rf'(<joint name="{joint}"[^>]*>)', rf"\1<dynamics {attributes}/>", urdf)
+        assert count == 1
+    return urdf
+
+
+def test_identifying_a_simulated_robot_with_joint_dynamics_recovers_its_damping_and_friction(rp_arm, tmp_path):
+    """The rp_arm with ``<dynamics>`` and armature, simulated (stick–slip friction, armature
+    in M) under computed torque along its exciting trajectory: the friction columns give back
+    the file's b and f, the inertial base values the file's, and the identified URDF carries
+    them in its ``<dynamics>``. Samples with a joint at rest (friction anywhere in ±f) are left out."""
+    from robodyn.sim.control import ComputedTorque
+
+    robot = rp_arm[0]
+    excitation = excite(robot, duration=4.0, harmonics=3, iterations=15, base=base_parameters(robot, friction=True))
+    text = _with_dynamics(
+        robodyn.load("rp_arm").urdf, {"joint1": 'damping="0.3" friction="0.8"', "joint2": 'damping="2" friction="1.5"'}
+    )
+    plant = robodyn.load(text, armature={"joint2": 0.3})  # (on joint1 it would be one with link1's Izz)
+    np.testing.assert_array_equal(inertial_parameters(plant, friction=True)[-4:], [0.3, 2.0, 0.8, 1.5])
+    reference = lambda t: tuple(x[0] for x in excitation.evaluate(np.array([t])))  # noqa: E731
+    q0, v0, _ = reference(0.0)
+    trajectory = robodyn.simulate(plant, q0, v0, 4.0, 2e-3, controller=ComputedTorque(robot, reference))
+    moving = np.all(trajectory.v != 0, axis=1)
+    assert moving.mean() > 0.5  # it sticks at some reversals: the rigid-body controller does not compensate friction
+    data = Trajectory(
+        trajectory.t[moving], trajectory.q[moving], trajectory.v[moving], trajectory.a[moving], trajectory.tau[moving],
+        list(plant.joint_names), plant.name,
+    )  # fmt: skip
+    base = base_parameters(plant, friction=True)
+    for method in ("ls", "physical"):
+        result = identify(plant, data, method=method, base=base)
+        found = dict(zip(result.base.names, result.values, strict=True))
+        np.testing.assert_allclose(
+            [found[n] for n in ("fv[joint1]", "fv[joint2]", "fc[joint1]", "fc[joint2]")], [0.3, 2.0, 0.8, 1.5], rtol=1e-4
+        )
+        np.testing.assert_allclose(result.values, base.values, rtol=1e-4, atol=1e-5)  # physical: solver precision
+    written = robodyn.load(identified_urdf(plant, result.standard, base.columns))
+    np.testing.assert_allclose(written.joint_damping, [0.3, 2.0], rtol=1e-4)
+    np.testing.assert_allclose(written.joint_friction, [0.8, 1.5], rtol=1e-4)
+    # Negative controls: without the friction columns, or with the armature forgotten, the data are not explained.
+    assert identify(plant, data).relative_error > 1e-3
+    forgot = robodyn.load(text)  # the same robot without its armature
+    assert identify(forgot, data, base=base_parameters(forgot, friction=True)).relative_error > 1e-6

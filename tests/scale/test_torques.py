@@ -105,6 +105,7 @@ def driven(panda):
         0.3,
         1e-3,
         controller=lambda t, q, v: gains * np.sin(7 * t + q),
+        joint_friction=False,  # rigid body: RNEA gives the applied torque back
     )
     trajectory.a[-1] = panda.forward_dynamics(
         trajectory.q[-1], trajectory.v[-1], trajectory.tau[-1]

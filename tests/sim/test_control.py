@@ -23,6 +23,7 @@ from scipy.linalg import expm
 
 import robodyn
 import robodyn.reference
+from robodyn.exceptions import InputError
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace, quintic_reference
 
 DATA = Path(__file__).parents[1] / "data"
@@ -84,7 +85,7 @@ def test_pd_gravity_transient_matches_an_independent_integration(path):
     # Gains scaled to each joint's inertia: a transient of about 10 rad/s on every joint.
     inertia = np.diag(robot.mass_matrix(q0))
     kp, kd = 100.0 * inertia, 8.0 * inertia
-    trajectory = robodyn.simulate(robot, q0, v0, 0.6, DT, controller=PDGravity(robot, target, kp, kd))
+    trajectory = robodyn.simulate(robot, q0, v0, 0.6, DT, controller=PDGravity(robot, target, kp, kd), joint_friction=False)
 
     def law(t, q, v, mass, cv, g):
         return kp * (target - q) - kd * v + g
@@ -103,7 +104,9 @@ def _computed_torque_run():
     v0 = rng.normal(size=robot.nv)
     reference = quintic_reference(q0 + 0.2, robot.random_configuration(rng) * 0.5, 0.4)
     kp, kd = 100.0, 12.0
-    trajectory = robodyn.simulate(robot, q0, v0, 0.6, DT, controller=ComputedTorque(robot, reference, kp, kd))
+    trajectory = robodyn.simulate(
+        robot, q0, v0, 0.6, DT, controller=ComputedTorque(robot, reference, kp, kd), joint_friction=False
+    )
     return robot, q0, v0, reference, kp, kd, trajectory
 
 
@@ -146,7 +149,9 @@ def _task_space_deviation(path, frame, speed, *, flip_bias=False):
     kp, kd = 60.0, 12.0
     jacobian = robot.frame_jacobian(q0, frame)[:3]
     assert np.linalg.svd(jacobian, compute_uv=False)[-1] > 0.05  # full row rank: the task is reachable
-    trajectory = robodyn.simulate(robot, q0, v0, 1.0, 2 * DT, controller=TaskSpace(robot, frame, target, kp, kd))
+    trajectory = robodyn.simulate(
+        robot, q0, v0, 1.0, 2 * DT, controller=TaskSpace(robot, frame, target, kp, kd), joint_friction=False
+    )
     error = target - robot.frame_position(trajectory.q, frame)
     exact = _linear_error(target - start, -jacobian @ v0, kp, kd, trajectory.t)
     size = np.max(np.abs(exact))
@@ -256,7 +261,7 @@ def test_task_space_damps_the_motion_the_task_leaves_free():
     v0 = np.array([0.5, -0.3, 0.2, 2.0])
     target = robot.frame_position(q0, "end_effector") + np.array([0.02, 0.01, -0.02])
     controller = TaskSpace(robot, "end_effector", target, 60.0, 12.0, joint_damping=4.0)
-    trajectory = robodyn.simulate(robot, q0, v0, 0.5, 2 * DT, controller=controller)
+    trajectory = robodyn.simulate(robot, q0, v0, 0.5, 2 * DT, controller=controller, joint_friction=False)
     np.testing.assert_allclose(trajectory.v[:, 3], 2.0 * np.exp(-4.0 * trajectory.t), atol=1e-6)
 
 
@@ -290,3 +295,48 @@ def test_task_space_damped_least_squares_bounds_the_command():
     command = robot.forward_dynamics(q, zero, controller(0.0, q, zero))
     desired = 50.0 * 0.01
     assert np.linalg.norm(command) == pytest.approx(desired / (2 * np.sqrt(damping)), rel=1e-6)
+
+
+SOLO_TARGET = np.array([0.1, 0.8, -1.6, -0.1, 0.8, -1.6, 0.1, -0.8, 1.6, -0.1, -0.8, 1.6])
+
+
+@pytest.mark.parametrize("free_base", [True, False], ids=["free_base", "negative_control_base_held"])
+def test_computed_torque_of_a_floating_robot_moves_its_joints_by_the_closed_loop_law_with_its_base_free(free_base):
+    """solo12, joints only in the reference: the tracking error obeys ë + Kd ė + Kp e = 0
+    while the base, free and pushed by no torque, moves as the legs make it. The negative
+    control computes the torques as if the base were held (its acceleration zero)."""
+    from robodyn.sim.control import free_base_torques
+
+    robot = robodyn.load("solo12")
+    rng = np.random.default_rng(5)
+    q0 = robot.floating_configuration([0.1, -0.2, 0.4], [0.3, -0.2, 0.5], SOLO_TARGET + rng.normal(scale=0.2, size=12))
+    v0 = np.concatenate([rng.normal(size=6) * 0.3, rng.normal(size=12)])
+    kp, kd = 100.0, 12.0
+
+    def law(t, q, v):
+        command = kd * (0.0 - v[6:]) + kp * (SOLO_TARGET - q[7:])
+        if free_base:
+            return free_base_torques(robot, q, v, command)
+        torques = robot.inverse_dynamics(q, v, np.concatenate([np.zeros(6), command]))
+        torques[:6] = 0.0
+        return torques
+
+    trajectory = robodyn.simulate(robot, q0, v0, 0.5, DT, controller=law)
+    exact = _linear_error(SOLO_TARGET - q0[7:], -v0[6:], kp, kd, trajectory.t)
+    assert np.abs(trajectory.tau[:, :6]).max() == 0.0
+    assert np.ptp(trajectory.q[:, :3], axis=0).max() > 0.1  # the base moved (it fell, and the legs pushed it)
+    deviation = np.abs((SOLO_TARGET - trajectory.q[:, 7:]) - exact).max()
+    assert (deviation < 1e-6) == free_base, deviation
+
+
+def test_a_joint_target_of_a_floating_robot_is_its_joints_and_any_other_length_is_refused():
+    from robodyn.sim.control import joint_target
+
+    robot = robodyn.load("solo12")
+    np.testing.assert_array_equal(joint_target(robot, SOLO_TARGET, "pd"), SOLO_TARGET)
+    for wrong in (np.zeros(19), np.zeros(18), np.zeros(11)):
+        with pytest.raises(InputError) as raised:
+            joint_target(robot, wrong, "pd")
+        assert "12 joint values" in str(raised.value) and "'FL_HAA'" in str(raised.value) and "'HR_KFE'" in str(raised.value)
+    with pytest.raises(InputError):
+        joint_target(robodyn.load("rp_arm"), [0.1, np.nan], "pd")

@@ -102,7 +102,9 @@ def test_simulate_feeds_the_observer_once_a_step_at_the_reached_state(rp_arm):
 def test_operational_space_control_reaches_a_full_pose_on_the_panda_with_a_posture():
     robot = robodyn.load("panda")
     target = [0.35, 0.05, 0.55, np.pi, 0.0, 0.0]
-    trajectory, summary = run_simulation(robot, controller="osc", target=target, posture=PANDA_READY, duration=3.0)
+    trajectory, summary = run_simulation(
+        robot, controller="osc", target=target, posture=PANDA_READY, duration=3.0, joint_friction=False
+    )
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, trajectory.q[-1])
     placement = data.oMf[robot.model.getFrameId(robot.end_effector)]

@@ -77,7 +77,9 @@ def panda_runs():
     runs = {}
     for name, kwargs in (("posture", {"posture": posture}), ("free", {})):
         law = OperationalSpace(model, None, target.translation, orientation=target.rotation, kp=KP, kd=KD, **kwargs)
-        trajectory = robodyn.simulate(plant, PANDA_READY, np.zeros(7), 1.2, DT, controller=law, limits="ignore")
+        trajectory = robodyn.simulate(
+            plant, PANDA_READY, np.zeros(7), 1.2, DT, controller=law, limits="ignore", joint_friction=False
+        )  # the rigid-body law (the panda's joints have damping)
         runs[name] = (law, trajectory)
     return plant, target, runs
 

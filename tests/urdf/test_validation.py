@@ -166,3 +166,25 @@ def test_lower_above_upper_crosses_the_other_load_options(bullet_urdf, kind, tmp
     assert lower.size and np.all(np.isneginf(lower)) and np.all(np.isposinf(upper))
     with pytest.raises(URDFError, match="above upper limit"):
         robodyn.load(path, strict=True, **options)
+
+
+DYNAMICS_ARM = """<robot name="arm"><link name="base"/>
+<link name="l1"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<link name="l2"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="shoulder" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>{shoulder}</joint>
+<joint name="weld" type="fixed"><parent link="l1"/><child link="l2"/>{weld}</joint>
+</robot>"""
+
+
+def test_joint_dynamics_are_read_and_bad_values_refused_naming_the_joint():
+    from robodyn.urdf.validation import lint_urdf, parse_urdf
+
+    spec = parse_urdf(DYNAMICS_ARM.format(shoulder='<dynamics damping="0.25" friction="1e-1"/>', weld=""))
+    assert (spec.joints["shoulder"].damping, spec.joints["shoulder"].friction) == (0.25, 0.1)
+    assert parse_urdf(DYNAMICS_ARM.format(shoulder='<dynamics friction="2"/>', weld="")).joints["shoulder"].damping == 0.0
+    for bad in ('damping="-0.5"', 'friction="-1e-3"', 'damping="nan"', 'friction="inf"', 'damping="fast"', 'damping="1e13"'):
+        with pytest.raises(URDFError) as raised:
+            parse_urdf(DYNAMICS_ARM.format(shoulder=f"<dynamics {bad}/>", weld=""), "arm.urdf")
+        assert 'joint "shoulder"' in str(raised.value) and "\n" not in str(raised.value)
+    _, problems = lint_urdf(DYNAMICS_ARM.format(shoulder="", weld='<dynamics damping="3"/>'))
+    assert [(p.element, p.severity) for p in problems if "dynamics" in p.rule] == [('joint "weld"', "warning")]

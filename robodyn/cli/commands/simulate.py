@@ -63,6 +63,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         " (the same as --engine compiled)",
     )
     _add_engine_arguments(parser)
+    no_friction = "leave out the joints' damping and friction (<dynamics>): the rigid-body motion"
+    parser.add_argument("--no-joint-friction", dest="joint_friction", action="store_false", help=no_friction)
     parser.add_argument("--out", help="trajectory file (.csv or .npz)")
     parser.add_argument(
         "--reference",
@@ -108,6 +110,7 @@ def run(arguments: argparse.Namespace) -> int:
         force_at=arguments.force_at,
         observer_gain=arguments.observer_gain,
         actuated=None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")],
+        joint_friction=arguments.joint_friction,
         out=arguments.out,
         plot=arguments.plot,
         record=arguments.record,

@@ -83,3 +83,24 @@ def test_frame_names_the_path_drawn_under_a_pd_controller(tmp_path, capsys):
     assert main(_simulate(tmp_path, "--frame", "left")) == 0, capsys.readouterr().err
     html = (tmp_path / "m.html").read_text()
     assert "path" in html and (tmp_path / "m.html").stat().st_size > 10_000
+
+
+SOLO_JOINTS = "0.1,0.8,-1.6,-0.1,0.8,-1.6,0.1,-0.8,1.6,-0.1,-0.8,1.6"
+
+
+@pytest.mark.parametrize("controller", ["pd", "computed-torque"])
+def test_joint_space_control_of_a_floating_robot_takes_its_joints_and_leaves_the_base_free(controller, capsys):
+    assert main(["simulate", "solo12", "--controller", controller, "--target", SOLO_JOINTS, "--duration", "1", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    torques = dict(zip(summary["dof_names"], summary["peak_abs_torque"], strict=True))
+    assert all(torques[name] == 0.0 for name in ("base.x", "base.y", "base.z", "base.rx", "base.ry", "base.rz"))
+    assert torques["FL_KFE"] > 0.0
+    assert summary["final_joint_error"] < (1e-6 if controller == "computed-torque" else 0.02)
+
+
+def test_a_floating_robots_joint_target_of_the_wrong_length_is_one_line_naming_its_joints(capsys):
+    full = "0,0,0.3,0,0,0,1," + SOLO_JOINTS  # 19 values: the whole configuration
+    assert main(["simulate", "solo12", "--controller", "pd", "--target", full, "--duration", "0.1"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert len(error.splitlines()) == 1 and "Traceback" not in error
+    assert "--target must be 12 joint values" in error and "'FL_HAA'" in error and "got 19 values" in error
