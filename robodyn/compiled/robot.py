@@ -56,9 +56,11 @@ def _generator_source() -> str:
 
 
 def robot_key(robot: Robot) -> str:
-    """The cache key of a robot's generated kernels: its URDF text, gravity and the generator."""
+    """The cache key of a robot's generated kernels: its URDF text, gravity, the armature
+    given to :func:`robodyn.load` (the file's is in the text) and the generator."""
     gravity = ",".join(repr(float(g)) for g in robot.gravity_vector)
-    return build.digest(robot.urdf, gravity, CODEGEN_VERSION, f"compact snap={SNAP}", _generator_source())
+    armature = repr(tuple(robot.options.armature))
+    return build.digest(robot.urdf, gravity, armature, CODEGEN_VERSION, f"compact snap={SNAP}", _generator_source())
 
 
 def generate_kernels(robot: Robot) -> str:

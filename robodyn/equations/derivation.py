@@ -247,7 +247,7 @@ def _tidy(rename: dict, q: list, speeds: list):
 
 def _check_size(model: ReferenceRobot) -> None:
     """Refuse a robot of more than :data:`MAX_MOVING_JOINTS` moving joints, in one line."""
-    moving = len(model.tree.bodies)
+    moving = sum(not body.rotor for body in model.tree.bodies)  # an armature's rotor is no joint
     if moving > MAX_MOVING_JOINTS:
         raise InputError(
             "source",

@@ -91,7 +91,7 @@ def estimate_closed_form_seconds(robot: ReferenceRobot, *, keep_params: bool = F
     (1.0), the oblique robot's first joint 0.28 s (0.35) and first two 28 s (24.5), ur5's
     first four joints 52 s. Kept parameters cost about as much again.
     """
-    bodies = robot.tree.bodies
+    bodies = [body for body in robot.tree.bodies if not body.rotor]  # a rotor adds one term, not a level
     revolute = sum(body.revolute for body in bodies)
     mimic = len(bodies) - robot.nv
     estimate = 0.005 * 10.0**revolute * 3.0 ** (len(bodies) - revolute) * 1.5**mimic

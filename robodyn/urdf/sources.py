@@ -157,6 +157,7 @@ class _Reading:
     xacro_args: Mapping[str, str] | None
     lookup: PackageLookup
     strict: bool
+    interpret: bool = True
 
 
 _ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
@@ -171,7 +172,10 @@ def root_tag(text: str) -> str | None:
 
 
 def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
-    """A source read as what it is: xacro expanded, MJCF converted, SDF refused."""
+    """A source read as what it is: xacro expanded, MJCF converted, SDF refused (as it was
+    read, with ``reading.interpret`` false)."""
+    if not reading.interpret:
+        return source
     tag = root_tag(source.text)
     if tag == "sdf":
         raise URDFError(
@@ -206,6 +210,7 @@ def resolve_source(
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
     strict: bool = False,
+    interpret: bool = True,
 ) -> URDFSource:
     """Find the URDF a source names.
 
@@ -218,6 +223,8 @@ def resolve_source(
         packages: Package folders by package name, searched before ``$ROS_PACKAGE_PATH``
             and the zoo (:mod:`robodyn.urdf.packages`) for ``$(find)`` and ``package://``.
         strict: Refuse MJCF elements robodyn cannot take instead of warning.
+        interpret: Expand a xacro, convert an MJCF file and refuse SDF (``False``: the text
+            as read, for telling reading errors from the document's own problems).
 
     Raises:
         URDFError: If a file cannot be read, is not a regular file or is too large, a
@@ -225,7 +232,7 @@ def resolve_source(
         UnknownRobotError: If a name is neither a robot nor an existing file.
     """
     limit = max_urdf_bytes(max_bytes)
-    reading = _Reading(limit, xacro_args, package_lookup(packages), strict)
+    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret)
     if isinstance(source, os.PathLike):
         return _read_file(Path(source), limit, reading)
     if not isinstance(source, str):
@@ -310,13 +317,19 @@ def lint_source(
 ) -> list[Problem]:
     """Every problem of a robot file (a path, text or robot name), errors and warnings.
 
-    A document that is not even well-formed XML gives one error problem. A xacro is
-    linted as its expansion, an MJCF file as the URDF robodyn reads it into.
+    A document that is not even well-formed XML gives one error problem, and so does one
+    robodyn cannot read as a robot (SDF, a xacro that does not expand, an MJCF element it
+    refuses). A xacro is linted as its expansion, an MJCF file as the URDF robodyn reads it
+    into.
 
     Raises:
         UnknownRobotError, URDFError: If the source cannot be found or read.
     """
-    resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
+    resolve_source(source, interpret=False)  # a file that cannot be read is an error, not a problem
+    try:
+        resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
+    except URDFError as error:
+        return [Problem(error.element, error.rule)]
     floating = resolved.floating_base if floating_base is None else floating_base
     try:
         _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, strict=True, **resolved.mesh_context)

@@ -184,6 +184,7 @@ def check_robot(
         gravity=tuple(robot.gravity_vector),
         check_inertia=check_inertia,
         floating_base=robot.floating_base,
+        armature=dict(robot.options.armature),
     )
     report = CheckReport(robot.name, samples, seed, list(robot.joint_names))
     unmatched = _unmatched_joints(robot.joint_names, model.joint_names)
