@@ -8,11 +8,14 @@ as the original was.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
+from robodyn.common.text import quoted
+from robodyn.exceptions import InputError
 from robodyn.urdf.sources import max_urdf_bytes
 
 #: Most degrees of freedom loaded by default. Pinocchio's data grows with njoints × nv²
@@ -93,8 +96,23 @@ def load_options(
         max_bytes=max_urdf_bytes(max_bytes),
         xacro_args=tuple((str(name), str(value)) for name, value in (xacro_args or {}).items()),
         packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
-        armature=tuple((str(name), float(value)) for name, value in (armature or {}).items()),
+        armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
     )
+
+
+def _armature(name: object, value: object) -> float:
+    """One ``armature=`` value as a float in [kg m²] / [kg].
+
+    Raises:
+        InputError: If it is not a finite number ≥ 0 (naming the joint).
+    """
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        number = math.nan
+    if not (math.isfinite(number) and number >= 0):
+        raise InputError(f"armature[{quoted(str(name))}]", "a finite number >= 0 in [kg m²] or [kg]", repr(value))
+    return number
 
 
 __all__ = ["MAX_DOF", "LoadOptions", "load_options"]

@@ -191,3 +191,9 @@ def test_a_rebuilt_or_unpickled_robot_keeps_its_armature():
     for copy in (rebuild(robot), pickle.loads(pickle.dumps(robot))):
         np.testing.assert_array_equal(copy.joint_armature, robot.joint_armature)
         np.testing.assert_array_equal(copy.model.armature, robot.model.armature)
+
+
+@pytest.mark.parametrize("value", ["abc", float("nan"), -1.0, None, float("inf")])
+def test_an_armature_that_is_not_a_finite_non_negative_number_is_one_input_error_naming_the_joint(value):
+    with pytest.raises(robodyn.exceptions.InputError, match=r"armature\['joint1'\] must be a finite number >= 0"):
+        robodyn.load("rp_arm", armature={"joint1": value})
