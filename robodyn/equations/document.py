@@ -9,7 +9,7 @@ derivation starts.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal, cast
 
@@ -23,6 +23,7 @@ from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
 from robodyn.equations.render_derivation import DerivationFormat, derivation_document
 from robodyn.equations.render_latex import tex_engine
 from robodyn.exceptions import InputError, MissingToolError
+from robodyn.urdf.sources import resolve_source
 
 #: Which document: the equations of motion, their Christoffel symbols, a frame's
 #: kinematics, the Lagrangian derivation step by step, or the lecture's RP arm with errata.
@@ -66,6 +67,8 @@ class Request:
     floating_base: bool | None = None
     frame: str | None = None
     precision: int = DEFAULT_PRECISION
+    xacro_args: Mapping[str, str] | None = None
+    packages: Mapping[str, str] | None = None
 
 
 def equations_document(
@@ -83,7 +86,8 @@ def equations_document(
         progress: Called as ``progress(stage, done, total)`` during long derivations.
         **options: The fields of :class:`Request`: ``format`` (one of :data:`FORMATS` for
             ``what``), ``form``, ``keep_params``, ``gravity`` in [m/s²], ``lock``,
-            ``floating_base``, ``frame`` (a link, for ``"kinematics"``), ``precision``.
+            ``floating_base``, ``frame`` (a link, for ``"kinematics"``), ``precision``,
+            ``xacro_args`` and ``packages`` (as for :func:`robodyn.load`).
 
     Raises:
         InputError: For a format the document does not come in, a lecture of another
@@ -91,6 +95,8 @@ def equations_document(
         MissingToolError: For a PDF without pdflatex.
     """
     request = Request(**options)  # type: ignore[arg-type]
+    if request.xacro_args or request.packages:  # read once, as robodyn.load reads it
+        source = resolve_source(source, xacro_args=request.xacro_args, packages=request.packages).text
     _check(source, what, request)
     if what == "lecture":
         return Document(lecture_text(), "the lecture's RP arm")

@@ -86,3 +86,16 @@ def test_lint_takes_the_file_flags_and_an_sdf_is_one_line(capsys, tmp_path):
     (tmp_path / "m.sdf").write_text('<sdf version="1.7"><model name="m"/></sdf>')
     status, _, err = run(capsys, "info", str(tmp_path / "m.sdf"))
     assert status == 2 and "gz sdf -p model.sdf > model.urdf" in err and len(err.strip().splitlines()) == 1
+
+
+def test_symbolic_equations_of_a_xacro_take_its_packages_and_arguments(capsys, monkeypatch):
+    """``equations --symbolic`` reads a xacro as ``robodyn.load`` does: ``--package`` resolves
+    its ``$(find)`` and ``--xacro-arg`` reaches it (the prefix renames the joints); without the
+    package the same call is one line naming it."""
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    status, out, _ = run(capsys, "equations", *MODELS["xacro"], "--symbolic", "--format", "json")
+    assert status == 0
+    names = json.loads(out)["joint_names"]
+    assert names and all(name.startswith("left_") for name in names)
+    status, _, err = run(capsys, "equations", str(PACKAGE / "urdf" / "arm.urdf.xacro"), "--symbolic")
+    assert status == 2 and "package 'robodyn_test_arm' not found" in err and "--package" in err

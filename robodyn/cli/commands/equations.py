@@ -7,7 +7,16 @@ import sys
 
 import numpy as np
 
-from robodyn.cli.common import Progress, add_model_arguments, load_robot, lock_values, state, vector
+from robodyn.cli.common import (
+    Progress,
+    add_model_arguments,
+    load_robot,
+    lock_values,
+    package_arguments,
+    state,
+    vector,
+    xacro_arguments,
+)
 from robodyn.common.text import json_text
 from robodyn.exceptions import InputError
 
@@ -82,6 +91,7 @@ def _symbolic(arguments: argparse.Namespace) -> int:
             arguments.model, what, progress=progress, format=arguments.format, form=arguments.form,
             keep_params=arguments.keep_params, gravity=arguments.gravity, lock=lock_values(arguments.lock),
             floating_base=arguments.floating_base, frame=arguments.kinematics, precision=arguments.precision,
+            xacro_args=xacro_arguments(arguments.xacro_arg) or None, packages=package_arguments(arguments.package) or None,
         )  # fmt: skip
     finally:
         progress.close()
