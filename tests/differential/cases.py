@@ -95,8 +95,9 @@ def _load(case: Case) -> robodyn.Robot:
 def _reference(case: Case):
     options = case.options
     return robodyn.reference.load(
-        case.source, gravity=options.get("gravity"), lock=options.get("lock"), floating_base=case.floating
-    )
+        case.source, gravity=options.get("gravity"), lock=options.get("lock"), floating_base=case.floating,
+        armature=options.get("armature"),
+    )  # fmt: skip
 
 
 # ----------------------------------------------------------------------------------------
@@ -124,7 +125,7 @@ def lockable(text_or_path: str | Path) -> dict[str, tuple[float, float]]:
 
 def draw_options(rng: np.random.Generator, source: str | Path, *, floating: bool | None = None) -> dict:
     """Random load options: gravity (any direction), a lock at a non-zero position, a
-    floating base, a thread count (each drawn or not)."""
+    floating base, a thread count, a rotor's armature at one joint (each drawn or not)."""
     options: dict = {}
     if rng.random() < 0.7:
         options["gravity"] = random_gravity(rng)
@@ -139,6 +140,9 @@ def draw_options(rng: np.random.Generator, source: str | Path, *, floating: bool
     else:
         options["floating_base"] = False
     options["threads"] = int(rng.integers(1, 4))
+    free = sorted(set(candidates) - set(options.get("lock", {})))
+    if free and rng.random() < 0.3:  # drawn last: the other options of a seed stay as they were
+        options["armature"] = {free[int(rng.integers(len(free)))]: float(rng.uniform(0.01, 0.2))}
     return options
 
 

@@ -426,12 +426,13 @@ def _initial(robot, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
 
 
 def simulation_energy(case: Case, rng: np.random.Generator) -> None:
-    """A passive run conserves T + U: RK4 to 1e-6 of the energy's swing, semi-implicit Euler
-    to 1e-2; the two integrators agree to O(dt)."""
+    """A passive rigid-body run conserves T + U: RK4 to 1e-6 of the energy's swing,
+    semi-implicit Euler to 1e-2; the two integrators agree to O(dt); with the joints'
+    damping and friction acting (a file's ``<dynamics>``), T + U never grows."""
     robot = case.robot()
     q0, v0 = _initial(robot, rng)
     runs = {
-        integrator: robodyn.simulate(robot, q0, v0, 0.1, 5e-4, integrator=integrator, limits="ignore")
+        integrator: robodyn.simulate(robot, q0, v0, 0.1, 5e-4, integrator=integrator, limits="ignore", joint_friction=False)
         for integrator in ("rk4", "semi-implicit-euler")
     }
     size = (
@@ -452,6 +453,10 @@ def simulation_energy(case: Case, rng: np.random.Generator) -> None:
         )
     agree(case, "rk4 vs semi-implicit Euler v", runs["semi-implicit-euler"].v, runs["rk4"].v, rtol=0.05,
           floor=scale(runs["rk4"].v) + 1e-3, test="simulation")  # fmt: skip
+    if robot.joint_damping.any() or robot.joint_friction.any():
+        damped = _energy(robot, robodyn.simulate(robot, q0, v0, 0.1, 5e-4, limits="ignore"))
+        agree(case, "energy growth under joint friction", np.maximum(np.diff(damped), 0.0), np.zeros(damped.size - 1),
+              rtol=1e-6, floor=size, test="simulation")  # fmt: skip
     run = runs["rk4"]  # the samples are the dynamics': a = forward dynamics at the sample
     agree(
         case,
@@ -529,6 +534,14 @@ def _cli(arguments: list[str]) -> str:
     return f"{code}" + (f": {stderr.getvalue().strip()}" if code else "")
 
 
+def _cli_robot(case: Case):
+    """The case's robot as the CLI can give it: every option but ``armature=`` (no flag: a
+    file states its armature itself)."""
+    if not case.options.get("armature"):
+        return case.robot()
+    return robodyn.load(case.source, **{key: value for key, value in case.options.items() if key != "armature"})
+
+
 def _model_arguments(case: Case, robot) -> list[str]:
     """The CLI's model arguments for the case: the robot's own URDF (locks applied) as text."""
     arguments = [robot.urdf, "--floating-base" if robot.floating_base else "--fixed-base"]
@@ -575,7 +588,7 @@ def cli_torques_columns(case: Case, rng: np.random.Generator) -> None:
     import tempfile
     from pathlib import Path
 
-    robot = case.robot()
+    robot = _cli_robot(case)
     count = int(rng.choice([7, 129]))
     trajectory = _trajectory(robot, rng, count)
     chunk = int(rng.choice([5, 6, 64, 100]))
@@ -610,7 +623,7 @@ def cli_simulate_columns(case: Case, rng: np.random.Generator) -> None:
     import tempfile
     from pathlib import Path
 
-    robot = case.robot()
+    robot = _cli_robot(case)
     q0, _ = _initial(robot, rng)
     integrator = ["rk4", "semi-implicit-euler"][int(rng.integers(2))]
     expected = robodyn.simulate(robot, q0, np.zeros(robot.nv), 0.02, 1e-3, integrator=integrator, limits="ignore")
@@ -636,7 +649,7 @@ def cli_equations_json(case: Case, rng: np.random.Generator) -> None:
 
     from robodyn.cli.app import main
 
-    robot = case.robot()
+    robot = _cli_robot(case)
     q, v, a = (x[0] for x in random_state_batch(robot, rng, 1))
     stdout = io.StringIO()
     text = [f"--{name}={','.join(repr(float(x)) for x in value)}" for name, value in (("q", q), ("v", v), ("a", a))]
