@@ -77,9 +77,9 @@ def error_text(error: RobodynError) -> str:
     argument the message suggests (``form='compact'``) becomes the flag (``--form compact``),
     a boolean one (``floating_base=False``) its switch (``--fixed-base``).
     """
-    if isinstance(error, InputError) and error.argument in FLAGS:
-        return printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
     text = str(error)
+    if isinstance(error, InputError) and error.argument in FLAGS:
+        text = printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
     for keyword, switch in SWITCHES.items():
         text = text.replace(keyword, switch)
     return _KEYWORD.sub(_keyword_flag, text)

@@ -194,21 +194,20 @@ class ModelHandle:
 def _matrix_call(
     kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
 ) -> Callable[..., np.ndarray]:
-    """:meth:`ModelHandle.single_call` of CRBA: the upper triangle mirrored, ``M`` and the
-    world-attached joints' ``q`` checked."""
+    """:meth:`ModelHandle.single_call` of CRBA: the upper triangle mirrored, ``M`` and ``q``
+    checked."""
     isfinite = _isfinite
     lower, copyto = np.tri(model.nv, model.nv, -1, dtype=bool), np.copyto
-    # CRBA never uses the placement of a joint attached to the world, so those
-    # joints' q (only) are checked besides M itself; every other q moves M.
-    roots = tuple(_root_coordinates(model))
-    root = roots[0] if len(roots) == 1 else None
+    # CRBA never uses the placement of a joint attached to the world, and M need not move
+    # with other joints either (a chain of prismatic joints: M is constant), so q is
+    # checked besides M itself.
 
     def matrix(q: np.ndarray) -> np.ndarray:
         try:
             result = raw(model, local.data, q)
             copyto(result, result.T, where=lower)
             flat = result.ravel()
-            if isfinite(flat.dot(flat) + (q.item(root) if root is not None else sum(map(q.item, roots)))):
+            if isfinite(flat.dot(flat) + sum(q.tolist())):
                 return result
         except PINOCCHIO_ERRORS:
             pass
@@ -261,13 +260,6 @@ def _vector_call(
         return evaluate(kernel, q, v, third)
 
     return vector3
-
-
-def _root_coordinates(model: pin.Model) -> list[int]:
-    """Indices in ``q`` of the joints attached to the world (the universe, joint 0)."""
-    return [
-        model.joints[j].idx_q + k for j in range(1, model.njoints) if model.parents[j] == 0 for k in range(model.joints[j].nq)
-    ]
 
 
 class SingleCalls(NamedTuple):

@@ -298,7 +298,8 @@ def lqr_gain(
     if np.abs(missing).max() > 1e-6 * scale:  # [N m] / [N]: a target typed to 8 digits holds
         unheld = ", ".join(f"{x:.3g}" for x in missing)
         raise InputError("q_eq", "an equilibrium the actuated joints can hold", f"gravity torques left unheld [{unheld}]")
-    A, B = linearize(model, q_eq, v_eq, holding, dt=dt, integrator=integrator, actuation=selection)
+    # designed on the rigid-body model, as every controller here (no friction compensated)
+    A, B = linearize(model, q_eq, v_eq, holding, dt=dt, integrator=integrator, actuation=selection, joint_friction=False)
     weights = _weight(Q, 2 * model.nv, "Q"), _weight(R, selection.shape[1], "R")
     try:
         if dt is None:

@@ -33,7 +33,7 @@ from typing import Any, Literal
 import numpy as np
 import pinocchio as pin
 
-from robodyn.common.text import printable
+from robodyn.common.text import printable, quoted
 from robodyn.dynamics.dofs import Dof
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
@@ -181,6 +181,7 @@ def linearize(
     dt: float | None = None,
     integrator: StepIntegrator = "rk4",
     actuation: np.ndarray | None = None,
+    joint_friction: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(A, B)`` of the dynamics about ``(q, v, tau)``: continuous, or one step of ``dt``.
 
@@ -193,6 +194,11 @@ def linearize(
         dt: Step in [s] for the Jacobians of one integrator step; ``None``: continuous time.
         integrator: With ``dt``: ``"rk4"`` or ``"semi-implicit-euler"`` (as :func:`robodyn.simulate`).
         actuation: ``S_act`` of shape (nv, nu), torques ``τ = S_act u``; default the identity.
+        joint_friction: Include the joints' damping and Coulomb friction, as
+            :func:`robodyn.simulate` does by default: the viscous torque ``−b v`` exactly
+            (``∂q̈/∂v`` gets ``−M⁻¹ diag(b)``) and a sliding joint's ``−f sign(v)`` (constant
+            near the state). A joint with Coulomb friction at rest is refused (stiction is not
+            differentiable there); ``False`` linearizes the rigid-body dynamics.
 
     Returns:
         ``A`` of shape (2 nv, 2 nv) and ``B`` of shape (2 nv, nu) (module docstring:
@@ -203,7 +209,7 @@ def linearize(
             actuation matrix.
         SingularMassMatrixError: If ``M(q)`` is singular.
     """
-    result = linearization(robot, q, v, tau, dt=dt, integrator=integrator, actuation=actuation)
+    result = linearization(robot, q, v, tau, dt=dt, integrator=integrator, actuation=actuation, joint_friction=joint_friction)
     return result.A, result.B
 
 
@@ -216,18 +222,21 @@ def linearization(
     dt: float | None = None,
     integrator: StepIntegrator = "rk4",
     actuation: np.ndarray | None = None,
+    joint_friction: bool = True,
 ) -> Linearization:
     """:func:`linearize` with the state, names and units (a :class:`Linearization`)."""
     q, v, tau = _state(robot, q, v, tau)
+    damping = _damping(robot, v) if joint_friction else np.zeros(robot.nv)
+    on = bool(joint_friction)
     selection = _actuation(robot, actuation)
     if dt is not None and not (isinstance(dt, numbers.Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0):
         raise InputError("dt", "a finite step > 0 in [s] (or None for continuous time)", repr(dt))
     if integrator not in STEP_INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(STEP_INTEGRATORS)}", repr(integrator))
     if dt is None:
-        A, B = _continuous(robot, q, v, tau, selection)
+        A, B = _continuous(robot, q, v, tau, selection, damping, on)
     else:
-        A, B = _Step(robot, tau, selection).jacobians(q, v, float(dt), integrator)
+        A, B = _Step(robot, tau, selection, damping, on).jacobians(q, v, float(dt), integrator)
     return Linearization(
         robot.name, robot.dofs, q, v, tau, None if dt is None else float(dt),
         None if dt is None else integrator, A, B, selection,
@@ -245,6 +254,30 @@ def _state(robot: Robot, q: Any, v: Any, tau: Any) -> tuple[np.ndarray, np.ndarr
     return arrays[0], arrays[1], arrays[2]
 
 
+def _damping(robot: Robot, v: np.ndarray) -> np.ndarray:
+    """The joints' viscous damping ``b`` (length nv), after refusing Coulomb friction at rest.
+
+    Raises:
+        InputError: If a joint with Coulomb friction does not move at ``v`` (naming them).
+    """
+    stuck = [dof.name for dof in robot.dofs if dof.friction > 0 and v[dof.index] == 0]
+    if stuck:
+        listed = ", ".join(quoted(name) for name in stuck[:8]) + (", …" if len(stuck) > 8 else "")
+        raise InputError(
+            "joint_friction",
+            "False to linearize at rest joints with Coulomb friction (stiction is not differentiable there)",
+            f"True with {listed} at rest",
+        )
+    return robot.joint_damping.copy()
+
+
+def _friction_torque(robot: Robot, v: np.ndarray, damping: np.ndarray, on: bool) -> np.ndarray:
+    """The joints' friction torque at ``v``: ``−b v − f sign(v)`` (``on``), else zero."""
+    if not on:
+        return np.zeros(robot.nv)
+    return -damping * v - robot.joint_friction * np.sign(v)
+
+
 def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
     """The actuation matrix, checked: (nv, nu) finite, nu ≥ 1; the identity for ``None``."""
     if actuation is None:
@@ -255,10 +288,13 @@ def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
     return matrix
 
 
-def _continuous(robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray):
-    """Continuous-time ``(A, B)``."""
+def _continuous(
+    robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray, damping: np.ndarray, on: bool
+):
+    """Continuous-time ``(A, B)`` (``on``: with the joints' friction, ``damping`` its ``b``)."""
     nv = robot.nv
-    dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau)
+    dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau + _friction_torque(robot, v, damping, on))
+    dv = dv - inverse * damping
     velocity_block = np.zeros((nv, nv))
     if robot.floating_base:  # the tangent space moves with the base: −ad(v_base)
         velocity_block[:6, :6] = -pin.Motion(v[:6]).action
@@ -272,8 +308,9 @@ class _Step:
     ``z = (δq, δv, δu)`` (each a matrix with 2 nv + nu columns), stage by stage as
     :mod:`robodyn.sim.simulation` computes the step (torque held over the step)."""
 
-    def __init__(self, robot: Robot, tau: np.ndarray, selection: np.ndarray) -> None:
+    def __init__(self, robot: Robot, tau: np.ndarray, selection: np.ndarray, damping: np.ndarray, on: bool) -> None:
         self.robot, self.tau, nv, nu = robot, tau, robot.nv, selection.shape[1]
+        self.damping, self.on = damping, on
         self.dq0 = np.hstack([np.eye(nv), np.zeros((nv, nv + nu))])
         self.dv0 = np.hstack([np.zeros((nv, nv)), np.eye(nv), np.zeros((nv, nu))])
         self.dtau = np.hstack([np.zeros((nv, 2 * nv)), selection])
@@ -290,8 +327,10 @@ class _Step:
 
     def acceleration(self, q: np.ndarray, dq: np.ndarray, v: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Forward dynamics at a stage and its Jacobian by the chain rule."""
-        robot, tau = self.robot, self.tau
+        robot, damping = self.robot, self.damping
+        tau = self.tau + _friction_torque(robot, v, damping, self.on)
         by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, tau)
+        by_v = by_v - inverse * damping
         return robot.forward_dynamics(q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
 
     def jacobians(self, q: np.ndarray, v: np.ndarray, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:

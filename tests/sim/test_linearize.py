@@ -79,7 +79,7 @@ def test_continuous_time_is_the_limit_of_small_steps(name, rng):
     """(A_d − I) / dt → A_c: the floating base's −ad(v) block included (v ≠ 0 here)."""
     robot = load_case(name)
     q, v, tau = (x[0] for x in random_states(robot, rng, 1))
-    A, B = linearize(robot, q, v, tau)
+    A, B = linearize(robot, q, v, tau, joint_friction=False)  # the rigid-body derivatives themselves
     dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau)
     nv = robot.nv
     np.testing.assert_array_equal(A[nv:, :nv], dq)
@@ -87,7 +87,7 @@ def test_continuous_time_is_the_limit_of_small_steps(name, rng):
     np.testing.assert_array_equal(A[:nv, nv:], np.eye(nv))
     np.testing.assert_array_equal(B[nv:], inverse)
     dt = 1e-6
-    A_d, B_d = linearize(robot, q, v, tau, dt=dt, integrator="rk4")
+    A_d, B_d = linearize(robot, q, v, tau, dt=dt, integrator="rk4", joint_friction=False)
     assert relative(A, (A_d - np.eye(2 * nv)) / dt) < 1e-4
     assert relative(B, B_d / dt) < 1e-4
     if robot.floating_base:  # negative control: without the moving tangent space it fails
@@ -182,8 +182,41 @@ def test_one_euler_step_matches_mujocos_transition_jacobians(name, rng):
     nv = robot.nv
     A_mj, B_mj = np.zeros((2 * nv, 2 * nv)), np.zeros((2 * nv, nv))
     mujoco.mjd_transitionFD(model, data, 1e-7, 1, A_mj, B_mj, None, None)
-    A, B = linearize(robot, q, v, tau, dt=dt, integrator="semi-implicit-euler")
+    # MuJoCo's model has no <dynamics> (its Euler step treats damping implicitly): rigid body
+    A, B = linearize(robot, q, v, tau, dt=dt, integrator="semi-implicit-euler", joint_friction=False)
     assert relative(A, A_mj) < 1e-5, relative(A, A_mj)
     assert relative(B, B_mj) < 1e-5, relative(B, B_mj)
-    rk4 = linearize(robot, q, v, tau, dt=dt, integrator="rk4")[0]
+    rk4 = linearize(robot, q, v, tau, dt=dt, integrator="rk4", joint_friction=False)[0]
     assert relative(rk4, A_mj) > 10 * relative(A, A_mj)  # negative control: another integrator
+
+
+def test_joint_damping_enters_the_linearisation_as_the_simulator_applies_it(rng):
+    """The double pendulum's <dynamics damping>: ∂q̈/∂v gets −M⁻¹ diag(b), and one rk4 step's
+    Jacobians match central differences of simulate with its default joint friction; the
+    rigid-body linearisation (negative control) misses them."""
+    robot = load_case("double_pendulum_continuous")
+    assert robot.joint_damping.any()
+    q, v, tau = (x[0] for x in random_states(robot, rng, 1))
+    nv = robot.nv
+    damped = linearize(robot, q, v, tau)[0]
+    _, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau - robot.joint_damping * v)
+    np.testing.assert_allclose(damped[nv:, nv:], dv - inverse * robot.joint_damping, rtol=0, atol=1e-12)
+    dt, h = 1e-3, 1e-6
+
+    def step(x):
+        run = robodyn.simulate(robot, x[:nv], x[nv:], dt, dt, controller=lambda t, q_, v_: tau, limits="ignore")
+        return np.concatenate([run.q[-1], run.v[-1]])
+
+    x = np.concatenate([q, v])
+    differences = np.column_stack([(step(x + h * e) - step(x - h * e)) / (2 * h) for e in np.eye(2 * nv)])
+    assert relative(linearize(robot, q, v, tau, dt=dt)[0], differences) < 1e-6
+    assert relative(linearize(robot, q, v, tau, dt=dt, joint_friction=False)[0], differences) > 1e-5
+
+
+def test_coulomb_friction_at_rest_is_refused_naming_the_way_out():
+    robot = robodyn.load("z1")
+    q = robot.default_configuration()
+    with pytest.raises(robodyn.exceptions.InputError, match="joint_friction must be False to linearize at rest"):
+        linearize(robot, q, np.zeros(robot.nv))
+    A, _ = linearize(robot, q, np.zeros(robot.nv), joint_friction=False)
+    assert np.isfinite(A).all()

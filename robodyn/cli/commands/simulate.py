@@ -27,24 +27,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="controlled frame for task-space, osc, impedance (default: the end effector 'robodyn info' shows; it must move);"
         " with any controller, the path --record and --plot draw",
     )
-    parser.add_argument("--posture", type=vector, help="osc: a configuration drawn toward in the task's null space")
-    parser.add_argument("--stiffness", type=vector, help="impedance: K, 3 values in [N/m] (or 6, then [N m/rad])")
-    parser.add_argument("--damping", type=vector, help="impedance: D, in [N s/m] (then [N m s/rad])")
-    parser.add_argument(
-        "--force-at",
-        dest="force_at",
-        action="append",
-        default=[],
-        metavar="T:FX,FY,FZ[@FRAME]",
-        help="a push of FX,FY,FZ [N] from time T [s] on, at FRAME (default: the controlled frame); repeatable",
-    )
-    parser.add_argument(
-        "--observer-gain",
-        dest="observer_gain",
-        type=float,
-        help="run a momentum observer of this gain [1/s]; --out then has tau_ext[<joint>] columns",
-    )
-    parser.add_argument("--actuated", help="lqr: the actuated joints, comma-separated (default all; the others get no torque)")
+    _add_controller_options(parser)
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
     parser.add_argument("--dt", type=float, default=1e-3, help=f"step, {RANGES['dt'].text()}, at most --duration (default 0.001)")
@@ -59,8 +42,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--compiled",
         action="store_true",
-        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD and computed torque run in C too"
-        " (the same as --engine compiled)",
+        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD, computed torque, task-space, osc and"
+        " impedance run in C too (the same as --engine compiled)",
     )
     _add_engine_arguments(parser)
     no_friction = "leave out the joints' damping and friction (<dynamics>): the rigid-body motion"
@@ -133,6 +116,28 @@ def _engine(arguments: argparse.Namespace) -> str:
     if arguments.compiled and arguments.engine not in (None, "compiled"):
         raise InputError("--compiled", "not combined with another --engine", f"--engine {arguments.engine}")
     return "compiled" if arguments.compiled else (arguments.engine or "auto")
+
+
+def _add_controller_options(parser: argparse.ArgumentParser) -> None:
+    """The options of particular controllers, pushes and the observer."""
+    parser.add_argument("--posture", type=vector, help="osc: a configuration drawn toward in the task's null space")
+    parser.add_argument("--stiffness", type=vector, help="impedance: K, 3 values in [N/m] (or 6, then [N m/rad])")
+    parser.add_argument("--damping", type=vector, help="impedance: D, in [N s/m] (then [N m s/rad])")
+    parser.add_argument(
+        "--force-at",
+        dest="force_at",
+        action="append",
+        default=[],
+        metavar="T:FX,FY,FZ[@FRAME]",
+        help="a push of FX,FY,FZ [N] from time T [s] on, at FRAME (default: the controlled frame); repeatable",
+    )
+    parser.add_argument(
+        "--observer-gain",
+        dest="observer_gain",
+        type=float,
+        help="run a momentum observer of this gain [1/s]; --out then has tau_ext[<joint>] columns",
+    )
+    parser.add_argument("--actuated", help="lqr: the actuated joints, comma-separated (default all; the others get no torque)")
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
