@@ -33,6 +33,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robodyn.common.extras import require
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, OptimizationError
 from robodyn.export import casadi_functions
@@ -65,6 +66,8 @@ class OptimalMotion:
         iterations: IPOPT's iterations.
         solve_time: Wall-clock time of the solve (export and problem building excluded), in [s].
         peak_torque: Largest ``|tau|`` of each degree of freedom, in [N m] / [N].
+        effort_units: The unit of each degree of freedom's effort (``"N m"`` or ``"N"``).
+        kind: The cost asked for (``"effort"`` or ``"time"``).
     """
 
     trajectory: Trajectory
@@ -74,6 +77,21 @@ class OptimalMotion:
     iterations: int
     solve_time: float
     peak_torque: tuple[float, ...]
+    effort_units: tuple[str, ...] = ()
+    kind: str = "effort"
+
+    def text(self) -> str:
+        """One line: IPOPT's status, the cost, the duration, the solve and the peak efforts."""
+        units = self.effort_units or ("",) * len(self.peak_torque)
+        names = self.trajectory.coordinate_names[1]  # one per degree of freedom
+        peaks = ", ".join(
+            f"{printable(name)} {peak:.4g} {unit}".rstrip()
+            for name, peak, unit in zip(names, self.peak_torque, units, strict=True)
+        )
+        return (
+            f"{printable(self.status)}: {self.kind} cost {self.cost:.6g} s, duration {self.duration:.6g} s, "
+            f"{self.iterations} iterations in {self.solve_time:.3g} s; peak efforts {peaks}"
+        )
 
 
 def _rk4(ca: Any, forward: Any, nv: int) -> Any:
@@ -229,10 +247,10 @@ def point_to_point(
         status = str(problem.opti.stats().get("return_status", "an error"))
         raise OptimizationError(robot.name, status, _limiting(problem)) from None
     elapsed = time.perf_counter() - began
-    return _motion(robot, problem, solution, int(intervals), elapsed)
+    return _motion(robot, problem, solution, int(intervals), elapsed, cost)
 
 
-def _motion(robot: Robot, problem: _Problem, solution: Any, intervals: int, elapsed: float) -> OptimalMotion:
+def _motion(robot: Robot, problem: _Problem, solution: Any, intervals: int, elapsed: float, cost: str) -> OptimalMotion:
     """The solution as a trajectory at the grid (``a`` by the engine's forward dynamics)."""
     nv = robot.nv
     X = np.atleast_2d(solution.value(problem.X)).reshape(2 * nv, intervals + 1)
@@ -252,4 +270,6 @@ def _motion(robot: Robot, problem: _Problem, solution: Any, intervals: int, elap
         iterations=int(stats.get("iter_count", 0)),
         solve_time=elapsed,
         peak_torque=tuple(float(x) for x in np.abs(tau).max(axis=0)),
+        effort_units=tuple(dof.effort_unit for dof in robot.dofs),
+        kind=cost,
     )

@@ -37,10 +37,6 @@ def run(arguments: argparse.Namespace) -> int:
     finally:
         progress.close()
     motion.trajectory.save(arguments.out)
-    peaks = ", ".join(f"{printable(name)} {peak:.4g}" for name, peak in zip(robot.joint_names, motion.peak_torque, strict=True))
-    print(
-        f"{motion.status}: {arguments.cost} cost {motion.cost:.6g}, duration {motion.duration:.6g} s, "
-        f"{motion.iterations} iterations in {motion.solve_time:.3g} s; peak torques {peaks}"
-    )
+    print(motion.text())
     print(f"wrote {printable(arguments.out)} ({len(motion.trajectory)} samples)", file=sys.stderr)
     return 0
