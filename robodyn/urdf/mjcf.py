@@ -430,7 +430,10 @@ def _write_joint(robot: _Robot, name: str, attributes: dict[str, str], parent: s
     ET.SubElement(joint, "axis", xyz=_text(axis))
     if urdf_type != "continuous":
         bounded = math.isfinite(lower)
-        ET.SubElement(joint, "limit", lower=repr(lower if bounded else 1.0), upper=repr(upper if bounded else -1.0))
+        if bounded:
+            ET.SubElement(joint, "limit", lower=repr(lower), upper=repr(upper))
+        else:  # Bullet's encoding of no position limit, marked as robodyn's own (no warning)
+            ET.SubElement(joint, "limit", lower="1.0", upper="-1.0", unlimited="true")
     damping, friction, armature = (
         _number(robot.label, where, attributes.get(key, "0")) for key in ("damping", "frictionloss", "armature")
     )

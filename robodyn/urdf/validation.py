@@ -212,7 +212,9 @@ def _read_limits(reader: _Reader, where: str, node: ET.Element, joint_type: str)
         if not (math.isfinite(lower) and math.isfinite(upper)):
             reader.error(where, f"limits [{lower}, {upper}] must be finite")
             return None
-        if lower > upper:  # Bullet's (and urdfdom's) encoding of a joint without a position limit
+        if lower > upper and limit.get("unlimited") == "true":  # written so by robodyn's MJCF reader
+            lower, upper = -math.inf, math.inf
+        elif lower > upper:  # Bullet's (and urdfdom's) encoding of a joint without a position limit
             reader.warn(
                 where,
                 f"lower limit {lower} is above upper limit {upper}: read as no position limit (Bullet's encoding)",

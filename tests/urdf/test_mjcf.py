@@ -269,3 +269,17 @@ def test_mujocos_own_test_models_are_refused_in_one_line_where_out_of_scope():
             robodyn.load(path)
         except URDFError as error:
             assert "\n" not in str(error)
+
+
+def test_a_joint_without_range_loads_unlimited_without_a_warning_about_the_file():
+    """MuJoCo's joints are unlimited unless limited: nothing in the file to warn about."""
+    text = (
+        '<mujoco model="free_slide"><worldbody><body name="a" pos="0 0 0.1">'
+        '<joint name="slide" type="slide" axis="1 1 0"/><joint name="turn" type="hinge" axis="0 0 1"/>'
+        '<inertial pos="0 0 0" mass="1.2" diaginertia="0.01 0.02 0.03"/></body></worldbody></mujoco>'
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        robot = robodyn.load(text)
+    assert [dof.joint_type for dof in robot.dofs] == ["prismatic", "continuous"]
+    assert all(dof.lower == -np.inf and dof.upper == np.inf for dof in robot.dofs)
