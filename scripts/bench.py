@@ -270,7 +270,7 @@ def bench_simulation(quick: bool) -> list[dict]:
             try:
                 elapsed = median_once(
                     lambda integrator=integrator, robot=robot, q0=q0, v0=v0: simulate(
-                        robot, q0, v0, duration, 1e-3, integrator=integrator
+                        robot, q0, v0, duration, 1e-3, integrator=integrator, engine="pinocchio"
                     )
                 )
                 factor, note = duration / elapsed, ""
@@ -278,7 +278,7 @@ def bench_simulation(quick: bool) -> list[dict]:
                 shorter = max(1.0, float(np.floor(error.time)) - 1.0)
                 elapsed = median_once(
                     lambda integrator=integrator, robot=robot, q0=q0, v0=v0: simulate(
-                        robot, q0, v0, shorter, 1e-3, integrator=integrator
+                        robot, q0, v0, shorter, 1e-3, integrator=integrator, engine="pinocchio"
                     )
                 )
                 factor = shorter / elapsed
@@ -535,12 +535,15 @@ def bench_compiled_simulation(quick: bool) -> list[dict]:
     steps = round(duration / 1e-3)
     for integrator, mj_integrator in (("rk4", "mjINT_RK4"), ("semi-implicit-euler", "mjINT_EULER")):
         row = {"robot": "panda (arm, fingers locked)", "integrator": integrator, "duration_s": duration, "dt_s": 1e-3}
-        compiled_run = lambda: simulate_compiled(compiled, q0, v0, duration, 1e-3, integrator=integrator)  # noqa: E731
+        compiled_run = lambda: simulate_compiled(compiled, q0, v0, duration, 1e-3, integrator=integrator, joint_friction=False)  # noqa: E731
         row["compiled_rtf"] = duration / median_once(compiled_run)
         row["compiled_rtf_cpu"] = duration / median_cpu(compiled_run)
         python_duration = min(duration, 2.0)
         row["python_engine_rtf"] = python_duration / median_once(
-            lambda: simulate(robot, q0, v0, python_duration, 1e-3, integrator=integrator), repeats=1 if quick else 3
+            lambda: simulate(
+                robot, q0, v0, python_duration, 1e-3, integrator=integrator, engine="pinocchio", joint_friction=False
+            ),
+            repeats=1 if quick else 3,
         )
         if mujoco is not None:
             model.opt.integrator = getattr(mujoco.mjtIntegrator, mj_integrator)
@@ -810,8 +813,8 @@ def bench_compiled_control(quick: bool) -> list[dict]:
     robot, compiled = _compiled("rp_arm", {})
     law = TaskSpace(robot, None, [0.7, 0.0, 0.7])
     twin, q0, v0 = compiled_controller(law), np.array([0.0, 0.1]), np.zeros(2)
-    run = lambda: simulate_compiled(compiled, q0, v0, 3.0, 1e-3, controller=twin)  # noqa: E731
-    python = simulate(robot, q0, v0, 3.0, 1e-3, controller=law)
+    run = lambda: simulate_compiled(compiled, q0, v0, 3.0, 1e-3, controller=twin, joint_friction=False)  # noqa: E731
+    python = simulate(robot, q0, v0, 3.0, 1e-3, controller=law, engine="pinocchio")
     rows.append(
         {
             "robot": "rp_arm (the demo)",
@@ -819,7 +822,8 @@ def bench_compiled_control(quick: bool) -> list[dict]:
             "duration_s": 3.0,
             "compiled_loop_rtf": 3.0 / median_once(run, 7),
             "compiled_loop_rtf_cpu": 3.0 / median_cpu(run, 7),
-            "python_engine_rtf": 3.0 / median_once(lambda: simulate(robot, q0, v0, 3.0, 1e-3, controller=law), 1),
+            "python_engine_rtf": 3.0
+            / median_once(lambda: simulate(robot, q0, v0, 3.0, 1e-3, controller=law, engine="pinocchio"), 1),
             "max_q_difference": float(np.abs(run().q - python.q).max()),
             "mujoco_passive_rk4_rtf": float("nan"),
             "mujoco_passive_rk4_rtf_cpu": float("nan"),
@@ -854,7 +858,10 @@ def bench_compiled_control(quick: bool) -> list[dict]:
         pass
     for name, law in laws.items():
         twin = compiled_controller(law)
-        run = lambda twin=twin: simulate_compiled(compiled, q0, np.zeros(robot.nv), duration, 1e-3, controller=twin)  # noqa: E731
+
+        def run(twin=twin):
+            return simulate_compiled(compiled, q0, np.zeros(robot.nv), duration, 1e-3, controller=twin, joint_friction=False)
+
         row = {"robot": "panda (arm, fingers locked)", "controller": name, "duration_s": duration}
         row["compiled_loop_rtf"] = duration / median_once(run)
         row["compiled_loop_rtf_cpu"] = duration / median_cpu(run)

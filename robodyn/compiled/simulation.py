@@ -25,6 +25,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from robodyn.common.inputs import as_state
+from robodyn.common.text import quoted
 from robodyn.compiled.controllers import CompiledFrameController, CompiledImpedance, CompiledOperationalSpace, CompiledTaskSpace
 from robodyn.compiled.robot import CompiledRobot, compile
 from robodyn.exceptions import CompileError, InputError, SimulationError
@@ -113,6 +114,7 @@ def simulate_compiled(
     controller: CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | PythonController | None = None,
     control_period: float | None = None,
     hold: bool = False,
+    joint_friction: bool = True,
 ) -> SimulationArrays:
     """Simulate a compiled robot from ``(q0, v0)`` for ``duration`` seconds, in C.
 
@@ -128,6 +130,9 @@ def simulate_compiled(
         control_period: For a Python controller, in [s], a whole number of steps
             (default ``dt``).
         hold: For a compiled controller: sample it once a step instead of at every stage.
+        joint_friction: The loop in C is rigid-body: a robot whose joints have damping or
+            Coulomb friction (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`) is
+            refused unless ``joint_friction=False`` asks for the rigid-body motion.
 
     Returns:
         ``round(duration / dt) + 1`` samples (the conventions of :func:`robodyn.simulate`).
@@ -138,6 +143,13 @@ def simulate_compiled(
     """
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
+    robot = compiled.robot
+    if joint_friction and (robot.joint_damping.any() or robot.joint_friction.any()):
+        raise InputError(
+            "joint_friction",
+            "False for a robot whose joints have damping or friction (the compiled loop is rigid-body)",
+            f"True for {quoted(robot.name)}",
+        )
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
     (q, v), batch = compiled.robot.validate(q=q0, v=v0)

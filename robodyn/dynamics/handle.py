@@ -172,6 +172,10 @@ class ModelHandle:
         """
         what, names, single, batch = kernel
         try:
+            # one state only (Pinocchio takes a (1, 1) array for a vector of one: a batch of
+            # one state of a one-joint robot would come back as one state's result)
+            if any(value.ndim != 1 for value in values):
+                raise ValueError("a batch")
             result = single(*values)
             q = values[0]
             # accept, written out on the hot path: finite result and q, unit quaternion.
@@ -204,6 +208,8 @@ def _matrix_call(
 
     def matrix(q: np.ndarray) -> np.ndarray:
         try:
+            if q.ndim != 1:  # a batch (Pinocchio would take a (1, 1) array as one state)
+                return evaluate(kernel, q)
             result = raw(model, local.data, q)
             copyto(result, result.T, where=lower)
             flat = result.ravel()
@@ -229,6 +235,8 @@ def _vector_call(
 
         def vector1(q: np.ndarray) -> np.ndarray:
             try:
+                if q.ndim != 1:  # a batch (Pinocchio would take a (1, 1) array as one state)
+                    return evaluate(kernel, q)
                 result = raw(model, local.data, q)
                 if isfinite(sum(result.tolist())):
                     return result
@@ -241,6 +249,8 @@ def _vector_call(
 
         def vector2(q: np.ndarray, v: np.ndarray) -> np.ndarray:
             try:
+                if q.ndim != 1 or v.ndim != 1:  # a batch (Pinocchio would take (1, 1) as one state)
+                    return evaluate(kernel, q, v)
                 result = raw(model, local.data, q, v)
                 if isfinite(sum(result.tolist())):
                     return result
@@ -252,6 +262,8 @@ def _vector_call(
 
     def vector3(q: np.ndarray, v: np.ndarray, third: np.ndarray) -> np.ndarray:
         try:
+            if q.ndim != 1 or v.ndim != 1 or third.ndim != 1:  # a batch (see vector2)
+                return evaluate(kernel, q, v, third)
             result = raw(model, local.data, q, v, third)
             if isfinite(sum(result.tolist())):
                 return result

@@ -635,7 +635,7 @@ def _simulate_compiled(
         run = simulate_compiled(
             plant, q, v, steps * dt, dt, integrator=integrator, controller=law,  # type: ignore[arg-type]
             control_period=None if compiled.law is not None or controller is None else every * dt,  # type: ignore[operator]
-            hold=every is not None,
+            hold=every is not None, joint_friction=False,  # refused before when friction acts
         )  # fmt: skip
         arrays = (run.q, run.v, run.a, run.tau)
     loop = perf_counter() - began

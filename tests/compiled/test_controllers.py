@@ -54,10 +54,13 @@ def deviation(python, compiled) -> float:
 
 def runs(robot, controller, q0, duration, dt=1e-3, integrator="rk4", twin=None):
     python = robodyn.simulate(
-        robot, q0, np.zeros(robot.nv), duration, dt, controller=controller, integrator=integrator, limits="ignore"
-    )
+        robot, q0, np.zeros(robot.nv), duration, dt, controller=controller, integrator=integrator, limits="ignore",
+        engine="pinocchio", joint_friction=False,  # the Python engine against the rigid-body loop in C
+    )  # fmt: skip
     law = twin if twin is not None else compiled_controller(controller)
-    compiled = simulate_compiled(compile(robot), q0, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator)
+    compiled = simulate_compiled(
+        compile(robot), q0, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, joint_friction=False
+    )
     return python, compiled
 
 

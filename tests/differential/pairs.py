@@ -325,7 +325,7 @@ def _in_order(names: list[str], robot) -> np.ndarray:
 def generated_python_vs_robot(case: Case, rng: np.random.Generator) -> None:
     from robodyn.equations.derive import render
 
-    robot = case.robot()
+    robot = _cli_robot(case)  # the generated code states what the file states (no armature=)
     namespace: dict = {}
     exec(render(_equations(case), "python"), namespace)
     order = _in_order(namespace["JOINT_NAMES"], robot)
@@ -358,7 +358,7 @@ def generated_c_vs_robot(case: Case, rng: np.random.Generator) -> None:
 
     from robodyn.equations.derive import render
 
-    robot = case.robot()
+    robot = _cli_robot(case)  # as for the generated Python
     equations = _equations(case)
     with tempfile.TemporaryDirectory() as folder:
         lib = _c_library(render(equations, "c"), Path(folder))

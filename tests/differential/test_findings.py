@@ -35,3 +35,26 @@ def test_a_massless_floating_root_with_one_child_is_refused_not_answered():
         assert regular.massless_joints == []
         state = regular.random_configuration(np.random.default_rng(1))
         assert np.all(np.isfinite(regular.forward_dynamics(state, np.zeros(regular.nv), np.zeros(regular.nv))))
+
+
+def test_a_batch_of_one_state_of_a_one_joint_robot_stays_a_batch():
+    """Seed random_tree:310003 (slow sweep): Pinocchio takes a (1, 1) array for a vector of
+    one entry, so the single-call fast path answered a batch of one state of a one-joint robot
+    with one state's shape ((1,) instead of (1, 1)); every quantity keeps the batch's shape."""
+    robot = robodyn.load(
+        "<robot name='one'><link name='a'/><link name='b'><inertial><mass value='1.3'/>"
+        "<inertia ixx='0.1' ixy='0' ixz='0' iyy='0.2' iyz='0' izz='0.1'/></inertial></link>"
+        "<joint name='j' type='continuous'><parent link='a'/><child link='b'/><origin xyz='0.1 0 0'/>"
+        "<axis xyz='0 1 0'/></joint></robot>"
+    )
+    q, v = np.array([[0.3]]), np.array([[0.1]])
+    for value, shape in (
+        (robot.inverse_dynamics(q, v, v), (1, 1)),
+        (robot.forward_dynamics(q, v, v), (1, 1)),
+        (robot.gravity(q), (1, 1)),
+        (robot.nonlinear_effects(q, v), (1, 1)),
+        (robot.mass_matrix(q), (1, 1, 1)),
+        (robot.inverse_dynamics(q[0], v[0], v[0]), (1,)),
+        (robot.mass_matrix(q[0]), (1, 1)),
+    ):
+        assert np.shape(value) == shape
