@@ -51,7 +51,7 @@ def test_passive_run_matches_python_simulate_step_for_step(tree, integrator):
     robot, compiled = tree
     q0, v0 = np.array([0.3, 0.1, -0.5]), np.array([0.2, -0.1, 0.4])
     run = simulate_compiled(compiled, q0, v0, 0.3, 1e-3, integrator=integrator)
-    _same_run(run, simulate(robot, q0, v0, 0.3, 1e-3, integrator=integrator))
+    _same_run(run, simulate(robot, q0, v0, 0.3, 1e-3, integrator=integrator, engine="pinocchio"))
 
 
 def test_negative_control_another_step_does_not_match(tree):
@@ -59,7 +59,7 @@ def test_negative_control_another_step_does_not_match(tree):
     q0, v0 = np.array([0.3, 0.1, -0.5]), np.zeros(3)
     run = simulate_compiled(compiled, q0, v0, 0.3, 1e-3)
     with pytest.raises(AssertionError):
-        _same_run(run, simulate(robot, q0, v0, 0.3, 1e-3, integrator="semi-implicit-euler"))
+        _same_run(run, simulate(robot, q0, v0, 0.3, 1e-3, integrator="semi-implicit-euler", engine="pinocchio"))
 
 
 def test_passive_rk4_conserves_energy_to_fourth_order(pendulum):
@@ -67,11 +67,11 @@ def test_passive_rk4_conserves_energy_to_fourth_order(pendulum):
     q0, v0 = np.array([1.2, -0.7]), np.array([0.5, 1.0])
 
     def drift(dt: float, integrator: str = "rk4") -> float:
-        run = simulate_compiled(compiled, q0, v0, 2.0, dt, integrator=integrator)
+        run = simulate_compiled(compiled, q0, v0, 2.0, dt, integrator=integrator, joint_friction=False)
         energy = robot.kinetic_energy(run.q, run.v) + robot.potential_energy(run.q)
         return float(np.abs(energy - energy[0]).max())
 
-    swing = np.ptp(robot.potential_energy(simulate_compiled(compiled, q0, v0, 2.0, 1e-3).q))
+    swing = np.ptp(robot.potential_energy(simulate_compiled(compiled, q0, v0, 2.0, 1e-3, joint_friction=False).q))
     assert swing > 1.0  # it really moves
     coarse, fine = drift(2e-3), drift(1e-3)
     assert coarse < 1e-5 * swing
@@ -85,7 +85,9 @@ def test_pd_gravity_matches_python_simulate(tree, hold):
     robot, compiled = tree
     target, kp, kd = np.array([0.5, 0.1, -1.0]), np.array([60.0, 200.0, 30.0]), 8.0
     q0, v0 = np.zeros(3), np.zeros(3)
-    run = simulate_compiled(compiled, q0, v0, 0.4, 1e-3, controller=CompiledPDGravity(compiled, target, kp, kd), hold=hold)
+    run = simulate_compiled(
+        compiled, q0, v0, 0.4, 1e-3, controller=CompiledPDGravity(compiled, target, kp, kd), hold=hold, joint_friction=False
+    )
     _same_run(run, simulate(robot, q0, v0, 0.4, 1e-3, controller=PDGravity(robot, target, kp, kd), hold=hold))
 
 
@@ -97,7 +99,7 @@ def test_computed_torque_on_a_mismatched_model_matches_python_simulate(tree, tmp
     model = robodyn.load(path)
     start, end = np.array([0.0, 0.0, 0.0]), np.array([0.8, 0.2, -1.2])
     controller = CompiledComputedTorque(compile(model), start, end, 0.3, kp=300.0, kd=35.0)
-    run = simulate_compiled(compiled, start, np.zeros(3), 0.5, 1e-3, controller=controller)
+    run = simulate_compiled(compiled, start, np.zeros(3), 0.5, 1e-3, controller=controller, joint_friction=False)
     python = ComputedTorque(model, quintic_reference(start, end, 0.3), kp=300.0, kd=35.0)
     _same_run(run, simulate(robot, start, np.zeros(3), 0.5, 1e-3, controller=python))
     assert np.abs(run.q[-1] - end).max() > 1e-4  # the wrong model leaves an error ...
@@ -113,7 +115,7 @@ def test_python_controller_is_held_for_its_control_period(tree):
         return -20.0 * q - 2.0 * v + np.array([0.0, 5.0, 0.0])
 
     q0, v0 = np.array([0.3, 0.0, 0.2]), np.zeros(3)
-    run = simulate_compiled(compiled, q0, v0, 0.2, 1e-3, controller=controller, control_period=5e-3)
+    run = simulate_compiled(compiled, q0, v0, 0.2, 1e-3, controller=controller, control_period=5e-3, joint_friction=False)
     assert len(calls) == 40 and calls[1] == pytest.approx(5e-3)
 
     held = {}
@@ -131,9 +133,9 @@ def test_divergence_is_reported_like_python_simulate(pendulum):
     robot, compiled = pendulum
     q0, v0 = np.array([0.1, 0.2]), np.array([1e154, 0.0])
     with pytest.raises(SimulationError) as theirs:
-        simulate(robot, q0, v0, 1.0, 1e-3)
+        simulate(robot, q0, v0, 1.0, 1e-3, engine="pinocchio", joint_friction=False)
     with pytest.raises(SimulationError) as ours:
-        simulate_compiled(compiled, q0, v0, 1.0, 1e-3)
+        simulate_compiled(compiled, q0, v0, 1.0, 1e-3, joint_friction=False)
     assert (ours.value.step, ours.value.joint) == (theirs.value.step, theirs.value.joint)
 
 
@@ -141,12 +143,24 @@ def test_bad_arguments_are_refused(pendulum):
     _, compiled = pendulum
     zero = np.zeros(2)
     with pytest.raises(InputError, match="integrator"):
-        simulate_compiled(compiled, zero, zero, 1.0, 1e-3, integrator="euler")
+        simulate_compiled(compiled, zero, zero, 1.0, 1e-3, integrator="euler", joint_friction=False)
     with pytest.raises(InputError, match="control_period"):
-        simulate_compiled(compiled, zero, zero, 1.0, 1e-3, controller=lambda t, q, v: zero, control_period=2.5e-3)
+        simulate_compiled(
+            compiled, zero, zero, 1.0, 1e-3, controller=lambda t, q, v: zero, control_period=2.5e-3, joint_friction=False
+        )
     with pytest.raises(InputError, match=r"^q "):
-        simulate_compiled(compiled, np.zeros(3), zero, 1.0, 1e-3)
+        simulate_compiled(compiled, np.zeros(3), zero, 1.0, 1e-3, joint_friction=False)
     with pytest.raises(InputError, match="controller output"):
-        simulate_compiled(compiled, zero, zero, 1.0, 1e-3, controller=lambda t, q, v: np.zeros(5))
-    run = simulate_compiled(compiled, zero, zero, 0.0, 1e-3)
+        simulate_compiled(compiled, zero, zero, 1.0, 1e-3, controller=lambda t, q, v: np.zeros(5), joint_friction=False)
+    run = simulate_compiled(compiled, zero, zero, 0.0, 1e-3, joint_friction=False)
     assert run.q.shape == (1, 2)
+
+
+def test_a_robot_with_joint_damping_is_refused_unless_the_rigid_body_motion_is_asked_for(pendulum):
+    """The zoo's double pendulum has <dynamics damping>: the rigid-body loop in C says so."""
+    robot, compiled = pendulum
+    assert robot.joint_damping.any()
+    zero = np.zeros(2)
+    with pytest.raises(InputError, match=r"joint_friction must be False .*\(the compiled loop is rigid-body\)"):
+        simulate_compiled(compiled, zero, zero, 0.1, 1e-3)
+    assert simulate_compiled(compiled, zero, zero, 0.1, 1e-3, joint_friction=False).q.shape == (101, 2)
