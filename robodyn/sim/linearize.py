@@ -35,6 +35,7 @@ import pinocchio as pin
 
 from robodyn.common.text import printable, quoted
 from robodyn.dynamics.dofs import Dof
+from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 
@@ -226,17 +227,16 @@ def linearization(
 ) -> Linearization:
     """:func:`linearize` with the state, names and units (a :class:`Linearization`)."""
     q, v, tau = _state(robot, q, v, tau)
-    damping = _damping(robot, v) if joint_friction else np.zeros(robot.nv)
-    on = bool(joint_friction)
+    friction = _joint_friction(robot, v, bool(joint_friction))
     selection = _actuation(robot, actuation)
     if dt is not None and not (isinstance(dt, numbers.Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0):
         raise InputError("dt", "a finite step > 0 in [s] (or None for continuous time)", repr(dt))
     if integrator not in STEP_INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(STEP_INTEGRATORS)}", repr(integrator))
     if dt is None:
-        A, B = _continuous(robot, q, v, tau, selection, damping, on)
+        A, B = _continuous(robot, q, v, tau, selection, friction)
     else:
-        A, B = _Step(robot, tau, selection, damping, on).jacobians(q, v, float(dt), integrator)
+        A, B = _Step(robot, tau, selection, friction).jacobians(q, v, float(dt), integrator)
     return Linearization(
         robot.name, robot.dofs, q, v, tau, None if dt is None else float(dt),
         None if dt is None else integrator, A, B, selection,
@@ -254,12 +254,15 @@ def _state(robot: Robot, q: Any, v: Any, tau: Any) -> tuple[np.ndarray, np.ndarr
     return arrays[0], arrays[1], arrays[2]
 
 
-def _damping(robot: Robot, v: np.ndarray) -> np.ndarray:
-    """The joints' viscous damping ``b`` (length nv), after refusing Coulomb friction at rest.
+def _joint_friction(robot: Robot, v: np.ndarray, on: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The viscous ``b`` and Coulomb ``f`` (length nv) the linearisation includes: the joints'
+    own (``on``), else zeros.
 
     Raises:
-        InputError: If a joint with Coulomb friction does not move at ``v`` (naming them).
+        InputError: If, ``on``, a joint with Coulomb friction does not move at ``v`` (naming them).
     """
+    if not on:
+        return np.zeros(robot.nv), np.zeros(robot.nv)
     stuck = [dof.name for dof in robot.dofs if dof.friction > 0 and v[dof.index] == 0]
     if stuck:
         listed = ", ".join(quoted(name) for name in stuck[:8]) + (", …" if len(stuck) > 8 else "")
@@ -268,14 +271,7 @@ def _damping(robot: Robot, v: np.ndarray) -> np.ndarray:
             "False to linearize at rest joints with Coulomb friction (stiction is not differentiable there)",
             f"True with {listed} at rest",
         )
-    return robot.joint_damping.copy()
-
-
-def _friction_torque(robot: Robot, v: np.ndarray, damping: np.ndarray, on: bool) -> np.ndarray:
-    """The joints' friction torque at ``v``: ``−b v − f sign(v)`` (``on``), else zero."""
-    if not on:
-        return np.zeros(robot.nv)
-    return -damping * v - robot.joint_friction * np.sign(v)
+    return robot.joint_damping, robot.joint_friction
 
 
 def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
@@ -289,12 +285,12 @@ def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
 
 
 def _continuous(
-    robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray, damping: np.ndarray, on: bool
+    robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray, friction: tuple[np.ndarray, np.ndarray]
 ):
-    """Continuous-time ``(A, B)`` (``on``: with the joints' friction, ``damping`` its ``b``)."""
+    """Continuous-time ``(A, B)`` (``friction``: the joints' ``(b, f)`` included)."""
     nv = robot.nv
-    dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau + _friction_torque(robot, v, damping, on))
-    dv = dv - inverse * damping
+    dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau + friction_torque(*friction, v))
+    dv = dv - inverse * friction[0]
     velocity_block = np.zeros((nv, nv))
     if robot.floating_base:  # the tangent space moves with the base: −ad(v_base)
         velocity_block[:6, :6] = -pin.Motion(v[:6]).action
@@ -308,9 +304,9 @@ class _Step:
     ``z = (δq, δv, δu)`` (each a matrix with 2 nv + nu columns), stage by stage as
     :mod:`robodyn.sim.simulation` computes the step (torque held over the step)."""
 
-    def __init__(self, robot: Robot, tau: np.ndarray, selection: np.ndarray, damping: np.ndarray, on: bool) -> None:
+    def __init__(self, robot: Robot, tau: np.ndarray, selection: np.ndarray, friction: tuple[np.ndarray, np.ndarray]) -> None:
         self.robot, self.tau, nv, nu = robot, tau, robot.nv, selection.shape[1]
-        self.damping, self.on = damping, on
+        self.friction = friction  # the joints' (b, f) included
         self.dq0 = np.hstack([np.eye(nv), np.zeros((nv, nv + nu))])
         self.dv0 = np.hstack([np.zeros((nv, nv)), np.eye(nv), np.zeros((nv, nu))])
         self.dtau = np.hstack([np.zeros((nv, 2 * nv)), selection])
@@ -327,10 +323,10 @@ class _Step:
 
     def acceleration(self, q: np.ndarray, dq: np.ndarray, v: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Forward dynamics at a stage and its Jacobian by the chain rule."""
-        robot, damping = self.robot, self.damping
-        tau = self.tau + _friction_torque(robot, v, damping, self.on)
+        robot, friction = self.robot, self.friction
+        tau = self.tau + friction_torque(*friction, v)
         by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, tau)
-        by_v = by_v - inverse * damping
+        by_v = by_v - inverse * friction[0]
         return robot.forward_dynamics(q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
 
     def jacobians(self, q: np.ndarray, v: np.ndarray, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:

@@ -206,12 +206,10 @@ def simulate(
     Warns:
         JointLimitWarning: With ``limits="warn"``, when a limit was broken.
     """
-    trajectory, _, violations = _simulate(
+    trajectory, _ = _simulate(
         robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
         limits=limits, engine=engine, control_period=control_period, observer=observer, joint_friction=joint_friction,
     )  # fmt: skip
-    if violations:
-        warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
     return trajectory
 
 
@@ -235,13 +233,10 @@ def simulate_run(
     """:func:`simulate`, also saying which engine ran, why, and the loop's and the
     compilation's wall-clock times (:class:`EngineRun`). Arguments, errors and warnings
     are :func:`simulate`'s."""
-    trajectory, run, violations = _simulate(
+    return _simulate(
         robot, q0, v0, duration, dt, controller=controller, integrator=integrator, external=external, hold=hold,
         limits=limits, engine=engine, control_period=control_period, observer=observer, joint_friction=joint_friction,
     )  # fmt: skip
-    if violations:
-        warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=2)
-    return trajectory, run
 
 
 def _simulate(
@@ -260,8 +255,9 @@ def _simulate(
     control_period: float | None,
     observer: MomentumObserver | None,
     joint_friction: bool,
-) -> tuple[Trajectory, EngineRun, list]:
-    """The run, how it went, and the limits it broke (none with ``limits="ignore"``)."""
+) -> tuple[Trajectory, EngineRun]:
+    """The run and how it went; a :class:`JointLimitWarning` for the limits it broke (with
+    ``limits="warn"``; none with ``"ignore"``)."""
     _check_modes(integrator, limits, engine)
     steps = _step_count(duration, dt)
     every = _period_steps(control_period, hold, dt, controller)
@@ -298,7 +294,9 @@ def _simulate(
         )  # fmt: skip
         run = replace(run, reason=reason, compile_time=compile_time)
     violations = [] if limits == "ignore" else JointLimits(robot).violations(trajectory)
-    return trajectory, run, violations
+    if violations:  # stack level 3: the caller of simulate / simulate_run
+        warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=3)
+    return trajectory, run
 
 
 def choose_engine(

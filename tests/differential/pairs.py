@@ -325,7 +325,7 @@ def _in_order(names: list[str], robot) -> np.ndarray:
 def generated_python_vs_robot(case: Case, rng: np.random.Generator) -> None:
     from robodyn.equations.derive import render
 
-    robot = _cli_robot(case)  # the generated code states what the file states (no armature=)
+    robot = _stated_robot(case)  # the generated code states what the file states (no armature=)
     namespace: dict = {}
     exec(render(_equations(case), "python"), namespace)
     order = _in_order(namespace["JOINT_NAMES"], robot)
@@ -358,7 +358,7 @@ def generated_c_vs_robot(case: Case, rng: np.random.Generator) -> None:
 
     from robodyn.equations.derive import render
 
-    robot = _cli_robot(case)  # as for the generated Python
+    robot = _stated_robot(case)  # as for the generated Python
     equations = _equations(case)
     with tempfile.TemporaryDirectory() as folder:
         lib = _c_library(render(equations, "c"), Path(folder))
@@ -534,9 +534,9 @@ def _cli(arguments: list[str]) -> str:
     return f"{code}" + (f": {stderr.getvalue().strip()}" if code else "")
 
 
-def _cli_robot(case: Case):
-    """The case's robot as the CLI can give it: every option but ``armature=`` (no flag: a
-    file states its armature itself)."""
+def _stated_robot(case: Case):
+    """The case's robot as its file and the CLI's flags state it: every option but
+    ``armature=`` (no flag, and generated code takes the file's), for the CLI and generated-code pairs."""
     if not case.options.get("armature"):
         return case.robot()
     return robodyn.load(case.source, **{key: value for key, value in case.options.items() if key != "armature"})
@@ -588,7 +588,7 @@ def cli_torques_columns(case: Case, rng: np.random.Generator) -> None:
     import tempfile
     from pathlib import Path
 
-    robot = _cli_robot(case)
+    robot = _stated_robot(case)
     count = int(rng.choice([7, 129]))
     trajectory = _trajectory(robot, rng, count)
     chunk = int(rng.choice([5, 6, 64, 100]))
@@ -623,7 +623,7 @@ def cli_simulate_columns(case: Case, rng: np.random.Generator) -> None:
     import tempfile
     from pathlib import Path
 
-    robot = _cli_robot(case)
+    robot = _stated_robot(case)
     q0, _ = _initial(robot, rng)
     integrator = ["rk4", "semi-implicit-euler"][int(rng.integers(2))]
     expected = robodyn.simulate(robot, q0, np.zeros(robot.nv), 0.02, 1e-3, integrator=integrator, limits="ignore")
@@ -649,7 +649,7 @@ def cli_equations_json(case: Case, rng: np.random.Generator) -> None:
 
     from robodyn.cli.app import main
 
-    robot = _cli_robot(case)
+    robot = _stated_robot(case)
     q, v, a = (x[0] for x in random_state_batch(robot, rng, 1))
     stdout = io.StringIO()
     text = [f"--{name}={','.join(repr(float(x)) for x in value)}" for name, value in (("q", q), ("v", v), ("a", a))]
