@@ -33,6 +33,7 @@ def _columns(path) -> dict[str, np.ndarray]:
     return {name: table[:, index] for index, name in enumerate(header)}
 
 
+@pytest.mark.slow
 def test_simulate_osc_reaches_a_full_pose_on_the_panda_by_pinocchios_forward_kinematics(tmp_path, capsys):
     out = tmp_path / "osc.csv"
     target = ",".join(repr(value) for value in POSE)

@@ -57,7 +57,7 @@ SLOW = pytest.mark.slow
 CASES = [
     # oblique non-unit axes, six-valued origins, a fixed joint mid-chain (its link), the base
     pytest.param(NONDEGENERATE_CASES["oblique"], ["end_effector", "bracket_link", "base"], id="oblique"),
-    pytest.param((TWO_BRANCHES, {}), ["a_tip", "z_slider"], id="two_branches"),  # a tree, a prismatic tip
+    pytest.param((TWO_BRANCHES, {}), ["a_tip", "z_slider"], id="two_branches", marks=SLOW),  # a tree, a prismatic tip
     pytest.param(NONDEGENERATE_CASES["oblique"], ["j_extend", "j_tool"], id="oblique_joint_frames", marks=SLOW),
     pytest.param(NONDEGENERATE_CASES["mimic_tree"], ["hand", "finger"], id="mimic_tree", marks=SLOW),  # J = J_bodies S
     pytest.param(

@@ -91,6 +91,7 @@ def test_pd_gravity_matches_python_simulate(tree, hold):
     _same_run(run, simulate(robot, q0, v0, 0.4, 1e-3, controller=PDGravity(robot, target, kp, kd), hold=hold))
 
 
+@pytest.mark.slow
 def test_computed_torque_on_a_mismatched_model_matches_python_simulate(tree, tmp_path):
     robot, compiled = tree
     text = MIMIC_TREE.read_text(encoding="utf-8").replace('<mass value="1.1"/>', '<mass value="1.6"/>')

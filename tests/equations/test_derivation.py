@@ -193,6 +193,7 @@ def test_the_mimic_arms_bodies_follow_the_mimic_map():
     assert not any("wrist" in str(s) for s in steps.L.free_symbols | steps.M.free_symbols)
 
 
+@pytest.mark.slow
 def test_kept_parameters_give_the_lectures_symbols_and_its_corrected_rigid_result():
     steps = derived("rp_arm", None, True)
     lecture_names = {"m1", "m2", "l1", "c2", "Iz1", "Iz2", "g"}

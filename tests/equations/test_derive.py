@@ -20,7 +20,12 @@ from robodyn.equations.derive import derive_equations, render
 from tests.random_robots import random_urdfs
 
 PANDA_ARM = {"panda_finger_joint1": 0.0}
-CODE_ROBOTS = [("double_pendulum", None), ("rp_arm", None), ("ur5", None), ("panda", PANDA_ARM)]
+CODE_ROBOTS = [
+    ("double_pendulum", None),
+    ("rp_arm", None),
+    ("ur5", None),
+    pytest.param("panda", PANDA_ARM, marks=pytest.mark.slow),
+]
 
 
 def test_rp_arm_with_kept_parameters_is_the_hand_derived_rigid_form():
@@ -61,7 +66,7 @@ def relative(a, b):
     return float(np.max(np.abs(a - b)) / max(1.0, np.max(np.abs(b))))
 
 
-@pytest.mark.parametrize(("name", "lock"), CODE_ROBOTS, ids=[n for n, _ in CODE_ROBOTS])
+@pytest.mark.parametrize(("name", "lock"), CODE_ROBOTS, ids=["double_pendulum", "rp_arm", "ur5", "panda"])
 def test_generated_python_agrees_with_pinocchio(name, lock, tmp_path, rng):
     path = tmp_path / f"{name}_dynamics.py"
     path.write_text(render(derive_equations(name, lock=lock), "python"))
@@ -87,7 +92,9 @@ def test_generated_python_agrees_with_pinocchio(name, lock, tmp_path, rng):
 
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="needs a C compiler")
-@pytest.mark.parametrize(("name", "lock"), [("ur5", None), ("panda", PANDA_ARM)], ids=["ur5", "panda"])
+@pytest.mark.parametrize(
+    ("name", "lock"), [("ur5", None), pytest.param("panda", PANDA_ARM, marks=pytest.mark.slow)], ids=["ur5", "panda"]
+)
 def test_generated_c_compiles_and_agrees_with_pinocchio(name, lock, tmp_path, rng):
     source, library = tmp_path / "dynamics.c", tmp_path / "libdynamics.so"
     source.write_text(render(derive_equations(name, lock=lock), "c"))

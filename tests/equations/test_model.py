@@ -50,7 +50,7 @@ def test_kept_gravity_is_a_symbol_along_its_axis_and_a_vector_otherwise():
     assert {"g_x", "g_z"} <= names and "g" not in names
 
 
-@pytest.mark.parametrize("form", ["closed", "compact"])
+@pytest.mark.parametrize("form", [pytest.param("closed", marks=pytest.mark.slow), "compact"])
 def test_mimic_joints_follow_the_linear_map(form, rng):
     """The mimic arm: wrist = -1.5 elbow + 0.2, so two coordinates; M, C, G equal Robot's."""
     equations = derive_equations(MIMIC, form=form)

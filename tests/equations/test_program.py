@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 import sympy as sp
 
 from robodyn import reference
@@ -63,6 +64,7 @@ def test_shortening_keeps_the_values_and_saves_operations(rng):
         np.testing.assert_allclose(evaluate(short, {"q": q, "qd": v})[name], values, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_the_compact_equations_are_the_same_every_run():
     """No set order leaks into the program: two processes with different hash seeds print
     the same equations (so the same C, and the same compiled kernels)."""

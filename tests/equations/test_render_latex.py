@@ -28,6 +28,7 @@ def overfull_points(log: str) -> list[float]:
     return [float(m) for m in re.findall(r"Overfull \\hbox \(([0-9.]+)pt too wide", log)]
 
 
+@pytest.mark.slow
 def test_symbols_are_typeset_with_dots_numbers_and_upright_names():
     tex = render(derive_equations(RRP, keep_params=True), "latex")
     assert r"\dot q_{2}" in tex and r"\ddot q" in tex and r"q_{3}" in tex

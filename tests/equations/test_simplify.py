@@ -88,7 +88,11 @@ def test_panda_arm_meets_the_size_target():
     assert derive_equations("panda", lock={"panda_finger_joint1": 0.0}).operation_count() <= 1700
 
 
-@pytest.mark.parametrize(("name", "form"), [("rp_arm", "closed"), (RRP, "closed"), (RRP, "compact"), ("ur5", "compact")], ids=str)
+@pytest.mark.parametrize(
+    ("name", "form"),
+    [("rp_arm", "closed"), pytest.param(RRP, "closed", marks=pytest.mark.slow), (RRP, "compact"), ("ur5", "compact")],
+    ids=str,
+)
 def test_kept_parameters_for_every_robot_give_the_robots_numbers(name, form, rng):
     equations = derive_equations(name, form=form, keep_params=True)
     kinds = {label[0] for label in equations.labels.values()}

@@ -47,6 +47,7 @@ def demo():
     return recording(robot, trajectory, target=summary["target_m"])
 
 
+@pytest.mark.slow
 def test_demo_shows_robot_target_and_a_growing_path(demo):
     start, early, late = capture(demo.html, [0.0, 0.1, 0.6], size=SIZE, hide=("Axes",))
     masks = capture(demo.html, [0.1, 0.6], size=SIZE, hide=("Axes", "task", "Grid", "Background"))
