@@ -961,7 +961,7 @@ def bench_single_thin(quick: bool) -> list[dict]:
 
 
 _COMPILE_PARTS = """
-import functools, json, sys, time, robodyn
+import functools, json, os, sys, time, robodyn
 from robodyn.compiled import build, codegen
 from robodyn.compiled import robot as compiled_robot
 from robodyn.equations import compact
@@ -982,13 +982,15 @@ timed(compiled_robot, "derive_newton_euler", "newton_euler_s")
 timed(codegen.KernelWriter, "source", "print_c_s")
 source = sys.stdin.read()
 robot = robodyn.load(source) if source.lstrip().startswith("<") else robodyn.load(**json.loads(source))
-start = time.perf_counter()
+start, cpu = time.perf_counter(), time.process_time()
 kernels = compiled_robot.generate_kernels(robot)
-derived = time.perf_counter()
+derived, derive_cpu, before = time.perf_counter(), time.process_time() - cpu, os.times()
 build.build_module(kernels, label="scaling")
+after = os.times()
 stages["compact_s"] -= stages.get("cse_s", 0.0)
+cc_cpu = after.children_user + after.children_system - before.children_user - before.children_system
 print(json.dumps({"nv": robot.nv, "derive_s": derived - start, "cc_s": time.perf_counter() - derived,
-                  "c_source_kB": len(kernels) / 1e3, **stages}))
+                  "derive_cpu_s": derive_cpu, "cc_cpu_s": cc_cpu, "c_source_kB": len(kernels) / 1e3, **stages}))
 """
 
 
