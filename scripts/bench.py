@@ -961,15 +961,36 @@ def bench_single_thin(quick: bool) -> list[dict]:
 
 
 _COMPILE_PARTS = """
-import sys, time, robodyn
-from robodyn.compiled import build
-from robodyn.compiled.robot import generate_kernels
-robot = robodyn.load(sys.stdin.read())
-start = time.perf_counter()
-kernels = generate_kernels(robot)
-derived = time.perf_counter()
+import functools, json, os, sys, time, robodyn
+from robodyn.compiled import build, codegen
+from robodyn.compiled import robot as compiled_robot
+from robodyn.equations import compact
+stages = {}
+def timed(owner, name, stage):
+    function = getattr(owner, name)
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return function(*args, **kwargs)
+        finally:
+            stages[stage] = stages.get(stage, 0.0) + time.perf_counter() - start
+    setattr(owner, name, wrapper)
+timed(compiled_robot, "derive_compact", "compact_s")
+timed(compact, "shortened", "cse_s")
+timed(compiled_robot, "derive_newton_euler", "newton_euler_s")
+timed(codegen.KernelWriter, "source", "print_c_s")
+source = sys.stdin.read()
+robot = robodyn.load(source) if source.lstrip().startswith("<") else robodyn.load(**json.loads(source))
+start, cpu = time.perf_counter(), time.process_time()
+kernels = compiled_robot.generate_kernels(robot)
+derived, derive_cpu, before = time.perf_counter(), time.process_time() - cpu, os.times()
 build.build_module(kernels, label="scaling")
-print(derived - start, time.perf_counter() - derived, len(kernels))
+after = os.times()
+stages["compact_s"] -= stages.get("cse_s", 0.0)
+cc_cpu = after.children_user + after.children_system - before.children_user - before.children_system
+print(json.dumps({"nv": robot.nv, "derive_s": derived - start, "cc_s": time.perf_counter() - derived,
+                  "derive_cpu_s": derive_cpu, "cc_cpu_s": cc_cpu, "c_source_kB": len(kernels) / 1e3, **stages}))
 """
 
 
@@ -984,39 +1005,46 @@ def _chain(urdf: str) -> str:
     )
 
 
-def bench_compile_scaling(quick: bool) -> list[dict]:
-    """Cold compile time against DoF, chains and trees of revolute and prismatic joints (a
-    new process, an empty cache): the sympy derivation and the C compiler apart."""
+def _cold_compile(source: str) -> dict:
+    """One cold compile in a new process with an empty cache, by stage (see ``_COMPILE_PARTS``);
+    ``source`` is URDF text or a JSON of :func:`robodyn.load` arguments."""
     import subprocess
     import tempfile
 
+    with tempfile.TemporaryDirectory() as folder:
+        env = os.environ | {"ROBODYN_CACHE": folder}
+        try:
+            done = subprocess.run(
+                [sys.executable, "-c", _COMPILE_PARTS], input=source, env=env, capture_output=True, text=True,
+                check=True, timeout=900,
+            )  # fmt: skip
+        except subprocess.TimeoutExpired:
+            return {"derive_s": None, "note": "over 900 s"}
+    parts = json.loads(done.stdout)
+    parts["total_s"] = parts["derive_s"] + parts["cc_s"]
+    return parts
+
+
+def bench_compile_scaling(quick: bool) -> list[dict]:
+    """Cold compile time against DoF, chains and trees of revolute and prismatic joints, and
+    fixed-base cuts of zoo robots (a new process, an empty cache), by stage: the compact
+    derivation (bodies, Newton–Euler for C v and G, composite-body M), its shortening
+    (``sympy.cse`` and products reused), the O(n) Newton–Euler tau, printing C, the C compiler."""
     sys.path.insert(0, str(ROOT))
     from tests.random_robots import urdf_from_seed
 
-    rows = []
-    for dof in (2, 4, 8) if quick else (2, 4, 8, 12, 16, 24, 30):
+    cases: list[tuple[str, str]] = []
+    for dof in (2, 4, 8) if quick else (2, 4, 8, 12, 16, 20, 24, 30):
         for shape in ("chain", "tree"):
             urdf = urdf_from_seed(dof, dof, ["revolute", "revolute", "prismatic"])
-            urdf = _chain(urdf) if shape == "chain" else urdf
-            with tempfile.TemporaryDirectory() as folder:
-                env = os.environ | {"ROBODYN_CACHE": folder}
-                try:
-                    done = subprocess.run(
-                        [sys.executable, "-c", _COMPILE_PARTS], input=urdf, env=env, capture_output=True, text=True,
-                        check=True, timeout=600,
-                    )  # fmt: skip
-                except subprocess.TimeoutExpired:
-                    rows.append({"shape": shape, "dof": dof, "derive_s": None, "note": "over 600 s"})
-                    continue
-            derive, cc, size = done.stdout.split()
-            rows.append(
-                {
-                    "shape": shape, "dof": dof, "derive_s": float(derive), "cc_s": float(cc),
-                    "total_s": float(derive) + float(cc), "c_source_kB": int(size) / 1e3,
-                    "load_average": os.getloadavg()[0],
-                }
-            )  # fmt: skip
-            print(rows[-1], file=sys.stderr)
+            cases.append((shape, _chain(urdf) if shape == "chain" else urdf))
+    zoo = (("talos_arm", {}),) if quick else (("talos_arm", {}), ("talos", {"floating_base": False}))
+    cases += [(f"{name} (fixed base)", json.dumps({"source": name, **options})) for name, options in zoo]
+    rows = []
+    for shape, source in cases:
+        row = {"shape": shape, **_cold_compile(source), "load_average": os.getloadavg()[0]}
+        rows.append(row)
+        print(row, file=sys.stderr)
     return rows
 
 
