@@ -806,7 +806,7 @@ def bench_compiled_control(quick: bool) -> list[dict]:
     """Compiled controllers (every RK4 stage, in C): the loop's real-time factor (start-up and
     compile excluded), against the Python engine and MuJoCo's passive RK4 loop on the same robot."""
     from robodyn.compiled.simulation import compiled_controller, simulate_compiled
-    from robodyn.sim.control import Impedance, OperationalSpace, TaskSpace
+    from robodyn.sim.control import LQR, Impedance, OperationalSpace, TaskSpace
 
     rows = []
     # The demo (Makefile): rp_arm, task space, --q0 0,0.1 --target 0.7,0.7 --duration 3.
@@ -839,6 +839,7 @@ def bench_compiled_control(quick: bool) -> list[dict]:
         "osc (position)": OperationalSpace(robot, None, goal),
         "osc (pose)": OperationalSpace(robot, None, goal, orientation=[3.0, 0.2, 0.1]),
         "impedance (pose)": Impedance(robot, None, goal, orientation=[3.0, 0.2, 0.1]),
+        "lqr": LQR(robot, q0 - 0.2, np.zeros(robot.nv), 10.0, 0.1),
     }
     mj_rtf = mj_rtf_cpu = float("nan")
     try:

@@ -632,6 +632,20 @@ static void rd_control_frame(const rd_controller *c, const double *q, const doub
 }
 
 
+/* params: S u_eq (n), S K (n × 2n, row-major), x_eq = (q_eq, v_eq) (2n)
+ * (robodyn.sim.control.LQR: tau = S (u_eq − K (x − x_eq)), S selecting the actuated joints) */
+static void rdc_lqr(const double *p, const double *q, const double *v, double *tau) {
+    const int n = RD_NV;
+    const double *K = p + n, *x_eq = p + n + 2 * n * n;
+    double e[2 * RD_NV];
+    for (int j = 0; j < n; ++j) e[j] = q[j] - x_eq[j], e[n + j] = v[j] - x_eq[n + j];
+    for (int i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (int j = 0; j < 2 * n; ++j) s += K[i * 2 * n + j] * e[j];
+        tau[i] = p[i] - s;
+    }
+}
+
 static void rd_control(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
     const int n = RD_NV;
     const double *p = c->params;
@@ -641,6 +655,8 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
         double g[RD_NV];
         c->model->gravity(q, g);
         for (int i = 0; i < n; ++i) tau[i] = p[n + i] * (p[i] - q[i]) - p[2 * n + i] * v[i] + g[i];
+    } else if (c->kind == 6) {
+        rdc_lqr(p, q, v, tau);
     } else if (c->kind >= 3) { /* task space, operational space, impedance */
         rd_control_frame(c, q, v, tau);
     } else { /* params: q_start, q_end, kp, kd, duration */
@@ -744,8 +760,8 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
     const long rk4 = PyLong_AsLong(args[5]), kind = PyLong_AsLong(args[6]), hold = PyLong_AsLong(args[7]);
     if (PyErr_Occurred()) return NULL;
     const int n = RD_NV;
-    const npy_intp sizes[6] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26};
-    if (kind < 0 || kind > 5 || steps < 0) {
+    const npy_intp sizes[7] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26, 2 * n * n + 3 * n};
+    if (kind < 0 || kind > 6 || steps < 0) {
         PyErr_SetString(PyExc_ValueError, "bad controller kind or step count");
         return NULL;
     }
@@ -766,7 +782,7 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         frame = (const rd_frame_kernels *)PyCapsule_GetPointer(args[14], RD_FRAME_CAPSULE);
         if (!frame) return NULL;
     }
-    if (kind >= 3 && (!frame || frame->nv != n)) {
+    if (kind >= 3 && kind <= 5 && (!frame || frame->nv != n)) {
         PyErr_SetString(PyExc_ValueError, "simulate: a frame controller needs its frame's kernels");
         return NULL;
     }

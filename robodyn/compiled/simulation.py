@@ -26,7 +26,13 @@ import numpy as np
 
 from robodyn.common.inputs import as_state
 from robodyn.common.text import quoted
-from robodyn.compiled.controllers import CompiledFrameController, CompiledImpedance, CompiledOperationalSpace, CompiledTaskSpace
+from robodyn.compiled.controllers import (
+    CompiledFrameController,
+    CompiledImpedance,
+    CompiledLQR,
+    CompiledOperationalSpace,
+    CompiledTaskSpace,
+)
 from robodyn.compiled.robot import CompiledRobot, compile
 from robodyn.exceptions import CompileError, InputError, SimulationError
 
@@ -159,7 +165,9 @@ def simulate_compiled(
     rk4 = int(integrator == "rk4")
     out = [np.empty((steps + 1, nv)) for _ in range(4)]
     q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
-    if controller is None or isinstance(controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController):
+    if controller is None or isinstance(
+        controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | CompiledLQR
+    ):
         if control_period is not None:
             raise InputError("control_period", "used with a Python controller only", repr(control_period))
         kind, params, model, frame = 0, np.zeros(nv), None, None
@@ -170,6 +178,8 @@ def simulate_compiled(
             params, model = controller.params(nv), controller.model.module._kernels
             if isinstance(controller, CompiledFrameController):
                 kind, frame = controller.kind, controller.frame_kernels()
+            if isinstance(controller, CompiledLQR):
+                kind = controller.kind
         failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out, frame)
         _raise_if_failed(compiled, failed, out, dt, 0)
     elif callable(controller):
@@ -218,9 +228,10 @@ _TWINS = {
     "robodyn.sim.control.TaskSpace": "task-space",
     "robodyn.sim.operational_space.OperationalSpace": "operational-space",
     "robodyn.sim.operational_space.Impedance": "impedance",
+    "robodyn.sim.control.LQR": "lqr",
 }
 
-CompiledController = CompiledPDGravity | CompiledComputedTorque | CompiledFrameController
+CompiledController = CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | CompiledLQR
 
 
 def has_twin(controller: object) -> bool:
@@ -239,7 +250,7 @@ def compiled_controller(controller: object) -> CompiledController:
     """The compiled twin of a Python controller of :mod:`robodyn.sim` (on its own model, compiled).
 
     ``PDGravity``, ``ComputedTorque`` along a quintic (:func:`robodyn.sim.control.quintic_reference`),
-    ``TaskSpace``, ``OperationalSpace`` with a fixed target, ``Impedance``: the same law in C,
+    ``TaskSpace``, ``OperationalSpace`` with a fixed target, ``Impedance``, ``LQR``: the same law in C,
     evaluated wherever the integrator evaluates the dynamics.
 
     Raises:
@@ -260,6 +271,8 @@ def compiled_controller(controller: object) -> CompiledController:
         if type(reference).__qualname__ != "QuinticReference":
             raise CompileError(c.model.name, "computed torque compiles along a quintic_reference only")
         return CompiledComputedTorque(compile(c.model), reference.q_start, reference.q_end, reference.duration, c.kp, c.kd)
+    if kind == "lqr":
+        return CompiledLQR(compile(c.model), c.gain, c.u_eq, c.actuation, c.x_eq)
     if kind == "task-space":
         return CompiledTaskSpace(compile(c.model), c.frame, c.target, c.kp, c.kd, c.damping, c.joint_damping)
     if callable(c.position):

@@ -579,7 +579,7 @@ def _check_compiled_applies(
 def _runs_in_c(controller: Controller, every: int | None) -> bool:
     """Whether a controller has a compiled twin the C loop evaluates at every stage
     (:func:`robodyn.compiled.has_twin`: PD, computed torque along a quintic, task space,
-    operational space with a fixed target, impedance)."""
+    operational space with a fixed target, impedance, LQR)."""
     from robodyn.compiled import has_twin
 
     return every in (None, 1) and has_twin(controller)
