@@ -277,6 +277,26 @@ static void rdc_ldl_apply(const double *M, double *b) {
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
 }
 
+/* rdc_ldl_apply on k right-hand sides at once, B n×k row-major (B[j k + c] is b_c[j]): each
+ * column gets rdc_ldl_apply's operations in its order (the same bits), the tree walked once. */
+static void rdc_ldl_apply_block(const double *M, double *B, int k) {
+    const int n = RD_NV;
+    for (int i = n - 1; i >= 0; --i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
+            const double x = M[i * n + j];
+            for (int c = 0; c < k; ++c) B[j * k + c] -= x * B[i * k + c];
+        }
+    for (int i = 0; i < n; ++i) {
+        const double d = M[i * n + i];
+        for (int c = 0; c < k; ++c) B[i * k + c] /= d;
+    }
+    for (int i = 0; i < n; ++i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
+            const double x = M[i * n + j];
+            for (int c = 0; c < k; ++c) B[i * k + c] -= x * B[j * k + c];
+        }
+}
+
 /* Eigen-decomposition of a symmetric m×m matrix (its lower triangle, as numpy's eigh): Householder
  * tridiagonalisation + implicit QL (EISPACK tred2/tql2, as in Numerical Recipes). */
 static void rdc_tred2(double *a, int n, double *d, double *e) {
@@ -335,6 +355,19 @@ static void rdc_tred2(double *a, int n, double *d, double *e) {
     }
 }
 
+/* sqrt(a² + b²) without overflow or underflow (Numerical Recipes' pythag): libm's hypot is
+ * correctly rounded and several times slower; the QL sweeps do not need its last bit. */
+static double rdc_pythag(double a, double b) {
+    const double x = fabs(a), y = fabs(b);
+    if (x > y) {
+        const double r = y / x;
+        return x * sqrt(1.0 + r * r);
+    }
+    if (y == 0.0) return 0.0;
+    const double r = x / y;
+    return y * sqrt(1.0 + r * r);
+}
+
 static void rdc_tqli(double *d, double *e, int n, double *z) {
     for (int i = 1; i < n; ++i) e[i - 1] = e[i];
     e[n - 1] = 0.0;
@@ -348,13 +381,13 @@ static void rdc_tqli(double *d, double *e, int n, double *z) {
             if (m != l) {
                 if (iter++ == 60) break;
                 double g = (d[l + 1] - d[l]) / (2.0 * e[l]);
-                double r = hypot(g, 1.0);
+                double r = rdc_pythag(g, 1.0);
                 g = d[m] - d[l] + e[l] / (g + (g >= 0.0 ? fabs(r) : -fabs(r)));
                 double s = 1.0, c = 1.0, p = 0.0;
                 int i;
                 for (i = m - 1; i >= l; --i) {
                     double f = s * e[i], b = c * e[i];
-                    e[i + 1] = (r = hypot(f, g));
+                    e[i + 1] = (r = rdc_pythag(f, g));
                     if (r == 0.0) {
                         d[i + 1] -= p;
                         e[m] = 0.0;
@@ -529,7 +562,7 @@ static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *fram
 /* params: rows m, position (3), R_d (9), kp, kd, damping, posture_kp, posture_kd, has_posture,
  * posture (n)  (robodyn.sim.operational_space.OperationalSpace, fixed target) */
 static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
-                                  const double *v, double *tau) {
+                                  const double *v, double *tau, double *a) {
     const int n = RD_NV, m = (int)p[0];
     double x[3], R[9], J[6 * RD_NV], bias[6], command[6], M[RD_NV * RD_NV], L[RD_NV * RD_NV], h[RD_NV];
     double MiJt[6 * RD_NV], A[36], Lam[36], f[6], posture[RD_NV], y[6];
@@ -545,12 +578,16 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     memcpy(L, M, sizeof M);
     if (rdc_ldl_factor(L)) {
         for (int i = 0; i < n; ++i) tau[i] = NAN;
+        if (a)
+            for (int i = 0; i < n; ++i) a[i] = NAN;
         return;
     }
-    for (int k = 0; k < m; ++k) { /* column k of M⁻¹ Jᵀ, stored as row k */
-        memcpy(MiJt + k * n, J + k * n, sizeof(double) * n);
-        rdc_ldl_apply(L, MiJt + k * n);
-    }
+    double block[6 * RD_NV]; /* M⁻¹ Jᵀ (n×m), solved for its m columns at once */
+    for (int j = 0; j < n; ++j)
+        for (int k = 0; k < m; ++k) block[j * m + k] = J[k * n + j];
+    rdc_ldl_apply_block(L, block, m);
+    for (int k = 0; k < m; ++k) /* column k of M⁻¹ Jᵀ, stored as row k */
+        for (int j = 0; j < n; ++j) MiJt[k * n + j] = block[j * m + k];
     for (int i = 0; i < m; ++i)
         for (int k = 0; k < m; ++k) {
             double s = 0.0;
@@ -580,6 +617,10 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
         double task = 0.0, back = 0.0;
         for (int i = 0; i < m; ++i) task += J[i * n + j] * f[i], back += J[i * n + j] * LJP[i];
         tau[j] = task + h[j] + (posture[j] - back);
+    }
+    if (a) { /* the plant's accelerations when it is this model: rd_fd_raw's arithmetic on M, h */
+        for (int i = 0; i < n; ++i) a[i] = tau[i] - h[i];
+        rdc_ldl_apply(L, a);
     }
 }
 
@@ -627,7 +668,7 @@ static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame
 static void rd_control_frame(const rd_controller *c, const double *q, const double *v, double *tau) {
     const rd_frame_kernels *frame = (const rd_frame_kernels *)c->frame;
     if (c->kind == 3) rdc_task_space(c->model, frame, c->params, q, v, tau);
-    if (c->kind == 4) rdc_operational_space(c->model, frame, c->params, q, v, tau);
+    if (c->kind == 4) rdc_operational_space(c->model, frame, c->params, q, v, tau, NULL);
     if (c->kind == 5) rdc_impedance(c->model, frame, c->params, q, v, tau);
 }
 
@@ -677,11 +718,23 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
     }
 }
 
+/* tau(t, q, v) and the plant's a = FD(q, v, tau) in one pass, when the controller's model is
+ * the plant's (this module's kernels) and it computes M and C v + G anyway (operational space):
+ * 1 when done (a NaN for a singular M), 0 when the caller is to call rd_control and rd_fd_raw.
+ * Bit-identical to those two: the same M, h and the same LDLᵀ arithmetic. */
+static int rd_control_fd(const rd_controller *c, const double *q, const double *v, double *tau, double *a) {
+    if (c->kind != 4 || c->model != &rd_self) return 0;
+    rdc_operational_space(c->model, (const rd_frame_kernels *)c->frame, c->params, q, v, tau, a);
+    return 1;
+}
+
 /* a = FD(q, v, tau(t, q, v)); the stage's torque is the held one when c->hold. */
 static void rd_stage(const rd_controller *c, double t, const double *q, const double *v, const double *held, double *a) {
     double tau[RD_NV];
     if (c->hold || c->kind == 0)
         memcpy(tau, held, sizeof tau);
+    else if (rd_control_fd(c, q, v, tau, a))
+        return;
     else
         rd_control(c, t, q, v, tau);
     if (rd_fd_raw(q, v, tau, a))
@@ -697,9 +750,10 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
         const double t = t0 + k * dt;
         memcpy(oq + k * n, q, n * sizeof(double));
         memcpy(ov + k * n, v, n * sizeof(double));
-        rd_control(c, t, q, v, tau);
+        const int fused = rd_control_fd(c, q, v, tau, a);
+        if (!fused) rd_control(c, t, q, v, tau);
         memcpy(otau + k * n, tau, n * sizeof(double));
-        if (rd_fd_raw(q, v, tau, a))
+        if (!fused && rd_fd_raw(q, v, tau, a))
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa + k * n, a, n * sizeof(double));
         if (rk4) {
