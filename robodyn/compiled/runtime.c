@@ -355,10 +355,12 @@ static void rdc_tred2(double *a, int n, double *d, double *e) {
     }
 }
 
-/* sqrt(a² + b²) without overflow or underflow (Numerical Recipes' pythag): libm's hypot is
- * correctly rounded and several times slower; the QL sweeps do not need its last bit. */
+/* sqrt(a² + b²) without overflow or underflow: directly when the squares are normal numbers
+ * (the QL sweeps' usual case), else scaled (Numerical Recipes' pythag). libm's hypot is
+ * correctly rounded and several times slower; the sweeps do not need its last bit. */
 static double rdc_pythag(double a, double b) {
     const double x = fabs(a), y = fabs(b);
+    if (x < 1e150 && y < 1e150 && (x > 1e-150 || y > 1e-150)) return sqrt(x * x + y * y);
     if (x > y) {
         const double r = y / x;
         return x * sqrt(1.0 + r * r);
@@ -414,7 +416,7 @@ static void rdc_tqli(double *d, double *e, int n, double *z) {
     }
 }
 
-/* Λ from Λ⁻¹ = A (m×m, destroyed), damped as operational_space.damped_task_inertia. */
+/* Λ from Λ⁻¹ = A (m×m, symmetric), damped as operational_space.damped_task_inertia. */
 static void rdc_task_inertia(double *A, double damping, int m, double *L) {
     double V[36], s[6], d[6], e[6], top = 0.0;
     memcpy(V, A, sizeof(double) * m * m); /* eigenvectors as the columns of V, values in d */
@@ -588,11 +590,11 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     rdc_ldl_apply_block(L, block, m);
     for (int k = 0; k < m; ++k) /* column k of M⁻¹ Jᵀ, stored as row k */
         for (int j = 0; j < n; ++j) MiJt[k * n + j] = block[j * m + k];
-    for (int i = 0; i < m; ++i)
-        for (int k = 0; k < m; ++k) {
+    for (int i = 0; i < m; ++i) /* J M⁻¹ Jᵀ: its lower triangle, all the eigen-decomposition reads */
+        for (int k = 0; k <= i; ++k) {
             double s = 0.0;
             for (int j = 0; j < n; ++j) s += J[i * n + j] * MiJt[k * n + j];
-            A[i * m + k] = s;
+            A[i * m + k] = A[k * m + i] = s;
         }
     rdc_task_inertia(A, p[15], m, Lam);
     for (int i = 0; i < m; ++i) y[i] = command[i] - bias[i];
@@ -600,9 +602,11 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
         f[i] = 0.0;
         for (int k = 0; k < m; ++k) f[i] += Lam[i * m + k] * y[k];
     }
+    double rate[RD_NV];
+    for (int j = 0; j < n; ++j) rate[j] = p[16] * (p[18] ? p[19 + j] - q[j] : 0.0) - p[17] * v[j];
     for (int i = 0; i < n; ++i) { /* posture = M (kp0 (q0 - q) - kd0 v) */
         double s = 0.0;
-        for (int j = 0; j < n; ++j) s += M[i * n + j] * (p[16] * (p[18] ? p[19 + j] - q[j] : 0.0) - p[17] * v[j]);
+        for (int j = 0; j < n; ++j) s += M[i * n + j] * rate[j];
         posture[i] = s;
     }
     double JP[6] = {0}; /* Nᵀ posture = posture - Jᵀ Λ (M⁻¹Jᵀ)ᵀ posture */
