@@ -213,6 +213,7 @@ typedef struct {
     const double *params;
     const rd_kernels *model;
     const void *frame; /* kinds 3-5: the controlled frame's rd_frame_kernels */
+    const double *damping; /* the plant's joint damping b (the torque − b v at every stage), or NULL */
 } rd_controller;
 
 /* ---- compiled frame controllers (task space, operational space, impedance) -------------
@@ -727,9 +728,18 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
  * 1 when done (a NaN for a singular M), 0 when the caller is to call rd_control and rd_fd_raw.
  * Bit-identical to those two: the same M, h and the same LDLᵀ arithmetic. */
 static int rd_control_fd(const rd_controller *c, const double *q, const double *v, double *tau, double *a) {
-    if (c->kind != 4 || c->model != &rd_self) return 0;
+    if (c->kind != 4 || c->model != &rd_self || c->damping) return 0;
     rdc_operational_space(c->model, (const rd_frame_kernels *)c->frame, c->params, q, v, tau, a);
     return 1;
+}
+
+/* The plant's forward dynamics under the torque tau and its joints' damping: FD(q, v, tau − b v)
+ * (robodyn.sim.joint_friction's order of operations), FD(q, v, tau) without damping. */
+static int rd_fd_damped(const rd_controller *c, const double *q, const double *v, const double *tau, double *a) {
+    if (!c->damping) return rd_fd_raw(q, v, tau, a);
+    double total[RD_NV];
+    for (int i = 0; i < RD_NV; ++i) total[i] = tau[i] - c->damping[i] * v[i];
+    return rd_fd_raw(q, v, total, a);
 }
 
 /* a = FD(q, v, tau(t, q, v)); the stage's torque is the held one when c->hold. */
@@ -741,7 +751,7 @@ static void rd_stage(const rd_controller *c, double t, const double *q, const do
         return;
     else
         rd_control(c, t, q, v, tau);
-    if (rd_fd_raw(q, v, tau, a))
+    if (rd_fd_damped(c, q, v, tau, a))
         for (int i = 0; i < RD_NV; ++i) a[i] = NAN;
 }
 
@@ -757,7 +767,7 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
         const int fused = rd_control_fd(c, q, v, tau, a);
         if (!fused) rd_control(c, t, q, v, tau);
         memcpy(otau + k * n, tau, n * sizeof(double));
-        if (!fused && rd_fd_raw(q, v, tau, a))
+        if (!fused && rd_fd_damped(c, q, v, tau, a))
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa + k * n, a, n * sizeof(double));
         if (rk4) {
@@ -791,7 +801,7 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
     } else {
         double zero[RD_NV] = {0};
         memcpy(otau, zero, sizeof zero);
-        if (rd_fd_raw(q, v, zero, a))
+        if (rd_fd_damped(c, q, v, zero, a))
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa, a, n * sizeof(double));
     }
@@ -808,8 +818,8 @@ static double *rd_array(PyObject *object, npy_intp size, int writable) {
 }
 
 static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 14 && nargs != 15) {
-        PyErr_SetString(PyExc_TypeError, "simulate takes 14 or 15 arguments");
+    if (nargs < 14 || nargs > 16) {
+        PyErr_SetString(PyExc_TypeError, "simulate takes 14 to 16 arguments");
         return NULL;
     }
     const double dt = PyFloat_AsDouble(args[2]);
@@ -836,7 +846,7 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         return NULL;
     }
     const rd_frame_kernels *frame = NULL; /* the 15th argument: the frame capsule of kinds 3-5 */
-    if (nargs == 15 && args[14] != Py_None) {
+    if (nargs >= 15 && args[14] != Py_None) {
         frame = (const rd_frame_kernels *)PyCapsule_GetPointer(args[14], RD_FRAME_CAPSULE);
         if (!frame) return NULL;
     }
@@ -844,7 +854,12 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         PyErr_SetString(PyExc_ValueError, "simulate: a frame controller needs its frame's kernels");
         return NULL;
     }
-    rd_controller controller = {(int)kind, (int)hold, params, model, frame};
+    const double *damping = NULL; /* the 16th argument: the joints' damping (nv), or None */
+    if (nargs == 16 && args[15] != Py_None && !(damping = rd_array(args[15], n, 0))) {
+        PyErr_SetString(PyExc_ValueError, "simulate: damping of the wrong type or size");
+        return NULL;
+    }
+    rd_controller controller = {(int)kind, (int)hold, params, model, frame, damping};
     double q[RD_NV], v[RD_NV];
     memcpy(q, q0, sizeof q);
     memcpy(v, v0, sizeof v);

@@ -136,9 +136,11 @@ def simulate_compiled(
         control_period: For a Python controller, in [s], a whole number of steps
             (default ``dt``).
         hold: For a compiled controller: sample it once a step instead of at every stage.
-        joint_friction: The loop in C is rigid-body: a robot whose joints have damping or
-            Coulomb friction (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`) is
-            refused unless ``joint_friction=False`` asks for the rigid-body motion.
+        joint_friction: The joints' damping (:attr:`Robot.joint_damping`) acts in C at
+            every stage, ``−b v`` added to the torque as :mod:`robodyn.sim.joint_friction`
+            does; a robot with Coulomb friction (:attr:`Robot.joint_friction`, stick–slip
+            events) is refused unless ``joint_friction=False`` asks for the rigid-body
+            motion (damping left out too).
 
     Returns:
         ``round(duration / dt) + 1`` samples (the conventions of :func:`robodyn.simulate`).
@@ -150,12 +152,13 @@ def simulate_compiled(
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
     robot = compiled.robot
-    if joint_friction and (robot.joint_damping.any() or robot.joint_friction.any()):
+    if joint_friction and robot.joint_friction.any():
         raise InputError(
             "joint_friction",
-            "False for a robot whose joints have damping or friction (the compiled loop is rigid-body)",
+            "False for a robot whose joints have Coulomb friction (the compiled loop has damping, not stick-slip)",
             f"True for {quoted(robot.name)}",
         )
+    damping = np.ascontiguousarray(robot.joint_damping, dtype=float) if joint_friction and robot.joint_damping.any() else None
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
     (q, v), batch = compiled.robot.validate(q=q0, v=v0)
@@ -180,7 +183,7 @@ def simulate_compiled(
                 kind, frame = controller.kind, controller.frame_kernels()
             if isinstance(controller, CompiledLQR):
                 kind = controller.kind
-        failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out, frame)
+        failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out, frame, damping)
         _raise_if_failed(compiled, failed, out, dt, 0)
     elif callable(controller):
         period = dt if control_period is None else control_period
@@ -188,7 +191,7 @@ def simulate_compiled(
         if every < 1 or abs(every * dt - period) > 1e-9 * period:
             raise InputError("control_period", f"a whole number of steps of dt = {dt}", repr(control_period))
         if steps == 0:  # one sample, zero torque (as robodyn.simulate)
-            failed = compiled.module.simulate(q, v, float(dt), 0, 0.0, rk4, 0, 1, np.zeros(nv), None, *out)
+            failed = compiled.module.simulate(q, v, float(dt), 0, 0.0, rk4, 0, 1, np.zeros(nv), None, *out, None, damping)
         for start in range(0, steps, every):
             count = min(every, steps - start)
             tau = np.asarray(controller(start * dt, q.copy(), v.copy()), dtype=float)
@@ -196,7 +199,7 @@ def simulate_compiled(
                 raise InputError("controller output", f"{nv} torques", f"shape {tau.shape}")
             views = [array[start : start + count + 1] for array in out]
             failed = compiled.module.simulate(
-                q, v, float(dt), count, start * dt, rk4, 0, 1, np.ascontiguousarray(tau), None, *views
+                q, v, float(dt), count, start * dt, rk4, 0, 1, np.ascontiguousarray(tau), None, *views, None, damping
             )
             _raise_if_failed(compiled, failed, out, dt, start)
             q, v = out[0][start + count].copy(), out[1][start + count].copy()
@@ -204,7 +207,8 @@ def simulate_compiled(
         raise InputError("controller", "None, a compiled controller or a callable (t, q, v) -> tau", repr(controller))
     q_out, v_out, a_out, tau_out = out
     if steps:  # the last sample's own acceleration, under the torque held at the end (as robodyn.simulate)
-        a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], tau_out[-1])
+        applied = tau_out[-1] if damping is None else tau_out[-1] - damping * v_out[-1]
+        a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], applied)
     return SimulationArrays(np.arange(steps + 1) * dt, *out)
 
 
