@@ -151,14 +151,7 @@ def simulate_compiled(
     """
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
-    robot = compiled.robot
-    if joint_friction and robot.joint_friction.any():
-        raise InputError(
-            "joint_friction",
-            "False for a robot whose joints have Coulomb friction (the compiled loop has damping, not stick-slip)",
-            f"True for {quoted(robot.name)}",
-        )
-    damping = np.ascontiguousarray(robot.joint_damping, dtype=float) if joint_friction and robot.joint_damping.any() else None
+    damping = _joint_damping(compiled, joint_friction)
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
     (q, v), batch = compiled.robot.validate(q=q0, v=v0)
@@ -210,6 +203,23 @@ def simulate_compiled(
         applied = tau_out[-1] if damping is None else tau_out[-1] - damping * v_out[-1]
         a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], applied)
     return SimulationArrays(np.arange(steps + 1) * dt, *out)
+
+
+def _joint_damping(compiled: CompiledRobot, joint_friction: bool) -> np.ndarray | None:
+    """The damping the loop in C applies, ``b`` per joint (``None``: none acts).
+
+    Raises:
+        InputError: For ``joint_friction`` on a robot with Coulomb friction (stick–slip has
+            no loop in C).
+    """
+    robot = compiled.robot
+    if joint_friction and robot.joint_friction.any():
+        raise InputError(
+            "joint_friction",
+            "False for a robot whose joints have Coulomb friction (the compiled loop has damping, not stick-slip)",
+            f"True for {quoted(robot.name)}",
+        )
+    return np.ascontiguousarray(robot.joint_damping, dtype=float) if joint_friction and robot.joint_damping.any() else None
 
 
 def _raise_if_failed(compiled: CompiledRobot, failed: int, out: list[np.ndarray], dt: float, start: int) -> None:
