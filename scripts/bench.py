@@ -806,7 +806,7 @@ def bench_compiled_control(quick: bool) -> list[dict]:
     """Compiled controllers (every RK4 stage, in C): the loop's real-time factor (start-up and
     compile excluded), against the Python engine and MuJoCo's passive RK4 loop on the same robot."""
     from robodyn.compiled.simulation import compiled_controller, simulate_compiled
-    from robodyn.sim.control import Impedance, OperationalSpace, TaskSpace
+    from robodyn.sim.control import LQR, Impedance, OperationalSpace, TaskSpace
 
     rows = []
     # The demo (Makefile): rp_arm, task space, --q0 0,0.1 --target 0.7,0.7 --duration 3.
@@ -839,6 +839,7 @@ def bench_compiled_control(quick: bool) -> list[dict]:
         "osc (position)": OperationalSpace(robot, None, goal),
         "osc (pose)": OperationalSpace(robot, None, goal, orientation=[3.0, 0.2, 0.1]),
         "impedance (pose)": Impedance(robot, None, goal, orientation=[3.0, 0.2, 0.1]),
+        "lqr": LQR(robot, q0 - 0.2, np.zeros(robot.nv), 10.0, 0.1),
     }
     mj_rtf = mj_rtf_cpu = float("nan")
     try:
@@ -919,8 +920,9 @@ def _cpu_paired(ours: Callable[[], object], raw: Callable[[], object], repeats: 
 
 
 def bench_single_thin(quick: bool) -> list[dict]:
-    """``Robot``'s single calls vs the raw Pinocchio call on a preallocated Data (M: CRBA
-    and the lower triangle mirrored, as ``Robot`` returns it); target: ratio <= 1.3."""
+    """``Robot``'s single calls vs the raw Pinocchio call on a preallocated Data (M: Python's
+    ``pin.crba``, which returns M with both triangles filled, as ``Robot`` does); target:
+    ratio <= 1.3."""
     rows = []
     for label, name, options in (("ur5", "ur5", {}), *[("panda (arm, fingers locked)", "panda", PANDA_ARM)]):
         robot = robodyn.load(name, **options)
@@ -929,16 +931,10 @@ def bench_single_thin(quick: bool) -> list[dict]:
         q = robot.random_configuration(rng).copy()
         v, a = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
         tau = robot.inverse_dynamics(q, v, a)
-        lower = np.tri(robot.nv, robot.nv, -1, dtype=bool)
-
-        def crba_mirrored(q=q, model=model, data=data, lower=lower):
-            mass = pin.crba(model, data, q)
-            np.copyto(mass, mass.T, where=lower)
-            return mass
 
         cases = {
             "inverse_dynamics vs pin.rnea": (lambda: robot.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a)),
-            "mass_matrix vs pin.crba + mirror": (lambda: robot.mass_matrix(q), crba_mirrored),
+            "mass_matrix vs pin.crba": (lambda: robot.mass_matrix(q), lambda: pin.crba(model, data, q)),
             "gravity vs pin.computeGeneralizedGravity": (
                 lambda: robot.gravity(q),
                 lambda: pin.computeGeneralizedGravity(model, data, q),

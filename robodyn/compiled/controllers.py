@@ -1,4 +1,4 @@
-"""Compiled twins of the frame controllers: task space, operational space, impedance.
+"""Compiled twins of the frame controllers (task space, operational space, impedance) and LQR.
 
 Each holds its **own** compiled model (like :class:`~robodyn.compiled.simulation.CompiledPDGravity`)
 and a frame whose kinematics is generated C (:mod:`robodyn.compiled.kinematics`); the C loop
@@ -145,3 +145,36 @@ class CompiledImpedance(CompiledFrameController):
                 [_scalar(self.null_damping, "null_damping")],
             ]
         )
+
+
+@dataclass(frozen=True)
+class CompiledLQR:
+    """:class:`robodyn.sim.control.LQR` in C: ``tau = S_act (u_eq − K (x − x_eq))``,
+    ``x = (q, v)`` (kind 6 of the C loop).
+
+    Attributes:
+        model: The controller's compiled model (fixed base; the law itself is linear).
+        gain: ``K``, shape (nu, 2 nv).
+        u_eq: The holding input, shape (nu,).
+        actuation: ``S_act``, shape (nv, nu): the actuated joints' columns of the identity.
+        x_eq: The equilibrium ``(q_eq, v_eq)``, shape (2 nv,).
+    """
+
+    model: CompiledRobot
+    gain: np.ndarray
+    u_eq: np.ndarray
+    actuation: np.ndarray
+    x_eq: np.ndarray
+    kind: ClassVar[int] = 6
+
+    def params(self, nv: int) -> np.ndarray:
+        actuation = np.asarray(self.actuation, dtype=float)
+        inputs = actuation.shape[1] if actuation.ndim == 2 else -1
+        gain = np.asarray(self.gain, dtype=float)
+        if actuation.shape != (nv, inputs) or gain.shape != (inputs, 2 * nv) or not np.isfinite(gain).all():
+            raise InputError(
+                "gain and actuation", f"K (nu, {2 * nv}) and S_act ({nv}, nu), finite", f"{gain.shape}, {actuation.shape}"
+            )
+        u_eq, x_eq = _vector(self.u_eq, "u_eq", inputs), _vector(self.x_eq, "x_eq", 2 * nv)
+        # S_act selects: S u and S K are the actuated rows, the others zero (exact products)
+        return np.concatenate([actuation @ u_eq, (actuation @ gain).reshape(-1), x_eq])

@@ -213,6 +213,7 @@ typedef struct {
     const double *params;
     const rd_kernels *model;
     const void *frame; /* kinds 3-5: the controlled frame's rd_frame_kernels */
+    const double *damping; /* the plant's joint damping b (the torque − b v at every stage), or NULL */
 } rd_controller;
 
 /* ---- compiled frame controllers (task space, operational space, impedance) -------------
@@ -277,6 +278,26 @@ static void rdc_ldl_apply(const double *M, double *b) {
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
 }
 
+/* rdc_ldl_apply on k right-hand sides at once, B n×k row-major (B[j k + c] is b_c[j]): each
+ * column gets rdc_ldl_apply's operations in its order (the same bits), the tree walked once. */
+static void rdc_ldl_apply_block(const double *M, double *B, int k) {
+    const int n = RD_NV;
+    for (int i = n - 1; i >= 0; --i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
+            const double x = M[i * n + j];
+            for (int c = 0; c < k; ++c) B[j * k + c] -= x * B[i * k + c];
+        }
+    for (int i = 0; i < n; ++i) {
+        const double d = M[i * n + i];
+        for (int c = 0; c < k; ++c) B[i * k + c] /= d;
+    }
+    for (int i = 0; i < n; ++i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
+            const double x = M[i * n + j];
+            for (int c = 0; c < k; ++c) B[i * k + c] -= x * B[j * k + c];
+        }
+}
+
 /* Eigen-decomposition of a symmetric m×m matrix (its lower triangle, as numpy's eigh): Householder
  * tridiagonalisation + implicit QL (EISPACK tred2/tql2, as in Numerical Recipes). */
 static void rdc_tred2(double *a, int n, double *d, double *e) {
@@ -335,6 +356,21 @@ static void rdc_tred2(double *a, int n, double *d, double *e) {
     }
 }
 
+/* sqrt(a² + b²) without overflow or underflow: directly when the squares are normal numbers
+ * (the QL sweeps' usual case), else scaled (Numerical Recipes' pythag). libm's hypot is
+ * correctly rounded and several times slower; the sweeps do not need its last bit. */
+static double rdc_pythag(double a, double b) {
+    const double x = fabs(a), y = fabs(b);
+    if (x < 1e150 && y < 1e150 && (x > 1e-150 || y > 1e-150)) return sqrt(x * x + y * y);
+    if (x > y) {
+        const double r = y / x;
+        return x * sqrt(1.0 + r * r);
+    }
+    if (y == 0.0) return 0.0;
+    const double r = x / y;
+    return y * sqrt(1.0 + r * r);
+}
+
 static void rdc_tqli(double *d, double *e, int n, double *z) {
     for (int i = 1; i < n; ++i) e[i - 1] = e[i];
     e[n - 1] = 0.0;
@@ -348,13 +384,13 @@ static void rdc_tqli(double *d, double *e, int n, double *z) {
             if (m != l) {
                 if (iter++ == 60) break;
                 double g = (d[l + 1] - d[l]) / (2.0 * e[l]);
-                double r = hypot(g, 1.0);
+                double r = rdc_pythag(g, 1.0);
                 g = d[m] - d[l] + e[l] / (g + (g >= 0.0 ? fabs(r) : -fabs(r)));
                 double s = 1.0, c = 1.0, p = 0.0;
                 int i;
                 for (i = m - 1; i >= l; --i) {
                     double f = s * e[i], b = c * e[i];
-                    e[i + 1] = (r = hypot(f, g));
+                    e[i + 1] = (r = rdc_pythag(f, g));
                     if (r == 0.0) {
                         d[i + 1] -= p;
                         e[m] = 0.0;
@@ -381,7 +417,7 @@ static void rdc_tqli(double *d, double *e, int n, double *z) {
     }
 }
 
-/* Λ from Λ⁻¹ = A (m×m, destroyed), damped as operational_space.damped_task_inertia. */
+/* Λ from Λ⁻¹ = A (m×m, symmetric), damped as operational_space.damped_task_inertia. */
 static void rdc_task_inertia(double *A, double damping, int m, double *L) {
     double V[36], s[6], d[6], e[6], top = 0.0;
     memcpy(V, A, sizeof(double) * m * m); /* eigenvectors as the columns of V, values in d */
@@ -529,7 +565,7 @@ static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *fram
 /* params: rows m, position (3), R_d (9), kp, kd, damping, posture_kp, posture_kd, has_posture,
  * posture (n)  (robodyn.sim.operational_space.OperationalSpace, fixed target) */
 static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
-                                  const double *v, double *tau) {
+                                  const double *v, double *tau, double *a) {
     const int n = RD_NV, m = (int)p[0];
     double x[3], R[9], J[6 * RD_NV], bias[6], command[6], M[RD_NV * RD_NV], L[RD_NV * RD_NV], h[RD_NV];
     double MiJt[6 * RD_NV], A[36], Lam[36], f[6], posture[RD_NV], y[6];
@@ -545,17 +581,21 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     memcpy(L, M, sizeof M);
     if (rdc_ldl_factor(L)) {
         for (int i = 0; i < n; ++i) tau[i] = NAN;
+        if (a)
+            for (int i = 0; i < n; ++i) a[i] = NAN;
         return;
     }
-    for (int k = 0; k < m; ++k) { /* column k of M⁻¹ Jᵀ, stored as row k */
-        memcpy(MiJt + k * n, J + k * n, sizeof(double) * n);
-        rdc_ldl_apply(L, MiJt + k * n);
-    }
-    for (int i = 0; i < m; ++i)
-        for (int k = 0; k < m; ++k) {
+    double block[6 * RD_NV]; /* M⁻¹ Jᵀ (n×m), solved for its m columns at once */
+    for (int j = 0; j < n; ++j)
+        for (int k = 0; k < m; ++k) block[j * m + k] = J[k * n + j];
+    rdc_ldl_apply_block(L, block, m);
+    for (int k = 0; k < m; ++k) /* column k of M⁻¹ Jᵀ, stored as row k */
+        for (int j = 0; j < n; ++j) MiJt[k * n + j] = block[j * m + k];
+    for (int i = 0; i < m; ++i) /* J M⁻¹ Jᵀ: its lower triangle, all the eigen-decomposition reads */
+        for (int k = 0; k <= i; ++k) {
             double s = 0.0;
             for (int j = 0; j < n; ++j) s += J[i * n + j] * MiJt[k * n + j];
-            A[i * m + k] = s;
+            A[i * m + k] = A[k * m + i] = s;
         }
     rdc_task_inertia(A, p[15], m, Lam);
     for (int i = 0; i < m; ++i) y[i] = command[i] - bias[i];
@@ -563,9 +603,11 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
         f[i] = 0.0;
         for (int k = 0; k < m; ++k) f[i] += Lam[i * m + k] * y[k];
     }
+    double rate[RD_NV];
+    for (int j = 0; j < n; ++j) rate[j] = p[16] * (p[18] ? p[19 + j] - q[j] : 0.0) - p[17] * v[j];
     for (int i = 0; i < n; ++i) { /* posture = M (kp0 (q0 - q) - kd0 v) */
         double s = 0.0;
-        for (int j = 0; j < n; ++j) s += M[i * n + j] * (p[16] * (p[18] ? p[19 + j] - q[j] : 0.0) - p[17] * v[j]);
+        for (int j = 0; j < n; ++j) s += M[i * n + j] * rate[j];
         posture[i] = s;
     }
     double JP[6] = {0}; /* Nᵀ posture = posture - Jᵀ Λ (M⁻¹Jᵀ)ᵀ posture */
@@ -580,6 +622,10 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
         double task = 0.0, back = 0.0;
         for (int i = 0; i < m; ++i) task += J[i * n + j] * f[i], back += J[i * n + j] * LJP[i];
         tau[j] = task + h[j] + (posture[j] - back);
+    }
+    if (a) { /* the plant's accelerations when it is this model: rd_fd_raw's arithmetic on M, h */
+        for (int i = 0; i < n; ++i) a[i] = tau[i] - h[i];
+        rdc_ldl_apply(L, a);
     }
 }
 
@@ -627,10 +673,24 @@ static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame
 static void rd_control_frame(const rd_controller *c, const double *q, const double *v, double *tau) {
     const rd_frame_kernels *frame = (const rd_frame_kernels *)c->frame;
     if (c->kind == 3) rdc_task_space(c->model, frame, c->params, q, v, tau);
-    if (c->kind == 4) rdc_operational_space(c->model, frame, c->params, q, v, tau);
+    if (c->kind == 4) rdc_operational_space(c->model, frame, c->params, q, v, tau, NULL);
     if (c->kind == 5) rdc_impedance(c->model, frame, c->params, q, v, tau);
 }
 
+
+/* params: S u_eq (n), S K (n × 2n, row-major), x_eq = (q_eq, v_eq) (2n)
+ * (robodyn.sim.control.LQR: tau = S (u_eq − K (x − x_eq)), S selecting the actuated joints) */
+static void rdc_lqr(const double *p, const double *q, const double *v, double *tau) {
+    const int n = RD_NV;
+    const double *K = p + n, *x_eq = p + n + 2 * n * n;
+    double e[2 * RD_NV];
+    for (int j = 0; j < n; ++j) e[j] = q[j] - x_eq[j], e[n + j] = v[j] - x_eq[n + j];
+    for (int i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (int j = 0; j < 2 * n; ++j) s += K[i * 2 * n + j] * e[j];
+        tau[i] = p[i] - s;
+    }
+}
 
 static void rd_control(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
     const int n = RD_NV;
@@ -641,6 +701,8 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
         double g[RD_NV];
         c->model->gravity(q, g);
         for (int i = 0; i < n; ++i) tau[i] = p[n + i] * (p[i] - q[i]) - p[2 * n + i] * v[i] + g[i];
+    } else if (c->kind == 6) {
+        rdc_lqr(p, q, v, tau);
     } else if (c->kind >= 3) { /* task space, operational space, impedance */
         rd_control_frame(c, q, v, tau);
     } else { /* params: q_start, q_end, kp, kd, duration */
@@ -661,14 +723,35 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
     }
 }
 
+/* tau(t, q, v) and the plant's a = FD(q, v, tau) in one pass, when the controller's model is
+ * the plant's (this module's kernels) and it computes M and C v + G anyway (operational space):
+ * 1 when done (a NaN for a singular M), 0 when the caller is to call rd_control and rd_fd_raw.
+ * Bit-identical to those two: the same M, h and the same LDLᵀ arithmetic. */
+static int rd_control_fd(const rd_controller *c, const double *q, const double *v, double *tau, double *a) {
+    if (c->kind != 4 || c->model != &rd_self || c->damping) return 0;
+    rdc_operational_space(c->model, (const rd_frame_kernels *)c->frame, c->params, q, v, tau, a);
+    return 1;
+}
+
+/* The plant's forward dynamics under the torque tau and its joints' damping: FD(q, v, tau − b v)
+ * (robodyn.sim.joint_friction's order of operations), FD(q, v, tau) without damping. */
+static int rd_fd_damped(const rd_controller *c, const double *q, const double *v, const double *tau, double *a) {
+    if (!c->damping) return rd_fd_raw(q, v, tau, a);
+    double total[RD_NV];
+    for (int i = 0; i < RD_NV; ++i) total[i] = tau[i] - c->damping[i] * v[i];
+    return rd_fd_raw(q, v, total, a);
+}
+
 /* a = FD(q, v, tau(t, q, v)); the stage's torque is the held one when c->hold. */
 static void rd_stage(const rd_controller *c, double t, const double *q, const double *v, const double *held, double *a) {
     double tau[RD_NV];
     if (c->hold || c->kind == 0)
         memcpy(tau, held, sizeof tau);
+    else if (rd_control_fd(c, q, v, tau, a))
+        return;
     else
         rd_control(c, t, q, v, tau);
-    if (rd_fd_raw(q, v, tau, a))
+    if (rd_fd_damped(c, q, v, tau, a))
         for (int i = 0; i < RD_NV; ++i) a[i] = NAN;
 }
 
@@ -681,9 +764,10 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
         const double t = t0 + k * dt;
         memcpy(oq + k * n, q, n * sizeof(double));
         memcpy(ov + k * n, v, n * sizeof(double));
-        rd_control(c, t, q, v, tau);
+        const int fused = rd_control_fd(c, q, v, tau, a);
+        if (!fused) rd_control(c, t, q, v, tau);
         memcpy(otau + k * n, tau, n * sizeof(double));
-        if (rd_fd_raw(q, v, tau, a))
+        if (!fused && rd_fd_damped(c, q, v, tau, a))
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa + k * n, a, n * sizeof(double));
         if (rk4) {
@@ -717,7 +801,7 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
     } else {
         double zero[RD_NV] = {0};
         memcpy(otau, zero, sizeof zero);
-        if (rd_fd_raw(q, v, zero, a))
+        if (rd_fd_damped(c, q, v, zero, a))
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa, a, n * sizeof(double));
     }
@@ -734,8 +818,8 @@ static double *rd_array(PyObject *object, npy_intp size, int writable) {
 }
 
 static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 14 && nargs != 15) {
-        PyErr_SetString(PyExc_TypeError, "simulate takes 14 or 15 arguments");
+    if (nargs < 14 || nargs > 16) {
+        PyErr_SetString(PyExc_TypeError, "simulate takes 14 to 16 arguments");
         return NULL;
     }
     const double dt = PyFloat_AsDouble(args[2]);
@@ -744,8 +828,8 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
     const long rk4 = PyLong_AsLong(args[5]), kind = PyLong_AsLong(args[6]), hold = PyLong_AsLong(args[7]);
     if (PyErr_Occurred()) return NULL;
     const int n = RD_NV;
-    const npy_intp sizes[6] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26};
-    if (kind < 0 || kind > 5 || steps < 0) {
+    const npy_intp sizes[7] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26, 2 * n * n + 3 * n};
+    if (kind < 0 || kind > 6 || steps < 0) {
         PyErr_SetString(PyExc_ValueError, "bad controller kind or step count");
         return NULL;
     }
@@ -762,15 +846,20 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         return NULL;
     }
     const rd_frame_kernels *frame = NULL; /* the 15th argument: the frame capsule of kinds 3-5 */
-    if (nargs == 15 && args[14] != Py_None) {
+    if (nargs >= 15 && args[14] != Py_None) {
         frame = (const rd_frame_kernels *)PyCapsule_GetPointer(args[14], RD_FRAME_CAPSULE);
         if (!frame) return NULL;
     }
-    if (kind >= 3 && (!frame || frame->nv != n)) {
+    if (kind >= 3 && kind <= 5 && (!frame || frame->nv != n)) {
         PyErr_SetString(PyExc_ValueError, "simulate: a frame controller needs its frame's kernels");
         return NULL;
     }
-    rd_controller controller = {(int)kind, (int)hold, params, model, frame};
+    const double *damping = NULL; /* the 16th argument: the joints' damping (nv), or None */
+    if (nargs == 16 && args[15] != Py_None && !(damping = rd_array(args[15], n, 0))) {
+        PyErr_SetString(PyExc_ValueError, "simulate: damping of the wrong type or size");
+        return NULL;
+    }
+    rd_controller controller = {(int)kind, (int)hold, params, model, frame, damping};
     double q[RD_NV], v[RD_NV];
     memcpy(q, q0, sizeof q);
     memcpy(v, v0, sizeof v);

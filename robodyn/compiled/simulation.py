@@ -26,7 +26,13 @@ import numpy as np
 
 from robodyn.common.inputs import as_state
 from robodyn.common.text import quoted
-from robodyn.compiled.controllers import CompiledFrameController, CompiledImpedance, CompiledOperationalSpace, CompiledTaskSpace
+from robodyn.compiled.controllers import (
+    CompiledFrameController,
+    CompiledImpedance,
+    CompiledLQR,
+    CompiledOperationalSpace,
+    CompiledTaskSpace,
+)
 from robodyn.compiled.robot import CompiledRobot, compile
 from robodyn.exceptions import CompileError, InputError, SimulationError
 
@@ -130,9 +136,11 @@ def simulate_compiled(
         control_period: For a Python controller, in [s], a whole number of steps
             (default ``dt``).
         hold: For a compiled controller: sample it once a step instead of at every stage.
-        joint_friction: The loop in C is rigid-body: a robot whose joints have damping or
-            Coulomb friction (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`) is
-            refused unless ``joint_friction=False`` asks for the rigid-body motion.
+        joint_friction: The joints' damping (:attr:`Robot.joint_damping`) acts in C at
+            every stage, ``−b v`` added to the torque as :mod:`robodyn.sim.joint_friction`
+            does; a robot with Coulomb friction (:attr:`Robot.joint_friction`, stick–slip
+            events) is refused unless ``joint_friction=False`` asks for the rigid-body
+            motion (damping left out too).
 
     Returns:
         ``round(duration / dt) + 1`` samples (the conventions of :func:`robodyn.simulate`).
@@ -143,13 +151,7 @@ def simulate_compiled(
     """
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
-    robot = compiled.robot
-    if joint_friction and (robot.joint_damping.any() or robot.joint_friction.any()):
-        raise InputError(
-            "joint_friction",
-            "False for a robot whose joints have damping or friction (the compiled loop is rigid-body)",
-            f"True for {quoted(robot.name)}",
-        )
+    damping = _joint_damping(compiled, joint_friction)
     if not (math.isfinite(dt) and dt > 0 and math.isfinite(duration) and duration >= 0):
         raise InputError("dt and duration", "finite, dt > 0 and duration >= 0", f"dt={dt}, duration={duration}")
     (q, v), batch = compiled.robot.validate(q=q0, v=v0)
@@ -159,7 +161,9 @@ def simulate_compiled(
     rk4 = int(integrator == "rk4")
     out = [np.empty((steps + 1, nv)) for _ in range(4)]
     q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
-    if controller is None or isinstance(controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController):
+    if controller is None or isinstance(
+        controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | CompiledLQR
+    ):
         if control_period is not None:
             raise InputError("control_period", "used with a Python controller only", repr(control_period))
         kind, params, model, frame = 0, np.zeros(nv), None, None
@@ -170,7 +174,9 @@ def simulate_compiled(
             params, model = controller.params(nv), controller.model.module._kernels
             if isinstance(controller, CompiledFrameController):
                 kind, frame = controller.kind, controller.frame_kernels()
-        failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out, frame)
+            if isinstance(controller, CompiledLQR):
+                kind = controller.kind
+        failed = compiled.module.simulate(q, v, float(dt), steps, 0.0, rk4, kind, int(hold), params, model, *out, frame, damping)
         _raise_if_failed(compiled, failed, out, dt, 0)
     elif callable(controller):
         period = dt if control_period is None else control_period
@@ -178,7 +184,7 @@ def simulate_compiled(
         if every < 1 or abs(every * dt - period) > 1e-9 * period:
             raise InputError("control_period", f"a whole number of steps of dt = {dt}", repr(control_period))
         if steps == 0:  # one sample, zero torque (as robodyn.simulate)
-            failed = compiled.module.simulate(q, v, float(dt), 0, 0.0, rk4, 0, 1, np.zeros(nv), None, *out)
+            failed = compiled.module.simulate(q, v, float(dt), 0, 0.0, rk4, 0, 1, np.zeros(nv), None, *out, None, damping)
         for start in range(0, steps, every):
             count = min(every, steps - start)
             tau = np.asarray(controller(start * dt, q.copy(), v.copy()), dtype=float)
@@ -186,7 +192,7 @@ def simulate_compiled(
                 raise InputError("controller output", f"{nv} torques", f"shape {tau.shape}")
             views = [array[start : start + count + 1] for array in out]
             failed = compiled.module.simulate(
-                q, v, float(dt), count, start * dt, rk4, 0, 1, np.ascontiguousarray(tau), None, *views
+                q, v, float(dt), count, start * dt, rk4, 0, 1, np.ascontiguousarray(tau), None, *views, None, damping
             )
             _raise_if_failed(compiled, failed, out, dt, start)
             q, v = out[0][start + count].copy(), out[1][start + count].copy()
@@ -194,8 +200,26 @@ def simulate_compiled(
         raise InputError("controller", "None, a compiled controller or a callable (t, q, v) -> tau", repr(controller))
     q_out, v_out, a_out, tau_out = out
     if steps:  # the last sample's own acceleration, under the torque held at the end (as robodyn.simulate)
-        a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], tau_out[-1])
+        applied = tau_out[-1] if damping is None else tau_out[-1] - damping * v_out[-1]
+        a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], applied)
     return SimulationArrays(np.arange(steps + 1) * dt, *out)
+
+
+def _joint_damping(compiled: CompiledRobot, joint_friction: bool) -> np.ndarray | None:
+    """The damping the loop in C applies, ``b`` per joint (``None``: none acts).
+
+    Raises:
+        InputError: For ``joint_friction`` on a robot with Coulomb friction (stick–slip has
+            no loop in C).
+    """
+    robot = compiled.robot
+    if joint_friction and robot.joint_friction.any():
+        raise InputError(
+            "joint_friction",
+            "False for a robot whose joints have Coulomb friction (the compiled loop has damping, not stick-slip)",
+            f"True for {quoted(robot.name)}",
+        )
+    return np.ascontiguousarray(robot.joint_damping, dtype=float) if joint_friction and robot.joint_damping.any() else None
 
 
 def _raise_if_failed(compiled: CompiledRobot, failed: int, out: list[np.ndarray], dt: float, start: int) -> None:
@@ -218,9 +242,10 @@ _TWINS = {
     "robodyn.sim.control.TaskSpace": "task-space",
     "robodyn.sim.operational_space.OperationalSpace": "operational-space",
     "robodyn.sim.operational_space.Impedance": "impedance",
+    "robodyn.sim.control.LQR": "lqr",
 }
 
-CompiledController = CompiledPDGravity | CompiledComputedTorque | CompiledFrameController
+CompiledController = CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | CompiledLQR
 
 
 def has_twin(controller: object) -> bool:
@@ -239,7 +264,7 @@ def compiled_controller(controller: object) -> CompiledController:
     """The compiled twin of a Python controller of :mod:`robodyn.sim` (on its own model, compiled).
 
     ``PDGravity``, ``ComputedTorque`` along a quintic (:func:`robodyn.sim.control.quintic_reference`),
-    ``TaskSpace``, ``OperationalSpace`` with a fixed target, ``Impedance``: the same law in C,
+    ``TaskSpace``, ``OperationalSpace`` with a fixed target, ``Impedance``, ``LQR``: the same law in C,
     evaluated wherever the integrator evaluates the dynamics.
 
     Raises:
@@ -260,6 +285,8 @@ def compiled_controller(controller: object) -> CompiledController:
         if type(reference).__qualname__ != "QuinticReference":
             raise CompileError(c.model.name, "computed torque compiles along a quintic_reference only")
         return CompiledComputedTorque(compile(c.model), reference.q_start, reference.q_end, reference.duration, c.kp, c.kd)
+    if kind == "lqr":
+        return CompiledLQR(compile(c.model), c.gain, c.u_eq, c.actuation, c.x_eq)
     if kind == "task-space":
         return CompiledTaskSpace(compile(c.model), c.frame, c.target, c.kp, c.kd, c.damping, c.joint_damping)
     if callable(c.position):

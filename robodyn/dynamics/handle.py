@@ -138,21 +138,24 @@ class ModelHandle:
         On a fixed-base robot (with mimic joints: for tau, G and C v + G only),
         ``raw(model, data, *values)`` runs on this
         thread's data (read from a ``threading.local`` without a call: thread-safe) and its
-        result is returned when it and ``q`` are finite (one ``isfinite`` of two sums); a
-        ``symmetric`` result (CRBA's upper triangle) gets its lower triangle filled first.
-        Anything else (other inputs, a first call in a thread, a non-finite value, a floating
+        result is returned when it and ``q`` are finite (one ``isfinite`` of two sums);
+        ``M(q)`` and ``G(q)`` of a model that keeps them finite for every finite ``q``
+        (:func:`bounded_for_finite_q`) check ``q`` alone. Anything else (other inputs, a first call in a thread, a non-finite value, a floating
         base, mimic joints) goes to :meth:`evaluate`, which checks and names the argument.
 
         Args:
             kernel: The quantity's kernel (the checked path).
             raw: The Pinocchio function ``raw(model, data, *values)`` of one state.
-            symmetric: Whether ``raw`` returns an upper triangle to mirror.
+            symmetric: Whether ``raw`` returns a matrix (CRBA's M: Pinocchio's Python
+                binding fills both triangles).
         """
         evaluate, model, local = self.evaluate, self.model, self._data.local
         if self.floating_base or (self.mimic is not None and (symmetric or raw is pin.aba)):
             # a floating base's quaternion needs its own check; with mimic joints, M and the
             # accelerations are not one Pinocchio call (kernels.py)
             return lambda *values: evaluate(kernel, *values)
+        if len(kernel.names) == 1 and bounded_for_finite_q(model):
+            return _configuration_call(kernel, raw, model, local, evaluate)
         if symmetric:
             return _matrix_call(kernel, raw, model, local, evaluate)
         return _vector_call(kernel, raw, model, local, evaluate)
@@ -195,25 +198,72 @@ class ModelHandle:
         return self.finite(per_state(single, *arrays), what)
 
 
+#: Pinocchio's joints whose one coordinate is an angle: their placement is a rotation by it.
+_ANGLE_JOINTS = frozenset({"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"})
+#: Bound on the model's constants under which no product CRBA or RNEA forms can overflow.
+_SAFE_CONSTANT = 1e50
+
+
+def bounded_for_finite_q(model: pin.Model) -> bool:
+    """Whether ``M(q)`` and ``G(q)`` are finite for every finite ``q``.
+
+    True when every joint is revolute with one angle coordinate (its rotation's entries,
+    cos and sin of the angle, lie in [-1, 1] for any finite angle) and the model's
+    constants (masses, centres of mass, inertias, joint placements, armature, gravity) stay
+    below 1e50 in magnitude: CRBA and RNEA at zero velocity then form sums of products of
+    a few such constants and rotation entries, far from overflow. A prismatic joint (a
+    translation by ``q``) or a continuous joint's (cos, sin) pair can overflow for large
+    finite ``q``, so their results are checked.
+    """
+    if any(joint.shortname() not in _ANGLE_JOINTS for joint in list(model.joints)[1:]):
+        return False
+    constants = [model.gravity.linear, model.armature]
+    for inertia, placement in zip(list(model.inertias)[1:], list(model.jointPlacements)[1:], strict=True):
+        constants += [np.array([inertia.mass]), inertia.lever, inertia.inertia, placement.translation]
+    return all(bool(np.all(np.abs(values) < _SAFE_CONSTANT)) for values in constants)
+
+
+def _configuration_call(
+    kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
+) -> Callable[..., np.ndarray]:
+    """:meth:`ModelHandle.single_call` of ``M(q)`` or ``G(q)`` on a model whose results are
+    finite for every finite ``q`` (:func:`bounded_for_finite_q`): ``q`` alone is checked."""
+    isfinite = _isfinite
+
+    def of_q(q: np.ndarray) -> np.ndarray:
+        try:
+            # One sum checks q: NaN or inf make it non-finite (a finite sum that overflows
+            # only sends q to the checked path), and a 2-D q (a batch, which Pinocchio
+            # would take as one state if it is a column) gives a list of rows that does
+            # not sum (TypeError).
+            if isfinite(sum(q.tolist())):
+                return raw(model, local.data, q)
+        except PINOCCHIO_ERRORS:
+            pass
+        return evaluate(kernel, q)
+
+    return of_q
+
+
 def _matrix_call(
     kernel: Kernel, raw: Callable[..., np.ndarray], model: pin.Model, local: Any, evaluate: Callable[..., np.ndarray]
 ) -> Callable[..., np.ndarray]:
-    """:meth:`ModelHandle.single_call` of CRBA: the upper triangle mirrored, ``M`` and ``q``
+    """:meth:`ModelHandle.single_call` of CRBA on any fixed-base model: ``M`` and ``q``
     checked."""
     isfinite = _isfinite
-    lower, copyto = np.tri(model.nv, model.nv, -1, dtype=bool), np.copyto
     # CRBA never uses the placement of a joint attached to the world, and M need not move
     # with other joints either (a chain of prismatic joints: M is constant), so q is
-    # checked besides M itself.
+    # checked besides M itself. Pinocchio's Python crba returns M whole (its binding
+    # mirrors the upper triangle: tests/dynamics/test_single_call.py), so M is returned
+    # as it comes.
 
     def matrix(q: np.ndarray) -> np.ndarray:
         try:
-            if q.ndim != 1:  # a batch (Pinocchio would take a (1, 1) array as one state)
+            if q.ndim != 1:  # a batch (Pinocchio would take a (nq, 1) array as one state)
                 return evaluate(kernel, q)
             result = raw(model, local.data, q)
-            copyto(result, result.T, where=lower)
-            flat = result.ravel()
-            if isfinite(flat.dot(flat) + sum(q.tolist())):
+            # sums of Python floats: an overflow gives inf without numpy's warning
+            if isfinite(sum(result.ravel().tolist()) + sum(q.tolist())):
                 return result
         except PINOCCHIO_ERRORS:
             pass
@@ -288,12 +338,9 @@ class SingleCalls(NamedTuple):
 
 def _all_finite(array: np.ndarray) -> bool:
     """Whether an array holds no NaN or inf, by the cheapest exact test for its size: a NaN
-    or inf anywhere makes the sum (a vector) or the sum of squares (a matrix) non-finite; a
-    finite sum that overflows only sends the caller to the exact check."""
-    if array.ndim == 1:
-        return _isfinite(sum(array.tolist()))
-    flat = array.ravel()
-    return _isfinite(flat.dot(flat))
+    or inf anywhere makes the sum of its entries non-finite; a finite sum that overflows
+    (to inf, without a warning: Python floats) only sends the caller to the exact check."""
+    return _isfinite(sum(array.ravel().tolist()))
 
 
 def per_state(function: Callable[..., np.ndarray], *states: np.ndarray) -> np.ndarray:

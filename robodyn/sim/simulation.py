@@ -31,9 +31,9 @@ the effort limits and stops joints at their position limits; ``"ignore"`` does n
 Joint damping and Coulomb friction (``<dynamics>``, :attr:`Robot.joint_damping`,
 :attr:`Robot.joint_friction`) act by default (``joint_friction=False``: the rigid-body
 motion): ``−b v``, and stick–slip friction with its events located inside the step
-(:mod:`robodyn.sim.joint_friction`, docs/joint-friction.md). The compiled engine has
-neither: it refuses a robot with either unless ``joint_friction=False`` (``engine="auto"``
-runs such a robot on the Pinocchio engine).
+(:mod:`robodyn.sim.joint_friction`, docs/joint-friction.md). The compiled engine has the
+damping (in C, at every stage) but no stick–slip: it refuses a robot with Coulomb friction
+unless ``joint_friction=False`` (``engine="auto"`` runs such a robot on the Pinocchio engine).
 
 A state that stops being finite ends the run with a :class:`SimulationError` saying when
 and which joint, or a :class:`SingularMassMatrixError` when the mass matrix is singular
@@ -285,7 +285,7 @@ def _simulate(
             chosen, reason = "pinocchio", f"the compiled engine does not apply: {error}"
     compile_time = perf_counter() - began if chosen == "compiled" or engine != "pinocchio" else 0.0
     if compiled is not None:
-        trajectory, run = _simulate_compiled(robot, q, v, steps, dt, controller, integrator, every, compiled)
+        trajectory, run = _simulate_compiled(robot, q, v, steps, dt, controller, integrator, every, compiled, friction=friction)
         run = replace(run, reason=reason or "asked for (engine='compiled')", compile_time=compile_time)
     else:
         trajectory, run = _simulate_pinocchio(
@@ -336,7 +336,7 @@ def choose_engine(
         (bool(external), "external wrenches"),
         (observer is not None, "a momentum observer"),
         (limits == "enforce", "limits enforced"),
-        (joint_friction, "joint damping and friction"),
+        (joint_friction and bool(robot.joint_friction.any()), "joint Coulomb friction"),
         (bool(robot.massless_joints) or robot.nv == 0, "no moving mass to compile"),
     ]
     for refused, what in refusals:
@@ -579,7 +579,7 @@ def _check_compiled_applies(
 def _runs_in_c(controller: Controller, every: int | None) -> bool:
     """Whether a controller has a compiled twin the C loop evaluates at every stage
     (:func:`robodyn.compiled.has_twin`: PD, computed torque along a quintic, task space,
-    operational space with a fixed target, impedance)."""
+    operational space with a fixed target, impedance, LQR)."""
     from robodyn.compiled import has_twin
 
     return every in (None, 1) and has_twin(controller)
@@ -615,17 +615,24 @@ def _simulate_compiled(
     integrator: str,
     every: int | None,
     compiled: _Compiled,
+    *,
+    friction: bool = False,
 ) -> tuple[Trajectory, EngineRun]:
     """The run on compiled kernels: wholly in C when passive or under a compiled law, or a
     Python controller sampled every ``every`` steps (C between samples); else stage by
-    stage from Python (the controller at every stage, the dynamics in C)."""
+    stage from Python (the controller at every stage, the dynamics in C). ``friction``:
+    the joints' damping acts (Coulomb friction was refused before)."""
     from robodyn.compiled import CompiledRobot, simulate_compiled
 
     plant = compiled.plant
     assert isinstance(plant, CompiledRobot)
     began = perf_counter()
     if controller is not None and compiled.law is None and every is None:
-        stepper = _Stepper(robot, (), controller, hold=False, rk4=integrator == "rk4", forward=_compiled_accelerator(plant))
+        forward = _compiled_accelerator(plant)
+        if friction and robot.joint_damping.any():  # − b v as JointFriction adds it
+            undamped, damping = forward, robot.joint_damping
+            forward = lambda t, q, v, tau: undamped(t, q, v, tau - damping * v)  # noqa: E731
+        stepper = _Stepper(robot, (), controller, hold=False, rk4=integrator == "rk4", forward=forward)
         qs, vs, accelerations, torques = _integrate(robot, stepper, q, v, steps, dt, None)
         arrays = (np.array(qs), np.array(vs), np.array(accelerations), np.array(torques))
     else:
@@ -633,7 +640,7 @@ def _simulate_compiled(
         run = simulate_compiled(
             plant, q, v, steps * dt, dt, integrator=integrator, controller=law,  # type: ignore[arg-type]
             control_period=None if compiled.law is not None or controller is None else every * dt,  # type: ignore[operator]
-            hold=every is not None, joint_friction=False,  # refused before when friction acts
+            hold=every is not None, joint_friction=friction,  # Coulomb friction refused before
         )  # fmt: skip
         arrays = (run.q, run.v, run.a, run.tau)
     loop = perf_counter() - began
@@ -705,14 +712,15 @@ def _accelerator(
 
 
 def _refuse_compiled_friction(robot: Robot) -> None:
-    """Refuse the compiled engine for a robot whose joints have damping or friction (its
-    loop in C has neither; ``joint_friction=False`` asks for the rigid-body motion)."""
-    if has_joint_friction(robot):
-        joints = [dof.name for dof in robot.dofs if dof.damping or dof.friction]
+    """Refuse the compiled engine for a robot whose joints have Coulomb friction (its loop
+    in C has the damping but no stick–slip; ``joint_friction=False`` asks for the
+    rigid-body motion)."""
+    if robot.joint_friction.any():
+        joints = [dof.name for dof in robot.dofs if dof.friction]
         listed = ", ".join(quoted(name) for name in joints[:8]) + (", …" if len(joints) > 8 else "")
         raise InputError(
             "engine",
-            "'pinocchio' for joint damping and friction (the compiled loop has neither; joint_friction=False "
-            "simulates the rigid-body motion compiled)",
+            "'pinocchio' for joint Coulomb friction (the compiled loop has the damping, not stick-slip; "
+            "joint_friction=False simulates the rigid-body motion compiled)",
             f"'compiled' for {quoted(robot.name)}, whose joints {listed} have some",
         )

@@ -107,3 +107,49 @@ def test_a_controller_without_a_twin_is_refused_in_one_sentence():
     with pytest.raises(CompileError, match="fixed target"):
         compiled_controller(path)
     assert not has_twin(path) and has_twin(TaskSpace(robot, None, [0.7, 0.0, 0.7]))
+
+
+def _lqr(robot, rng, **options):
+    """An LQR about a random held configuration (every joint actuated unless told)."""
+    from robodyn.sim.control import LQR
+
+    q_eq = robot.random_configuration(rng)
+    return LQR(robot, q_eq, np.zeros(robot.nv), 10.0, 0.1, **options), q_eq
+
+
+@pytest.mark.parametrize(
+    ("source", "options"),
+    [
+        pytest.param("rp_arm", {"gravity": [0.8, -0.5, -9.6]}, id="rp_arm"),
+        pytest.param("panda", {}, id="panda_with_a_mimic_finger", marks=pytest.mark.slow),
+    ],
+)
+def test_the_compiled_lqr_follows_the_python_engine_over_the_whole_run(source, options, rng):
+    robot = robodyn.load(source, **options)
+    law, q_eq = _lqr(robot, rng)
+    python, compiled = runs(robot, law, q_eq + 0.05 * rng.normal(size=robot.nv), 1.0)
+    assert deviation(python, compiled) <= TOLERANCE
+    assert np.abs(python.q[-1] - python.q[0]).max() > 1e-3  # the regulator moved the arm back
+
+
+def test_the_compiled_lqr_leaves_unactuated_joints_free_and_holds_like_the_python_engine(rng):
+    """An acrobot-like design (the second joint alone actuated, a discrete gain sampled and
+    held once a step): the same trajectory, zero torque on the first joint; negative
+    control: the twin with another gain departs."""
+    from robodyn.sim.control import LQR
+
+    robot = robodyn.load("double_pendulum_continuous", gravity=[1.2, 0.0, -9.7])
+    up = np.array([np.pi, 0.0])
+    law = LQR(robot, up, np.zeros(2), np.diag([10.0, 10.0, 1.0, 1.0]), 0.5, dt=2e-3, actuated=[robot.joint_names[1]])
+    q0, v0 = up + np.array([0.02, -0.01]), np.zeros(2)
+    python = robodyn.simulate(
+        robot, q0, v0, 1.5, 2e-3, controller=law, limits="ignore", engine="pinocchio", joint_friction=False, hold=True
+    )
+    twin = compiled_controller(law)
+    compiled = simulate_compiled(compile(robot), q0, v0, 1.5, 2e-3, controller=twin, hold=True, joint_friction=False)
+    assert deviation(python, compiled) <= TOLERANCE
+    assert np.abs(compiled.tau[:, 0]).max() == 0.0 and np.abs(compiled.tau[:, 1]).max() > 1e-3
+    assert np.abs(python.q - up).max() < 0.05  # held near the upright (it falls without control)
+    other = dataclasses.replace(twin, gain=twin.gain * 1.0001)
+    departed = simulate_compiled(compile(robot), q0, v0, 1.5, 2e-3, controller=other, hold=True, joint_friction=False)
+    assert deviation(python, departed) > TOLERANCE

@@ -157,11 +157,13 @@ def test_bad_arguments_are_refused(pendulum):
     assert run.q.shape == (1, 2)
 
 
-def test_a_robot_with_joint_damping_is_refused_unless_the_rigid_body_motion_is_asked_for(pendulum):
-    """The zoo's double pendulum has <dynamics damping>: the rigid-body loop in C says so."""
+def test_a_robot_with_joint_damping_is_damped_in_c_unless_the_rigid_body_motion_is_asked_for(pendulum):
+    """The zoo's double pendulum has <dynamics damping>: the loop in C applies it (the
+    Python engine's trajectory: tests/sim/test_joint_friction.py); joint_friction=False
+    leaves it out."""
     robot, compiled = pendulum
-    assert robot.joint_damping.any()
-    zero = np.zeros(2)
-    with pytest.raises(InputError, match=r"joint_friction must be False .*\(the compiled loop is rigid-body\)"):
-        simulate_compiled(compiled, zero, zero, 0.1, 1e-3)
-    assert simulate_compiled(compiled, zero, zero, 0.1, 1e-3, joint_friction=False).q.shape == (101, 2)
+    assert robot.joint_damping.any() and not robot.joint_friction.any()
+    q0, zero = np.array([1.0, -0.5]), np.zeros(2)
+    damped = simulate_compiled(compiled, q0, zero, 1.0, 1e-3)
+    rigid = simulate_compiled(compiled, q0, zero, 1.0, 1e-3, joint_friction=False)
+    assert rigid.q.shape == (1001, 2) and np.abs(damped.q - rigid.q).max() > 1e-3

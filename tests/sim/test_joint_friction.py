@@ -136,13 +136,15 @@ def test_a_constant_torque_below_the_friction_does_not_move_the_joint_and_above_
         assert (np.ptp(trajectory.q[:, 0]) > 1e-3) == moves
 
 
-def test_the_compiled_engine_refuses_joint_friction_and_names_the_way_out(tmp_path, capsys):
-    robot = robodyn.load(DAMPED)
+def test_the_compiled_engine_refuses_coulomb_friction_and_names_the_way_out(tmp_path, capsys):
+    """Stick–slip has no loop in C (damping has: the test below)."""
+    coulomb = DAMPED.replace('<dynamics damping="0.4"/>', '<dynamics damping="0.4" friction="0.3"/>')
+    robot = robodyn.load(coulomb)
     with pytest.raises(InputError) as raised:
         robodyn.simulate(robot, np.zeros(2), np.zeros(2), 0.1, 1e-3, engine="compiled")
     assert "joint_friction=False" in str(raised.value) and "'shoulder'" in str(raised.value)
-    path = tmp_path / "damped.urdf"
-    path.write_text(DAMPED, encoding="utf-8")
+    path = tmp_path / "coulomb.urdf"
+    path.write_text(coulomb, encoding="utf-8")
     assert main(["simulate", str(path), "--compiled", "--duration", "0.1"]) == 2
     error = capsys.readouterr().err
     assert "--no-joint-friction" in error and len(error.strip().splitlines()) == 1
@@ -157,3 +159,54 @@ def test_no_joint_friction_on_the_command_line_gives_the_rigid_body_motion(tmp_p
         summaries[bool(flags)] = json.loads(capsys.readouterr().out)
     assert abs(summaries[True]["energy_change_J"]) < 1e-6
     assert summaries[False]["energy_change_J"] < -1.0
+
+
+@pytest.fixture
+def compile_cache():
+    """The session's compile cache (never the user's)."""
+    from tests.compiled_helpers import shared_cache
+
+    with shared_cache() as folder:
+        yield folder
+
+
+def _engines_agree(robot, q0, v0, controller, duration=1.0):
+    """The largest difference of q, v over the run between the two engines, and the compiled
+    run's distance from the rigid-body motion (the damping's effect)."""
+    runs = {
+        engine: robodyn.simulate(robot, q0, v0, duration, 1e-3, controller=controller, limits="ignore", engine=engine)
+        for engine in ("pinocchio", "compiled")
+    }
+    rigid = robodyn.simulate(
+        robot, q0, v0, duration, 1e-3, controller=controller, limits="ignore", engine="compiled", joint_friction=False
+    )
+    python, compiled = runs["pinocchio"], runs["compiled"]
+    difference = max(np.abs(python.q - compiled.q).max(), np.abs(python.v - compiled.v).max())
+    return difference, np.abs(compiled.q - rigid.q).max()
+
+
+@pytest.mark.parametrize("name", ["double_pendulum", "damped"])
+def test_the_compiled_loop_damps_the_joints_as_the_pinocchio_engine_does(name, compile_cache, rng):
+    """Passive, under a compiled PD law and under a Python controller (called at every
+    stage): the same trajectory to 1e-9; negative control: the rigid-body motion departs.
+    The compiled run also matches MuJoCo's RK4 (its own reader of <dynamics damping>)."""
+    from robodyn.sim.control import PDGravity
+
+    robot = robodyn.load(DAMPED if name == "damped" else name, gravity=[0.6, -0.4, -9.7])
+    assert robot.joint_damping.all() and not robot.joint_friction.any()
+    q0, v0 = np.array([1.2, -0.8]), 0.5 * rng.normal(size=2)
+    for controller in (None, PDGravity(robot, np.array([0.3, 0.2]), kp=8.0, kd=1.0), lambda t, q, v: -0.2 * v):
+        difference, damped = _engines_agree(robot, q0, v0, controller)
+        assert difference <= 1e-9 and damped > 1e-3, (controller, difference, damped)
+    if name == "damped":
+        compiled = robodyn.simulate(robodyn.load(DAMPED), q0, np.zeros(2), 3.0, 2e-3, engine="compiled")
+        assert np.abs(compiled.q[-1] - mujoco_rk4(DAMPED, q0, 3.0, 2e-3)).max() < 1e-6
+
+
+@pytest.mark.slow
+def test_the_compiled_loop_damps_the_pandas_fingers_as_the_pinocchio_engine_does(compile_cache, rng):
+    """panda: damping 0.003 at the arm's joints, 0.6 at the mimic finger."""
+    robot = robodyn.load("panda")
+    q0, v0 = robot.random_configuration(rng), 0.3 * rng.normal(size=robot.nv)
+    difference, damped = _engines_agree(robot, q0, v0, None, duration=0.5)
+    assert difference <= 1e-9 and damped > 1e-4, (difference, damped)
