@@ -1,0 +1,106 @@
+/* robodyn.compiled SIMD blocks: one instruction set's variant (see simd.py, which writes
+ * this text once per variant with rdsT the vector type of RDS_L doubles and RDS_TARGET its
+ * target attribute, after that variant's vector kernels rdsT_tau, rdsT_mass, ...).
+ *
+ * A block is RDS_L consecutive rows of a batch (row-major, as the runtime's rows): they are
+ * transposed into structure-of-arrays vectors (entry j of every row in one vector), run
+ * through the vector kernels (the scalar kernels' statements on vectors: the same IEEE
+ * operations in the same order, cos/sin called lane by lane), and transposed back. Each
+ * block returns the runtime's row status: 1 a non-finite input, 2 a non-finite output, 3 a
+ * singular mass matrix (forward dynamics), the worst of its rows.
+ */
+
+static inline __attribute__((always_inline)) RDS_TARGET int rdsT_finite(const double *x, int n) {
+    int ok = 1;
+    for (int i = 0; i < n; ++i) ok &= isfinite(x[i]) != 0;
+    return ok;
+}
+
+/* RDS_L rows of n entries (stride n) -> n vectors. */
+static inline __attribute__((always_inline)) RDS_TARGET void rdsT_load(const double *rows, int n, rdsT *out) {
+    for (int j = 0; j < n; ++j) out[j] = rdsT_gather(rows + j, n);
+}
+
+/* n vectors -> RDS_L rows of n entries (stride n). */
+static inline __attribute__((always_inline)) RDS_TARGET void rdsT_store(const rdsT *in, int n, double *rows) {
+    for (int l = 0; l < RDS_L; ++l)
+        for (int j = 0; j < n; ++j) rows[l * n + j] = in[j][l];
+}
+
+static RDS_TARGET int rdsT_block_tau(const double *const *in, double *out) {
+    if (!rdsT_finite(in[0], RDS_L * RD_NV) || !rdsT_finite(in[1], RDS_L * RD_NV) || !rdsT_finite(in[2], RDS_L * RD_NV)) return 1;
+    rdsT q[RD_NV], v[RD_NV], a[RD_NV], tau[RD_NV];
+    rdsT_load(in[0], RD_NV, q);
+    rdsT_load(in[1], RD_NV, v);
+    rdsT_load(in[2], RD_NV, a);
+    rdsT_tau(q, v, a, tau);
+    rdsT_store(tau, RD_NV, out);
+    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 2;
+}
+
+static RDS_TARGET int rdsT_block_mass(const double *const *in, double *out) {
+    if (!rdsT_finite(in[0], RDS_L * RD_NV)) return 1;
+    rdsT q[RD_NV], M[RD_NV * RD_NV];
+    rdsT_load(in[0], RD_NV, q);
+    rdsT_mass(q, M);
+    rdsT_store(M, RD_NV * RD_NV, out);
+    return rdsT_finite(out, RDS_L * RD_NV * RD_NV) ? 0 : 2;
+}
+
+static RDS_TARGET int rdsT_block_nle(const double *const *in, double *out) {
+    if (!rdsT_finite(in[0], RDS_L * RD_NV) || !rdsT_finite(in[1], RDS_L * RD_NV)) return 1;
+    rdsT q[RD_NV], v[RD_NV], h[RD_NV];
+    rdsT_load(in[0], RD_NV, q);
+    rdsT_load(in[1], RD_NV, v);
+    rdsT_nle(q, v, h);
+    rdsT_store(h, RD_NV, out);
+    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 2;
+}
+
+static RDS_TARGET int rdsT_block_gravity(const double *const *in, double *out) {
+    if (!rdsT_finite(in[0], RDS_L * RD_NV)) return 1;
+    rdsT q[RD_NV], g[RD_NV];
+    rdsT_load(in[0], RD_NV, q);
+    rdsT_gravity(q, g);
+    rdsT_store(g, RD_NV, out);
+    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 2;
+}
+
+/* The runtime's rd_ldl_solve on every lane at once (the tree's sparsity is every state's):
+ * 3 if a pivot of any lane is not positive and finite. */
+static inline __attribute__((always_inline)) RDS_TARGET int rdsT_ldl_solve(rdsT *M, rdsT *b) {
+    const int n = RD_NV;
+    int bad = 0;
+    for (int k = n - 1; k >= 0; --k) {
+        const rdsT d = M[k * n + k];
+        for (int l = 0; l < RDS_L; ++l) bad |= !(d[l] > 0.0) || !isfinite(d[l]);
+        for (int i = rd_parent[k]; i >= 0; i = rd_parent[i]) {
+            const rdsT x = M[k * n + i] / d;
+            for (int j = i; j >= 0; j = rd_parent[j]) M[i * n + j] -= M[k * n + j] * x;
+            M[k * n + i] = x;
+        }
+    }
+    if (bad) return 3;
+    for (int i = n - 1; i >= 0; --i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= M[i * n + j] * b[i];
+    for (int i = 0; i < n; ++i) b[i] /= M[i * n + i];
+    for (int i = 0; i < n; ++i)
+        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
+    return 0;
+}
+
+static RDS_TARGET int rdsT_block_fd(const double *const *in, double *out) {
+    if (!rdsT_finite(in[0], RDS_L * RD_NV) || !rdsT_finite(in[1], RDS_L * RD_NV) || !rdsT_finite(in[2], RDS_L * RD_NV)) return 1;
+    rdsT q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], a[RD_NV];
+    rdsT_load(in[0], RD_NV, q);
+    rdsT_load(in[1], RD_NV, v);
+    rdsT_load(in[2], RD_NV, tau);
+    rdsT_mass_nle(q, v, M, a);
+    for (int i = 0; i < RD_NV; ++i) a[i] = tau[i] - a[i];
+    if (rdsT_ldl_solve(M, a)) return 3;
+    rdsT_store(a, RD_NV, out);
+    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 3;
+}
+
+static const rds_blocks rdsT_blocks = {RDS_NAME, RDS_L, rdsT_block_tau, rdsT_block_mass, rdsT_block_nle,
+                                       rdsT_block_gravity, rdsT_block_fd};
