@@ -15,10 +15,13 @@ Every row is bit-for-bit the scalar kernel's result: the vector code does the sa
 operations in the same order (no fused multiply-add: the variants' targets leave FMA out
 and contraction is off), and ``cos``/``sin`` are the same libm calls, lane by lane.
 
-The instruction set is chosen when the module is loaded: the widest one the CPU runs, or
-the one named by the environment variable ``ROBODYN_SIMD`` (``scalar``, ``sse2``, ``avx2``,
-``avx512`` or ``auto``); :attr:`robodyn.compiled.CompiledRobot.instruction_set` tells which
-runs. Only x86-64 builds get vector variants; elsewhere batches run the scalar kernels.
+A build compiles the widest variant the CPU runs (each variant costs about the scalar
+kernels' compile time again), or the one named by the environment variable
+``ROBODYN_SIMD`` (``sse2``, ``avx2``, ``avx512``; ``scalar`` for none, ``auto`` the default);
+the source, and so the cache key, names the variant. The loaded module checks the CPU
+(``__builtin_cpu_supports``) and runs scalar batches where the variant cannot run;
+:attr:`robodyn.compiled.CompiledRobot.instruction_set` tells which runs. Only x86-64
+builds get vector variants; elsewhere batches run the scalar kernels.
 """
 
 from __future__ import annotations
@@ -128,28 +131,76 @@ def _variant(functions: dict[str, list[str]], name: str, lanes: int, target: str
     return [*out, template.replace("rdsT", vector)]
 
 
-def vector_source(kernels: str) -> str:
+def _wanted() -> str:
+    """``$ROBODYN_SIMD``, lower case (empty when unset).
+
+    Raises:
+        InputError: If it names no instruction set.
+    """
+    wanted = os.environ.get(ENVIRONMENT, "").strip().lower()
+    names = ("auto", "scalar", *(name for name, _, _ in VARIANTS))
+    if wanted and wanted not in names:
+        raise InputError(ENVIRONMENT, f"one of {', '.join(names)}", repr(wanted))
+    return wanted
+
+
+def _cpu_flags() -> set[str] | None:
+    """The CPU's feature flags (Linux ``/proc/cpuinfo``), or None where they cannot be read."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
+            for line in info:
+                if line.startswith("flags"):
+                    return set(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return None
+
+
+def build_variants() -> tuple[tuple[str, int, str], ...]:
+    """The variants a build compiles: the one ``$ROBODYN_SIMD`` names (none for ``scalar``),
+    else the widest this CPU runs, or every one where the CPU's flags cannot be read (each
+    variant costs as much compile time as the scalar kernels; the module checks the CPU when
+    it runs and falls back to scalar batches).
+
+    Raises:
+        InputError: If ``$ROBODYN_SIMD`` names no instruction set.
+    """
+    wanted = _wanted()
+    named = tuple(variant for variant in VARIANTS if variant[0] == wanted)
+    if wanted == "scalar" or named:
+        return named
+    flags = _cpu_flags()
+    return VARIANTS if flags is None else tuple(variant for variant in VARIANTS if variant[2] in flags)[-1:]
+
+
+def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | None = None) -> str:
     """The SIMD variants of a robot's kernels (C, placed after the kernels and before
-    ``runtime.c``, which then defines ``RD_SIMD`` batches); empty when the kernels are not
-    the five of :mod:`robodyn.compiled.codegen` or use a function the vector printer does
-    not take (the batches then run the scalar kernels)."""
+    ``runtime.c``, which then defines ``RD_SIMD`` batches); empty when there are none to
+    build, the kernels are not the five of :mod:`robodyn.compiled.codegen` or use a function
+    the vector printer does not take (the batches then run the scalar kernels).
+
+    Args:
+        kernels: The robot's kernels.
+        variants: Which of :data:`VARIANTS`; default :func:`build_variants`.
+    """
+    variants = build_variants() if variants is None else variants
     functions = _functions(kernels)
-    if functions is None:
+    if functions is None or not variants:
         return ""
     out = [_COMMON.format(version=SIMD_VERSION)]
-    for name, lanes, target in VARIANTS:
+    for name, lanes, target in variants:
         variant = _variant(functions, name, lanes, target)
         if variant is None:
             return ""
         out += variant
     cases = "\n".join(
-        f'    case {k + 1}: return __builtin_cpu_supports("{target}");' for k, (_, _, target) in enumerate(VARIANTS)
+        f'    case {k + 1}: return __builtin_cpu_supports("{target}");' for k, (_, _, target) in enumerate(variants)
     )
     out.append(
         _DISPATCH.format(
-            count=len(VARIANTS) + 1,
-            names=", ".join(f'"{name}"' for name, _, _ in VARIANTS),
-            tables=", ".join(f"&rds{lanes}_blocks" for _, lanes, _ in VARIANTS),
+            count=len(variants) + 1,
+            names=", ".join(f'"{name}"' for name, _, _ in variants),
+            tables=", ".join(f"&rds{lanes}_blocks" for _, lanes, _ in variants),
             cases=cases,
         )
     )
@@ -167,7 +218,7 @@ def configure(module: ModuleType) -> ModuleType:
     Raises:
         InputError: If the variable names no instruction set this module runs on this CPU.
     """
-    wanted = os.environ.get(ENVIRONMENT, "").strip().lower()
+    wanted = _wanted()
     if not wanted:
         return module
     available = instruction_sets(module)
