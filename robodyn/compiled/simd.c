@@ -10,10 +10,13 @@
  * singular mass matrix (forward dynamics), the worst of its rows.
  */
 
-static inline __attribute__((always_inline)) RDS_TARGET int rdsT_finite(const double *x, int n) {
-    int ok = 1;
-    for (int i = 0; i < n; ++i) ok &= isfinite(x[i]) != 0;
-    return ok;
+/* 1 if an entry of n vectors is not finite (x * 0 is 0 for finite x, NaN otherwise). */
+static inline __attribute__((always_inline)) RDS_TARGET int rdsT_bad(const rdsT *x, int n) {
+    rdsT zero = x[0] * 0.0;
+    for (int j = 1; j < n; ++j) zero += x[j] * 0.0;
+    int bad = 0;
+    for (int l = 0; l < RDS_L; ++l) bad |= zero[l] != 0.0;
+    return bad;
 }
 
 /* RDS_L rows of n entries (stride n) -> n vectors. */
@@ -23,47 +26,53 @@ static inline __attribute__((always_inline)) RDS_TARGET void rdsT_load(const dou
 
 /* n vectors -> RDS_L rows of n entries (stride n). */
 static inline __attribute__((always_inline)) RDS_TARGET void rdsT_store(const rdsT *in, int n, double *rows) {
-    for (int l = 0; l < RDS_L; ++l)
-        for (int j = 0; j < n; ++j) rows[l * n + j] = in[j][l];
+    for (int j = 0; j < n; ++j) {
+        const rdsT x = in[j];
+        RDS_SCATTER
+    }
 }
 
 static RDS_TARGET int rdsT_block_tau(const double *const *in, double *out) {
-    if (!rdsT_finite(in[0], RDS_L * RD_NV) || !rdsT_finite(in[1], RDS_L * RD_NV) || !rdsT_finite(in[2], RDS_L * RD_NV)) return 1;
     rdsT q[RD_NV], v[RD_NV], a[RD_NV], tau[RD_NV];
     rdsT_load(in[0], RD_NV, q);
     rdsT_load(in[1], RD_NV, v);
     rdsT_load(in[2], RD_NV, a);
+    if (rdsT_bad(q, RD_NV) || rdsT_bad(v, RD_NV) || rdsT_bad(a, RD_NV)) return 1;
     rdsT_tau(q, v, a, tau);
+    if (rdsT_bad(tau, RD_NV)) return 2;
     rdsT_store(tau, RD_NV, out);
-    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 2;
+    return 0;
 }
 
 static RDS_TARGET int rdsT_block_mass(const double *const *in, double *out) {
-    if (!rdsT_finite(in[0], RDS_L * RD_NV)) return 1;
     rdsT q[RD_NV], M[RD_NV * RD_NV];
     rdsT_load(in[0], RD_NV, q);
+    if (rdsT_bad(q, RD_NV)) return 1;
     rdsT_mass(q, M);
+    if (rdsT_bad(M, RD_NV * RD_NV)) return 2;
     rdsT_store(M, RD_NV * RD_NV, out);
-    return rdsT_finite(out, RDS_L * RD_NV * RD_NV) ? 0 : 2;
+    return 0;
 }
 
 static RDS_TARGET int rdsT_block_nle(const double *const *in, double *out) {
-    if (!rdsT_finite(in[0], RDS_L * RD_NV) || !rdsT_finite(in[1], RDS_L * RD_NV)) return 1;
     rdsT q[RD_NV], v[RD_NV], h[RD_NV];
     rdsT_load(in[0], RD_NV, q);
     rdsT_load(in[1], RD_NV, v);
+    if (rdsT_bad(q, RD_NV) || rdsT_bad(v, RD_NV)) return 1;
     rdsT_nle(q, v, h);
+    if (rdsT_bad(h, RD_NV)) return 2;
     rdsT_store(h, RD_NV, out);
-    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 2;
+    return 0;
 }
 
 static RDS_TARGET int rdsT_block_gravity(const double *const *in, double *out) {
-    if (!rdsT_finite(in[0], RDS_L * RD_NV)) return 1;
     rdsT q[RD_NV], g[RD_NV];
     rdsT_load(in[0], RD_NV, q);
+    if (rdsT_bad(q, RD_NV)) return 1;
     rdsT_gravity(q, g);
+    if (rdsT_bad(g, RD_NV)) return 2;
     rdsT_store(g, RD_NV, out);
-    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 2;
+    return 0;
 }
 
 /* The runtime's rd_ldl_solve on every lane at once (the tree's sparsity is every state's):
@@ -90,16 +99,16 @@ static inline __attribute__((always_inline)) RDS_TARGET int rdsT_ldl_solve(rdsT 
 }
 
 static RDS_TARGET int rdsT_block_fd(const double *const *in, double *out) {
-    if (!rdsT_finite(in[0], RDS_L * RD_NV) || !rdsT_finite(in[1], RDS_L * RD_NV) || !rdsT_finite(in[2], RDS_L * RD_NV)) return 1;
     rdsT q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], a[RD_NV];
     rdsT_load(in[0], RD_NV, q);
     rdsT_load(in[1], RD_NV, v);
     rdsT_load(in[2], RD_NV, tau);
+    if (rdsT_bad(q, RD_NV) || rdsT_bad(v, RD_NV) || rdsT_bad(tau, RD_NV)) return 1;
     rdsT_mass_nle(q, v, M, a);
     for (int i = 0; i < RD_NV; ++i) a[i] = tau[i] - a[i];
-    if (rdsT_ldl_solve(M, a)) return 3;
+    if (rdsT_ldl_solve(M, a) || rdsT_bad(a, RD_NV)) return 3;
     rdsT_store(a, RD_NV, out);
-    return rdsT_finite(out, RDS_L * RD_NV) ? 0 : 3;
+    return 0;
 }
 
 static const rds_blocks rdsT_blocks = {RDS_NAME, RDS_L, rdsT_block_tau, rdsT_block_mass, rdsT_block_nle,

@@ -35,7 +35,7 @@ from robodyn.equations.c_printer import vector_lines
 from robodyn.exceptions import InputError
 
 #: Bumped whenever the generated vector code changes meaning (it is part of the module's source).
-SIMD_VERSION = "1"
+SIMD_VERSION = "2"
 #: The environment variable that forces an instruction set.
 ENVIRONMENT = "ROBODYN_SIMD"
 #: (name, lanes, GCC target): the x86-64 variants, narrowest first.
@@ -127,7 +127,13 @@ def _variant(functions: dict[str, list[str]], name: str, lanes: int, target: str
             return None
         out += [f"static {attribute} void {vector}_{kernel}({arguments}) {{", *body, "}"]
     template = _TEMPLATE.read_text(encoding="utf-8")
-    template = template.replace("RDS_TARGET", attribute).replace("RDS_NAME", f'"{name}"').replace("RDS_L", str(lanes))
+    scatter = " ".join(f"rows[{lane} * n + j] = x[{lane}];" for lane in range(lanes))
+    template = (
+        template.replace("RDS_SCATTER", scatter)
+        .replace("RDS_TARGET", attribute)
+        .replace("RDS_NAME", f'"{name}"')
+        .replace("RDS_L", str(lanes))
+    )
     return [*out, template.replace("rdsT", vector)]
 
 

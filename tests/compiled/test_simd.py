@@ -131,3 +131,27 @@ def test_negative_control_fused_multiply_add_breaks_the_bit_for_bit_check(pair, 
     wrong = type(compiled)(robot, module, threads=THREADS)
     bad = _mismatched_rows(wrong, robot, rng, 129)
     assert bad["inverse_dynamics"] > 0 and bad["mass_matrix"] > 0, bad
+
+
+def test_a_block_with_a_bad_row_reports_what_the_scalar_rows_report(pair, rng):
+    """A NaN in one row (status 1) and velocities so large the results overflow (2; forward
+    dynamics 3): the module's statuses are the scalar rows' in every instruction set."""
+    robot, compiled = pair
+    module, sets = compiled.module, simd.instruction_sets(compiled.module)
+    q, v, a = (np.ascontiguousarray(x) for x in arguments(robot, rng, 129)["inverse_dynamics"])
+    nan, huge = v.copy(), v.copy()
+    nan[37, 0] = np.nan
+    huge[64:67] = 1e300
+    calls = {
+        "tau": lambda w: module.tau(q, w, a, THREADS),
+        "mass": lambda w: module.mass(np.where(np.isnan(w), np.nan, q), THREADS),
+        "nle": lambda w: module.nle(q, w, THREADS),
+        "fd": lambda w: module.fd(q, w, a, THREADS),
+    }
+    statuses = {}
+    for name in sets:
+        module.simd(name) if hasattr(module, "simd") else None
+        statuses[name] = {kind: (call(nan), call(huge) if kind != "mass" else None) for kind, call in calls.items()}
+    module.simd(sets[-1]) if hasattr(module, "simd") else None
+    assert statuses["scalar"] == {"tau": (1, 2), "mass": (1, None), "nle": (1, 2), "fd": (1, 3)}
+    assert all(found == statuses["scalar"] for found in statuses.values()), statuses
