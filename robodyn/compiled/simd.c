@@ -75,28 +75,9 @@ static RDS_TARGET int rdsT_block_gravity(const double *const *in, double *out) {
     return 0;
 }
 
-/* The runtime's rd_ldl_solve on every lane at once (the tree's sparsity is every state's):
- * 3 if a pivot of any lane is not positive and finite. */
-static inline __attribute__((always_inline)) RDS_TARGET int rdsT_ldl_solve(rdsT *M, rdsT *b) {
-    const int n = RD_NV;
-    int bad = 0;
-    for (int k = n - 1; k >= 0; --k) {
-        const rdsT d = M[k * n + k];
-        for (int l = 0; l < RDS_L; ++l) bad |= !(d[l] > 0.0) || !isfinite(d[l]);
-        for (int i = rd_parent[k]; i >= 0; i = rd_parent[i]) {
-            const rdsT x = M[k * n + i] / d;
-            for (int j = i; j >= 0; j = rd_parent[j]) M[i * n + j] -= M[k * n + j] * x;
-            M[k * n + i] = x;
-        }
-    }
-    if (bad) return 3;
-    for (int i = n - 1; i >= 0; --i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= M[i * n + j] * b[i];
-    for (int i = 0; i < n; ++i) b[i] /= M[i * n + i];
-    for (int i = 0; i < n; ++i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
-    return 0;
-}
+/* rdsT_ldl_solve(M, b), written by simd.py before this text: the runtime's rd_ldl_solve on
+ * every lane at once, unrolled along the tree (the same operations in the same order; 3 if
+ * a pivot of any lane is not positive and finite). */
 
 static RDS_TARGET int rdsT_block_fd(const double *const *in, double *out) {
     rdsT q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], a[RD_NV];

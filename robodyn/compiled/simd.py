@@ -35,7 +35,7 @@ from robodyn.equations.c_printer import vector_lines
 from robodyn.exceptions import InputError
 
 #: Bumped whenever the generated vector code changes meaning (it is part of the module's source).
-SIMD_VERSION = "2"
+SIMD_VERSION = "3"
 #: The environment variable that forces an instruction set.
 ENVIRONMENT = "ROBODYN_SIMD"
 #: (name, lanes, GCC target): the x86-64 variants, narrowest first.
@@ -97,7 +97,44 @@ def _lanes(lanes: int, value: str) -> str:
     return f"for (int l = 0; l < {lanes}; ++l) r[l] = {value}; return r;"
 
 
-def _variant(functions: dict[str, list[str]], name: str, lanes: int, target: str) -> list[str] | None:
+def _parents(kernels: str) -> list[int] | None:
+    """``rd_parent`` of the kernels (each coordinate's parent, -1 at a root), or None."""
+    match = re.search(r"static const int rd_parent\[RD_NV\] = \{([-0-9, ]*)\};", kernels)
+    return None if match is None else [int(p) for p in match.group(1).split(",") if p.strip()]
+
+
+def _ancestors(parents: list[int], i: int) -> list[int]:
+    """``i``, its parent, its parent's parent, ... (the runtime's ``j = rd_parent[j]`` walk)."""
+    chain = []
+    while i >= 0:
+        chain.append(i)
+        i = parents[i]
+    return chain
+
+
+def _ldl(parents: list[int], vector: str, attribute: str) -> list[str]:
+    """``{vector}_ldl_solve``: ``runtime.c``'s ``rd_ldl_solve`` unrolled along the tree, on
+    vectors (the loops' operations in their order, each a statement)."""
+    n = len(parents)
+    out = [f"static inline __attribute__((always_inline)) {attribute} int {vector}_ldl_solve({vector} *M, {vector} *b) {{"]
+    out.append("    int bad = 0;")
+    for k in reversed(range(n)):
+        out.append(
+            f"    for (int l = 0; l < {vector}_lanes; ++l) bad |= !(M[{k * n + k}][l] > 0.0) || !isfinite(M[{k * n + k}][l]);"
+        )
+        for i in _ancestors(parents, parents[k]):
+            updates = " ".join(f"M[{i * n + j}] -= M[{k * n + j}] * x;" for j in _ancestors(parents, i))
+            out.append(f"    {{ const {vector} x = M[{k * n + i}] / M[{k * n + k}]; {updates} M[{k * n + i}] = x; }}")
+    out.append("    if (bad) return 3;")
+    for i in reversed(range(n)):
+        out += [f"    b[{j}] -= M[{i * n + j}] * b[{i}];" for j in _ancestors(parents, parents[i])]
+    out += [f"    b[{i}] /= M[{i * n + i}];" for i in range(n)]
+    for i in range(n):
+        out += [f"    b[{i}] -= M[{i * n + j}] * b[{j}];" for j in _ancestors(parents, parents[i])]
+    return [*out, "    return 0;", "}"]
+
+
+def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lanes: int, target: str) -> list[str] | None:
     """One instruction set's vector kernels and blocks, or None if a kernel has a statement
     the vector printer does not take."""
     vector = f"rds{lanes}"
@@ -127,6 +164,8 @@ def _variant(functions: dict[str, list[str]], name: str, lanes: int, target: str
             return None
         out += [f"static {attribute} void {vector}_{kernel}({arguments}) {{", *body, "}"]
     template = _TEMPLATE.read_text(encoding="utf-8")
+    out.append(f"enum {{ {vector}_lanes = {lanes} }};")
+    out += _ldl(parents, vector, attribute)
     scatter = " ".join(f"rows[{lane} * n + j] = x[{lane}];" for lane in range(lanes))
     template = (
         template.replace("RDS_SCATTER", scatter)
@@ -190,12 +229,12 @@ def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | Non
         variants: Which of :data:`VARIANTS`; default :func:`build_variants`.
     """
     variants = build_variants() if variants is None else variants
-    functions = _functions(kernels)
-    if functions is None or not variants:
+    functions, parents = _functions(kernels), _parents(kernels)
+    if functions is None or parents is None or not variants:
         return ""
     out = [_COMMON.format(version=SIMD_VERSION)]
     for name, lanes, target in variants:
-        variant = _variant(functions, name, lanes, target)
+        variant = _variant(functions, parents, name, lanes, target)
         if variant is None:
             return ""
         out += variant
