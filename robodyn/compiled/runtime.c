@@ -6,7 +6,10 @@
  * Each returns a new float64 array, or None when an argument is not a C-contiguous native
  * float64 array of the right shape (the caller then checks and converts it), or an int
  * status: 1 a non-finite input, 2 a non-finite output, 3 a singular mass matrix.
- * Batches run across rows on `threads` POSIX threads with the GIL released.
+ * Batches run across rows on `threads` POSIX threads with the GIL released; where the
+ * module has SIMD variants (robodyn/compiled/simd.py, RD_SIMD), several rows at a time:
+ *   simd([name]) -> the instruction set batches run ("scalar", "sse2", "avx2", "avx512"),
+ *   after choosing `name`; info() names it ("instruction_set", "lanes", "instruction_sets").
  *
  *   simulate(q0, v0, dt, steps, t0, rk4, kind, hold, params, controller, out_q, out_v,
  *            out_a, out_tau[, frame]) -> -1, or the step after which the state stopped being finite
@@ -840,6 +843,10 @@ static PyObject *py_info(PyObject *m, PyObject *unused) {
  * ("scalar", "sse2", "avx2", "avx512"), for every batch of this module, and returns it. */
 static PyObject *py_simd(PyObject *m, PyObject *const *args, Py_ssize_t nargs) {
     rds_current();
+    if (nargs > 1) {
+        PyErr_SetString(PyExc_TypeError, "simd takes at most one argument");
+        return NULL;
+    }
     if (nargs == 1) {
         const char *wanted = PyUnicode_AsUTF8(args[0]);
         if (!wanted) return NULL;

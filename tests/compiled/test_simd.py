@@ -64,7 +64,7 @@ def test_the_widest_instruction_set_this_cpu_runs_is_built_and_runs(pair):
     _, compiled = pair
     sets = simd.instruction_sets(compiled.module)
     assert compiled.instruction_set == sets[-1]
-    if X86:  # the vector variant built (a failed build would fall back to scalar quietly)
+    if X86 and simd._cpu_flags() is not None:  # the vector variant built (a failed build would run scalar rows)
         assert sets == ("scalar", simd.build_variants()[0][0])
 
 
