@@ -13,15 +13,21 @@ the same for every state).
 
 Every row is bit-for-bit the scalar kernel's result: the vector code does the same IEEE
 operations in the same order (no fused multiply-add: the variants' targets leave FMA out
-and contraction is off), and ``cos``/``sin`` are the same libm calls, lane by lane.
+and contraction is off), and ``cos``/``sin`` are the same libm calls, lane by lane (paired
+into ``sincos`` as the scalar kernel's compiler pairs them). Those calls bound the gain:
+on ur5 five ``sincos`` a state are ~680 of its ~1 070 instructions with AVX2 (callgrind),
+and 70-80 % of the time with AVX-512. Forward dynamics' LDLᵀ on vectors, unrolled along the
+tree, beat factoring each lane with the scalar solve (panda arm 230 against 384 ns a state).
 
-A build compiles the widest variant the CPU runs (each variant costs about the scalar
-kernels' compile time again), or the one named by the environment variable
+A build compiles the widest variant the CPU runs (a variant adds ~60 % to the C compile:
+ur5 0.7 -> 1.1 s, panda arm 1.0 -> 1.5 s of compiler CPU), or the one named by the environment variable
 ``ROBODYN_SIMD`` (``sse2``, ``avx2``, ``avx512``; ``scalar`` for none, ``auto`` the default);
 the source, and so the cache key, names the variant. The loaded module checks the CPU
 (``__builtin_cpu_supports``) and runs scalar batches where the variant cannot run;
 :attr:`robodyn.compiled.CompiledRobot.instruction_set` tells which runs. Only x86-64
-builds get vector variants; elsewhere batches run the scalar kernels.
+builds get vector variants; elsewhere, or when a compiler rejects the vector code (a
+function the kernels call that the vector printer passes through), batches run the scalar
+kernels.
 """
 
 from __future__ import annotations
