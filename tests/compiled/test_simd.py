@@ -68,32 +68,39 @@ def test_the_widest_instruction_set_this_cpu_runs_is_built_and_runs(pair):
         assert sets == ("scalar", simd.build_variants()[0][0])
 
 
-def _variants(robot) -> list[str]:
-    """The instruction sets to check on a robot: each one this CPU runs on ur5 (a build
-    each), the default one on the others."""
-    if robot.name != "ur5" or not X86:
-        return [""]
-    return [name for name, _, _ in simd.VARIANTS if _runs(name)]
-
-
 def _runs(name: str) -> bool:
     flags = simd._cpu_flags()
     return flags is not None and dict((v[0], v[2]) for v in simd.VARIANTS)[name] in flags
 
 
-def test_every_batch_row_equals_the_single_call_bit_for_bit(pair, rng, monkeypatch):
-    robot, _ = pair
-    for variant in _variants(robot):
-        monkeypatch.setenv(simd.ENVIRONMENT, variant)
-        compiled = compile(robot, threads=THREADS)
-        for name in simd.instruction_sets(compiled.module):  # the vector variant, then scalar rows
-            compiled.module.simd(name) if hasattr(compiled.module, "simd") else None
-            assert compiled.instruction_set == name
-            for count in _sizes(compiled.module.info()["lanes"]):
-                bad = _mismatched_rows(compiled, robot, rng, count)
-                assert set(bad) == set(QUANTITIES)
-                assert not any(bad.values()), (name, count, bad)
-        compiled.module.simd(simd.instruction_sets(compiled.module)[-1]) if hasattr(compiled.module, "simd") else None
+def _check_every_row(robot, compiled, rng) -> None:
+    """Every row of batches of :func:`_sizes` equal to its single call, in the module's
+    instruction set and then in scalar rows (``simd("scalar")``)."""
+    for name in simd.instruction_sets(compiled.module)[::-1]:
+        compiled.module.simd(name) if hasattr(compiled.module, "simd") else None
+        assert compiled.instruction_set == name
+        for count in _sizes(compiled.module.info()["lanes"]):
+            bad = _mismatched_rows(compiled, robot, rng, count)
+            assert set(bad) == set(QUANTITIES)
+            assert not any(bad.values()), (name, count, bad)
+    compiled.module.simd(simd.instruction_sets(compiled.module)[-1]) if hasattr(compiled.module, "simd") else None
+
+
+def test_every_batch_row_equals_the_single_call_bit_for_bit(pair, rng):
+    _check_every_row(*pair, rng)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("variant", [name for name, _, _ in simd.VARIANTS])
+def test_every_instruction_set_this_cpu_runs_is_bit_for_bit_the_single_call(variant, rng, monkeypatch):
+    """Each variant (a build each; the fast tier checks the widest) on ur5 under a tilted gravity."""
+    if not X86 or not _runs(variant):
+        pytest.skip(f"this CPU does not run {variant}")
+    monkeypatch.setenv(simd.ENVIRONMENT, variant)
+    robot = robodyn.load(*CASES["ur5"][:1], **CASES["ur5"][1])
+    compiled = compile(robot, threads=THREADS)
+    assert compiled.instruction_set == variant
+    _check_every_row(robot, compiled, rng)
 
 
 def test_the_environment_forces_the_scalar_fallback_and_refuses_unknown_sets(pair, rng, monkeypatch):
