@@ -236,8 +236,9 @@ def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | Non
     """
     variants = build_variants() if variants is None else variants
     functions, parents = _functions(kernels), _parents(kernels)
-    if functions is None or parents is None or not variants:
-        return ""
+    sizes = re.findall(r"^#define RD_N[QV] (\d+)$", kernels, flags=re.MULTILINE)
+    if functions is None or parents is None or not variants or len(set(sizes)) != 1:
+        return ""  # the blocks read q with the stride of v: not for a configuration of another size
     out = [_COMMON.format(version=SIMD_VERSION)]
     for name, lanes, target in variants:
         variant = _variant(functions, parents, name, lanes, target)
