@@ -16,6 +16,8 @@ Sections:
     compiled-single      robodyn.compiled single calls vs pin.rnea / pin.crba / pin.aba
     compiled-batch       100 000 states, compiled vs rneaInParallel / abaInParallel / a Python loop
     compiled-compile     cold and cached compile times
+    compiled-batch-simd  SIMD batches (100 000 and 100 003 states): the instruction set that ran, the
+                         scalar kernels' batch, Pinocchio's parallel API; the kernels' operation counts
     compiled-simulation  panda-arm real-time factor: compiled RK4 / Euler vs Python engine vs MuJoCo
     derivatives  Robot.*_derivatives single calls vs pin.computeRNEADerivatives / computeABADerivatives
     export     CasADi instruction counts of M + C v + G vs adam's (bench-only), forward dynamics
@@ -439,6 +441,118 @@ def bench_compiled_batch(quick: bool) -> list[dict]:
                     "speedup_vs_loop": loop_s / ours_s,
                 }
             )
+    return rows
+
+
+def _kernel_counts(kernels: str) -> dict[str, tuple[int, int]]:
+    """Per kernel of a robot's generated C: arithmetic operations (``+ - * /`` outside array
+    indices) and ``sin``/``cos`` calls, per state."""
+    import re
+
+    counts, name = {}, None
+    for line in kernels.splitlines():
+        header = re.match(r"^static void rd_(\w+)\(", line)
+        if header:
+            name, counts[header.group(1)] = header.group(1), (0, 0)
+        elif name is not None and line != "}":
+            text = re.sub(r"\[[^\]]*\]", "", line.split("=", 1)[-1])
+            ops, trig = counts[name]
+            counts[name] = (ops + len(re.findall(r"[-+*/]", text)), trig + len(re.findall(r"\b(?:sin|cos)\(", text)))
+        if line == "}":
+            name = None
+    return counts
+
+
+def _wall_paired(
+    functions: list[Callable[[], object]], repeats: int, clock: Callable[[], float] = time.perf_counter
+) -> list[float]:
+    """Median times (wall by default) of several functions run alternately (each repeat runs
+    each once): load from other processes then weighs on all of them alike."""
+    times: list[list[float]] = [[] for _ in functions]
+    for _ in range(repeats):
+        for function, spent in zip(functions, times, strict=True):
+            start = clock()
+            function()
+            spent.append(clock() - start)
+    return [statistics.median(spent) for spent in times]
+
+
+def bench_compiled_batch_simd(quick: bool) -> list[dict]:
+    """The SIMD batches against the scalar kernels' batch (the same module, forced scalar)
+    and Pinocchio's parallel API on the same threads (nle and G through rneaInParallel with
+    a = 0, resp. v = a = 0; M has no parallel call in Pinocchio: its Python loop over crba).
+    Wall time on every core, and (steadier on a shared machine) this thread's CPU time per
+    state on one thread (``*_cpu_ns``)."""
+    from robodyn.compiled import build
+    from robodyn.compiled.robot import robot_key
+
+    threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    rows = []
+    for label, name, options in COMPILED_ROBOTS:
+        robot, compiled = _compiled(name, options)
+        compiled.threads = threads
+        counts = _kernel_counts(build.cached_kernels(robot_key(robot)) or "")
+        pool, model, data = pin.ModelPool(robot.model, threads), robot.model, robot.model.createData()
+        for count in (20_000, 20_003) if quick else (100_000, 100_003):
+            rng = np.random.default_rng(2)
+            q = robot.random_configuration(rng, count)
+            v, a = rng.normal(size=(2, count, robot.nv))
+            tau = robot.inverse_dynamics(q, v, a)
+            zero = np.zeros((robot.nv, count))
+            qt, vt, at, taut = (np.ascontiguousarray(x.T) for x in (q, v, a, tau))
+            loop_count = min(count, 5000)
+            cases = (
+                ("inverse_dynamics", "tau", lambda: compiled.inverse_dynamics(q, v, a), "rneaInParallel",
+                 lambda n=threads: pin.rneaInParallel(n, pool, qt, vt, at), count),
+                ("mass_matrix", "mass", lambda: compiled.mass_matrix(q), "crba, Python loop (no crbaInParallel)",
+                 lambda n=threads: [pin.crba(model, data, q[i]) for i in range(loop_count)], loop_count),
+                ("nonlinear_effects", "nle", lambda: compiled.nonlinear_effects(q, v), "rneaInParallel (a = 0)",
+                 lambda n=threads: pin.rneaInParallel(n, pool, qt, vt, zero), count),
+                ("gravity", "gravity", lambda: compiled.gravity(q), "rneaInParallel (v = a = 0)",
+                 lambda n=threads: pin.rneaInParallel(n, pool, qt, zero, zero), count),
+                ("forward_dynamics", "mass_nle", lambda: compiled.forward_dynamics(q, v, tau), "abaInParallel",
+                 lambda n=threads: pin.abaInParallel(n, pool, qt, vt, taut), count),
+            )  # fmt: skip
+            for method, kernel, ours, reference_name, reference_call, reference_count in cases:
+                instruction_set = compiled.instruction_set
+                compiled.module.simd("scalar") if hasattr(compiled.module, "simd") else None
+                scalar_s = median_once(ours, repeats=1)  # warm
+                compiled.module.simd(instruction_set) if hasattr(compiled.module, "simd") else None
+
+                def scalar(ours=ours, instruction_set=instruction_set):
+                    compiled.module.simd("scalar") if hasattr(compiled.module, "simd") else None
+                    ours()
+                    compiled.module.simd(instruction_set) if hasattr(compiled.module, "simd") else None
+
+                ours_s, scalar_s, reference_s = _wall_paired([ours, scalar, reference_call], repeats=3 if quick else 7)
+                compiled.threads = 1
+                cpu = _wall_paired(
+                    [ours, scalar, lambda r=reference_call: r(1)], repeats=3 if quick else 7, clock=time.thread_time
+                )
+                compiled.threads = threads
+                ops, trig = counts.get(kernel, (0, 0))
+                rows.append(
+                    {
+                        "robot": label,
+                        "method": method,
+                        "states": count,
+                        "threads": threads,
+                        "instruction_set": instruction_set,
+                        "states_per_s": count / ours_s,
+                        "scalar_states_per_s": count / scalar_s,
+                        "simd_gain": scalar_s / ours_s,
+                        "pinocchio": reference_name,
+                        "pinocchio_states_per_s": reference_count / reference_s,
+                        "speedup_vs_pinocchio": (reference_s / reference_count) / (ours_s / count),
+                        "cpu_ns": cpu[0] / count * 1e9,
+                        "scalar_cpu_ns": cpu[1] / count * 1e9,
+                        "pinocchio_cpu_ns": cpu[2] / reference_count * 1e9,
+                        "cpu_speedup_vs_pinocchio": (cpu[2] / reference_count) / (cpu[0] / count),
+                        "ops_per_state": ops,
+                        "sin_cos_per_state": trig,
+                        "load_average": os.getloadavg()[0],
+                    }
+                )
     return rows
 
 
@@ -1084,6 +1198,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-single": bench_compiled_single,
     "compiled-batch": bench_compiled_batch,
     "compiled-compile": bench_compiled_compile,
+    "compiled-batch-simd": bench_compiled_batch_simd,
     "compiled-simulation": bench_compiled_simulation,
     "derivatives": bench_derivatives,
     "export": bench_export,

@@ -39,6 +39,7 @@ from types import ModuleType
 import numpy as np
 
 from robodyn.common.files import atomic_write_text
+from robodyn.compiled import simd
 from robodyn.exceptions import CompileError, CompilerNotFoundError
 
 #: Compiler flags. No -ffast-math: results must match Pinocchio to 1e-12. -O1, not -O2/-O3:
@@ -148,17 +149,23 @@ def store_kernels(key: str, kernels: str) -> None:
         atomic_write_text(cache_dir() / f"src-{key}.c", kernels)
 
 
-def build_module(kernels: str, *, label: str) -> ModuleType:
+def build_module(kernels: str, *, label: str, vector: bool = True) -> ModuleType:
     """Compile (or find in the cache) and import the extension module for some kernels.
 
     Args:
         kernels: The robot's generated kernels (:mod:`robodyn.compiled.codegen`).
         label: The robot's name, for messages only.
+        vector: Add the kernels' SIMD variants for batches (:mod:`robodyn.compiled.simd`).
 
     Raises:
         CompilerNotFoundError: No C compiler.
         CompileError: The compiler failed (its first error line is quoted).
+        InputError: ``$ROBODYN_SIMD`` names an instruction set the module cannot run here.
     """
+    if vector and (variants := simd.vector_source(kernels)):
+        # The SIMD batches (robodyn.compiled.simd); if a compiler cannot build them, scalar batches.
+        with contextlib.suppress(CompileError):
+            return simd.configure(build_module(kernels + variants, label=label, vector=False))
     compiler = find_compiler()
     runtime = _RUNTIME.read_text(encoding="utf-8")
     name = "rd_" + digest(kernels, runtime, toolchain_key(compiler))

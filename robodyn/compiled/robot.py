@@ -167,6 +167,12 @@ class CompiledRobot:
     def __repr__(self) -> str:
         return f"<CompiledRobot {self.name!r}: nv={self.nv}, threads={self.threads}>"
 
+    @property
+    def instruction_set(self) -> str:
+        """The instruction set the batches run: ``"avx512"``, ``"avx2"``, ``"sse2"`` (blocks of
+        8, 4, 2 states) or ``"scalar"``; see :mod:`robodyn.compiled.simd` (``$ROBODYN_SIMD``)."""
+        return str(self.module.info()["instruction_set"])
+
     def _checked(self, kind: str, function, status, **named: object) -> np.ndarray:
         """The checked path: validate, convert, compute again, refuse what is not finite."""
         arrays, _ = self.robot.validate(**named)

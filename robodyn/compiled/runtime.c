@@ -6,7 +6,10 @@
  * Each returns a new float64 array, or None when an argument is not a C-contiguous native
  * float64 array of the right shape (the caller then checks and converts it), or an int
  * status: 1 a non-finite input, 2 a non-finite output, 3 a singular mass matrix.
- * Batches run across rows on `threads` POSIX threads with the GIL released.
+ * Batches run across rows on `threads` POSIX threads with the GIL released; where the
+ * module has SIMD variants (robodyn/compiled/simd.py, RD_SIMD), several rows at a time:
+ *   simd([name]) -> the instruction set batches run ("scalar", "sse2", "avx2", "avx512"),
+ *   after choosing `name`; info() names it ("instruction_set", "lanes", "instruction_sets").
  *
  *   simulate(q0, v0, dt, steps, t0, rk4, kind, hold, params, controller, out_q, out_v,
  *            out_a, out_tau[, frame]) -> -1, or the step after which the state stopped being finite
@@ -102,13 +105,26 @@ typedef struct {
     double *out;
     Py_ssize_t begin, end;
     int status;
+    rd_row block; /* SIMD: `lanes` rows at once (robodyn.compiled.simd), or NULL */
+    int lanes;
 } rd_job;
 
 static void *rd_run(void *arg) {
     rd_job *job = (rd_job *)arg;
     int worst = 0;
     const double *in[3] = {0, 0, 0};
-    for (Py_ssize_t r = job->begin; r < job->end; ++r) {
+    Py_ssize_t r = job->begin;
+    if (job->block) /* blocks of `lanes` rows; a failing block's rows again one by one (their exact statuses) */
+        for (; r + job->lanes <= job->end; r += job->lanes) {
+            for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * RD_NV;
+            if (!job->block(in, job->out + r * job->out_size)) continue;
+            for (Py_ssize_t s = r; s < r + job->lanes; ++s) {
+                for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + s * RD_NV;
+                const int status = job->row(in, job->out + s * job->out_size);
+                if (status > worst) worst = status;
+            }
+        }
+    for (; r < job->end; ++r) {
         for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * RD_NV;
         const int status = job->row(in, job->out + r * job->out_size);
         if (status > worst) worst = status;
@@ -126,10 +142,11 @@ static int rd_parallel(rd_job *base, Py_ssize_t rows, long threads) {
     rd_job jobs[RD_MAX_THREADS];
     pthread_t ids[RD_MAX_THREADS];
     int started[RD_MAX_THREADS];
+    const Py_ssize_t unit = base->block ? base->lanes : 1, blocks = rows / unit; /* whole blocks a thread */
     for (long k = 0; k < threads; ++k) {
         jobs[k] = *base;
-        jobs[k].begin = rows * k / threads;
-        jobs[k].end = rows * (k + 1) / threads;
+        jobs[k].begin = blocks * k / threads * unit;
+        jobs[k].end = k + 1 == threads ? rows : blocks * (k + 1) / threads * unit;
         started[k] = 0;
     }
     for (long k = 1; k < threads; ++k) started[k] = pthread_create(&ids[k], NULL, rd_run, &jobs[k]) == 0;
@@ -166,6 +183,22 @@ static int rd_accept(PyObject *object, int *ndim, npy_intp *rows) {
     return 0;
 }
 
+/* The job's SIMD block for its row kernel, in the instruction set chosen (none: scalar rows). */
+static void rd_simd_block(rd_job *job) {
+    job->block = NULL;
+    job->lanes = 1;
+#ifdef RD_SIMD
+    const rds_blocks *b = rds_current();
+    if (!b) return;
+    job->lanes = b->lanes;
+    if (job->row == row_tau) job->block = b->tau;
+    if (job->row == row_mass) job->block = b->mass;
+    if (job->row == row_nle) job->block = b->nle;
+    if (job->row == row_gravity) job->block = b->gravity;
+    if (job->row == row_fd) job->block = b->fd;
+#endif
+}
+
 static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_row row, int matrix) {
     if (nargs != nin + 1) {
         PyErr_SetString(PyExc_TypeError, "wrong number of arguments");
@@ -186,6 +219,7 @@ static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_r
     if (!out) return NULL;
     rd_job job = {row, nin, matrix ? RD_NV * RD_NV : RD_NV, {0, 0, 0}, (double *)PyArray_DATA((PyArrayObject *)out), 0, rows, 0};
     for (int k = 0; k < nin; ++k) job.in[k] = (const double *)PyArray_DATA((PyArrayObject *)args[k]);
+    rd_simd_block(&job);
     int status;
     if (ndim == 1) {
         status = row(job.in, job.out);
@@ -874,8 +908,48 @@ static PyObject *py_info(PyObject *m, PyObject *unused) {
     PyObject *parents = PyTuple_New(RD_NV);
     if (!parents) return NULL;
     for (int i = 0; i < RD_NV; ++i) PyTuple_SET_ITEM(parents, i, PyLong_FromLong(rd_parent[i]));
-    return Py_BuildValue("{s:i,s:N}", "nv", RD_NV, "parents", parents);
+#ifdef RD_SIMD
+    const rds_blocks *b = rds_current();
+    PyObject *sets = PyList_New(0);
+    for (int level = 0; sets && level < RDS_COUNT; ++level) {
+        PyObject *name = rds_supported(level) ? PyUnicode_FromString(rds_names[level]) : NULL;
+        if (name && PyList_Append(sets, name) < 0) Py_CLEAR(sets);
+        Py_XDECREF(name);
+    }
+    if (!sets) {
+        Py_DECREF(parents);
+        return NULL;
+    }
+    return Py_BuildValue("{s:i,s:N,s:s,s:i,s:N}", "nv", RD_NV, "parents", parents, "instruction_set", rds_names[rds_level], "lanes",
+                         b ? b->lanes : 1, "instruction_sets", sets);
+#else
+    return Py_BuildValue("{s:i,s:N,s:s,s:i}", "nv", RD_NV, "parents", parents, "instruction_set", "scalar", "lanes", 1);
+#endif
 }
+
+#ifdef RD_SIMD
+/* simd() -> the instruction set the batches run; simd(name) chooses one this CPU runs
+ * ("scalar", "sse2", "avx2", "avx512"), for every batch of this module, and returns it. */
+static PyObject *py_simd(PyObject *m, PyObject *const *args, Py_ssize_t nargs) {
+    rds_current();
+    if (nargs > 1) {
+        PyErr_SetString(PyExc_TypeError, "simd takes at most one argument");
+        return NULL;
+    }
+    if (nargs == 1) {
+        const char *wanted = PyUnicode_AsUTF8(args[0]);
+        if (!wanted) return NULL;
+        int level = 0;
+        while (level < RDS_COUNT && strcmp(rds_names[level], wanted) != 0) ++level;
+        if (level == RDS_COUNT || !rds_supported(level)) {
+            PyErr_Format(PyExc_ValueError, "instruction set %s is not one this module runs on this CPU", wanted);
+            return NULL;
+        }
+        rds_level = level;
+    }
+    return PyUnicode_FromString(rds_names[rds_level]);
+}
+#endif
 
 static PyMethodDef rd_methods[] = {
     {"tau", (PyCFunction)(void (*)(void))py_tau, METH_FASTCALL, "tau(q, v, a, threads)"},
@@ -885,6 +959,9 @@ static PyMethodDef rd_methods[] = {
     {"fd", (PyCFunction)(void (*)(void))py_fd, METH_FASTCALL, "fd(q, v, tau, threads)"},
     {"simulate", (PyCFunction)(void (*)(void))py_simulate, METH_FASTCALL, "simulate(...)"},
     {"info", py_info, METH_NOARGS, "info()"},
+#ifdef RD_SIMD
+    {"simd", (PyCFunction)(void (*)(void))py_simd, METH_FASTCALL, "simd([name])"},
+#endif
     {NULL, NULL, 0, NULL},
 };
 

@@ -12,6 +12,8 @@ compiled engine's kernels (:mod:`robodyn.compiled.codegen`).
   ``sin``/``cos`` as they are; anything else (``sqrt``, ``π``, ...) goes to
   ``sympy.ccode`` (a printer of its own: the slowest step of a compile when used for
   everything).
+- :func:`vector_lines` turns printed statements into the same statements on SIMD vectors
+  of doubles (one state a lane, :mod:`robodyn.compiled.simd`).
 - Symbols are printed by the names the caller gives (``q[3]``, ``t12``): no name from a
   URDF reaches the code unless a caller puts it there. A symbol without a name is printed
   as sympy names it, so callers name every symbol.
@@ -19,6 +21,7 @@ compiled engine's kernels (:mod:`robodyn.compiled.codegen`).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Mapping
 
 import sympy as sp
@@ -121,3 +124,65 @@ class CPrinter:
     def statements(self, assignments: Iterable[Assignment], *, indent: str = "    ") -> list[str]:
         """A straight-line program's assignments as C declarations, one a line."""
         return [indent + self.assignment(symbol, expr) for symbol, expr in assignments]
+
+
+#: Calls the vector form takes lane by lane (the same libm call on each lane's double).
+LANE_CALLS = ("cos", "sin", "pow", "sqrt", "fabs")
+_CALL = re.compile(r"\b([A-Za-z_]\w*)\(")
+_CONSTANT = re.compile(r"^(.*= )([^=]+);$")
+#: What a constant's C may consist of besides operators: numbers, ``M_*`` constants, lane calls.
+_NOT_NAMES = re.compile(r"\bM_[A-Z0-9_]+\b|\b(?:" + "|".join(LANE_CALLS) + r")\(|\b\d+\.?\d*(?:[eE][-+]?\d+)?")
+
+
+def vector_lines(lines: Iterable[str], *, vector: str, prefix: str, kernels: Iterable[str] = ()) -> list[str] | None:
+    """Statements printed by :class:`CPrinter` (and the kernels' loops around them) on
+    vectors of doubles, one state a lane: the same operations in the same order, so every
+    lane rounds as the scalar statement does.
+
+    ``double`` becomes ``vector`` (a GCC/Clang vector type); a call of a :data:`LANE_CALLS`
+    function ``f`` becomes ``{prefix}f`` (the caller defines it, lane by lane); a call of one
+    of ``kernels`` (``rd_mass``) becomes the vector kernel (``{prefix}mass``); a constant
+    right-hand side becomes ``{prefix}splat(c)``.
+
+    Returns:
+        The lines, or None if one has a call or an operator (``?:``) the vector form does not take.
+    """
+    renamed = {kernel: prefix + kernel.split("_", 1)[1] for kernel in kernels}
+    renamed.update({name: prefix + name for name in LANE_CALLS}, **{word: word for word in ("for", "if", "while")})
+    out = []
+    for line in lines:
+        if "?" in line:
+            return None
+        line = re.sub(r"\bdouble\b", vector, line)
+        constant = _CONSTANT.match(line)
+        if constant and not re.search(r"[A-Za-z_]", _NOT_NAMES.sub("", constant.group(2))):
+            out.append(f"{constant.group(1)}{prefix}splat({constant.group(2)});")  # a constant (2.5, M_SQRT2)
+            continue
+        if any(name not in renamed for name in _CALL.findall(line)):
+            return None
+        out.append(_CALL.sub(lambda match: renamed[match.group(1)] + "(", line))
+    return _paired(out, prefix)
+
+
+def _paired(lines: list[str], prefix: str) -> list[str]:
+    """``sin(x)`` and ``cos(x)`` of one ``x`` as one ``{prefix}sincos`` statement where the
+    first of the two stood (the scalar kernel's compiler pairs them into ``sincos`` too)."""
+    pattern = re.compile(rf"^(\s*)const (\w+) (\w+) = {re.escape(prefix)}(sin|cos)\((\w+)\);$")
+    found: dict[tuple[str, str], tuple[int, str]] = {}
+    for index, line in enumerate(lines):
+        match = pattern.match(line)
+        if match:
+            found.setdefault((match.group(4), match.group(5)), (index, match.group(3)))
+    replaced: dict[int, str | None] = {}
+    for (function, argument), (index, name) in found.items():
+        other = found.get(("cos", argument)) if function == "sin" else None
+        if other is None:
+            continue
+        first, second = sorted([index, other[0]])
+        match = pattern.match(lines[first])
+        assert match is not None
+        indent, vector = match.group(1), match.group(2)
+        replaced[first] = f"{indent}{vector} {name}, {other[1]}; {prefix}sincos({argument}, &{name}, &{other[1]});"
+        replaced[second] = None
+    kept = (replaced.get(index, line) for index, line in enumerate(lines))
+    return [line for line in kept if line is not None]
