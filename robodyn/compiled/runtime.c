@@ -17,6 +17,9 @@
  * of a frame module, robodyn/compiled/kinematics.py).
  */
 
+#ifndef RD_NQ
+#define RD_NQ RD_NV /* a floating base's q has one entry more than v (its quaternion) */
+#endif
 #define RD_CAPSULE "robodyn.compiled.kernels"
 #define RD_MIN_ROWS_PER_THREAD 64
 
@@ -70,27 +73,27 @@ static int rd_fd_raw(const double *q, const double *v, const double *tau, double
 typedef int (*rd_row)(const double *const *in, double *out);
 
 static int row_tau(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
+    if (!rd_finite(in[0], RD_NQ) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     rd_tau(in[0], in[1], in[2], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_mass(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV)) return 1;
+    if (!rd_finite(in[0], RD_NQ)) return 1;
     rd_mass(in[0], out);
     return rd_finite(out, RD_NV * RD_NV) ? 0 : 2;
 }
 static int row_nle(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV)) return 1;
+    if (!rd_finite(in[0], RD_NQ) || !rd_finite(in[1], RD_NV)) return 1;
     rd_nle(in[0], in[1], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_gravity(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV)) return 1;
+    if (!rd_finite(in[0], RD_NQ)) return 1;
     rd_gravity(in[0], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_fd(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
+    if (!rd_finite(in[0], RD_NQ) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     if (rd_fd_raw(in[0], in[1], in[2], out)) return 3;
     return rd_finite(out, RD_NV) ? 0 : 3;
 }
@@ -109,7 +112,7 @@ static void *rd_run(void *arg) {
     int worst = 0;
     const double *in[3] = {0, 0, 0};
     for (Py_ssize_t r = job->begin; r < job->end; ++r) {
-        for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * RD_NV;
+        for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * (k ? RD_NV : RD_NQ);
         const int status = job->row(in, job->out + r * job->out_size);
         if (status > worst) worst = status;
     }
@@ -145,19 +148,19 @@ static int rd_parallel(rd_job *base, Py_ssize_t rows, long threads) {
     return worst;
 }
 
-/* A C-contiguous, aligned, native float64 array of shape (RD_NV,) or (rows, RD_NV). */
-static int rd_accept(PyObject *object, int *ndim, npy_intp *rows) {
+/* A C-contiguous, aligned, native float64 array of shape (width,) or (rows, width). */
+static int rd_accept(PyObject *object, int *ndim, npy_intp *rows, npy_intp width) {
     if (!PyArray_CheckExact(object)) return 0;
     PyArrayObject *array = (PyArrayObject *)object;
     if (PyArray_TYPE(array) != NPY_DOUBLE || !PyArray_ISCARRAY_RO(array) || !PyArray_ISNOTSWAPPED(array)) return 0;
     const int nd = PyArray_NDIM(array);
     const npy_intp *dims = PyArray_DIMS(array);
-    if (nd == 1 && dims[0] == RD_NV) {
+    if (nd == 1 && dims[0] == width) {
         if (*ndim == 2) return 0;
         *ndim = 1;
         return 1;
     }
-    if (nd == 2 && dims[1] == RD_NV) {
+    if (nd == 2 && dims[1] == width) {
         if (*ndim == 1 || (*ndim == 2 && *rows != dims[0])) return 0;
         *ndim = 2;
         *rows = dims[0];
@@ -176,7 +179,7 @@ static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_r
     int ndim = 0;
     npy_intp rows = 1;
     for (int k = 0; k < nin; ++k)
-        if (!rd_accept(args[k], &ndim, &rows)) Py_RETURN_NONE;
+        if (!rd_accept(args[k], &ndim, &rows, k ? RD_NV : RD_NQ)) Py_RETURN_NONE;
     npy_intp dims[3];
     int out_nd = 0;
     if (ndim == 2) dims[out_nd++] = rows;
