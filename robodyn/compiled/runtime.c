@@ -635,9 +635,64 @@ static void rd_control_frame(const rd_controller *c, const double *q, const doub
 }
 
 
+#if RD_NQ != RD_NV
+/* Joint torques giving the joints the accelerations a[6:] with no torque on the free base
+ * (robodyn.sim.control.free_base_torques): a[0:6] = -M_bb⁻¹ (M_bj a_j + h_b), tau = ID(q, v, a), tau[0:6] = 0. */
+static void rd_free_base_torques(const rd_kernels *model, const double *q, const double *v, double *a, double *tau) {
+    const int n = RD_NV;
+    double M[RD_NV * RD_NV], h[RD_NV], A[36], b[6];
+    model->mass_nle(q, v, M, h);
+    for (int i = 0; i < 6; ++i) {
+        double s = 0.0;
+        for (int j = 6; j < n; ++j) s += M[i * n + j] * a[j];
+        b[i] = -(s + h[i]);
+        for (int k = 0; k < 6; ++k) A[i * 6 + k] = M[i * n + k];
+    }
+    rdc_solve(A, b, 6, 1);
+    memcpy(a, b, sizeof b);
+    model->tau(q, v, a, tau);
+    for (int i = 0; i < 6; ++i) tau[i] = 0.0;
+}
+
+/* PD + gravity (kind 1) and computed torque along a quintic (kind 2) on a floating robot's
+ * joints, its base free (robodyn.sim.control: _floating_pd, ComputedTorque): params as for a
+ * fixed base, of the joints only. */
+static void rd_control_free_base(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
+    const int m = RD_NV - 6;
+    const double *p = c->params;
+    double a[RD_NV] = {0}, zero[RD_NV] = {0};
+    if (c->kind == 1) {
+        double holding[RD_NV];
+        rd_free_base_torques(c->model, q, zero, a, holding);
+        for (int i = 0; i < 6; ++i) tau[i] = 0.0;
+        for (int i = 0; i < m; ++i) tau[6 + i] = p[m + i] * (p[i] - q[7 + i]) - p[2 * m + i] * v[6 + i] + holding[6 + i];
+        return;
+    }
+    const double duration = p[4 * m];
+    double s = t / duration;
+    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    const int moving = 0 < t && t < duration;
+    const double position = 10 * pow(s, 3) - 15 * pow(s, 4) + 6 * pow(s, 5);
+    const double speed = moving ? (30 * pow(s, 2) - 60 * pow(s, 3) + 30 * pow(s, 4)) / duration : 0.0;
+    const double acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double delta = p[m + i] - p[i];
+        const double q_d = p[i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
+        a[6 + i] = a_d + p[3 * m + i] * (v_d - v[6 + i]) + p[2 * m + i] * (q_d - q[7 + i]);
+    }
+    rd_free_base_torques(c->model, q, v, a, tau);
+}
+#endif
+
 static void rd_control(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
     const int n = RD_NV;
     const double *p = c->params;
+#if RD_NQ != RD_NV
+    if (c->kind == 1 || c->kind == 2) { /* the joints' laws with the base free */
+        rd_control_free_base(c, t, q, v, tau);
+        return;
+    }
+#endif
     if (c->kind == 0) {
         for (int i = 0; i < n; ++i) tau[i] = p[i];
     } else if (c->kind == 1) { /* params: target, kp, kd */
@@ -664,6 +719,48 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
     }
 }
 
+/* out = q ⊕ h w (Pinocchio's integrate): joints by addition; a floating base on SE(3),
+ * M0 exp6(h w) in the base frame, its quaternion (x, y, z, w) on the side of q's and
+ * renormalised to first order, as pinocchio::integrate of a free flyer. */
+static void rd_qplus(const double *q, const double *w, double h, double *out) {
+#if RD_NQ != RD_NV
+    double u[6];
+    for (int i = 0; i < 6; ++i) u[i] = h * w[i];
+    const double th2 = u[3] * u[3] + u[4] * u[4] + u[5] * u[5], th = sqrt(th2);
+    double a, b, c, s; /* V = 1 + a [ω]× + b [ω]×²; the half-angle quaternion (s ω, c) */
+    if (th < 1e-3) {
+        a = 0.5 - th2 / 24.0 + th2 * th2 / 720.0;
+        b = 1.0 / 6.0 - th2 / 120.0 + th2 * th2 / 5040.0;
+        s = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0;
+    } else {
+        a = (1.0 - cos(th)) / th2;
+        b = (th - sin(th)) / (th2 * th);
+        s = sin(0.5 * th) / th;
+    }
+    c = cos(0.5 * th);
+    const double *o = u + 3, *l = u;
+    const double ol[3] = {o[1] * l[2] - o[2] * l[1], o[2] * l[0] - o[0] * l[2], o[0] * l[1] - o[1] * l[0]};
+    const double ool[3] = {o[1] * ol[2] - o[2] * ol[1], o[2] * ol[0] - o[0] * ol[2], o[0] * ol[1] - o[1] * ol[0]};
+    double p[3];
+    for (int i = 0; i < 3; ++i) p[i] = l[i] + a * ol[i] + b * ool[i];
+    const double x = q[3], y = q[4], z = q[5], qw = q[6];
+    const double R[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * qw), 2 * (x * z + y * qw),
+                         2 * (x * y + z * qw), 1 - 2 * (x * x + z * z), 2 * (y * z - x * qw),
+                         2 * (x * z - y * qw), 2 * (y * z + x * qw), 1 - 2 * (x * x + y * y)};
+    for (int i = 0; i < 3; ++i) out[i] = q[i] + R[3 * i] * p[0] + R[3 * i + 1] * p[1] + R[3 * i + 2] * p[2];
+    const double ex = s * o[0], ey = s * o[1], ez = s * o[2], ew = c; /* q ⊗ exp(ω/2) */
+    double r[4] = {qw * ex + x * ew + y * ez - z * ey, qw * ey - x * ez + y * ew + z * ex,
+                   qw * ez + x * ey - y * ex + z * ew, qw * ew - x * ex - y * ey - z * ez};
+    const double dot = r[0] * x + r[1] * y + r[2] * z + r[3] * qw;
+    const double n2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
+    const double scale = (dot < 0.0 ? -1.0 : 1.0) * (3.0 - n2) / 2.0;
+    for (int i = 0; i < 4; ++i) out[3 + i] = scale * r[i];
+    for (int i = 6; i < RD_NV; ++i) out[i + 1] = q[i + 1] + h * w[i];
+#else
+    for (int i = 0; i < RD_NV; ++i) out[i] = q[i] + h * w[i];
+#endif
+}
+
 /* a = FD(q, v, tau(t, q, v)); the stage's torque is the held one when c->hold. */
 static void rd_stage(const rd_controller *c, double t, const double *q, const double *v, const double *held, double *a) {
     double tau[RD_NV];
@@ -677,12 +774,12 @@ static void rd_stage(const rd_controller *c, double t, const double *q, const do
 
 static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, double dt, Py_ssize_t steps, double t0, int rk4,
                                double *oq, double *ov, double *oa, double *otau) {
-    const int n = RD_NV;
+    const int n = RD_NV, nq = RD_NQ;
     const double half = 0.5 * dt, sixth = dt / 6.0;
-    double tau[RD_NV], a[RD_NV], q2[RD_NV], v2[RD_NV], a2[RD_NV], v3[RD_NV], a3[RD_NV], v4[RD_NV], a4[RD_NV];
+    double tau[RD_NV], a[RD_NV], q2[RD_NQ], v2[RD_NV], a2[RD_NV], v3[RD_NV], a3[RD_NV], v4[RD_NV], a4[RD_NV], w[RD_NV];
     for (Py_ssize_t k = 0; k < steps; ++k) {
         const double t = t0 + k * dt;
-        memcpy(oq + k * n, q, n * sizeof(double));
+        memcpy(oq + k * nq, q, nq * sizeof(double));
         memcpy(ov + k * n, v, n * sizeof(double));
         rd_control(c, t, q, v, tau);
         memcpy(otau + k * n, tau, n * sizeof(double));
@@ -690,29 +787,32 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa + k * n, a, n * sizeof(double));
         if (rk4) {
-            for (int i = 0; i < n; ++i) v2[i] = v[i] + half * a[i], q2[i] = q[i] + half * v[i];
+            for (int i = 0; i < n; ++i) v2[i] = v[i] + half * a[i];
+            rd_qplus(q, v, half, q2);
             rd_stage(c, t + half, q2, v2, tau, a2);
-            for (int i = 0; i < n; ++i) v3[i] = v[i] + half * a2[i], q2[i] = q[i] + half * v2[i];
+            for (int i = 0; i < n; ++i) v3[i] = v[i] + half * a2[i];
+            rd_qplus(q, v2, half, q2);
             rd_stage(c, t + half, q2, v3, tau, a3);
-            for (int i = 0; i < n; ++i) v4[i] = v[i] + dt * a3[i], q2[i] = q[i] + dt * v3[i];
+            for (int i = 0; i < n; ++i) v4[i] = v[i] + dt * a3[i];
+            rd_qplus(q, v3, dt, q2);
             rd_stage(c, t + dt, q2, v4, tau, a4);
             for (int i = 0; i < n; ++i) {
-                q[i] = q[i] + sixth * (v[i] + v4[i] + 2.0 * (v2[i] + v3[i]));
+                w[i] = v[i] + v4[i] + 2.0 * (v2[i] + v3[i]);
                 v[i] = v[i] + sixth * (a[i] + a4[i] + 2.0 * (a2[i] + a3[i]));
             }
+            rd_qplus(q, w, sixth, q2);
         } else {
-            for (int i = 0; i < n; ++i) {
-                v[i] = v[i] + dt * a[i];
-                q[i] = q[i] + dt * v[i];
-            }
+            for (int i = 0; i < n; ++i) v[i] = v[i] + dt * a[i];
+            rd_qplus(q, v, dt, q2);
         }
-        if (!rd_finite(q, n) || !rd_finite(v, n)) {
-            memcpy(oq + (k + 1) * n, q, n * sizeof(double));
+        memcpy(q, q2, nq * sizeof(double));
+        if (!rd_finite(q, nq) || !rd_finite(v, n)) {
+            memcpy(oq + (k + 1) * nq, q, nq * sizeof(double));
             memcpy(ov + (k + 1) * n, v, n * sizeof(double));
             return k;
         }
     }
-    memcpy(oq + steps * n, q, n * sizeof(double));
+    memcpy(oq + steps * nq, q, nq * sizeof(double));
     memcpy(ov + steps * n, v, n * sizeof(double));
     if (steps > 0) {
         memcpy(otau + steps * n, otau + (steps - 1) * n, n * sizeof(double));
@@ -746,14 +846,14 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
     const double t0 = PyFloat_AsDouble(args[4]);
     const long rk4 = PyLong_AsLong(args[5]), kind = PyLong_AsLong(args[6]), hold = PyLong_AsLong(args[7]);
     if (PyErr_Occurred()) return NULL;
-    const int n = RD_NV;
-    const npy_intp sizes[6] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26};
+    const int n = RD_NV, nj = RD_NV - 6 * (RD_NQ - RD_NV); /* a floating base's PD and CT params: its joints' */
+    const npy_intp sizes[6] = {n, 3 * nj, 4 * nj + 1, 7, 19 + n, 26};
     if (kind < 0 || kind > 5 || steps < 0) {
         PyErr_SetString(PyExc_ValueError, "bad controller kind or step count");
         return NULL;
     }
-    const double *q0 = rd_array(args[0], n, 0), *v0 = rd_array(args[1], n, 0), *params = rd_array(args[8], sizes[kind], 0);
-    double *oq = rd_array(args[10], (steps + 1) * n, 1), *ov = rd_array(args[11], (steps + 1) * n, 1);
+    const double *q0 = rd_array(args[0], RD_NQ, 0), *v0 = rd_array(args[1], n, 0), *params = rd_array(args[8], sizes[kind], 0);
+    double *oq = rd_array(args[10], (steps + 1) * RD_NQ, 1), *ov = rd_array(args[11], (steps + 1) * n, 1);
     double *oa = rd_array(args[12], (steps + 1) * n, 1), *otau = rd_array(args[13], (steps + 1) * n, 1);
     const rd_kernels *model = &rd_self;
     if (args[9] != Py_None) {
@@ -774,7 +874,7 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         return NULL;
     }
     rd_controller controller = {(int)kind, (int)hold, params, model, frame};
-    double q[RD_NV], v[RD_NV];
+    double q[RD_NQ], v[RD_NV];
     memcpy(q, q0, sizeof q);
     memcpy(v, v0, sizeof v);
     Py_ssize_t failed;
