@@ -75,7 +75,9 @@ def test_refusals_are_one_line_robodyn_errors():
     floating = robodyn.load("solo12")  # compiled frame controllers model fixed bases
     task = TaskSpace(floating, "FL_FOOT", np.zeros(3))
     with pytest.raises(CompileError, match="floating base"):
-        robodyn.simulate(floating, floating.default_configuration(), np.zeros(floating.nv), 0.1, 1e-3, engine="compiled", controller=task)
+        robodyn.simulate(
+            floating, floating.default_configuration(), np.zeros(floating.nv), 0.1, 1e-3, engine="compiled", controller=task
+        )
 
 
 def test_compiled_runs_warn_about_limits_like_the_python_engine():
