@@ -247,7 +247,7 @@ def compiled_controller(controller: object) -> CompiledController:
 
     Raises:
         CompileError: For any other controller (one sentence saying why), or a model that
-            does not compile (a floating base).
+            does not compile (a floating base under a frame controller).
     """
     kind = _TWINS.get(f"{type(controller).__module__}.{type(controller).__qualname__}")
     c: Any = controller
