@@ -149,7 +149,7 @@ static int rd_parallel(rd_job *base, Py_ssize_t rows, long threads) {
 }
 
 /* A C-contiguous, aligned, native float64 array of shape (width,) or (rows, width). */
-static int rd_accept(PyObject *object, int *ndim, npy_intp *rows, npy_intp width) {
+static int rd_accept_width(PyObject *object, int *ndim, npy_intp *rows, npy_intp width) {
     if (!PyArray_CheckExact(object)) return 0;
     PyArrayObject *array = (PyArrayObject *)object;
     if (PyArray_TYPE(array) != NPY_DOUBLE || !PyArray_ISCARRAY_RO(array) || !PyArray_ISNOTSWAPPED(array)) return 0;
@@ -169,6 +169,9 @@ static int rd_accept(PyObject *object, int *ndim, npy_intp *rows, npy_intp width
     return 0;
 }
 
+/* The same of width RD_NV (a velocity-sized argument; the derivative kernels' entry points). */
+static inline int rd_accept(PyObject *object, int *ndim, npy_intp *rows) { return rd_accept_width(object, ndim, rows, RD_NV); }
+
 static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_row row, int matrix) {
     if (nargs != nin + 1) {
         PyErr_SetString(PyExc_TypeError, "wrong number of arguments");
@@ -179,7 +182,7 @@ static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_r
     int ndim = 0;
     npy_intp rows = 1;
     for (int k = 0; k < nin; ++k)
-        if (!rd_accept(args[k], &ndim, &rows, k ? RD_NV : RD_NQ)) Py_RETURN_NONE;
+        if (!rd_accept_width(args[k], &ndim, &rows, k ? RD_NV : RD_NQ)) Py_RETURN_NONE;
     npy_intp dims[3];
     int out_nd = 0;
     if (ndim == 2) dims[out_nd++] = rows;
