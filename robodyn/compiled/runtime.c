@@ -40,6 +40,17 @@ static int rd_finite(const double *x, int n) {
     return 1;
 }
 
+/* A finite q; a floating base's quaternion unit within RD_QUATERNION_TOLERANCE (as
+ * robodyn.dynamics.handle's validate: anything else goes back to the checked path, its error). */
+static int rd_q_ok(const double *q) {
+    if (!rd_finite(q, RD_NQ)) return 0;
+#if RD_NQ != RD_NV
+    const double norm = sqrt(q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]);
+    if (!(fabs(norm - 1.0) < RD_QUATERNION_TOLERANCE)) return 0;
+#endif
+    return 1;
+}
+
 /* Solve M x = b in place (b -> x), M destroyed: M = Lᵀ D L with L following the tree
  * (Featherstone's LTDL: no fill-in when parents precede children). 3 if not positive definite. */
 static int rd_ldl_solve(double *M, double *b) {
@@ -73,27 +84,27 @@ static int rd_fd_raw(const double *q, const double *v, const double *tau, double
 typedef int (*rd_row)(const double *const *in, double *out);
 
 static int row_tau(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NQ) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
+    if (!rd_q_ok(in[0]) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     rd_tau(in[0], in[1], in[2], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_mass(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NQ)) return 1;
+    if (!rd_q_ok(in[0])) return 1;
     rd_mass(in[0], out);
     return rd_finite(out, RD_NV * RD_NV) ? 0 : 2;
 }
 static int row_nle(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NQ) || !rd_finite(in[1], RD_NV)) return 1;
+    if (!rd_q_ok(in[0]) || !rd_finite(in[1], RD_NV)) return 1;
     rd_nle(in[0], in[1], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_gravity(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NQ)) return 1;
+    if (!rd_q_ok(in[0])) return 1;
     rd_gravity(in[0], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_fd(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NQ) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
+    if (!rd_q_ok(in[0]) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     if (rd_fd_raw(in[0], in[1], in[2], out)) return 3;
     return rd_finite(out, RD_NV) ? 0 : 3;
 }

@@ -278,3 +278,18 @@ def test_solo12_runs_in_c_as_in_python_passive_and_under_pd(rng):
         compiled, python = _both_engines(robot, q0, v0, 0.3, 1e-3, controller=controller)
         for name in ("q", "v", "tau"):
             assert relative_error(getattr(compiled, name), getattr(python, name)) < 1e-9, name
+
+
+def test_a_quaternion_that_is_not_unit_is_refused_like_the_robot(tree):
+    """The fast path (straight to C) must not compute with a non-unit quaternion that the
+    robot refuses: same InputError, one state and a batch."""
+    robot, compiled = tree
+    q, v = robot.neutral_configuration(), np.zeros(robot.nv)
+    q[3:7] = [0.3, 0.2, 0.1, 2.0]
+    for call in (lambda q: robot.inverse_dynamics(q, v, v), lambda q: compiled.inverse_dynamics(q, v, v)):
+        with pytest.raises(robodyn.InputError, match="unit quaternion"):
+            call(q)
+    with pytest.raises(robodyn.InputError, match="unit quaternion"):
+        compiled.mass_matrix(np.tile(q, (7, 1)))
+    q[3:7] /= np.linalg.norm(q[3:7])
+    assert relative_error(compiled.gravity(q), robot.gravity(q)) < 1e-12
