@@ -220,6 +220,8 @@ def test_generated_code_has_no_urdf_names(mimic_tree):
         "for",
         "define",
         "RD_NV",
+        "RD_NQ",
+        "RD_QUATERNION_TOLERANCE",
         "rd_parent",
         "q",
         "v",
