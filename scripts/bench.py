@@ -1187,6 +1187,43 @@ def bench_engines(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_compiled_floating(quick: bool) -> list[dict]:
+    """solo12 (floating base, Pinocchio's free flyer) compiled single calls vs raw Pinocchio on
+    a preallocated Data; targets: tau <= 0.5x pin.rnea, forward dynamics <= 0.5x pin.aba."""
+    robot, compiled = _compiled("solo12", {})
+    model, data = robot.model, robot.model.createData()
+    rng = np.random.default_rng(0)
+    q = robot.random_configuration(rng).copy()
+    v, a = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    tau = robot.inverse_dynamics(q, v, a)
+    cases = {
+        "inverse_dynamics vs pin.rnea": (lambda: compiled.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a), 0.5),
+        "forward_dynamics vs pin.aba": (
+            lambda: compiled.forward_dynamics(q, v, tau),
+            lambda: pin.aba(model, data, q, v, tau),
+            0.5,
+        ),
+        "mass_matrix vs pin.crba": (lambda: compiled.mass_matrix(q), lambda: pin.crba(model, data, q), None),
+        "nonlinear_effects vs pin.nonLinearEffects": (
+            lambda: compiled.nonlinear_effects(q, v),
+            lambda: pin.nonLinearEffects(model, data, q, v),
+            None,
+        ),
+        "gravity vs pin.computeGeneralizedGravity": (
+            lambda: compiled.gravity(q),
+            lambda: pin.computeGeneralizedGravity(model, data, q),
+            None,
+        ),
+    }
+    rows = []
+    for method, (ours, raw, target) in cases.items():
+        ours_s, raw_s, ratio = paired(ours, raw, repeats=7 if quick else 15)
+        row = {"robot": "solo12", "method": method, "compiled_us": ours_s * 1e6, "pinocchio_us": raw_s * 1e6, "ratio": ratio}
+        row["target"] = "" if target is None else f"<= {target}x: {'met' if ratio <= target else 'missed'}"
+        rows.append(row)
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -1210,6 +1247,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single-thin": bench_single_thin,
     "compile-scaling": bench_compile_scaling,
     "engines": bench_engines,
+    "compiled-floating": bench_compiled_floating,
 }
 
 

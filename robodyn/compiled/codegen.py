@@ -23,8 +23,13 @@ The kernels, each for one state (arrays of doubles, ``M`` row-major)::
     static void rd_gravity(const double *q, double *g);
     static void rd_mass_nle(const double *q, const double *v, double *M, double *nle);
 
-plus ``RD_NV`` and ``rd_parent`` (the tree's parent of each coordinate, for the LDLᵀ
-factorisation). ``runtime.c`` supplies everything else.
+plus ``RD_NV``, ``RD_NQ`` and ``rd_parent`` (the tree's parent of each coordinate, for the
+LDLᵀ factorisation). ``runtime.c`` supplies everything else.
+
+A floating base (the compact program's ``base``, Pinocchio's free flyer) takes ``q[0:7]``
+(position, quaternion x, y, z, w), ``v[0:6]`` and ``a[0:6]`` (linear then angular, base
+frame) before the joints: its rows of ``tau``, ``M``, ``C v`` and ``G`` come first, the joints'
+follow (``RD_NQ = RD_NV + 1``); the position never enters the dynamics.
 """
 
 from __future__ import annotations
@@ -34,12 +39,13 @@ from collections.abc import Sequence
 import numpy as np
 import sympy as sp
 
+from robodyn.dynamics.handle import QUATERNION_TOLERANCE
 from robodyn.equations.c_printer import CPrinter, c_combination, c_number
 from robodyn.equations.compact import CompactDynamics
 from robodyn.equations.program import Program, needed
 
 #: Bumped whenever the generated code changes meaning (part of every cache key).
-CODEGEN_VERSION = "2"
+CODEGEN_VERSION = "4"
 
 #: The body coordinates' C names, and the robot's arrays they are made of.
 _COORDINATES = (("th", "q", True), ("thd", "v", False), ("thdd", "a", False))
@@ -73,11 +79,28 @@ class KernelWriter:
         self.offset = np.asarray(offset, float)
         self.parents = list(parents)
         self.bodies, self.nv = self.selection.shape
+        self.base = equations.base
+        self._v0 = 0 if self.base is None else 6  # the joints' first entry in v (and q - 1)
+        self._q0 = 0 if self.base is None else 7
+        self.size = self.nv + self._v0  # RD_NV
         # Local names: assignments t0, t1, ... (r0, r1, ... in tau); body coordinates th0, thd0, thdd0.
-        self._compact = CPrinter(self._names(equations.assignments, "t", (equations.q, equations.qd)))
+        self._compact = CPrinter(self._names(equations.assignments, "t", (equations.q, equations.qd)) | self._base_names())
         if newton_euler is not None:
             inputs = newton_euler.inputs
-            self._tau = CPrinter(self._names(newton_euler.assignments, "r", (inputs["q"], inputs["qd"], inputs["qdd"])))
+            names = self._names(newton_euler.assignments, "r", (inputs["q"], inputs["qd"], inputs["qdd"]))
+            if "base_q" in inputs:
+                entries = (("base_q", "q", 3), ("base_v", "v", 0), ("base_a", "a", 0))
+                names |= {
+                    symbol: f"{array}[{start + i}]" for key, array, start in entries for i, symbol in enumerate(inputs[key])
+                }
+            self._tau = CPrinter(names)
+
+    def _base_names(self) -> dict[sp.Symbol, str]:
+        """The free base's inputs as array entries (``q[3]``.. the quaternion, ``v[0]``..)."""
+        if self.base is None:
+            return {}
+        names = {symbol: f"q[{3 + i}]" for i, symbol in enumerate(self.base.quaternion)}
+        return names | {symbol: f"v[{i}]" for i, symbol in enumerate(self.base.velocity)}
 
     @staticmethod
     def _names(
@@ -95,7 +118,8 @@ class KernelWriter:
             for symbols, (local, array, shifted) in zip(coordinates, _COORDINATES, strict=False):
                 if symbols[b] not in used:
                     continue
-                terms = [(self.selection[b, j], f"{array}[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
+                first = self._q0 if array == "q" else self._v0
+                terms = [(self.selection[b, j], f"{array}[{first + j}]") for j in range(self.nv) if self.selection[b, j] != 0]
                 value = c_combination(terms)
                 if shifted and self.offset[b] != 0:
                     value += f" + {c_number(self.offset[b])}"
@@ -119,12 +143,12 @@ class KernelWriter:
         lines = []
         for j in range(self.nv):
             terms = [(self.selection[b, j], f"{local}[{b}]") for b in range(self.bodies) if self.selection[b, j] != 0]
-            lines.append(f"    {out}[{j}] = {c_combination(terms)};")
+            lines.append(f"    {out}[{self._v0 + j}] = {c_combination(terms)};")
         return lines
 
     def _project_matrix(self, local: str, out: str) -> list[str]:
         """``out = Sᵀ local S`` (symmetric: the lower triangle, mirrored)."""
-        n, nb, S = self.nv, self.bodies, self.selection
+        n, nb, S, size, v0 = self.nv, self.bodies, self.selection, self.size, self._v0
         lines = []
         for j in range(n):
             for k in range(j + 1):
@@ -134,9 +158,26 @@ class KernelWriter:
                     for c in range(nb)
                     if S[b, j] != 0 and S[c, k] != 0
                 ]
-                lines.append(f"    {out}[{j * n + k}] = {c_combination(terms)};")
+                lines.append(f"    {out}[{(v0 + j) * size + v0 + k}] = {c_combination(terms)};")
                 if j != k:
-                    lines.append(f"    {out}[{k * n + j}] = {out}[{j * n + k}];")
+                    lines.append(f"    {out}[{(v0 + k) * size + v0 + j}] = {out}[{(v0 + j) * size + v0 + k}];")
+        return lines
+
+    def _base_vector(self, printer: CPrinter, out: str, entries: Sequence[sp.Expr]) -> list[str]:
+        """The base's six rows of a vector: ``out[0..5]``."""
+        return [f"    {out}[{i}] = {printer.expression(entry)};" for i, entry in enumerate(entries)]
+
+    def _base_mass_lines(self) -> list[str]:
+        """The base's rows and columns of ``M``: its 6×6 block, and ``M_base,bodies S``."""
+        rows, size, nb, S = self.equations.base_rows["M"], self.size, self.bodies, self.selection
+        lines = [f"    double mbb[{6 * nb}];"]
+        lines += [f"    mbb[{r * nb + b}] = {self._compact.expression(rows[r, 6 + b])};" for r in range(6) for b in range(nb)]
+        for r in range(6):
+            for c in range(r + 1):
+                lines.append(f"    M[{r * size + c}] = M[{c * size + r}] = {self._compact.expression(rows[r, c])};")
+            for j in range(self.nv):
+                value = c_combination([(S[b, j], f"mbb[{r * nb + b}]") for b in range(nb) if S[b, j] != 0])
+                lines.append(f"    M[{r * size + 6 + j}] = M[{(6 + j) * size + r}] = {value};")
         return lines
 
     def _vector_lines(self, printer: CPrinter, local: str, out: str, entries: list[sp.Expr]) -> list[str]:
@@ -151,10 +192,23 @@ class KernelWriter:
         for b in range(nb):
             for c in range(b + 1):
                 lines.append(f"    mb[{b * nb + c}] = mb[{c * nb + b}] = {self._compact.expression(M[b, c])};")
-        return lines + self._project_matrix("mb", "M")
+        lines += self._project_matrix("mb", "M")
+        return lines if self.base is None else lines + self._base_mass_lines()
+
+    def _base_entries(self, name: str) -> list[sp.Expr]:
+        """The base's rows of ``name`` (``"M"``: every entry; none for a fixed base)."""
+        return [] if self.base is None else list(self.equations.base_rows[name])
+
+    def _with_base(self, printer: CPrinter, out: str, name: str) -> list[str]:
+        """The base's six rows of ``Cv + G`` (``name="nle"``) or ``G`` into ``out``."""
+        if self.base is None:
+            return []
+        rows = self.equations.base_rows
+        entries = [rows["Cv"][i] + rows["G"][i] for i in range(6)] if name == "nle" else list(rows["G"])
+        return self._base_vector(printer, out, entries)
 
     def _tau_kernel(self) -> list[str]:
-        n = self.nv
+        n = self.size
         head = "static void rd_tau(const double *q, const double *v, const double *a, double *tau) {"
         if self.newton_euler is None:
             return [
@@ -169,26 +223,33 @@ class KernelWriter:
         ne = self.newton_euler
         tau = list(ne.outputs["tau"])
         coordinates = (ne.inputs["q"], ne.inputs["qd"], ne.inputs["qdd"])
-        lines = [head, *self._program(self._tau, ne.assignments, tau, coordinates)]
+        base = list(ne.outputs.get("base", ()))
+        lines = [head, *self._program(self._tau, ne.assignments, tau + base, coordinates)]
+        lines += self._base_vector(self._tau, "tau", base)
         return [*lines, *self._vector_lines(self._tau, "tb", "tau", tau), "}", ""]
 
     def source(self) -> str:
         """The kernels' C source (no includes; ``runtime.c`` is appended after it)."""
-        e, nb, n = self.equations, self.bodies, self.nv
-        mass_entries = [e.M[b, c] for b in range(nb) for c in range(b + 1)]
+        e, nb, n = self.equations, self.bodies, self.size
+        mass_entries = [e.M[b, c] for b in range(nb) for c in range(b + 1)] + self._base_entries("M")
         nle = [e.Cv[b] + e.G[b] for b in range(nb)]
+        base_nle = self._base_entries("Cv") + self._base_entries("G")
         out = [
             "/* Generated by robodyn.compiled (codegen version " + CODEGEN_VERSION + "). */",
             f"#define RD_NV {n}",
+            f"#define RD_NQ {n + (self.base is not None)}",
+            f"#define RD_QUATERNION_TOLERANCE {c_number(QUATERNION_TOLERANCE)}",
             f"static const int rd_parent[RD_NV] = {{{', '.join(str(p) for p in self.parents)}}};",
             "",
             "static void rd_gravity(const double *q, double *g) {",
-            *self._body(list(e.G), velocity=False),
+            *self._body(list(e.G) + self._base_entries("G"), velocity=False),
+            *self._with_base(self._compact, "g", "G"),
             *self._vector_lines(self._compact, "gb", "g", list(e.G)),
             "}",
             "",
             "static void rd_nle(const double *q, const double *v, double *nle) {",
-            *self._body(nle, velocity=True),
+            *self._body(nle + base_nle, velocity=True),
+            *self._with_base(self._compact, "nle", "nle"),
             *self._vector_lines(self._compact, "hb", "nle", nle),
             "}",
             "",
@@ -198,8 +259,9 @@ class KernelWriter:
             "}",
             "",
             "static void rd_mass_nle(const double *q, const double *v, double *M, double *nle) {",
-            *self._body(mass_entries + nle, velocity=True),
+            *self._body(mass_entries + nle + base_nle, velocity=True),
             *self._mass_lines(),
+            *self._with_base(self._compact, "nle", "nle"),
             *self._vector_lines(self._compact, "hb", "nle", nle),
             "}",
             "",

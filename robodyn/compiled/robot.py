@@ -1,7 +1,9 @@
 """``compile(robot)``: a robot's dynamics as native code, with the same API as :class:`robodyn.Robot`.
 
 A :class:`CompiledRobot` computes ``tau``, ``M``, ``C v + G``, ``G`` and the forward
-dynamics of a fixed-base robot in generated C (see :mod:`robodyn.compiled.codegen`),
+dynamics of a robot in generated C (a floating base is Pinocchio's free flyer: ``q`` starts
+with the base position and quaternion x, y, z, w, ``v`` with its linear and angular velocity
+in its own frame) (see :mod:`robodyn.compiled.codegen`),
 built once and cached (see :mod:`robodyn.compiled.build`). The rules are the
 :class:`~robodyn.Robot`'s: one state as 1-D arrays gives one result, a stack (one state a
 row) gives a stack; inputs go through the robot's own boundary
@@ -31,7 +33,7 @@ from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
 from robodyn.equations import c_printer, compact, newton_euler, program, sharing
 from robodyn.equations.compact import derive_compact
-from robodyn.equations.newton_euler import derive_newton_euler
+from robodyn.equations.newton_euler import BaseSymbols, derive_newton_euler, floating_tree
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
 from robodyn.reference import symbolic as reference_symbolic
 from robodyn.reference import tree as reference_tree
@@ -64,17 +66,18 @@ def robot_key(robot: Robot) -> str:
 
 
 def generate_kernels(robot: Robot) -> str:
-    """The C kernels of a fixed-base robot (the slow part: a sympy derivation).
+    """The C kernels of a robot (the slow part: a sympy derivation).
+
+    A floating base is the tree's body 0, free (:func:`robodyn.equations.newton_euler.floating_tree`).
 
     Raises:
-        CompileError: For a floating base, or joints the reference does not map.
+        CompileError: For joints the reference does not map.
     """
+    tree = build_tree(robot.spec, robot.urdf, floating_base=robot.floating_base)
+    base = BaseSymbols.make() if robot.floating_base else None
     if robot.floating_base:
-        raise CompileError(
-            robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
-        )
-    tree = build_tree(robot.spec, robot.urdf, floating_base=False)
-    names = list(robot.joint_names)
+        tree = floating_tree(tree)
+    names = [name for name in robot.joint_names if not (robot.floating_base and name == robot.joint_names[0])]
     if sorted(tree.joint_names) != sorted(names):
         raise CompileError(robot.name, "the reference tree and the Pinocchio model disagree on the joints")
     column = [tree.joint_names.index(name) for name in names]
@@ -82,8 +85,8 @@ def generate_kernels(robot: Robot) -> str:
     count = len(tree.bodies)
     free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
     reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
-    equations = derive_compact(reference, snap=SNAP)
-    tau = derive_newton_euler(reference, snap=SNAP)
+    equations = derive_compact(reference, snap=SNAP, free_base=base)
+    tau = derive_newton_euler(reference, snap=SNAP, free_base=base)
     return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), tau).source()
 
 
@@ -91,42 +94,41 @@ def coordinate_parents(robot: Robot) -> list[int]:
     """The parent coordinate of each coordinate (-1 at the root), for the tree LDLᵀ.
 
     With mimic joints ``M = Sᵀ M_bodies S`` need not keep the tree's sparsity, so the chain
-    ``i - 1`` (a dense factorisation) is used.
+    ``i - 1`` (a dense factorisation) is used. A floating base's six coordinates are a chain
+    (a dense 6×6 block) and its children hang from the last.
     """
     model = robot.model
     if robot.mimic is not None:
         return list(range(-1, robot.nv - 1))
-    parents = []
+    parents: list[int] = []
     for joint_id in range(1, model.njoints):
         if model.joints[joint_id].nv == 0:
             continue
         parent = model.parents[joint_id]
         while parent > 0 and model.joints[parent].nv == 0:
             parent = model.parents[parent]
-        parents.append(model.joints[parent].idx_v if parent > 0 else -1)
+        joint = model.joints[joint_id]
+        parents.extend(range(joint.idx_v - 1, joint.idx_v + joint.nv - 1))
+        parents[joint.idx_v] = model.joints[parent].idx_v + model.joints[parent].nv - 1 if parent > 0 else -1
     return parents
 
 
 def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
-    """Compile a fixed-base robot's dynamics to native code (cached: fast the second time).
+    """Compile a robot's dynamics to native code (cached: fast the second time).
 
     Args:
-        robot: From :func:`robodyn.load` (fixed base; mimic joints are fine).
+        robot: From :func:`robodyn.load` (mimic joints and a floating base are fine).
         threads: Native threads for batches; ``None`` for every available core.
 
     Returns:
         The compiled robot.
 
     Raises:
-        CompileError: For a floating base, or if the build fails.
+        CompileError: If the build fails.
         CompilerNotFoundError: If there is no C compiler (``Robot`` keeps working).
         InputError: For a bad ``threads``.
     """
     threads = check_threads(threads)
-    if robot.floating_base:
-        raise CompileError(
-            robot.name, "it has a floating base; the compiled engine models fixed-base robots (floating_base=False)"
-        )
     if robot.nv == 0:
         raise CompileError(robot.name, "it has no moving joints")
     build.find_compiler()  # fail early, before the slow derivation
@@ -248,6 +250,7 @@ class CompiledRobot:
         and kept in the instance's ``__dict__`` (so a call costs one dictionary look-up)."""
         module = self.__dict__.get("_derivative_module")
         if module is None:
+            _fixed_base_only(self.robot, "derivatives")
             key = robot_key(self.robot)
             kernels = build.cached_kernels(key) or generate_kernels(self.robot)
             module = derivatives.derivative_module(self.robot, key=key, kernels=kernels, snap=SNAP)
@@ -312,6 +315,7 @@ class CompiledRobot:
         """
         modules = self.__dict__.setdefault("_frames", {})
         if frame not in modules:
+            _fixed_base_only(self.robot, "frame kinematics")
             modules[frame] = build_frame(self.robot, frame, robot_key(self.robot))
         return modules[frame]
 
@@ -348,3 +352,9 @@ class CompiledRobot:
         acceleration in [rad/s²] follows, shape (6,) or (N, 6)."""
         bias = self._frame_call("bias", frame, q=q, v=v)
         return bias if angular else bias[..., :3].copy()
+
+
+def _fixed_base_only(robot: Robot, what: str) -> None:
+    """Refuse a floating base for the compiled ``what`` (its kernels model fixed bases)."""
+    if robot.floating_base:
+        raise CompileError(robot.name, f"it has a floating base; the compiled {what} model fixed-base robots")

@@ -20,6 +20,9 @@
  * of a frame module, robodyn/compiled/kinematics.py).
  */
 
+#ifndef RD_NQ
+#define RD_NQ RD_NV /* a floating base's q has one entry more than v (its quaternion) */
+#endif
 #define RD_CAPSULE "robodyn.compiled.kernels"
 #define RD_MIN_ROWS_PER_THREAD 64
 
@@ -37,6 +40,17 @@ static const rd_kernels rd_self = {RD_NV, rd_tau, rd_mass, rd_nle, rd_gravity, r
 static int rd_finite(const double *x, int n) {
     for (int i = 0; i < n; ++i)
         if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+/* A finite q; a floating base's quaternion unit within RD_QUATERNION_TOLERANCE (as
+ * robodyn.dynamics.handle's validate: anything else goes back to the checked path, its error). */
+static int rd_q_ok(const double *q) {
+    if (!rd_finite(q, RD_NQ)) return 0;
+#if RD_NQ != RD_NV
+    const double norm = sqrt(q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]);
+    if (!(fabs(norm - 1.0) < RD_QUATERNION_TOLERANCE)) return 0;
+#endif
     return 1;
 }
 
@@ -73,27 +87,27 @@ static int rd_fd_raw(const double *q, const double *v, const double *tau, double
 typedef int (*rd_row)(const double *const *in, double *out);
 
 static int row_tau(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
+    if (!rd_q_ok(in[0]) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     rd_tau(in[0], in[1], in[2], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_mass(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV)) return 1;
+    if (!rd_q_ok(in[0])) return 1;
     rd_mass(in[0], out);
     return rd_finite(out, RD_NV * RD_NV) ? 0 : 2;
 }
 static int row_nle(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV)) return 1;
+    if (!rd_q_ok(in[0]) || !rd_finite(in[1], RD_NV)) return 1;
     rd_nle(in[0], in[1], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_gravity(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV)) return 1;
+    if (!rd_q_ok(in[0])) return 1;
     rd_gravity(in[0], out);
     return rd_finite(out, RD_NV) ? 0 : 2;
 }
 static int row_fd(const double *const *in, double *out) {
-    if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
+    if (!rd_q_ok(in[0]) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     if (rd_fd_raw(in[0], in[1], in[2], out)) return 3;
     return rd_finite(out, RD_NV) ? 0 : 3;
 }
@@ -116,16 +130,16 @@ static void *rd_run(void *arg) {
     Py_ssize_t r = job->begin;
     if (job->block) /* blocks of `lanes` rows; a failing block's rows again one by one (their exact statuses) */
         for (; r + job->lanes <= job->end; r += job->lanes) {
-            for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * RD_NV;
+            for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * (k ? RD_NV : RD_NQ);
             if (!job->block(in, job->out + r * job->out_size)) continue;
             for (Py_ssize_t s = r; s < r + job->lanes; ++s) {
-                for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + s * RD_NV;
+                for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + s * (k ? RD_NV : RD_NQ);
                 const int status = job->row(in, job->out + s * job->out_size);
                 if (status > worst) worst = status;
             }
         }
     for (; r < job->end; ++r) {
-        for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * RD_NV;
+        for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * (k ? RD_NV : RD_NQ);
         const int status = job->row(in, job->out + r * job->out_size);
         if (status > worst) worst = status;
     }
@@ -162,19 +176,19 @@ static int rd_parallel(rd_job *base, Py_ssize_t rows, long threads) {
     return worst;
 }
 
-/* A C-contiguous, aligned, native float64 array of shape (RD_NV,) or (rows, RD_NV). */
-static int rd_accept(PyObject *object, int *ndim, npy_intp *rows) {
+/* A C-contiguous, aligned, native float64 array of shape (width,) or (rows, width). */
+static int rd_accept_width(PyObject *object, int *ndim, npy_intp *rows, npy_intp width) {
     if (!PyArray_CheckExact(object)) return 0;
     PyArrayObject *array = (PyArrayObject *)object;
     if (PyArray_TYPE(array) != NPY_DOUBLE || !PyArray_ISCARRAY_RO(array) || !PyArray_ISNOTSWAPPED(array)) return 0;
     const int nd = PyArray_NDIM(array);
     const npy_intp *dims = PyArray_DIMS(array);
-    if (nd == 1 && dims[0] == RD_NV) {
+    if (nd == 1 && dims[0] == width) {
         if (*ndim == 2) return 0;
         *ndim = 1;
         return 1;
     }
-    if (nd == 2 && dims[1] == RD_NV) {
+    if (nd == 2 && dims[1] == width) {
         if (*ndim == 1 || (*ndim == 2 && *rows != dims[0])) return 0;
         *ndim = 2;
         *rows = dims[0];
@@ -182,6 +196,9 @@ static int rd_accept(PyObject *object, int *ndim, npy_intp *rows) {
     }
     return 0;
 }
+
+/* The same of width RD_NV (a velocity-sized argument; the derivative kernels' entry points). */
+static inline int rd_accept(PyObject *object, int *ndim, npy_intp *rows) { return rd_accept_width(object, ndim, rows, RD_NV); }
 
 /* The job's SIMD block for its row kernel, in the instruction set chosen (none: scalar rows). */
 static void rd_simd_block(rd_job *job) {
@@ -209,7 +226,7 @@ static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_r
     int ndim = 0;
     npy_intp rows = 1;
     for (int k = 0; k < nin; ++k)
-        if (!rd_accept(args[k], &ndim, &rows)) Py_RETURN_NONE;
+        if (!rd_accept_width(args[k], &ndim, &rows, k ? RD_NV : RD_NQ)) Py_RETURN_NONE;
     npy_intp dims[3];
     int out_nd = 0;
     if (ndim == 2) dims[out_nd++] = rows;
@@ -726,9 +743,64 @@ static void rdc_lqr(const double *p, const double *q, const double *v, double *t
     }
 }
 
+#if RD_NQ != RD_NV
+/* Joint torques giving the joints the accelerations a[6:] with no torque on the free base
+ * (robodyn.sim.control.free_base_torques): a[0:6] = -M_bb⁻¹ (M_bj a_j + h_b), tau = ID(q, v, a), tau[0:6] = 0. */
+static void rd_free_base_torques(const rd_kernels *model, const double *q, const double *v, double *a, double *tau) {
+    const int n = RD_NV;
+    double M[RD_NV * RD_NV], h[RD_NV], A[36], b[6];
+    model->mass_nle(q, v, M, h);
+    for (int i = 0; i < 6; ++i) {
+        double s = 0.0;
+        for (int j = 6; j < n; ++j) s += M[i * n + j] * a[j];
+        b[i] = -(s + h[i]);
+        for (int k = 0; k < 6; ++k) A[i * 6 + k] = M[i * n + k];
+    }
+    rdc_solve(A, b, 6, 1);
+    memcpy(a, b, sizeof b);
+    model->tau(q, v, a, tau);
+    for (int i = 0; i < 6; ++i) tau[i] = 0.0;
+}
+
+/* PD + gravity (kind 1) and computed torque along a quintic (kind 2) on a floating robot's
+ * joints, its base free (robodyn.sim.control: _floating_pd, ComputedTorque): params as for a
+ * fixed base, of the joints only. */
+static void rd_control_free_base(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
+    const int m = RD_NV - 6;
+    const double *p = c->params;
+    double a[RD_NV] = {0}, zero[RD_NV] = {0};
+    if (c->kind == 1) {
+        double holding[RD_NV];
+        rd_free_base_torques(c->model, q, zero, a, holding);
+        for (int i = 0; i < 6; ++i) tau[i] = 0.0;
+        for (int i = 0; i < m; ++i) tau[6 + i] = p[m + i] * (p[i] - q[7 + i]) - p[2 * m + i] * v[6 + i] + holding[6 + i];
+        return;
+    }
+    const double duration = p[4 * m];
+    double s = t / duration;
+    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    const int moving = 0 < t && t < duration;
+    const double position = 10 * pow(s, 3) - 15 * pow(s, 4) + 6 * pow(s, 5);
+    const double speed = moving ? (30 * pow(s, 2) - 60 * pow(s, 3) + 30 * pow(s, 4)) / duration : 0.0;
+    const double acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double delta = p[m + i] - p[i];
+        const double q_d = p[i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
+        a[6 + i] = a_d + p[3 * m + i] * (v_d - v[6 + i]) + p[2 * m + i] * (q_d - q[7 + i]);
+    }
+    rd_free_base_torques(c->model, q, v, a, tau);
+}
+#endif
+
 static void rd_control(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
     const int n = RD_NV;
     const double *p = c->params;
+#if RD_NQ != RD_NV
+    if (c->kind == 1 || c->kind == 2) { /* the joints' laws with the base free */
+        rd_control_free_base(c, t, q, v, tau);
+        return;
+    }
+#endif
     if (c->kind == 0) {
         for (int i = 0; i < n; ++i) tau[i] = p[i];
     } else if (c->kind == 1) { /* params: target, kp, kd */
@@ -776,6 +848,48 @@ static int rd_fd_damped(const rd_controller *c, const double *q, const double *v
     return rd_fd_raw(q, v, total, a);
 }
 
+/* out = q ⊕ h w (Pinocchio's integrate): joints by addition; a floating base on SE(3),
+ * M0 exp6(h w) in the base frame, its quaternion (x, y, z, w) on the side of q's and
+ * renormalised to first order, as pinocchio::integrate of a free flyer. */
+static void rd_qplus(const double *q, const double *w, double h, double *out) {
+#if RD_NQ != RD_NV
+    double u[6];
+    for (int i = 0; i < 6; ++i) u[i] = h * w[i];
+    const double th2 = u[3] * u[3] + u[4] * u[4] + u[5] * u[5], th = sqrt(th2);
+    double a, b, c, s; /* V = 1 + a [ω]× + b [ω]×²; the half-angle quaternion (s ω, c) */
+    if (th < 1e-3) {
+        a = 0.5 - th2 / 24.0 + th2 * th2 / 720.0;
+        b = 1.0 / 6.0 - th2 / 120.0 + th2 * th2 / 5040.0;
+        s = 0.5 - th2 / 48.0 + th2 * th2 / 3840.0;
+    } else {
+        a = (1.0 - cos(th)) / th2;
+        b = (th - sin(th)) / (th2 * th);
+        s = sin(0.5 * th) / th;
+    }
+    c = cos(0.5 * th);
+    const double *o = u + 3, *l = u;
+    const double ol[3] = {o[1] * l[2] - o[2] * l[1], o[2] * l[0] - o[0] * l[2], o[0] * l[1] - o[1] * l[0]};
+    const double ool[3] = {o[1] * ol[2] - o[2] * ol[1], o[2] * ol[0] - o[0] * ol[2], o[0] * ol[1] - o[1] * ol[0]};
+    double p[3];
+    for (int i = 0; i < 3; ++i) p[i] = l[i] + a * ol[i] + b * ool[i];
+    const double x = q[3], y = q[4], z = q[5], qw = q[6];
+    const double R[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * qw), 2 * (x * z + y * qw),
+                         2 * (x * y + z * qw), 1 - 2 * (x * x + z * z), 2 * (y * z - x * qw),
+                         2 * (x * z - y * qw), 2 * (y * z + x * qw), 1 - 2 * (x * x + y * y)};
+    for (int i = 0; i < 3; ++i) out[i] = q[i] + R[3 * i] * p[0] + R[3 * i + 1] * p[1] + R[3 * i + 2] * p[2];
+    const double ex = s * o[0], ey = s * o[1], ez = s * o[2], ew = c; /* q ⊗ exp(ω/2) */
+    double r[4] = {qw * ex + x * ew + y * ez - z * ey, qw * ey - x * ez + y * ew + z * ex,
+                   qw * ez + x * ey - y * ex + z * ew, qw * ew - x * ex - y * ey - z * ez};
+    const double dot = r[0] * x + r[1] * y + r[2] * z + r[3] * qw;
+    const double n2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
+    const double scale = (dot < 0.0 ? -1.0 : 1.0) * (3.0 - n2) / 2.0;
+    for (int i = 0; i < 4; ++i) out[3 + i] = scale * r[i];
+    for (int i = 6; i < RD_NV; ++i) out[i + 1] = q[i + 1] + h * w[i];
+#else
+    for (int i = 0; i < RD_NV; ++i) out[i] = q[i] + h * w[i];
+#endif
+}
+
 /* a = FD(q, v, tau(t, q, v)); the stage's torque is the held one when c->hold. */
 static void rd_stage(const rd_controller *c, double t, const double *q, const double *v, const double *held, double *a) {
     double tau[RD_NV];
@@ -791,12 +905,12 @@ static void rd_stage(const rd_controller *c, double t, const double *q, const do
 
 static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, double dt, Py_ssize_t steps, double t0, int rk4,
                                double *oq, double *ov, double *oa, double *otau) {
-    const int n = RD_NV;
+    const int n = RD_NV, nq = RD_NQ;
     const double half = 0.5 * dt, sixth = dt / 6.0;
-    double tau[RD_NV], a[RD_NV], q2[RD_NV], v2[RD_NV], a2[RD_NV], v3[RD_NV], a3[RD_NV], v4[RD_NV], a4[RD_NV];
+    double tau[RD_NV], a[RD_NV], q2[RD_NQ], v2[RD_NV], a2[RD_NV], v3[RD_NV], a3[RD_NV], v4[RD_NV], a4[RD_NV], w[RD_NV];
     for (Py_ssize_t k = 0; k < steps; ++k) {
         const double t = t0 + k * dt;
-        memcpy(oq + k * n, q, n * sizeof(double));
+        memcpy(oq + k * nq, q, nq * sizeof(double));
         memcpy(ov + k * n, v, n * sizeof(double));
         const int fused = rd_control_fd(c, q, v, tau, a);
         if (!fused) rd_control(c, t, q, v, tau);
@@ -805,29 +919,32 @@ static Py_ssize_t rd_integrate(const rd_controller *c, double *q, double *v, dou
             for (int i = 0; i < n; ++i) a[i] = NAN;
         memcpy(oa + k * n, a, n * sizeof(double));
         if (rk4) {
-            for (int i = 0; i < n; ++i) v2[i] = v[i] + half * a[i], q2[i] = q[i] + half * v[i];
+            for (int i = 0; i < n; ++i) v2[i] = v[i] + half * a[i];
+            rd_qplus(q, v, half, q2);
             rd_stage(c, t + half, q2, v2, tau, a2);
-            for (int i = 0; i < n; ++i) v3[i] = v[i] + half * a2[i], q2[i] = q[i] + half * v2[i];
+            for (int i = 0; i < n; ++i) v3[i] = v[i] + half * a2[i];
+            rd_qplus(q, v2, half, q2);
             rd_stage(c, t + half, q2, v3, tau, a3);
-            for (int i = 0; i < n; ++i) v4[i] = v[i] + dt * a3[i], q2[i] = q[i] + dt * v3[i];
+            for (int i = 0; i < n; ++i) v4[i] = v[i] + dt * a3[i];
+            rd_qplus(q, v3, dt, q2);
             rd_stage(c, t + dt, q2, v4, tau, a4);
             for (int i = 0; i < n; ++i) {
-                q[i] = q[i] + sixth * (v[i] + v4[i] + 2.0 * (v2[i] + v3[i]));
+                w[i] = v[i] + v4[i] + 2.0 * (v2[i] + v3[i]);
                 v[i] = v[i] + sixth * (a[i] + a4[i] + 2.0 * (a2[i] + a3[i]));
             }
+            rd_qplus(q, w, sixth, q2);
         } else {
-            for (int i = 0; i < n; ++i) {
-                v[i] = v[i] + dt * a[i];
-                q[i] = q[i] + dt * v[i];
-            }
+            for (int i = 0; i < n; ++i) v[i] = v[i] + dt * a[i];
+            rd_qplus(q, v, dt, q2);
         }
-        if (!rd_finite(q, n) || !rd_finite(v, n)) {
-            memcpy(oq + (k + 1) * n, q, n * sizeof(double));
+        memcpy(q, q2, nq * sizeof(double));
+        if (!rd_finite(q, nq) || !rd_finite(v, n)) {
+            memcpy(oq + (k + 1) * nq, q, nq * sizeof(double));
             memcpy(ov + (k + 1) * n, v, n * sizeof(double));
             return k;
         }
     }
-    memcpy(oq + steps * n, q, n * sizeof(double));
+    memcpy(oq + steps * nq, q, nq * sizeof(double));
     memcpy(ov + steps * n, v, n * sizeof(double));
     if (steps > 0) {
         memcpy(otau + steps * n, otau + (steps - 1) * n, n * sizeof(double));
@@ -861,14 +978,14 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
     const double t0 = PyFloat_AsDouble(args[4]);
     const long rk4 = PyLong_AsLong(args[5]), kind = PyLong_AsLong(args[6]), hold = PyLong_AsLong(args[7]);
     if (PyErr_Occurred()) return NULL;
-    const int n = RD_NV;
-    const npy_intp sizes[7] = {n, 3 * n, 4 * n + 1, 7, 19 + n, 26, 2 * n * n + 3 * n};
+    const int n = RD_NV, nj = RD_NV - 6 * (RD_NQ - RD_NV); /* a floating base's PD and CT params: its joints' */
+    const npy_intp sizes[7] = {n, 3 * nj, 4 * nj + 1, 7, 19 + n, 26, 2 * n * n + 3 * n};
     if (kind < 0 || kind > 6 || steps < 0) {
         PyErr_SetString(PyExc_ValueError, "bad controller kind or step count");
         return NULL;
     }
-    const double *q0 = rd_array(args[0], n, 0), *v0 = rd_array(args[1], n, 0), *params = rd_array(args[8], sizes[kind], 0);
-    double *oq = rd_array(args[10], (steps + 1) * n, 1), *ov = rd_array(args[11], (steps + 1) * n, 1);
+    const double *q0 = rd_array(args[0], RD_NQ, 0), *v0 = rd_array(args[1], n, 0), *params = rd_array(args[8], sizes[kind], 0);
+    double *oq = rd_array(args[10], (steps + 1) * RD_NQ, 1), *ov = rd_array(args[11], (steps + 1) * n, 1);
     double *oa = rd_array(args[12], (steps + 1) * n, 1), *otau = rd_array(args[13], (steps + 1) * n, 1);
     const rd_kernels *model = &rd_self;
     if (args[9] != Py_None) {
@@ -894,7 +1011,7 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         return NULL;
     }
     rd_controller controller = {(int)kind, (int)hold, params, model, frame, damping};
-    double q[RD_NV], v[RD_NV];
+    double q[RD_NQ], v[RD_NV];
     memcpy(q, q0, sizeof q);
     memcpy(v, v0, sizeof v);
     Py_ssize_t failed;

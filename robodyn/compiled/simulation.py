@@ -126,7 +126,8 @@ def simulate_compiled(
 
     Args:
         compiled: The plant.
-        q0, v0: Initial state, shape (nv,).
+        q0, v0: Initial state, shapes (nq,) and (nv,) (a floating base: Pinocchio's free
+            flyer, integrated on SE(3) as ``pinocchio.integrate``).
         duration: Simulated time in [s]; dt: step in [s].
         integrator: ``"rk4"`` or ``"semi-implicit-euler"``.
         controller: ``None`` (passive), a compiled controller (joint space, or a frame
@@ -159,7 +160,8 @@ def simulate_compiled(
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     nv, steps = compiled.nv, round(duration / dt)
     rk4 = int(integrator == "rk4")
-    out = [np.empty((steps + 1, nv)) for _ in range(4)]
+    out = [np.empty((steps + 1, size)) for size in (compiled.nq, nv, nv, nv)]
+    joints = nv - 6 if robot.floating_base else nv  # a floating base's PD and CT laws: its joints
     q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
     if controller is None or isinstance(
         controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | CompiledLQR
@@ -171,7 +173,7 @@ def simulate_compiled(
             if controller.model.nv != nv:
                 raise InputError("controller.model", f"a compiled robot with {nv} joints", f"{controller.model.nv}")
             kind = 1 if isinstance(controller, CompiledPDGravity) else 2
-            params, model = controller.params(nv), controller.model.module._kernels
+            params, model = controller.params(joints), controller.model.module._kernels
             if isinstance(controller, CompiledFrameController):
                 kind, frame = controller.kind, controller.frame_kernels()
             if isinstance(controller, CompiledLQR):
@@ -228,8 +230,9 @@ def _raise_if_failed(compiled: CompiledRobot, failed: int, out: list[np.ndarray]
         return
     step = start + failed
     q, v = out[0][step + 1], out[1][step + 1]
-    bad = np.flatnonzero(~np.isfinite(v)) if not np.isfinite(v).all() else np.flatnonzero(~np.isfinite(q))
-    joint = compiled.joint_names[int(bad[0]) if bad.size else 0]
+    bad = np.flatnonzero(~np.isfinite(v)) if not np.isfinite(v).all() else np.flatnonzero(~np.isfinite(q[q.size - v.size :]))
+    names = compiled.joint_names  # as robodyn.simulate names it (a floating base's q: its velocity's entries)
+    joint = names[min(int(bad[0]) if bad.size else 0, len(names) - 1)]
     raise SimulationError(step * dt, step, joint)
 
 
@@ -269,7 +272,7 @@ def compiled_controller(controller: object) -> CompiledController:
 
     Raises:
         CompileError: For any other controller (one sentence saying why), or a model that
-            does not compile (a floating base).
+            does not compile (a floating base under a frame controller).
     """
     kind = _TWINS.get(f"{type(controller).__module__}.{type(controller).__qualname__}")
     c: Any = controller

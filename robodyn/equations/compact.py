@@ -33,7 +33,15 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from robodyn.equations.newton_euler import SymbolicBody, check_fixed_base, newton_euler, project, symbolic_bodies
+from robodyn.equations.newton_euler import (
+    BaseSymbols,
+    SymbolicBody,
+    check_fixed_base,
+    free_base_newton_euler,
+    newton_euler,
+    project,
+    symbolic_bodies,
+)
 from robodyn.equations.program import Program, ProgramBuilder
 from robodyn.equations.sharing import shortened, without_copies
 from robodyn.reference.numeric import ReferenceRobot
@@ -56,6 +64,9 @@ class CompactDynamics:
         G: Gravity entries.
         parameters: Kept parameters and their values (``keep_params``).
         labels: ``(kind, owner, component)`` of every kept parameter.
+        base: With a free base (``free_base``): its inputs, and its rows ``M`` (6 × (6 +
+            bodies): the base block, then the bodies' columns), ``Cv`` and ``G`` (6 each),
+            Pinocchio's order (force then moment).
     """
 
     q: list[sp.Symbol]
@@ -67,17 +78,18 @@ class CompactDynamics:
     G: sp.Matrix = field(default_factory=sp.Matrix)
     parameters: dict = field(default_factory=dict)
     labels: dict = field(default_factory=dict)
+    base: BaseSymbols | None = None
+    base_rows: dict[str, sp.Matrix] = field(default_factory=dict)
 
     def program(self) -> Program:
         """The same as a :class:`~robodyn.equations.program.Program` (inputs ``q``, ``qd``;
         outputs ``M`` row-major, ``Cv``, ``G``)."""
-        return Program(
-            {"q": tuple(self.q), "qd": tuple(self.qd)},
-            tuple(self.assignments),
-            {"M": tuple(self.M), "Cv": tuple(self.Cv), "G": tuple(self.G)},
-            self.parameters,
-            self.labels,
-        )
+        inputs = {"q": tuple(self.q), "qd": tuple(self.qd)}
+        outputs = {"M": tuple(self.M), "Cv": tuple(self.Cv), "G": tuple(self.G)}
+        if self.base is not None:
+            inputs.update(base_q=self.base.quaternion, base_v=self.base.velocity)
+            outputs.update({f"base_{name}": tuple(rows) for name, rows in self.base_rows.items()})
+        return Program(inputs, tuple(self.assignments), outputs, self.parameters, self.labels)
 
 
 def _composites(
@@ -109,10 +121,15 @@ def _composites(
     return mass, first, inertia
 
 
-def _mass_matrix(bodies: Sequence[SymbolicBody], builder: ProgramBuilder) -> sp.Matrix:
+def _mass_matrix(bodies: Sequence[SymbolicBody], builder: ProgramBuilder, base: sp.Matrix | None = None) -> sp.Matrix:
     """``M`` of the bodies' coordinates: column ``i`` is the composite body beyond joint ``i``
-    moving along its axis, carried up to each ancestor and projected on its axis."""
+    moving along its axis, carried up to each ancestor and projected on its axis.
+
+    With ``base`` (6 × bodies, zeros; body 0 a free base) its columns are filled with the
+    force then moment that reach body 0, unprojected."""
     mass, first, inertia = _composites(bodies, builder)
+    if base is not None:
+        _base_block(base, mass[0], first[0], inertia[0])
     count = len(bodies)
     M = sp.zeros(count, count)
     for i, body in enumerate(bodies):
@@ -124,6 +141,8 @@ def _mass_matrix(bodies: Sequence[SymbolicBody], builder: ProgramBuilder) -> sp.
         j = i
         while j >= 0:
             M[i, j] = M[j, i] = project(bodies[j], n, f)
+            if base is not None and j == 0 and i > 0:
+                base[:, 6 + i] = sp.Matrix([*f, *n])
             parent = bodies[j].parent
             if parent < 0:
                 break
@@ -136,6 +155,30 @@ def _mass_matrix(bodies: Sequence[SymbolicBody], builder: ProgramBuilder) -> sp.
     return M
 
 
+def _base_block(base: sp.Matrix, mass: sp.Expr, first: sp.Matrix, inertia: sp.Matrix) -> None:
+    """The base-base block of a free base: the whole tree's spatial inertia at the base origin,
+    ``[[m 1, −[h]×], [[h]×, I_o]]`` (``h = m c``), into ``base[:, :6]``."""
+    x, y, z = first
+    hx = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    base[:3, :3] = mass * sp.eye(3)
+    base[:3, 3:6] = -hx
+    base[3:6, :3] = hx
+    base[3:6, 3:6] = inertia
+
+
+def _free_base_equations(
+    bodies: Sequence[SymbolicBody], builder: ProgramBuilder, params: Parameters, robot: ReferenceRobot, theta_dot, free_base
+) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix, dict[str, sp.Matrix]]:
+    """``M``, ``C v``, ``G`` of the bodies and the base's rows, body 0 a free base."""
+    gravity = builder.vector(free_base.gravity(params.gravity(robot.gravity_vector)), "gb_")
+    velocity = free_base.velocity
+    base_cv, Cv = free_base_newton_euler(bodies, builder, speed=list(theta_dot), base_velocity=velocity)
+    base_g, G = free_base_newton_euler(bodies, builder, gravity=gravity, tag="g")
+    base_m = sp.zeros(6, 6 + len(bodies))
+    M = _mass_matrix(bodies, builder, base_m)
+    return M, sp.Matrix(Cv), sp.Matrix(G), {"M": base_m, "Cv": sp.Matrix(base_cv), "G": sp.Matrix(base_g)}
+
+
 def derive_compact(
     robot: ReferenceRobot,
     *,
@@ -144,6 +187,7 @@ def derive_compact(
     keep_params: bool = False,
     symbols: tuple[list[sp.Symbol], list[sp.Symbol], list[sp.Symbol]] | None = None,
     progress: Callable[[str, int, int], None] | None = None,
+    free_base: BaseSymbols | None = None,
 ) -> CompactDynamics:
     """Derive the compact (intermediate-variable) equations of a reference robot.
 
@@ -155,6 +199,9 @@ def derive_compact(
             symbols (see :class:`robodyn.reference.symbolic.Parameters`).
         symbols: ``(q, qd, qdd)`` to use instead of the reference's joint symbols.
         progress: Called as ``progress(stage, done, total)``.
+        free_base: Body 0 is a free base (``robot`` from
+            :func:`robodyn.equations.newton_euler.floating_reference`) with these inputs:
+            the result's ``base_rows`` are its rows of ``M``, ``C v`` and ``G``.
 
     Raises:
         InputError: For a floating base.
@@ -167,23 +214,37 @@ def derive_compact(
     bodies = symbolic_bodies(robot, list(theta), builder, params, snap=snap, progress=progress)
     if progress:
         progress("Newton-Euler", 0, 3)
-    Cv = sp.Matrix(newton_euler(bodies, builder, speed=list(theta_dot)))
-    if progress:
-        progress("Newton-Euler", 1, 3)
-    G = sp.Matrix(newton_euler(bodies, builder, base_acceleration=-params.gravity(robot.gravity_vector), tag="g"))
-    if progress:
-        progress("composite bodies", 2, 3)
-    M = _mass_matrix(bodies, builder)
+    base_rows: dict[str, sp.Matrix] = {}
+    if free_base is not None:
+        M, Cv, G, base_rows = _free_base_equations(bodies, builder, params, robot, theta_dot, free_base)
+    else:
+        Cv = sp.Matrix(newton_euler(bodies, builder, speed=list(theta_dot)))
+        if progress:
+            progress("Newton-Euler", 1, 3)
+        G = sp.Matrix(newton_euler(bodies, builder, base_acceleration=-params.gravity(robot.gravity_vector), tag="g"))
+        if progress:
+            progress("composite bodies", 2, 3)
+        M = _mass_matrix(bodies, builder)
     selection = exact_matrix(robot.tree.selection, 0.0)
     if selection != sp.eye(len(bodies)):  # mimic joints: tau = Sᵀ tau_full, theta'' = S q''
         M, Cv, G = selection.T * M * selection, selection.T * Cv, selection.T * G
-    program = builder.program({"q": tuple(q), "qd": tuple(qd)}, {"M": list(M), "Cv": list(Cv), "G": list(G)})
+        if base_rows:
+            base_rows["M"] = base_rows["M"][:, :6].row_join(base_rows["M"][:, 6:] * selection)
+    inputs = {"q": tuple(q), "qd": tuple(qd)}
+    outputs: dict[str, Sequence[sp.Expr]] = {"M": list(M), "Cv": list(Cv), "G": list(G)}
+    if free_base is not None:
+        inputs.update(base_q=free_base.quaternion, base_v=free_base.velocity)
+        outputs.update({f"base_{name}": list(rows) for name, rows in base_rows.items()})
+    program = builder.program(inputs, outputs)
     if cse:
         if progress:
             progress("common subexpressions", 0, 1)
         program = shortened(program)
     program = without_copies(program)
     n = len(q)
+    base_rows = {
+        name: sp.Matrix(base_rows[name].rows, base_rows[name].cols, list(program.outputs[f"base_{name}"])) for name in base_rows
+    }
     return CompactDynamics(
         q,
         qd,
@@ -194,4 +255,6 @@ def derive_compact(
         sp.Matrix(program.outputs["G"]),
         params.values,
         params.labels,
+        free_base,
+        base_rows,
     )

@@ -25,14 +25,16 @@ No Pinocchio here.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import numpy as np
 import sympy as sp
 
 from robodyn.equations.program import Program, ProgramBuilder
 from robodyn.exceptions import InputError
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, axis_rotation, body_coordinates, exact_matrix, joint_symbols
+from robodyn.reference.tree import KinematicTree
 
 #: Default tolerance for exact rotation and axis entries of the program: float rounding only
 #: (cos(π/2) = 6e-17), so the program is the URDF's robot. The printed equations snap more
@@ -90,6 +92,78 @@ def check_fixed_base(robot: ReferenceRobot) -> None:
             "a fixed-base robot (floating_base=False): the Newton–Euler program models fixed bases",
             f"a floating {robot.name}",
         )
+
+
+def floating_tree(tree: KinematicTree) -> KinematicTree:
+    """A floating tree (six virtual joints) as a tree whose body 0 is the free base.
+
+    Body 0 is the root link (no joint: zero axis, identity origin, parent -1), the moving
+    joints' bodies follow with their parents renumbered, armature rotors stay roots; the
+    selection and offset keep the independent joints' columns (body 0's row is zero).
+    The programs take body 0's motion as inputs (``free_base=True`` of
+    :func:`derive_newton_euler` and :func:`robodyn.equations.compact.derive_compact`).
+
+    Raises:
+        InputError: For a fixed-base tree.
+    """
+    if not tree.floating_base:
+        raise InputError("tree", "a floating-base tree (floating_base=True)", f"the fixed-base {tree.name}")
+    root = tree.bodies[5]
+    base = replace(root, parent=-1, axis=np.zeros(3), revolute=False, origin=np.eye(4))
+    moved = [replace(body, parent=body.parent - 5 if body.parent >= 5 else -1) for body in tree.bodies[6:]]
+    keep = [5, *range(6, len(tree.bodies))]
+    return KinematicTree(
+        tree.name,
+        [base, *moved],
+        list(tree.joint_names[6:]),
+        tree.selection[keep][:, 6:],
+        tree.offset[keep],
+        tree.ancestors[np.ix_(keep, keep)],
+        floating_base=False,
+    )
+
+
+def floating_reference(robot: ReferenceRobot) -> ReferenceRobot:
+    """A floating reference robot with its tree as :func:`floating_tree` (for ``free_base=True``)."""
+    tree = floating_tree(robot.tree)
+    return ReferenceRobot(tree, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
+
+
+@dataclass(frozen=True)
+class BaseSymbols:
+    """The free base's inputs of a program (Pinocchio's free flyer).
+
+    Attributes:
+        quaternion: ``x, y, z, w`` of the base's orientation (``q[3:7]``).
+        velocity: Linear then angular velocity of the base in its own frame (``v[0:6]``).
+        acceleration: Pinocchio's ``v̇[0:6]``: the spatial acceleration in the base frame
+            (the base origin's classical acceleration is ``a_lin + ω × v_lin``).
+    """
+
+    quaternion: tuple[sp.Symbol, ...]
+    velocity: tuple[sp.Symbol, ...]
+    acceleration: tuple[sp.Symbol, ...]
+
+    @classmethod
+    def make(cls) -> BaseSymbols:
+        """Fresh symbols (``Dummy``: never equal to a joint's symbol, whatever its name)."""
+
+        def dummies(names: str) -> tuple[sp.Symbol, ...]:
+            return tuple(sp.Dummy(name, real=True) for name in names.split())
+
+        return cls(dummies("qx qy qz qw"), dummies("vx vy vz wx wy wz"), dummies("ax ay az bx by bz"))
+
+    def gravity(self, gravity: sp.Matrix) -> sp.Matrix:
+        """``Rᵀ g``: world gravity in the base frame, ``R`` of the quaternion (Eigen's formula)."""
+        x, y, z, w = self.quaternion
+        R = sp.Matrix(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        return R.T * gravity
 
 
 def symbolic_bodies(
@@ -152,6 +226,8 @@ def forward_pass(
     acceleration: Sequence[sp.Expr] | None = None,
     base_acceleration: sp.Matrix | None = None,
     tag: str = "",
+    base_velocity: sp.Matrix | None = None,
+    base_angular_acceleration: sp.Matrix | None = None,
 ) -> Motion:
     """Angular velocities and accelerations and origin accelerations, parents first.
 
@@ -162,12 +238,17 @@ def forward_pass(
         base_acceleration: The fixed root's acceleration in its frame, ``-g`` for gravity
             (``None``: zero).
         tag: Put in front of the names, to tell passes apart.
+        base_velocity, base_angular_acceleration: Of the frame body 0 hangs from, in its
+            frame (a free base, :func:`floating_tree`; ``None``: zero); the other roots
+            (armature rotors) hang from a frame that does not turn.
     """
     count = len(bodies)
     w, dw, acc = [_ZERO] * count, [_ZERO] * count, [_ZERO] * count  # each set (parents first) before it is read
+    base_w = _ZERO if base_velocity is None else base_velocity
+    base_dw = _ZERO if base_angular_acceleration is None else base_angular_acceleration
     for b, body in enumerate(bodies):
         root = body.parent < 0
-        w_p, dw_p = (_ZERO, _ZERO) if root else (w[body.parent], dw[body.parent])
+        w_p, dw_p = ((base_w, base_dw) if b == 0 else (_ZERO, _ZERO)) if root else (w[body.parent], dw[body.parent])
         a_p = (_ZERO if base_acceleration is None else base_acceleration) if root else acc[body.parent]
         t, Rt = body.translation, body.rotation.T
         w_in = builder.vector(Rt * w_p, f"{tag}wi{b + 1}_")
@@ -235,12 +316,60 @@ def newton_euler(
     return [project(body, moment[b], force[b]) for b, body in enumerate(bodies)]
 
 
+def free_base_newton_euler(
+    bodies: Sequence[SymbolicBody],
+    builder: ProgramBuilder,
+    *,
+    speed: Sequence[sp.Expr] | None = None,
+    acceleration: Sequence[sp.Expr] | None = None,
+    base_velocity: Sequence[sp.Expr] | None = None,
+    base_acceleration: Sequence[sp.Expr] | None = None,
+    gravity: sp.Matrix | None = None,
+    tag: str = "",
+) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """:func:`newton_euler` with body 0 a free base (:func:`floating_tree`).
+
+    Args:
+        bodies, builder, speed, acceleration, tag: As :func:`newton_euler`.
+        base_velocity: The base's linear then angular velocity in its frame (6; ``None``: 0).
+        base_acceleration: Pinocchio's base ``v̇`` (6; ``None``: 0).
+        gravity: Gravity in the base frame, 3×1 (``None``: none).
+
+    Returns:
+        ``(base, joints)``: the force then moment the tree needs at the base origin, in the
+        base frame (Pinocchio's base rows of ``tau``), and each body's joint force.
+    """
+    linear, angular, spin = sp.zeros(3, 1), None, None
+    if base_velocity is not None:
+        angular = sp.Matrix(base_velocity[3:])
+        linear += angular.cross(sp.Matrix(base_velocity[:3]))
+    if base_acceleration is not None:
+        linear += sp.Matrix(base_acceleration[:3])
+        spin = sp.Matrix(base_acceleration[3:])
+    if gravity is not None:
+        linear -= gravity
+    origin = builder.vector(linear, f"{tag}ab_")
+    motion = forward_pass(
+        bodies,
+        builder,
+        speed=speed,
+        acceleration=acceleration,
+        base_acceleration=origin,
+        tag=tag,
+        base_velocity=angular,
+        base_angular_acceleration=spin,
+    )
+    force, moment = backward_pass(bodies, builder, motion, tag=tag)
+    return [*force[0], *moment[0]], [project(body, moment[b], force[b]) for b, body in enumerate(bodies)]
+
+
 def derive_newton_euler(
     robot: ReferenceRobot,
     *,
     snap: float = SNAP,
     keep_params: bool = False,
     symbols: tuple[list[sp.Symbol], list[sp.Symbol], list[sp.Symbol]] | None = None,
+    free_base: BaseSymbols | None = None,
 ) -> Program:
     """``tau(q, q̇, q̈)`` of a fixed-base reference robot as a straight-line program.
 
@@ -251,6 +380,9 @@ def derive_newton_euler(
             symbols (:class:`robodyn.reference.symbolic.Parameters`; in the program's
             ``parameters``).
         symbols: ``(q, qd, qdd)`` to use instead of the reference's joint symbols.
+        free_base: Body 0 is a free base (``robot`` from :func:`floating_reference`) with
+            these inputs: the program has inputs ``base_q``, ``base_v``, ``base_a`` too and
+            an output ``base`` (its force then moment, Pinocchio's base rows of ``tau``).
 
     Returns:
         Inputs ``q``, ``qd``, ``qdd`` (order of ``robot.joint_names``), output ``tau``
@@ -266,8 +398,24 @@ def derive_newton_euler(
     params = Parameters(keep_params)
     builder = ProgramBuilder()
     bodies = symbolic_bodies(robot, list(theta), builder, params, snap=snap)
-    gravity = -params.gravity(robot.gravity_vector)  # the base "accelerates upwards"
-    tau_bodies = newton_euler(bodies, builder, speed=list(theta_dot), acceleration=list(theta_ddot), base_acceleration=gravity)
+    inputs = {"q": tuple(q), "qd": tuple(qd), "qdd": tuple(qdd)}
+    outputs: dict[str, list[sp.Expr]] = {}
+    if free_base is None:
+        gravity = -params.gravity(robot.gravity_vector)  # the base "accelerates upwards"
+        tau_bodies = newton_euler(
+            bodies, builder, speed=list(theta_dot), acceleration=list(theta_ddot), base_acceleration=gravity
+        )
+    else:
+        outputs["base"], tau_bodies = free_base_newton_euler(
+            bodies,
+            builder,
+            speed=list(theta_dot),
+            acceleration=list(theta_ddot),
+            base_velocity=free_base.velocity,
+            base_acceleration=free_base.acceleration,
+            gravity=builder.vector(free_base.gravity(params.gravity(robot.gravity_vector)), "gb_"),
+        )
+        inputs.update(base_q=free_base.quaternion, base_v=free_base.velocity, base_a=free_base.acceleration)
     tau = exact_matrix(robot.tree.selection, 0.0).T * sp.Matrix(tau_bodies)  # tau = Sᵀ tau_bodies
-    program = builder.program({"q": tuple(q), "qd": tuple(qd), "qdd": tuple(qdd)}, {"tau": list(tau)})
+    program = builder.program(inputs, {"tau": list(tau), **outputs})
     return Program(program.inputs, program.assignments, program.outputs, params.values, params.labels)

@@ -172,8 +172,8 @@ def simulate(
         limits: ``"warn"``, ``"enforce"`` or ``"ignore"`` (see :mod:`robodyn.sim.limits`).
         engine: ``"auto"`` (default: see :func:`choose_engine`), ``"pinocchio"`` (this
             loop in Python, ABA per stage) or ``"compiled"`` (:mod:`robodyn.compiled`;
-            fixed-base robots, no external wrenches, no observer, limits warned or
-            ignored). Passive runs, PD + gravity and computed torque along a quintic run
+            no external wrenches, no observer, limits warned or ignored; a floating base
+            passive or under PD / computed torque, or a Python controller). Passive runs, PD + gravity and computed torque along a quintic run
             wholly in C on their own compiled models; any other controller is called from
             Python at every stage around the compiled dynamics.
         control_period: Sample the controller every ``control_period`` [s] (a whole
@@ -197,7 +197,8 @@ def simulate(
         InputError: For bad initial states, step, integrator, limits mode, engine or
             control period, or a duration that is not a whole number of steps (to 1e-9
             relative); with ``engine="compiled"``, for what it does not model.
-        CompileError: With ``engine="compiled"``, for a floating base.
+        CompileError: With ``engine="compiled"``, for a floating base under a frame
+            controller (task space, operational space, impedance).
         FrameError: An external wrench on a frame that is unknown or that no joint moves.
         SingularMassMatrixError: If the mass matrix is singular (no motion is defined).
         SimulationError: If the state stops being finite (``ControllerFailedError``: if
@@ -311,8 +312,8 @@ def choose_engine(
 ) -> tuple[Literal["pinocchio", "compiled"], str]:
     """The engine ``engine="auto"`` runs, and why (one sentence).
 
-    The compiled engine when the whole loop runs in C there: a fixed-base robot with
-    moving mass, no external wrenches, no observer, limits not enforced, passive or under
+    The compiled engine when the whole loop runs in C there: a robot with moving mass
+    (a floating base: passive, or PD / computed torque on its joints), no external wrenches, no observer, limits not enforced, passive or under
     a controller with a compiled counterpart (PD + gravity, computed torque along a
     quintic; evaluated at every stage or once a step), a C compiler on the PATH, and the
     robot compiled before (its kernels in the cache: loading them takes milliseconds,
@@ -330,8 +331,8 @@ def choose_engine(
     Returns:
         ``"compiled"`` or ``"pinocchio"``, and the reason.
     """
-    if robot.floating_base:
-        return "pinocchio", "a floating base (the compiled engine models fixed-base robots)"
+    if robot.floating_base and _frame_law_in_c(controller, every):
+        return "pinocchio", f"a floating base under {type(controller).__name__} (compiled frame controllers model fixed bases)"
     refusals = [
         (bool(external), "external wrenches"),
         (observer is not None, "a momentum observer"),
@@ -355,7 +356,7 @@ def choose_engine(
             "not compiled yet (engine='compiled' builds it once, in seconds to minutes; auto uses it from then on)"
         )
     what = "passive" if controller is None else f"{type(controller).__name__} in C"
-    return "compiled", f"fixed base, {what}, compiled before (cached)"
+    return "compiled", f"{'floating' if robot.floating_base else 'fixed'} base, {what}, compiled before (cached)"
 
 
 def _compiled_before(robot: Robot, controller: Controller | None) -> bool:
@@ -585,6 +586,17 @@ def _runs_in_c(controller: Controller, every: int | None) -> bool:
     return every in (None, 1) and has_twin(controller)
 
 
+def _frame_law_in_c(controller: Controller | None, every: int | None) -> bool:
+    """Whether the controller's compiled twin is a frame controller (task space, operational
+    space, impedance: their compiled frame kinematics model fixed bases; PD and computed
+    torque run on a floating base's joints, its base free, in C as in Python)."""
+    return controller is not None and _runs_in_c(controller, every) and type(controller).__name__ not in _JOINT_LAWS
+
+
+#: The controllers whose compiled twins also drive a floating robot's joints.
+_JOINT_LAWS = ("PDGravity", "ComputedTorque")
+
+
 @dataclass(frozen=True)
 class _Compiled:
     """The compiled plant, the controller's compiled counterpart (``None``: Python or
@@ -600,6 +612,8 @@ def _prepare_compiled(robot: Robot, controller: Controller | None, every: int | 
     from robodyn.compiled import compile, compiled_controller
 
     began = perf_counter()
+    if robot.floating_base and _frame_law_in_c(controller, every):
+        raise CompileError(robot.name, f"it has a floating base; {type(controller).__name__} compiles for fixed-base robots")
     plant = compile(robot)
     law = compiled_controller(controller) if controller is not None and _runs_in_c(controller, every) else None
     return _Compiled(plant, law, perf_counter() - began)

@@ -119,3 +119,48 @@ def test_negative_control_a_perturbed_assignment_fails_the_comparison(rng):
     expected = robot.inverse_dynamics(q, v, a)
     assert _error(_program_tau(program, model, robot, q, v, a), expected) < RTOL
     assert _error(_program_tau(perturbed, model, robot, q, v, a), expected) > 1e-9
+
+
+def _free_base_programs(rng):
+    """The floating oblique robot's reference robot and its free-base programs (tau; M, C v, G)."""
+    from robodyn.equations.newton_euler import BaseSymbols, floating_reference
+    from tests.conftest import NONDEGENERATE_CASES
+
+    path = str(NONDEGENERATE_CASES["oblique_floating"][0])
+    model = reference.load(path, floating_base=True, gravity=GRAVITY)
+    base = BaseSymbols.make()
+    folded = floating_reference(model)
+    return model, derive_newton_euler(folded, free_base=base), derive_compact(folded, free_base=base, cse=False).program()
+
+
+def test_a_free_base_program_gives_the_references_floating_dynamics(rng):
+    """Base rows (force then moment, base frame) and joint rows of tau, M, C v, G against the
+    reference's floating model (its own Lagrangian, no Pinocchio), at a tilted pose; negative
+    control: the velocity in world axes fails."""
+    model, tau_program, compact = _free_base_programs(rng)
+    n = model.nv - 6
+    quaternion = rng.normal(size=4)
+    q = np.concatenate([rng.normal(size=3), quaternion / np.linalg.norm(quaternion), rng.normal(size=n)])
+    v, a = rng.normal(size=model.nv), rng.normal(size=model.nv)
+
+    def inputs(v):
+        return {"q": q[7:], "qd": v[6:], "qdd": a[6:], "base_q": q[3:7], "base_v": v[:6], "base_a": a[:6]}
+
+    def torques(v):
+        out = evaluate(tau_program, inputs(v))
+        return np.concatenate([out["base"], out["tau"]])
+
+    expected = model.inverse_dynamics(q, v, a)
+    assert np.abs(torques(v) - expected).max() < RTOL * np.abs(expected).max()
+    world = v.copy()
+    world[:3] = v[3:6]  # a wrong velocity (the angular part as the linear one)
+    assert np.abs(torques(world) - expected).max() > 1e-3 * np.abs(expected).max()
+    out = evaluate(compact, {key: value for key, value in inputs(v).items() if key in compact.inputs})
+    M = model.mass_matrix(q)
+    M_ours = np.zeros_like(M)
+    M_ours[:6] = out["base_M"].reshape(6, -1)
+    M_ours[:, :6] = M_ours[:6].T
+    M_ours[6:, 6:] = out["M"].reshape(n, n)
+    assert np.abs(M_ours - M).max() < RTOL * np.abs(M).max()
+    nle = np.concatenate([out["base_Cv"] + out["base_G"], out["Cv"] + out["G"]])
+    assert np.abs(nle - model.nonlinear_effects(q, v)).max() < RTOL * np.abs(nle).max()

@@ -110,7 +110,8 @@ def test_auto_runs_the_compiled_engine_only_where_the_whole_loop_runs_in_c(monke
     )
     assert "external" in choose_engine(robot, None, external=[ExternalWrench(robot.end_effector, [1.0, 0, 0])])[1]
     assert "enforced" in choose_engine(robot, None, limits="enforce")[1]
-    assert "floating" in choose_engine(robodyn.load("solo12"), None)[1]
+    solo12 = robodyn.load("solo12")  # a floating base runs in C passive or under PD / computed torque only
+    assert "floating" in choose_engine(solo12, TaskSpace(solo12, "FL_FOOT", np.zeros(3)))[1]
     monkeypatch.setenv("CC", "no-such-compiler-here")
     assert choose_engine(robot, pd)[0] == "pinocchio" and "compiler" in choose_engine(robot, pd)[1]
     monkeypatch.delenv("CC")

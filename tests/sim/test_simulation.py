@@ -72,9 +72,12 @@ def test_refusals_are_one_line_robodyn_errors():
     wrench = ExternalWrench(robot.end_effector, np.array([1.0, 0, 0, 0, 0, 0]))
     with pytest.raises(InputError, match="wrench"):
         robodyn.simulate(robot, q0, np.zeros(2), 0.1, 1e-3, engine="compiled", external=[wrench])
-    floating = robodyn.load("solo12")
-    with pytest.raises(CompileError):
-        robodyn.simulate(floating, floating.default_configuration(), np.zeros(floating.nv), 0.1, 1e-3, engine="compiled")
+    floating = robodyn.load("solo12")  # compiled frame controllers model fixed bases
+    task = TaskSpace(floating, "FL_FOOT", np.zeros(3))
+    with pytest.raises(CompileError, match="floating base"):
+        robodyn.simulate(
+            floating, floating.default_configuration(), np.zeros(floating.nv), 0.1, 1e-3, engine="compiled", controller=task
+        )
 
 
 def test_compiled_runs_warn_about_limits_like_the_python_engine():

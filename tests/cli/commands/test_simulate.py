@@ -47,7 +47,8 @@ def test_compiled_flag_gives_the_same_summary(capsys):
     assert compiled["engine"] == "compiled"
     for left, right in zip(python["final_q"], compiled["final_q"], strict=True):
         assert abs(left - right) < 1e-9
-    assert main(["simulate", "solo12", "--duration", "0.1", "--compiled"]) == 2
+    floating_task = ["--controller", "task-space", "--target", "0.1,0.1,0.1", "--frame", "FL_FOOT"]  # floating: PD / CT only
+    assert main(["simulate", "solo12", "--duration", "0.1", "--compiled", *floating_task]) == 2
     assert "floating" in capsys.readouterr().err
 
 
