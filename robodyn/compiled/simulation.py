@@ -161,7 +161,7 @@ def simulate_compiled(
     nv, steps = compiled.nv, round(duration / dt)
     rk4 = int(integrator == "rk4")
     out = [np.empty((steps + 1, size)) for size in (compiled.nq, nv, nv, nv)]
-    joints = nv - 6 if robot.floating_base else nv  # a floating base's PD and CT laws: its joints
+    joints = nv - 6 if compiled.robot.floating_base else nv  # a floating base's PD and CT laws: its joints
     q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
     if controller is None or isinstance(
         controller, CompiledPDGravity | CompiledComputedTorque | CompiledFrameController | CompiledLQR
@@ -169,6 +169,8 @@ def simulate_compiled(
         if control_period is not None:
             raise InputError("control_period", "used with a Python controller only", repr(control_period))
         kind, params, model, frame = 0, np.zeros(nv), None, None
+        if compiled.robot.floating_base and isinstance(controller, CompiledFrameController | CompiledLQR):
+            raise InputError("controller", "passive, PD or computed torque on a floating base", type(controller).__name__)
         if controller is not None:
             if controller.model.nv != nv:
                 raise InputError("controller.model", f"a compiled robot with {nv} joints", f"{controller.model.nv}")

@@ -332,7 +332,7 @@ def choose_engine(
         ``"compiled"`` or ``"pinocchio"``, and the reason.
     """
     if robot.floating_base and _frame_law_in_c(controller, every):
-        return "pinocchio", f"a floating base under {type(controller).__name__} (compiled frame controllers model fixed bases)"
+        return "pinocchio", f"a floating base under {type(controller).__name__} (its compiled twin models fixed bases)"
     refusals = [
         (bool(external), "external wrenches"),
         (observer is not None, "a momentum observer"),

@@ -54,3 +54,23 @@ def test_the_cache_key_covers_the_one_program_and_the_one_printer():
     source = _generator_source()
     for module in (newton_euler, program, sharing, compact, c_printer):
         assert Path(module.__file__).read_text(encoding="utf-8") in source
+
+
+def test_a_long_program_splits_mass_and_nle_into_calls_with_the_same_numbers(monkeypatch, tmp_path, rng):
+    """Above ``SPLIT_ASSIGNMENTS`` the ``M`` and ``C v + G`` kernel calls the two kernels
+    (shorter functions for the C compiler): forward dynamics, one state and a batch on the
+    SIMD blocks and their remainder rows, bit for bit the one-pass kernel's."""
+    from robodyn.compiled import build, codegen
+
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))
+    writer, robot = _writer(str(ROOT / "tests/data/mimic_arm.urdf"))
+    whole = writer.source()
+    monkeypatch.setattr(codegen, "SPLIT_ASSIGNMENTS", 0)
+    split = writer.source()
+    assert "    rd_mass(q, M);" in split and "    rd_mass(q, M);" not in whole  # negative control: not split by default
+    n = robot.nv
+    q, v, tau = (np.ascontiguousarray(rng.uniform(-2, 2, (19, n))) for _ in range(3))  # 8k + 3 rows
+    one, two = build.build_module(whole, label="whole"), build.build_module(split, label="split")
+    for rows in (q[0], v[0], tau[0]), (q, v, tau):
+        expected, got = one.fd(*rows, 2), two.fd(*rows, 2)
+        assert expected is not None and np.array_equal(expected, got)
