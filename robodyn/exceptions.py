@@ -217,7 +217,7 @@ class OutputError(RobodynError, OSError):
 
 
 class CompileError(RobodynError):
-    """A robot the compiled engine cannot compile (a floating base, a failed build).
+    """A robot the compiled engine cannot compile (a failed build, a controller with no C twin).
 
     Attributes:
         robot: The robot's name.

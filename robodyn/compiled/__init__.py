@@ -1,4 +1,4 @@
-"""Compiled dynamics: a fixed-base robot's equations as generated C, built and cached.
+"""Compiled dynamics: a robot's equations (fixed or floating base) as generated C, built and cached.
 
 - :func:`compile` gives a :class:`CompiledRobot` with the :class:`robodyn.Robot` methods
   ``inverse_dynamics``, ``mass_matrix``, ``nonlinear_effects``, ``gravity`` and
