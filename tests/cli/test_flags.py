@@ -24,6 +24,7 @@ PACKAGE = Path(robodyn.__file__).parent
 NOT_OUR_FLAGS = {
     ("viz/plots.py", "--"),
     ("compiled/build.py", "--version"),
+    ("compiled/simd.py", "--rds"),  # C source: the decrement --rds_level
 }
 #: Files whose every ``--`` literal is a flag of the program they run.
 OTHER_PROGRAMS = {"viz/stills.py"}
