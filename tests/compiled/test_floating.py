@@ -213,6 +213,7 @@ def test_the_c_loop_follows_the_python_engine_on_se3(integrator, rng):
     assert relative_error(compiled.q, python.q) < 1e-9 and relative_error(compiled.v, python.v) < 1e-9
 
 
+@pytest.mark.slow
 def test_a_passive_floating_robot_keeps_its_energy_in_both_engines(rng):
     """Gravity off: RK4 conserves energy to its fourth order; gravity on: to second order (the
     base's orientation, no dexp correction, as robodyn.simulate documents). Negative control:
