@@ -5,7 +5,7 @@
  * A block is RDS_L consecutive rows of a batch (row-major, as the runtime's rows): they are
  * transposed into structure-of-arrays vectors (entry j of every row in one vector), run
  * through the vector kernels (the scalar kernels' statements on vectors: the same IEEE
- * operations in the same order, cos/sin called lane by lane), and transposed back. Each
+ * operations in the same order, sin/cos the kernels' own on vectors), and transposed back. Each
  * block returns the runtime's row status: 1 a non-finite input, 2 a non-finite output, 3 a
  * singular mass matrix (forward dynamics), the worst of its rows.
  */
