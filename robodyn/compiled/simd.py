@@ -44,7 +44,7 @@ from robodyn.equations.c_printer import vector_lines
 from robodyn.exceptions import InputError
 
 #: Bumped whenever the generated vector code changes meaning (it is part of the module's source).
-SIMD_VERSION = "4"
+SIMD_VERSION = "5"
 #: The environment variable that forces an instruction set.
 ENVIRONMENT = "ROBODYN_SIMD"
 #: (name, lanes, GCC target): the x86-64 variants, narrowest first.
@@ -190,6 +190,7 @@ def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lan
     scatter = " ".join(f"rows[{lane} * n + j] = x[{lane}];" for lane in range(lanes))
     template = (
         template.replace("RDS_SCATTER", scatter)
+        .replace("RDS_VZEROUPPER", "__builtin_ia32_vzeroupper();" if lanes > 2 else "")
         .replace("RDS_TARGET", attribute)
         .replace("RDS_NAME", f'"{name}"')
         .replace("RDS_L", str(lanes))
