@@ -12,8 +12,10 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
+import sympy as sp
 
 from robodyn.compiled import build, codegen, simd
+from robodyn.equations.c_printer import CPrinter, vector_lines
 
 #: The bound the functions are held to, in units in the last place of the true value.
 ULP_BOUND = 1.0
@@ -149,3 +151,13 @@ def test_a_perturbed_polynomial_coefficient_exceeds_the_bound(tmp_path):
     assert coefficient in text
     perturbed = _library(tmp_path, text.replace(coefficient, "-1.98412698500000000000e-04"))
     assert max(_worst(perturbed, _arguments(10_000, 5))) > ULP_BOUND
+
+
+def test_the_vector_form_pairs_own_sin_and_cos_and_refuses_libms():
+    x = sp.Symbol("x")
+    printer = CPrinter({x: "q[0]"}, trig="rd_")
+    assert printer.expression(sp.sin(x) * sp.cos(x)) == "rd_cos(q[0])*rd_sin(q[0])"
+    assert CPrinter({x: "q[0]"}).expression(sp.sin(x)) == "sin(q[0])"  # the equations' C keeps libm
+    own = ["    const double t0 = rd_sin(th0);", "    const double t1 = rd_cos(th0);"]
+    assert vector_lines(own, vector="v4", prefix="v4_") == ["    v4 t0, t1; v4_sincos(th0, &t0, &t1);"]
+    assert vector_lines(["    const double t0 = sin(th0);"], vector="v4", prefix="v4_") is None
