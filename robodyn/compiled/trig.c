@@ -17,7 +17,14 @@
  *   taking the tail lo), Horner;
  * - the quadrant picks sin or cos and the sign by bit masks; sin of |x| < 2^-27 is x.
  * Arguments with |x| > RD_TRIG_LIMIT (2^20: |n| stays below 2^20) or not finite go to libm,
- * on every type, so a vector lane stays the scalar's result. */
+ * on every type, so a vector lane stays the scalar's result.
+ *
+ * The kernels' polynomials and expressions, and the split of π/2, are fdlibm's (FreeBSD
+ * k_sin.c, k_cos.c, e_rem_pio2.c), under its notice:
+ * Copyright (C) 1993 by Sun Microsystems, Inc. All rights reserved.
+ * Developed at SunSoft, a Sun Microsystems, Inc. business.
+ * Permission to use, copy, modify, and distribute this software is freely granted,
+ * provided that this notice is preserved. */
 
 #define RD_TRIG_LIMIT 1048576.0
 
