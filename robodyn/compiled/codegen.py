@@ -26,6 +26,12 @@ The kernels, each for one state (arrays of doubles, ``M`` row-major)::
 plus ``RD_NV``, ``RD_NQ`` and ``rd_parent`` (the tree's parent of each coordinate, for the
 LDLᵀ factorisation). ``runtime.c`` supplies everything else.
 
+``sin`` and ``cos`` in the kernels are robodyn's own (``trig.c``: branch-free arithmetic
+written once as the macro ``RD_TRIG_DEFINE``, within 1 ulp; libm's beyond
+``|x| > 2^20``), placed before the kernels as ``rd_sin``/``rd_cos`` on doubles; the SIMD
+batches (:mod:`robodyn.compiled.simd`) instantiate the same macro on vectors of states, so
+a batch row is bit for bit a single call, and no batch calls libm lane by lane.
+
 A floating base (the compact program's ``base``, Pinocchio's free flyer) takes ``q[0:7]``
 (position, quaternion x, y, z, w), ``v[0:6]`` and ``a[0:6]`` (linear then angular, base
 frame) before the joints: its rows of ``tau``, ``M``, ``C v`` and ``G`` come first, the joints'
@@ -35,6 +41,7 @@ follow (``RD_NQ = RD_NV + 1``); the position never enters the dynamics.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 import sympy as sp
@@ -45,13 +52,33 @@ from robodyn.equations.compact import CompactDynamics
 from robodyn.equations.program import Program, needed
 
 #: Bumped whenever the generated code changes meaning (part of every cache key).
-CODEGEN_VERSION = "5"
+CODEGEN_VERSION = "6"
 
 #: Above this many assignments ``rd_mass_nle`` calls ``rd_mass`` and ``rd_nle`` instead of
 #: repeating both programs: the C compiler's register allocation grows faster than linearly
 #: with a function's length (fixed-base talos: compiler CPU 6.8 -> 3.7 s; a 30-joint chain
 #: 68 -> 34 s). ur5 (270) and the panda arm (425) stay below it.
 SPLIT_ASSIGNMENTS = 1000
+
+#: The generic sin and cos (C, the macro ``RD_TRIG_DEFINE``); a change is a :data:`CODEGEN_VERSION` bump.
+TRIG = Path(__file__).with_name("trig.c")
+#: Its instantiation on doubles (``rd_sin``, ``rd_cos``, ``rd_sincos``) with the helpers it needs.
+_SCALAR_TRIG = """typedef unsigned long long rd_u64;
+static inline __attribute__((always_inline)) rd_u64 rd_bits(double x) { union { double d; rd_u64 u; } b = {x}; return b.u; }
+static inline __attribute__((always_inline)) double rd_double(rd_u64 u) { union { rd_u64 u; double d; } b = {u}; return b.d; }
+static inline __attribute__((always_inline)) rd_u64 rd_mask(int c) { return -(rd_u64)c; }
+static inline __attribute__((always_inline)) void rd_libm(double x, rd_u64 m, double *s, double *c) {
+    if (m) { *s = sin(x); *c = cos(x); }
+}
+RD_TRIG_DEFINE(rd_, double, rd_u64, )
+"""
+
+
+def trig_source(generic: str | None = None) -> str:
+    """The generic sin and cos (``generic``, default :data:`TRIG`'s text) and their
+    instantiation on doubles: C, before the kernels."""
+    return (TRIG.read_text(encoding="utf-8") if generic is None else generic) + _SCALAR_TRIG
+
 
 #: The body coordinates' C names, and the robot's arrays they are made of.
 _COORDINATES = (("th", "q", True), ("thd", "v", False), ("thdd", "a", False))
@@ -90,7 +117,9 @@ class KernelWriter:
         self._q0 = 0 if self.base is None else 7
         self.size = self.nv + self._v0  # RD_NV
         # Local names: assignments t0, t1, ... (r0, r1, ... in tau); body coordinates th0, thd0, thdd0.
-        self._compact = CPrinter(self._names(equations.assignments, "t", (equations.q, equations.qd)) | self._base_names())
+        self._compact = CPrinter(
+            self._names(equations.assignments, "t", (equations.q, equations.qd)) | self._base_names(), trig="rd_"
+        )
         if newton_euler is not None:
             inputs = newton_euler.inputs
             names = self._names(newton_euler.assignments, "r", (inputs["q"], inputs["qd"], inputs["qdd"]))
@@ -99,7 +128,7 @@ class KernelWriter:
                 names |= {
                     symbol: f"{array}[{start + i}]" for key, array, start in entries for i, symbol in enumerate(inputs[key])
                 }
-            self._tau = CPrinter(names)
+            self._tau = CPrinter(names, trig="rd_")
 
     def _base_names(self) -> dict[sp.Symbol, str]:
         """The free base's inputs as array entries (``q[3]``.. the quaternion, ``v[0]``..)."""
@@ -258,7 +287,7 @@ class KernelWriter:
             f"#define RD_NQ {n + (self.base is not None)}",
             f"#define RD_QUATERNION_TOLERANCE {c_number(QUATERNION_TOLERANCE)}",
             f"static const int rd_parent[RD_NV] = {{{', '.join(str(p) for p in self.parents)}}};",
-            "",
+            trig_source(),
             "static void rd_gravity(const double *q, double *g) {",
             *self._body(list(e.G) + self._base_entries("G"), velocity=False),
             *self._with_base(self._compact, "g", "G"),

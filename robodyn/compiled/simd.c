@@ -5,7 +5,7 @@
  * A block is RDS_L consecutive rows of a batch (row-major, as the runtime's rows): they are
  * transposed into structure-of-arrays vectors (entry j of every row in one vector), run
  * through the vector kernels (the scalar kernels' statements on vectors: the same IEEE
- * operations in the same order, cos/sin called lane by lane), and transposed back. Each
+ * operations in the same order, sin/cos the kernels' own on vectors), and transposed back. Each
  * block returns the runtime's row status: 1 a non-finite input, 2 a non-finite output, 3 a
  * singular mass matrix (forward dynamics), the worst of its rows.
  */
@@ -92,5 +92,34 @@ static RDS_TARGET int rdsT_block_fd(const double *const *in, double *out) {
     return 0;
 }
 
-static const rds_blocks rdsT_blocks = {RDS_NAME, RDS_L, rdsT_block_tau, rdsT_block_mass, rdsT_block_nle,
-                                       rdsT_block_gravity, rdsT_block_fd};
+/* The blocks as the runtime calls them: each clears the vector registers' upper halves on
+ * its way out (RDS_VZEROUPPER: vzeroupper for AVX variants; -O1 does not insert it), or the
+ * SSE code that runs next (the scalar kernels, numpy, Python) runs ~3 times slower. */
+static RDS_TARGET int rdsT_out_tau(const double *const *in, double *out) {
+    const int status = rdsT_block_tau(in, out);
+    RDS_VZEROUPPER
+    return status;
+}
+static RDS_TARGET int rdsT_out_mass(const double *const *in, double *out) {
+    const int status = rdsT_block_mass(in, out);
+    RDS_VZEROUPPER
+    return status;
+}
+static RDS_TARGET int rdsT_out_nle(const double *const *in, double *out) {
+    const int status = rdsT_block_nle(in, out);
+    RDS_VZEROUPPER
+    return status;
+}
+static RDS_TARGET int rdsT_out_gravity(const double *const *in, double *out) {
+    const int status = rdsT_block_gravity(in, out);
+    RDS_VZEROUPPER
+    return status;
+}
+static RDS_TARGET int rdsT_out_fd(const double *const *in, double *out) {
+    const int status = rdsT_block_fd(in, out);
+    RDS_VZEROUPPER
+    return status;
+}
+
+static const rds_blocks rdsT_blocks = {RDS_NAME, RDS_L, rdsT_out_tau, rdsT_out_mass, rdsT_out_nle,
+                                       rdsT_out_gravity, rdsT_out_fd};

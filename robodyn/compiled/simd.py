@@ -13,11 +13,14 @@ the same for every state).
 
 Every row is bit-for-bit the scalar kernel's result: the vector code does the same IEEE
 operations in the same order (no fused multiply-add: the variants' targets leave FMA out
-and contraction is off), and ``cos``/``sin`` are the same libm calls, lane by lane (paired
-into ``sincos`` as the scalar kernel's compiler pairs them). Those calls bound the gain:
-on ur5 five ``sincos`` a state are ~680 of its ~1 070 instructions with AVX2 (callgrind),
-and 70-80 % of the time with AVX-512. Forward dynamics' LDLᵀ on vectors, unrolled along the
-tree, beat factoring each lane with the scalar solve (panda arm 230 against 384 ns a state).
+and contraction is off), and ``sin``/``cos`` are the kernels' own (``trig.c``, the macro
+``RD_TRIG_DEFINE`` the kernels' text defines, instantiated here on the vector type: the
+scalar ``rd_sin``'s operations on every lane at once, ``sin`` and ``cos`` of one argument
+paired into one ``sincos``; libm's, lane by lane, only for a lane beyond ``|x| > 2^20``, as
+the scalar does). With libm's ``sincos`` called lane by lane, five a state were ~680 of ur5's
+~1 070 instructions with AVX2 (callgrind) and 70-80 % of the time with AVX-512. Forward
+dynamics' LDLᵀ on vectors, unrolled along the tree, beat factoring each lane with the scalar
+solve (panda arm 230 against 384 ns a state).
 
 A build compiles the widest variant the CPU runs (a variant adds ~60 % to the C compile:
 ur5 0.7 -> 1.1 s, panda arm 1.0 -> 1.5 s of compiler CPU), or the one named by the environment variable
@@ -26,8 +29,8 @@ the source, and so the cache key, names the variant. The loaded module checks th
 (``__builtin_cpu_supports``) and runs scalar batches where the variant cannot run;
 :attr:`robodyn.compiled.CompiledRobot.instruction_set` tells which runs. Only x86-64
 builds get vector variants; elsewhere, or when a compiler rejects the vector code (a
-function the kernels call that the vector printer passes through), batches run the scalar
-kernels.
+function the kernels call that the vector printer passes through, or kernels calling libm's
+``sin``/``cos``), batches run the scalar kernels.
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from robodyn.equations.c_printer import vector_lines
 from robodyn.exceptions import InputError
 
 #: Bumped whenever the generated vector code changes meaning (it is part of the module's source).
-SIMD_VERSION = "3"
+SIMD_VERSION = "5"
 #: The environment variable that forces an instruction set.
 ENVIRONMENT = "ROBODYN_SIMD"
 #: (name, lanes, GCC target): the x86-64 variants, narrowest first.
@@ -140,6 +143,22 @@ def _ldl(parents: list[int], vector: str, attribute: str) -> list[str]:
     return [*out, "    return 0;", "}"]
 
 
+def vector_trig(vector: str, lanes: int, attribute: str) -> list[str]:
+    """``{vector}_sin``, ``_cos``, ``_sincos``: the kernels' own ``RD_TRIG_DEFINE`` (``trig.c``,
+    defined in the kernels' text) on vectors, with its helpers (bit casts; libm's sin and cos
+    on the lanes beyond its range, as the scalar ``rd_sin`` does)."""
+    inline = f"static inline __attribute__((always_inline)) {attribute}"
+    return [
+        f"typedef unsigned long long {vector}u __attribute__((vector_size({8 * lanes})));",
+        f"#define {vector}_bits(x) (({vector}u)(x))",
+        f"#define {vector}_double(u) (({vector})(u))",
+        f"#define {vector}_mask(c) (({vector}u)(c))",
+        f"{inline} void {vector}_libm({vector} x, {vector}u m, {vector} *s, {vector} *c) {{"
+        f" for (int l = 0; l < {lanes}; ++l) if (m[l]) {{ (*s)[l] = sin(x[l]); (*c)[l] = cos(x[l]); }} }}",
+        f"RD_TRIG_DEFINE({vector}_, {vector}, {vector}u, {attribute})",
+    ]
+
+
 def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lanes: int, target: str) -> list[str] | None:
     """One instruction set's vector kernels and blocks, or None if a kernel has a statement
     the vector printer does not take."""
@@ -147,18 +166,14 @@ def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lan
     attribute = f'__attribute__((target("{target}")))'
     out = [f"typedef double {vector} __attribute__((vector_size({8 * lanes})));"]
     inline = f"static inline __attribute__((always_inline)) {attribute}"
-    for function in ("cos", "sin", "sqrt", "fabs"):
+    for function in ("sqrt", "fabs"):
         out.append(f"{inline} {vector} {vector}_{function}({vector} x) {{ {vector} r; {_lanes(lanes, f'{function}(x[l])')} }}")
     out.append(f"{inline} {vector} {vector}_pow({vector} x, double n) {{ {vector} r; {_lanes(lanes, 'pow(x[l], n)')} }}")
     # Lanes gathered into a vector by an initialiser (in registers; writing lanes to memory one by
     # one and reading the vector back stalls store forwarding).
     gather = ", ".join(f"(p)[{lane} * (n)]" for lane in range(lanes))
     out.append(f"#define {vector}_gather(p, n) (({vector}){{{gather}}})")
-    out.append(
-        f"{inline} void {vector}_sincos({vector} x, {vector} *s, {vector} *c) {{ double sl[{lanes}], cl[{lanes}];"
-        f" for (int l = 0; l < {lanes}; ++l) {{ sl[l] = sin(x[l]); cl[l] = cos(x[l]); }}"
-        f" *s = {vector}_gather(sl, 1); *c = {vector}_gather(cl, 1); }}"
-    )
+    out += vector_trig(vector, lanes, attribute)
     out.append(f"{inline} {vector} {vector}_splat(double x) {{ {vector} r; {_lanes(lanes, 'x')} }}")
     for kernel in _KERNELS:
         lines = functions[kernel]
@@ -175,6 +190,7 @@ def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lan
     scatter = " ".join(f"rows[{lane} * n + j] = x[{lane}];" for lane in range(lanes))
     template = (
         template.replace("RDS_SCATTER", scatter)
+        .replace("RDS_VZEROUPPER", "__builtin_ia32_vzeroupper();" if lanes > 2 else "")
         .replace("RDS_TARGET", attribute)
         .replace("RDS_NAME", f'"{name}"')
         .replace("RDS_L", str(lanes))
@@ -237,7 +253,7 @@ def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | Non
     variants = build_variants() if variants is None else variants
     functions, parents = _functions(kernels), _parents(kernels)
     sizes = re.findall(r"^#define RD_N[QV] (\d+)$", kernels, flags=re.MULTILINE)
-    if functions is None or parents is None or not variants or len(set(sizes)) != 1:
+    if functions is None or parents is None or not variants or len(set(sizes)) != 1 or "RD_TRIG_DEFINE(" not in kernels:
         return ""  # the blocks read q with the stride of v: not for a configuration of another size
     out = [_COMMON.format(version=SIMD_VERSION)]
     for name, lanes, target in variants:

@@ -9,7 +9,8 @@ compiled engine's kernels (:mod:`robodyn.compiled.codegen`).
   literal a constant pass expressions through :func:`robodyn.equations.model.numeric`
   first.
 - ``x**2`` is ``(x*x)``, ``x**-1`` is ``(1.0/x)``, other whole powers ``pow(x, n)``;
-  ``sin``/``cos`` as they are; anything else (``sqrt``, ``π``, ...) goes to
+  ``sin``/``cos`` as they are (libm's), or with a prefix (``CPrinter(trig="rd_")``: the
+  compiled kernels' own, :mod:`robodyn.compiled.codegen`); anything else (``sqrt``, ``π``, ...) goes to
   ``sympy.ccode`` (a printer of its own: the slowest step of a compile when used for
   everything).
 - :func:`vector_lines` turns printed statements into the same statements on SIMD vectors
@@ -50,10 +51,13 @@ class CPrinter:
 
     Args:
         names: Symbol -> C text (an identifier or an array entry such as ``q[2]``).
+        trig: A prefix for ``sin`` and ``cos`` calls: ``"rd_"`` prints ``rd_sin(x)``, the
+            compiled kernels' own (:mod:`robodyn.compiled.codegen`); empty for libm's.
     """
 
-    def __init__(self, names: Mapping[sp.Symbol, str]) -> None:
+    def __init__(self, names: Mapping[sp.Symbol, str], *, trig: str = "") -> None:
         self.names = dict(names)
+        self.trig = trig
         self._printed: dict[sp.Symbol, str] = {}
 
     def expression(self, expr: sp.Expr) -> str:
@@ -81,7 +85,7 @@ class CPrinter:
         if expr.is_Pow and expr.exp.is_Integer:
             return f"pow({self.expression(expr.base)}, {int(expr.exp)})", _ATOM
         if isinstance(expr, sp.cos | sp.sin) and len(expr.args) == 1:
-            return f"{type(expr).__name__}({self.expression(expr.args[0])})", _ATOM
+            return f"{self.trig}{type(expr).__name__}({self.expression(expr.args[0])})", _ATOM
         named = {symbol: sp.Symbol(self.names[symbol]) for symbol in expr.free_symbols if symbol in self.names}
         text = sp.ccode(expr.xreplace(named), standard="C99")
         called = expr.is_Pow or expr.is_NumberSymbol or isinstance(expr, sp.Function)  # sqrt(x), M_PI, fabs(x)
@@ -127,11 +131,14 @@ class CPrinter:
 
 
 #: Calls the vector form takes lane by lane (the same libm call on each lane's double).
-LANE_CALLS = ("cos", "sin", "pow", "sqrt", "fabs")
+LANE_CALLS = ("pow", "sqrt", "fabs")
+#: The compiled kernels' own sin and cos (``CPrinter(trig="rd_")``), which the caller defines
+#: on vectors as the same operations (libm's ``sin``/``cos`` have no vector form here).
+OWN_CALLS = {"rd_sin": "sin", "rd_cos": "cos"}
 _CALL = re.compile(r"\b([A-Za-z_]\w*)\(")
 _CONSTANT = re.compile(r"^(.*= )([^=]+);$")
 #: What a constant's C may consist of besides operators: numbers, ``M_*`` constants, lane calls.
-_NOT_NAMES = re.compile(r"\bM_[A-Z0-9_]+\b|\b(?:" + "|".join(LANE_CALLS) + r")\(|\b\d+\.?\d*(?:[eE][-+]?\d+)?")
+_NOT_NAMES = re.compile(r"\bM_[A-Z0-9_]+\b|\b(?:" + "|".join((*LANE_CALLS, *OWN_CALLS)) + r")\(|\b\d+\.?\d*(?:[eE][-+]?\d+)?")
 
 
 def vector_lines(lines: Iterable[str], *, vector: str, prefix: str, kernels: Iterable[str] = ()) -> list[str] | None:
@@ -140,7 +147,8 @@ def vector_lines(lines: Iterable[str], *, vector: str, prefix: str, kernels: Ite
     lane rounds as the scalar statement does.
 
     ``double`` becomes ``vector`` (a GCC/Clang vector type); a call of a :data:`LANE_CALLS`
-    function ``f`` becomes ``{prefix}f`` (the caller defines it, lane by lane); a call of one
+    function ``f`` becomes ``{prefix}f`` (the caller defines it, lane by lane), ``rd_sin`` and
+    ``rd_cos`` (:data:`OWN_CALLS`) become ``{prefix}sin`` and ``{prefix}cos``; a call of one
     of ``kernels`` (``rd_mass``) becomes the vector kernel (``{prefix}mass``); a constant
     right-hand side becomes ``{prefix}splat(c)``.
 
@@ -149,6 +157,7 @@ def vector_lines(lines: Iterable[str], *, vector: str, prefix: str, kernels: Ite
     """
     renamed = {kernel: prefix + kernel.split("_", 1)[1] for kernel in kernels}
     renamed.update({name: prefix + name for name in LANE_CALLS}, **{word: word for word in ("for", "if", "while")})
+    renamed.update({name: prefix + function for name, function in OWN_CALLS.items()})
     out = []
     for line in lines:
         if "?" in line:
