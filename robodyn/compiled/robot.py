@@ -54,7 +54,8 @@ def _generator_source() -> str:
     must not reuse kernels generated before it)."""
     modules = (codegen, c_printer, program, sharing, newton_euler, compact, reference_tree, reference_symbolic)
     # cast: these modules are loaded from source files, so __file__ is set
-    return "".join(Path(cast(str, module.__file__)).read_text(encoding="utf-8") for module in modules)
+    sources = [Path(cast(str, module.__file__)).read_text(encoding="utf-8") for module in modules]
+    return "".join(sources) + codegen.TRIG.read_text(encoding="utf-8")  # the kernels' own sin and cos
 
 
 def robot_key(robot: Robot) -> str:

@@ -54,6 +54,9 @@ def test_the_cache_key_covers_the_one_program_and_the_one_printer():
     source = _generator_source()
     for module in (newton_euler, program, sharing, compact, c_printer):
         assert Path(module.__file__).read_text(encoding="utf-8") in source
+    from robodyn.compiled import codegen
+
+    assert codegen.TRIG.read_text(encoding="utf-8") in source  # the kernels' own sin and cos
 
 
 def test_a_long_program_splits_mass_and_nle_into_calls_with_the_same_numbers(monkeypatch, tmp_path, rng):
