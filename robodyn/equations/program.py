@@ -94,11 +94,13 @@ class ProgramBuilder:
     def rewrite(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` expanded, with ``c² + s² = 1`` used where shorter (see the class)."""
         expr = sp.expand(expr)
+        present = expr.free_symbols if self.pairs else set()  # once, not a tree walk a pair
         for c, s in self.pairs:
-            if not expr.has(c) or not expr.has(s):
+            if c not in present or s not in present:
                 continue
             options = [expr, sp.expand(expr.subs(c**2, 1 - s**2)), sp.expand(expr.subs(s**2, 1 - c**2))]
             expr = min(options, key=sp.count_ops)
+            present = expr.free_symbols
         return expr
 
     def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
