@@ -1090,6 +1090,8 @@ timed(compiled_robot, "derive_compact", "compact_s")
 timed(compact, "shortened", "cse_s")
 timed(compiled_robot, "derive_newton_euler", "newton_euler_s")
 timed(codegen.KernelWriter, "source", "print_c_s")
+timed(compact, "_composites", "of_which_composites_s")
+timed(compact, "free_base_newton_euler", "of_which_free_base_passes_s")
 source = sys.stdin.read()
 robot = robodyn.load(source) if source.lstrip().startswith("<") else robodyn.load(**json.loads(source))
 start, cpu = time.perf_counter(), time.process_time()
@@ -1137,9 +1139,10 @@ def _cold_compile(source: str) -> dict:
 
 def bench_compile_scaling(quick: bool) -> list[dict]:
     """Cold compile time against DoF, chains and trees of revolute and prismatic joints, and
-    fixed-base cuts of zoo robots (a new process, an empty cache), by stage: the compact
-    derivation (bodies, Newton–Euler for C v and G, composite-body M), its shortening
-    (``sympy.cse`` and products reused), the O(n) Newton–Euler tau, printing C, the C compiler."""
+    fixed-base cuts of zoo robots and the floating talos (a new process, an empty cache), by
+    stage: the compact derivation (bodies, Newton–Euler for C v and G, composite-body M; of it
+    the composite bodies and a free base's Newton–Euler passes), its shortening (``sympy.cse``
+    and products reused), the O(n) Newton–Euler tau, printing C, the C compiler."""
     sys.path.insert(0, str(ROOT))
     from tests.random_robots import urdf_from_seed
 
@@ -1150,6 +1153,8 @@ def bench_compile_scaling(quick: bool) -> list[dict]:
             cases.append((shape, _chain(urdf) if shape == "chain" else urdf))
     zoo = (("talos_arm", {}),) if quick else (("talos_arm", {}), ("talos", {"floating_base": False}))
     cases += [(f"{name} (fixed base)", json.dumps({"source": name, **options})) for name, options in zoo]
+    if not quick:  # the whole humanoid, its free-flyer root compiled (issue 30: under 60 s cold)
+        cases.append(("talos (floating base)", json.dumps({"source": "talos"})))
     rows = []
     for shape, source in cases:
         row = {"shape": shape, **_cold_compile(source), "load_average": os.getloadavg()[0]}

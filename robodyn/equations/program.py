@@ -72,6 +72,11 @@ def trivial(expr: sp.Expr) -> bool:
     )
 
 
+def _symbols_and_powers(expr: sp.Expr) -> tuple[set[sp.Basic], set[sp.Basic]]:
+    """An expression's symbols, and the bases of its powers (one walk each, not one a pair)."""
+    return expr.free_symbols, {power.base for power in expr.atoms(sp.Pow)}
+
+
 class ProgramBuilder:
     """Collects assignments; a variable is made only for a non-trivial expression.
 
@@ -94,11 +99,14 @@ class ProgramBuilder:
     def rewrite(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` expanded, with ``c² + s² = 1`` used where shorter (see the class)."""
         expr = sp.expand(expr)
+        present, powered = _symbols_and_powers(expr) if self.pairs else (set(), set())
         for c, s in self.pairs:
-            if not expr.has(c) or not expr.has(s):
+            # c or s absent, or neither under a power: both substitutions would change nothing
+            if c not in present or s not in present or not {c, s} & powered:
                 continue
             options = [expr, sp.expand(expr.subs(c**2, 1 - s**2)), sp.expand(expr.subs(s**2, 1 - c**2))]
             expr = min(options, key=sp.count_ops)
+            present, powered = _symbols_and_powers(expr)
         return expr
 
     def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
