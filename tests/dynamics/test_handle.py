@@ -10,6 +10,7 @@ import pytest
 
 import robodyn
 from robodyn.dynamics.loading import rebuild
+from robodyn.exceptions import InputError
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda"])
@@ -80,3 +81,15 @@ def test_rebuild_is_an_independent_copy_with_the_same_options():
     assert copy.options == robot.options
     q = robot.random_configuration(np.random.default_rng(1))
     np.testing.assert_array_equal(copy.gravity(q), robot.gravity(q))
+
+
+@pytest.mark.parametrize(("norms", "named"), [((1.0, 0.3, 1.2), "0.3"), ((1.0, 0.8, 1.5), "1.5")])
+def test_a_batch_of_floating_states_names_the_quaternion_farthest_from_unit(norms, named):
+    """The refusal quotes the row whose quaternion norm is farthest from 1 (not the largest
+    norm, not the smallest): found by mutation testing, where only one-state refusals were checked."""
+    robot = robodyn.load("solo12")
+    q = np.tile(robot.neutral_configuration(), (len(norms), 1))
+    q[:, 3:7] *= np.asarray(norms)[:, None]
+    with pytest.raises(InputError) as raised:
+        robot.gravity(q)
+    assert raised.value.argument == "q[3:7]" and f"norm {named}" in str(raised.value), str(raised.value)
