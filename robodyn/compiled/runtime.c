@@ -54,9 +54,9 @@ static int rd_q_ok(const double *q) {
     return 1;
 }
 
-/* Solve M x = b in place (b -> x), M destroyed: M = Lᵀ D L with L following the tree
- * (Featherstone's LTDL: no fill-in when parents precede children). 3 if not positive definite. */
-static int rd_ldl_solve(double *M, double *b) {
+/* M = Lᵀ D L in place, L following the tree (Featherstone's LTDL: no fill-in when parents
+ * precede children): 3 if M is not positive definite. */
+static int rd_ldl_factor(double *M) {
     const int n = RD_NV;
     for (int k = n - 1; k >= 0; --k) {
         const double d = M[k * n + k];
@@ -67,11 +67,22 @@ static int rd_ldl_solve(double *M, double *b) {
             M[k * n + i] = x;
         }
     }
+    return 0;
+}
+/* b -> M⁻¹ b with the factor of rd_ldl_factor. */
+static void rd_ldl_apply(const double *M, double *b) {
+    const int n = RD_NV;
     for (int i = n - 1; i >= 0; --i)
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= M[i * n + j] * b[i];
     for (int i = 0; i < n; ++i) b[i] /= M[i * n + i];
     for (int i = 0; i < n; ++i)
         for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
+}
+
+/* Solve M x = b in place (b -> x), M destroyed; 3 if M is not positive definite. */
+static int rd_ldl_solve(double *M, double *b) {
+    if (rd_ldl_factor(M)) return 3;
+    rd_ldl_apply(M, b);
     return 0;
 }
 
@@ -306,31 +317,8 @@ static void rdc_solve(double *A, double *B, int m, int k) {
         }
 }
 
-/* The tree LDLᵀ of runtime's rd_ldl_solve, split: factor once, then solve for several b. */
-static int rdc_ldl_factor(double *M) {
-    const int n = RD_NV;
-    for (int k = n - 1; k >= 0; --k) {
-        const double d = M[k * n + k];
-        if (!(d > 0.0) || !isfinite(d)) return 3;
-        for (int i = rd_parent[k]; i >= 0; i = rd_parent[i]) {
-            const double x = M[k * n + i] / d;
-            for (int j = i; j >= 0; j = rd_parent[j]) M[i * n + j] -= M[k * n + j] * x;
-            M[k * n + i] = x;
-        }
-    }
-    return 0;
-}
-static void rdc_ldl_apply(const double *M, double *b) {
-    const int n = RD_NV;
-    for (int i = n - 1; i >= 0; --i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= M[i * n + j] * b[i];
-    for (int i = 0; i < n; ++i) b[i] /= M[i * n + i];
-    for (int i = 0; i < n; ++i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
-}
-
-/* rdc_ldl_apply on k right-hand sides at once, B n×k row-major (B[j k + c] is b_c[j]): each
- * column gets rdc_ldl_apply's operations in its order (the same bits), the tree walked once. */
+/* rd_ldl_apply on k right-hand sides at once, B n×k row-major (B[j k + c] is b_c[j]): each
+ * column gets rd_ldl_apply's operations in its order (the same bits), the tree walked once. */
 static void rdc_ldl_apply_block(const double *M, double *B, int k) {
     const int n = RD_NV;
     for (int i = n - 1; i >= 0; --i)
@@ -630,7 +618,7 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     if (m == 6) rdc_orientation_command(R, p + 4, velocity + 3, p[13], p[14], command + 3);
     model->mass_nle(q, v, M, h);
     memcpy(L, M, sizeof M);
-    if (rdc_ldl_factor(L)) {
+    if (rd_ldl_factor(L)) {
         for (int i = 0; i < n; ++i) tau[i] = NAN;
         if (a)
             for (int i = 0; i < n; ++i) a[i] = NAN;
@@ -676,7 +664,7 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     }
     if (a) { /* the plant's accelerations when it is this model: rd_fd_raw's arithmetic on M, h */
         for (int i = 0; i < n; ++i) a[i] = tau[i] - h[i];
-        rdc_ldl_apply(L, a);
+        rd_ldl_apply(L, a);
     }
 }
 
