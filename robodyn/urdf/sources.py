@@ -21,6 +21,7 @@ from pathlib import Path
 from robodyn.exceptions import RobodynWarning, UnknownRobotError, URDFError
 from robodyn.urdf import zoo
 from robodyn.urdf.edit import lock_joints
+from robodyn.urdf.equality import EqualityRecord
 from robodyn.urdf.models import GENERATED
 from robodyn.urdf.packages import PackageLookup, package_lookup
 from robodyn.urdf.validation import Problem, URDFSpec, lint_urdf, parse_urdf
@@ -43,6 +44,8 @@ class URDFSource:
             a tuple of folders that also knows ``packages=`` and ``$ROS_PACKAGE_PATH``).
         file_format: What the user's file was: ``"urdf"``, ``"xacro"`` (``text`` is its
             expansion) or ``"mjcf"`` (``text`` is the URDF robodyn's MJCF reader wrote).
+        equalities: Equality constraints the file declares (MJCF ``<equality>``), as
+            records :mod:`robodyn.constraints` turns into the robot's constraints.
     """
 
     text: str
@@ -52,6 +55,7 @@ class URDFSource:
     floating_base: bool = False
     package_dirs: tuple[Path, ...] = field(default_factory=tuple)
     file_format: str = "urdf"
+    equalities: tuple[EqualityRecord, ...] = ()
 
     @property
     def mesh_context(self) -> dict:
