@@ -49,6 +49,10 @@ class Dof:
         damping: Viscous damping b of the joint, in [N m s/rad] or [N s/m] (0: none).
         friction: Coulomb friction f of the joint, in [N m] or [N] (0: none).
         armature: Rotor inertia reflected to the joint, in [kg m²] or [kg] (0: none).
+        actuated: Whether an actuator drives it (a floating base's six: never; a joint of
+            a file that lists its actuators, such as MJCF ``<actuator>``: only those
+            listed; otherwise every joint). Controllers, ``optimize`` and ``linearize``
+            take this set as their default actuated set.
     """
 
     name: str
@@ -63,6 +67,7 @@ class Dof:
     damping: float = 0.0
     friction: float = 0.0
     armature: float = 0.0
+    actuated: bool = True
 
     @property
     def linear(self) -> bool:
@@ -130,7 +135,7 @@ def robot_dofs(
         if joint.type == "floating":
             for axis, name in enumerate(BASE_V_NAMES):
                 kind: Kind = "linear" if axis < 3 else "angular"
-                dofs.append(Dof(name, joint.name, "floating", kind, len(dofs), -inf, inf, inf, inf))
+                dofs.append(Dof(name, joint.name, "floating", kind, len(dofs), -inf, inf, inf, inf, actuated=False))
             continue
         kind = "linear" if joint.type == "prismatic" else "angular"
         dofs.append(
