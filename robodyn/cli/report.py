@@ -67,6 +67,10 @@ def info_dict(robot: Robot) -> dict:
             if not dof.is_base
         ],
         "package_paths": package_paths(robot),
+        "constraints": [
+            {"kind": constraint.kind, "name": constraint.name, "rows": constraint.rows, "description": str(constraint)}
+            for constraint in robot.constraints
+        ],
     }
 
 
@@ -119,11 +123,20 @@ def info_text(robot: Robot) -> str:
         )
     if open_limits:
         lines.append("* a placeholder (|limit| ≥ 1e3, lower = upper, or 0 effort / velocity): treated as no limit")
-    lines += _dynamics_lines(robot) + _mimic_lines(robot) + _package_lines(robot)
+    lines += _dynamics_lines(robot) + _mimic_lines(robot) + _constraint_lines(robot) + _package_lines(robot)
     lines += ["", f"{'link':30s} {'mass':>12s}"]
     lines += [f"{printable(name):30s} {mass:>9.4g} kg" for name, mass in robot.link_masses.items()]
     lines.append(f"{'total':30s} {robot.total_mass:>9.4g} kg")
     return "\n".join(lines)
+
+
+def _constraint_lines(robot: Robot) -> list[str]:
+    """The robot's constraints (its file's ``<equality>`` and ``load(constraints=)``'s), one a line."""
+    constraints = robot.constraints
+    if not constraints:
+        return []
+    rows = sum(constraint.rows for constraint in constraints)
+    return ["", f"constraints ({rows} rows; docs/constraints.md):"] + [f"  {printable(str(c))}" for c in constraints]
 
 
 def _dynamics_lines(robot: Robot) -> list[str]:

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from robodyn.constraints import check_frames, from_equalities
 from robodyn.dynamics import pickling
 from robodyn.dynamics.joint_dynamics import apply_joint_dynamics
 from robodyn.dynamics.mimic import has_mimic, mimic_expansion
@@ -73,6 +74,7 @@ def load(
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str | os.PathLike] | None = None,
     armature: Mapping[str, float] | None = None,
+    constraints: object = None,
 ) -> Robot:
     """Load a robot.
 
@@ -103,6 +105,10 @@ def load(
             and ``$(find name)`` resolve, before ``$ROS_PACKAGE_PATH`` and the zoo's folders.
         armature: Rotor inertia reflected to joints, ``{joint name: value in [kg m²] or
             [kg]}``, added to what the file says.
+        constraints: Constraints to add (:mod:`robodyn.constraints`: a ``PointAnchor``,
+            ``FrameAnchor``, ``PointContact`` or a list of them), after those the file
+            declares (MJCF ``<equality>``); :attr:`Robot.constraints` lists them all. See
+            docs/constraints.md.
 
     Returns:
         The robot.
@@ -111,7 +117,8 @@ def load(
         UnknownRobotError: If the name is not a file or known robot.
         URDFError: If the URDF cannot be read, describes an impossible robot or is too
             large for the limits above.
-        InputError: If ``gravity`` is not 3 finite numbers or ``lock`` not numbers.
+        InputError: If ``gravity`` is not 3 finite numbers or ``lock`` not numbers, or a
+            constraint names a link the robot does not have (listing its links).
 
     Warns:
         RobodynWarning: For what ``strict=True`` refuses.
@@ -133,6 +140,7 @@ def load(
         xacro_args=xacro_args,
         packages=folders,
         armature=armature,
+        constraints=constraints,
     )
     return build_robot(resolved, options)
 
@@ -232,6 +240,7 @@ def build_robot(resolved: URDFSource, options: LoadOptions) -> Robot:
         )
     spec = apply_joint_dynamics(spec, model, mimic, options, resolved.label)
     name = spec.name if resolved.name == "robot" else resolved.name
+    check_frames((*from_equalities(resolved.equalities), *options.constraints), list(spec.links), name)
     return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
 
 

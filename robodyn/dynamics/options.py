@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.common.text import quoted
+from robodyn.constraints import Constraint, as_constraints
 from robodyn.exceptions import InputError
 from robodyn.urdf.sources import max_urdf_bytes
 
@@ -48,6 +49,8 @@ class LoadOptions:
             ``(package name, folder)`` pairs, before ``$ROS_PACKAGE_PATH`` and the zoo's.
         armature: Rotor inertia added at joints, as ``(joint name, value in [kg m²] or
             [kg])`` pairs (on top of what the file says).
+        constraints: Constraints added to the robot (:mod:`robodyn.constraints`), after
+            those its file declares.
     """
 
     floating_base: bool
@@ -61,6 +64,7 @@ class LoadOptions:
     xacro_args: tuple[tuple[str, str], ...] = ()
     packages: tuple[tuple[str, str], ...] = ()
     armature: tuple[tuple[str, float], ...] = ()
+    constraints: tuple[Constraint, ...] = ()
 
 
 def load_options(
@@ -76,13 +80,14 @@ def load_options(
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
     armature: Mapping[str, float] | None = None,
+    constraints: object = None,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 
     Arguments as for :func:`robodyn.load` (``floating_base`` already decided).
 
     Raises:
-        InputError: If ``gravity`` is not 3 finite numbers.
+        InputError: If ``gravity`` is not 3 finite numbers, or ``constraints`` not constraints.
     """
     vector = STANDARD_GRAVITY if gravity is None else tuple(float(g) for g in as_state(gravity, "gravity", 3))
     return LoadOptions(
@@ -97,6 +102,7 @@ def load_options(
         xacro_args=tuple((str(name), str(value)) for name, value in (xacro_args or {}).items()),
         packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
         armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
+        constraints=as_constraints(constraints),
     )
 
 

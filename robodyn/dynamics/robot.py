@@ -29,7 +29,8 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics import configurations, derivatives, energies, frames, kinematics
+from robodyn.constraints import Constraint, from_equalities
+from robodyn.dynamics import configurations, constrained, derivatives, energies, frames, kinematics
 from robodyn.dynamics import regressor as identification
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
@@ -512,6 +513,42 @@ class Robot:
     def inertial_parameters(self, *, friction: bool = False) -> np.ndarray:
         """The URDF's standard inertial parameters π, in :meth:`regressor`'s order."""
         return identification.inertial_parameters(self.handle, friction=friction)
+
+    # ----------------------------------------------------------------------------------
+    # Constraints (robodyn.dynamics.constrained; the rows: robodyn.constraints.algebra).
+    # ``constraints=None``: the robot's own (:attr:`constraints`).
+    # ----------------------------------------------------------------------------------
+    @property
+    def constraints(self) -> tuple[Constraint, ...]:
+        """The robot's constraints: its file's (MJCF ``<equality>``), then ``load(constraints=)``'s."""
+        return (*from_equalities(self.source.equalities), *self.options.constraints)
+
+    def constrained_forward_dynamics(self, q, v, tau, constraints=None) -> tuple[np.ndarray, np.ndarray]:
+        """``(a, λ)`` of ``M a + C v + G = tau + Jᵀ λ``, ``J a + J̇ v = 0`` (contacts bilateral;
+        ``λ`` least-norm for a redundant set), shapes (nv,), (m,) or (N, nv), (N, m)
+        (:func:`robodyn.dynamics.constrained.forward_dynamics`)."""
+        return constrained.forward_dynamics(self, q, v, tau, constraints)
+
+    def contact_inverse_dynamics(self, q, v, a, constraints=None) -> tuple[np.ndarray, np.ndarray]:
+        """``(tau, λ)``: the least-norm ``λ`` that carries the unactuated coordinates, ``tau``
+        the rest (:func:`robodyn.dynamics.constrained.contact_inverse_dynamics`)."""
+        return constrained.contact_inverse_dynamics(self, q, v, a, constraints)
+
+    def constraint_jacobian(self, q, constraints=None) -> np.ndarray:
+        """``J(q)``, shape (m, nv) or (N, m, nv) (:func:`robodyn.dynamics.constrained.constraint_jacobian`)."""
+        return constrained.constraint_jacobian(self, q, constraints)
+
+    def constraint_drift(self, q, v, constraints=None) -> np.ndarray:
+        """``J̇(q, v) v``, shape (m,) or (N, m) (:func:`robodyn.dynamics.constrained.constraint_drift`)."""
+        return constrained.constraint_drift(self, q, v, constraints)
+
+    def constraint_residual(self, q, constraints=None) -> np.ndarray:
+        """``Φ(q)`` in [m] / [rad], shape (m,) or (N, m) (:func:`robodyn.dynamics.constrained.constraint_residual`)."""
+        return constrained.constraint_residual(self, q, constraints)
+
+    def constraint_rank(self, q, constraints=None) -> int:
+        """Independent rows of the constraints at ``q`` (nq,) (:func:`robodyn.dynamics.constrained.constraint_rank`)."""
+        return constrained.constraint_rank(self, q, constraints)
 
 
 def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:

@@ -1,0 +1,197 @@
+"""What a constraint's rows are, given the kinematics of its two ends (numpy only).
+
+A constraint bound to a robot (:func:`bind`) has two **ends**: frames rigidly attached to
+links (or to the world), each a position and a rotation in its link's frame. An engine
+(Pinocchio in :mod:`robodyn.dynamics.constrained`, the reference's own kinematics in
+:mod:`robodyn.reference.constraints`) supplies, for an end at a state, its world position
+``p`` and rotation ``R``, its linear and angular Jacobians ``J_v``, ``J_ω`` (world axes at
+the end's origin: ``ṗ = J_v v``, ``ω = J_ω v``) and its accelerations at ``v̇ = 0``
+(``J̇_v v``, the classical acceleration, and ``J̇_ω v``). :func:`rows` turns the two ends
+into the constraint's ``Φ``, ``J`` and ``J̇ v``:
+
+============== ===== ========================================= ================================
+constraint     rows  Φ(q)                                      J
+============== ===== ========================================= ================================
+PointAnchor    3     p₁ − p₂                                   J_v1 − J_v2
+FrameAnchor    6     (p₁ − p₂, log(R₁ R₂ᵀ))                    (J_v1 − J_v2, J_ω1 − J_ω2)
+PointContact   3     (n·(p − c)) n (the gap along the normal)  J_v
+(μ > 0)
+PointContact   1     n·(p − c)                                 nᵀ J_v
+(μ = 0)
+============== ===== ========================================= ================================
+
+so that ``Φ̈ = J v̇ + J̇ v`` (for a weld's orientation rows and a sticking contact's
+tangential rows, ``J v`` is the velocity the rows hold: they are not the derivative of
+``Φ`` away from ``Φ = 0``). The equations of motion with multipliers ``λ`` are
+``M v̇ + C v + G = τ + Jᵀ λ``: ``λ`` is the force (and torque) applied to the first end,
+world axes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from robodyn.common.rotations import rpy_matrix
+from robodyn.constraints.values import Constraint, FrameAnchor, PointAnchor, PointContact
+
+
+@dataclass(frozen=True, eq=False)
+class End:
+    """A frame rigidly attached to a link (or the world), one end of a bound constraint.
+
+    Attributes:
+        link: The link's name, or ``None`` for the world.
+        position: The frame's origin in the link's frame (world: in world coordinates), [m].
+        rotation: The frame's rotation in the link's frame, shape (3, 3).
+    """
+
+    link: str | None
+    position: np.ndarray
+    rotation: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Bound:
+    """A constraint with both ends resolved (the neutral configuration's points filled in).
+
+    Attributes:
+        constraint: The constraint as given.
+        first, second: Its two ends (a contact's second end is the world's plane point).
+        rows: Its number of rows.
+    """
+
+    constraint: Constraint
+    first: End
+    second: End
+    rows: int
+
+
+class EndKinematics(NamedTuple):
+    """An end's kinematics at one state (see the module docstring). ``nv`` columns."""
+
+    position: np.ndarray
+    rotation: np.ndarray
+    linear: np.ndarray
+    angular: np.ndarray
+    linear_drift: np.ndarray
+    angular_drift: np.ndarray
+
+
+#: The world pose of a link at the neutral configuration: ``pose(link) -> (R, p)``.
+NeutralPose = Callable[[str], tuple[np.ndarray, np.ndarray]]
+
+
+def _placement(origin: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation and position of ``(x, y, z, roll, pitch, yaw)``."""
+    return rpy_matrix(np.asarray(origin[3:6], float)), np.asarray(origin[:3], float)
+
+
+def _held_where(link: str | None, rotation: np.ndarray, position: np.ndarray, pose: NeutralPose) -> End:
+    """The end on ``link`` that coincides with the world frame ``(rotation, position)``."""
+    if link is None:
+        return End(None, position, rotation)
+    link_rotation, link_position = pose(link)
+    return End(link, link_rotation.T @ (position - link_position), link_rotation.T @ rotation)
+
+
+def bind(constraints: Sequence[Constraint], pose: NeutralPose) -> tuple[Bound, ...]:
+    """Resolve each constraint's two ends (what is ``None`` is taken at the neutral configuration).
+
+    Args:
+        constraints: Constraints whose links were checked (:func:`~robodyn.constraints.values.check_frames`).
+        pose: The world pose of a link at the robot's neutral configuration.
+    """
+    bound = []
+    for constraint in constraints:
+        if isinstance(constraint, PointAnchor):
+            first = End(constraint.frame1, np.asarray(constraint.point1, float), np.eye(3))
+            if constraint.point2 is None:
+                rotation, position = pose(constraint.frame1)
+                second = _held_where(constraint.frame2, np.eye(3), rotation @ first.position + position, pose)
+            else:
+                second = End(constraint.frame2, np.asarray(constraint.point2, float), np.eye(3))
+        elif isinstance(constraint, FrameAnchor):
+            first = End(constraint.frame1, *reversed(_placement(constraint.origin1)))
+            if constraint.origin2 is None:
+                rotation, position = pose(constraint.frame1)
+                world = (rotation @ first.rotation, rotation @ first.position + position)
+                second = _held_where(constraint.frame2, *world, pose)
+            else:
+                second = End(constraint.frame2, *reversed(_placement(constraint.origin2)))
+        else:
+            first = End(constraint.frame, np.asarray(constraint.point, float), np.eye(3))
+            second = End(None, np.asarray(constraint.plane_point, float), np.eye(3))
+        bound.append(Bound(constraint, first, second, constraint.rows))
+    return tuple(bound)
+
+
+def world_end(end: End, nv: int) -> EndKinematics:
+    """The kinematics of an end fixed in the world: it never moves."""
+    zeros = np.zeros((3, nv))
+    return EndKinematics(end.position, end.rotation, zeros, zeros, np.zeros(3), np.zeros(3))
+
+
+def rotation_log(rotation: np.ndarray) -> np.ndarray:
+    """The rotation vector (axis × angle in [rad], angle in [0, π]) of a rotation matrix."""
+    cosine = min(1.0, max(-1.0, (float(np.trace(rotation)) - 1.0) / 2.0))
+    angle = math.acos(cosine)
+    vector = 0.5 * np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0], rotation[1, 0] - rotation[0, 1]])
+    if angle < 1e-6:
+        return vector * (1.0 + angle * angle / 6.0)
+    if math.pi - angle > 1e-6:
+        return vector * (angle / math.sin(angle))
+    symmetric = (rotation + np.eye(3)) / 2.0  # ≈ a aᵀ at angle π
+    column = int(np.argmax(np.diag(symmetric)))
+    axis = symmetric[:, column] / math.sqrt(max(symmetric[column, column], 1e-300))
+    return axis * angle
+
+
+def rows(bound: Bound, first: EndKinematics, second: EndKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``Φ``, ``J`` and ``J̇ v`` of one bound constraint from its ends' kinematics.
+
+    Returns:
+        Shapes (rows,), (rows, nv), (rows,).
+    """
+    constraint = bound.constraint
+    gap = first.position - second.position
+    jacobian = first.linear - second.linear
+    drift = first.linear_drift - second.linear_drift
+    if isinstance(constraint, FrameAnchor):
+        phi = np.concatenate([gap, rotation_log(first.rotation @ second.rotation.T)])
+        return (
+            phi,
+            np.vstack([jacobian, first.angular - second.angular]),
+            np.concatenate([drift, first.angular_drift - second.angular_drift]),
+        )
+    if isinstance(constraint, PointContact):
+        normal = np.asarray(constraint.normal)
+        distance = float(normal @ gap)
+        if constraint.rows == 1:
+            return np.array([distance]), (normal @ jacobian)[None, :], np.array([normal @ drift])
+        return distance * normal, jacobian, drift
+    return gap, jacobian, drift
+
+
+def stack(
+    bounds: Sequence[Bound], kinematics: Callable[[End], EndKinematics], nv: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``Φ`` (m,), ``J`` (m, nv) and ``J̇ v`` (m,) of a set of bound constraints at one state.
+
+    Args:
+        bounds: The constraints.
+        kinematics: An end's kinematics at the state (an engine's; a world end may go to
+            :func:`world_end`).
+        nv: Size of a velocity.
+    """
+    parts = [rows(bound, kinematics(bound.first), kinematics(bound.second)) for bound in bounds]
+    if not parts:
+        return np.zeros(0), np.zeros((0, nv)), np.zeros(0)
+    return tuple(np.concatenate([part[k] for part in parts]) for k in range(3))  # type: ignore[return-value]
+
+
+__all__ = ["Bound", "End", "EndKinematics", "NeutralPose", "bind", "rotation_log", "rows", "stack", "world_end"]

@@ -1,0 +1,234 @@
+"""Constrained dynamics on Pinocchio: ``Φ``, ``J``, ``J̇ v`` of a robot's constraints, and the KKT solves.
+
+The rows of each constraint are :mod:`robodyn.constraints.algebra`'s; Pinocchio supplies
+the kinematics of their ends (frame placements, ``LOCAL_WORLD_ALIGNED`` frame Jacobians,
+classical accelerations at ``v̇ = 0``), shifted from the link's origin to the end's point.
+
+**Forward dynamics** solves the KKT system of ``M v̇ + C v + G = τ + Jᵀ λ`` with
+``J v̇ + J̇ v = 0`` by its own factorisation, not Pinocchio's ``constraintDynamics``: a
+Cholesky factor of ``M`` (robodyn's ``M``, so mimic joints and armature are included,
+which Pinocchio's constraint algorithms do not take), the Delassus matrix
+``A = J M⁻¹ Jᵀ`` and ``λ = A⁺ b`` by its eigendecomposition, eigenvalues below
+:data:`RANK_TOLERANCE` times the largest dropped. For a redundant set (a planar four-bar
+closed by a 3-row point anchor, where one row repeats the others) that is the
+least-norm ``λ``: the limit of the proximal iteration ``(A + ρ I) λₖ₊₁ = b + ρ λₖ`` from
+``λ₀ = 0`` (what Pinocchio's ``ProximalSettings`` runs), computed in one step. ``v̇`` is
+unique either way; :func:`constraint_rank` reports how many rows are independent. Pinocchio's
+``constraintDynamics`` is the outside check (tests/dynamics/test_constrained.py).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+import scipy.linalg
+
+from robodyn.common.rotations import skew
+from robodyn.constraints import Constraint, as_constraints, check_frames
+from robodyn.constraints.algebra import Bound, End, EndKinematics, bind, stack, world_end
+from robodyn.exceptions import InputError, SingularMassMatrixError
+
+if TYPE_CHECKING:
+    from robodyn.dynamics.robot import Robot
+
+#: Eigenvalues of the Delassus matrix below this times the largest are redundant rows.
+RANK_TOLERANCE = 1e-10
+#: Largest unbalanced force on the unactuated rows, relative to ``max |M a + C v + G|``
+#: (and 1), that :func:`contact_inverse_dynamics` accepts.
+BALANCE_TOLERANCE = 1e-8
+
+_BOUND: weakref.WeakKeyDictionary[Any, dict[tuple[Constraint, ...], tuple[Bound, ...]]] = weakref.WeakKeyDictionary()
+
+
+def bound(robot: Robot, constraints: object) -> tuple[Bound, ...]:
+    """The robot's constraints (``None``: :attr:`Robot.constraints`) with both ends resolved.
+
+    Raises:
+        InputError: For anything that is not a constraint, or a link the robot does not have.
+    """
+    given = robot.constraints if constraints is None else as_constraints(constraints)
+    cache = _BOUND.setdefault(robot, {})
+    if given not in cache:
+        check_frames(given, list(robot.spec.links), robot.name)
+        model, data, frames = robot.model, pin.Model.createData(robot.model), robot.handle.frames
+        pin.framesForwardKinematics(model, data, pin.neutral(model))
+
+        def pose(link: str) -> tuple[np.ndarray, np.ndarray]:
+            placement = data.oMf[frames[link]]
+            return placement.rotation.copy(), placement.translation.copy()
+
+        cache[given] = bind(given, pose)
+    return cache[given]
+
+
+def _end_kinematics(robot: Robot, v: np.ndarray) -> Callable[[End], EndKinematics]:
+    """An end's kinematics from the Pinocchio data of the state just computed."""
+    model, data, frames, nv = robot.model, robot.handle.data, robot.handle.frames, robot.nv
+
+    def kinematics(end: End) -> EndKinematics:
+        if end.link is None:
+            return world_end(end, nv)
+        index = frames[end.link]
+        placement = data.oMf[index]
+        lever = placement.rotation @ end.position
+        jacobian = pin.getFrameJacobian(model, data, index, pin.LOCAL_WORLD_ALIGNED).reshape(6, nv)
+        angular = jacobian[3:]
+        omega = angular @ v
+        acceleration = pin.getFrameClassicalAcceleration(model, data, index, pin.LOCAL_WORLD_ALIGNED)
+        alpha = acceleration.angular.copy()
+        return EndKinematics(
+            placement.translation + lever,
+            placement.rotation @ end.rotation,
+            jacobian[:3] - skew(lever) @ angular,
+            angular.copy(),
+            acceleration.linear + np.cross(alpha, lever) + np.cross(omega, np.cross(omega, lever)),
+            alpha,
+        )
+
+    return kinematics
+
+
+def state_rows(robot: Robot, bounds: tuple[Bound, ...], q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state."""
+    model, data = robot.model, robot.handle.data
+    pin.computeJointJacobians(model, data, q)
+    pin.forwardKinematics(model, data, q, v, np.zeros(robot.nv))
+    pin.updateFramePlacements(model, data)
+    return stack(bounds, _end_kinematics(robot, v), robot.nv)
+
+
+def _per_state(function: Callable[..., tuple[np.ndarray, ...]], batch: bool, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``function`` of one state, or of each row of a batch (results stacked)."""
+    if not batch:
+        return function(*arrays)
+    results = [function(*row) for row in zip(*arrays, strict=True)]
+    return tuple(np.array([result[k] for result in results]) for k in range(len(results[0]))) if results else ()
+
+
+def constraint_residual(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
+    """``Φ(q)``, shape (m,) or (N, m) (see :mod:`robodyn.constraints.algebra`), in [m] / [rad]."""
+    bounds = bound(robot, constraints)
+    (q,), batch = robot.validate(q=q)
+    zeros = np.zeros(robot.nv)
+    return _per_state(lambda qi: state_rows(robot, bounds, qi, zeros)[:1], batch, q)[0]
+
+
+def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
+    """``J(q)``, shape (m, nv) or (N, m, nv): the rows' velocities are ``J v``."""
+    bounds = bound(robot, constraints)
+    (q,), batch = robot.validate(q=q)
+    zeros = np.zeros(robot.nv)
+    return _per_state(lambda qi: state_rows(robot, bounds, qi, zeros)[1:2], batch, q)[0]
+
+
+def constraint_drift(robot: Robot, q: np.ndarray, v: np.ndarray, constraints: object = None) -> np.ndarray:
+    """``J̇(q, v) v``, shape (m,) or (N, m): the rows' accelerations at ``v̇ = 0``."""
+    bounds = bound(robot, constraints)
+    (q, v), batch = robot.validate(q=q, v=v)
+    return _per_state(lambda qi, vi: state_rows(robot, bounds, qi, vi)[2:], batch, q, v)[0]
+
+
+def constraint_rank(robot: Robot, q: np.ndarray, constraints: object = None) -> int:
+    """How many rows of the constraints are independent at one configuration (rank of ``J``;
+    rows minus rank are redundant)."""
+    jacobian = constraint_jacobian(robot, np.asarray(q, float).reshape(-1), constraints)
+    if not jacobian.size:
+        return 0
+    singular = np.linalg.svd(jacobian, compute_uv=False)
+    return int(np.sum(singular > RANK_TOLERANCE * max(singular[0], 1e-300)))
+
+
+def solve_kkt(
+    mass: np.ndarray, force: np.ndarray, jacobian: np.ndarray, drift: np.ndarray, name: str = "robot"
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(v̇, λ)`` of ``M v̇ = force + Jᵀ λ``, ``J v̇ = −drift`` (λ least-norm; module docstring).
+
+    Raises:
+        SingularMassMatrixError: If ``M`` is not positive definite.
+    """
+    try:
+        factor = scipy.linalg.cho_factor(mass)
+    except np.linalg.LinAlgError:
+        raise SingularMassMatrixError(name, []) from None
+    free = scipy.linalg.cho_solve(factor, force)
+    if not len(drift):
+        return free, np.zeros(0)
+    response = scipy.linalg.cho_solve(factor, jacobian.T)
+    delassus = jacobian @ response
+    values, vectors = np.linalg.eigh(0.5 * (delassus + delassus.T))
+    keep = values > RANK_TOLERANCE * max(float(values[-1]), 1e-300)
+    target = -(drift + jacobian @ free)
+    multipliers = vectors[:, keep] @ ((vectors[:, keep].T @ target) / values[keep])
+    return free + response @ multipliers, multipliers
+
+
+def forward_dynamics(
+    robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, constraints: object = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(v̇, λ)`` under bilateral constraints: shapes (nv,), (m,) or (N, nv), (N, m)."""
+    bounds = bound(robot, constraints)
+    (q, v, tau), batch = robot.validate(q=q, v=v, tau=tau)
+    if robot.massless_joints:
+        raise SingularMassMatrixError(robot.name, robot.massless_joints)
+
+    def one(qi: np.ndarray, vi: np.ndarray, ti: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        mass, bias = robot.mass_matrix(qi), robot.nonlinear_effects(qi, vi)
+        _, jacobian, drift = state_rows(robot, bounds, qi, vi)
+        return solve_kkt(mass, ti - bias, jacobian, drift, robot.name)
+
+    return _per_state(one, batch, q, v, tau)  # type: ignore[return-value]
+
+
+def contact_inverse_dynamics(
+    robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, constraints: object = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(τ, λ)`` with ``M a + C v + G = τ + Jᵀ λ`` and ``τ = 0`` on the unactuated coordinates.
+
+    ``λ`` is the least-norm solution of the unactuated rows ``Sᵤ Jᵀ λ = Sᵤ (M a + C v + G)``
+    (a floating base's six: the constraints carry the base); ``τ`` is what remains for the
+    actuated coordinates. When every coordinate is actuated, ``λ = 0``.
+
+    Raises:
+        InputError: If no multipliers balance the unactuated rows (``a`` is not reachable
+            with these constraints), naming the unbalanced force.
+    """
+    bounds = bound(robot, constraints)
+    (q, v, a), batch = robot.validate(q=q, v=v, a=a)
+    unactuated = [dof.index for dof in robot.dofs if not dof.actuated]
+
+    def one(qi: np.ndarray, vi: np.ndarray, ai: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        force = robot.inverse_dynamics(qi, vi, ai)
+        _, jacobian, _ = state_rows(robot, bounds, qi, vi)
+        multipliers = np.zeros(len(jacobian))
+        if unactuated and len(jacobian):
+            multipliers = np.linalg.lstsq(jacobian.T[unactuated], force[unactuated], rcond=RANK_TOLERANCE)[0]
+        tau = force - jacobian.T @ multipliers
+        unbalanced = float(np.max(np.abs(tau[unactuated]), initial=0.0))
+        if unbalanced > BALANCE_TOLERANCE * max(1.0, float(np.max(np.abs(force)))):
+            raise InputError(
+                "a",
+                "an acceleration the constraints and the actuated joints can produce",
+                f"{unbalanced:.3g} unbalanced on the unactuated coordinates",
+            )
+        tau[unactuated] = 0.0
+        return tau, multipliers
+
+    return _per_state(one, batch, q, v, a)  # type: ignore[return-value]
+
+
+__all__ = [
+    "RANK_TOLERANCE",
+    "bound",
+    "constraint_drift",
+    "constraint_jacobian",
+    "constraint_rank",
+    "constraint_residual",
+    "contact_inverse_dynamics",
+    "forward_dynamics",
+    "solve_kkt",
+    "state_rows",
+]
