@@ -26,6 +26,8 @@ import numpy as np
 from robodyn import reference
 from robodyn.dynamics.loading import load
 from robodyn.dynamics.robot import Robot
+from robodyn.verify.constrained import DESCRIPTIONS as CONSTRAINT_DESCRIPTIONS
+from robodyn.verify.constrained import constraint_values
 
 #: Default tolerance on the relative error of every compared quantity.
 DEFAULT_TOLERANCE = 1e-9
@@ -156,6 +158,7 @@ def check_robot(
     tolerance: float = DEFAULT_TOLERANCE,
     check_inertia: bool = True,
     reference_source: str | os.PathLike | None = None,
+    constraints: object = None,
 ) -> CheckReport:
     """Compare Pinocchio with the reference at random states within the joint limits.
 
@@ -171,6 +174,10 @@ def check_robot(
         seed: Seed of the random generator.
         tolerance: Largest accepted relative error.
         check_inertia: As for :func:`robodyn.load`.
+        constraints: As for :func:`robodyn.load` (when ``source`` is not a robot). A robot
+            with constraints (these, or its file's ``<equality>``) also has ``Φ``, ``J``,
+            ``J̇ v`` and the constrained ``v̇`` and ``λ`` compared
+            (:mod:`robodyn.verify.constrained`).
 
     Returns:
         The report; ``report.passed`` tells whether every error is within tolerance, and
@@ -178,7 +185,7 @@ def check_robot(
         the two models do not have the same joints, the report has one failed comparison,
         ``joints``, naming them (``max_abs``: how many differ).
     """
-    robot = source if isinstance(source, Robot) else load(source, check_inertia=check_inertia)
+    robot = source if isinstance(source, Robot) else load(source, check_inertia=check_inertia, constraints=constraints)
     model = reference.load(
         robot.urdf if reference_source is None else reference_source,
         gravity=tuple(robot.gravity_vector),
@@ -195,7 +202,12 @@ def check_robot(
     q = robot.random_configuration(rng, samples)
     v = rng.normal(size=(samples, robot.nv))
     a = rng.normal(size=(samples, robot.nv))
-    report.comparisons.update(_compare_dynamics(robot, _Matched(robot, model), q, v, a, tolerance))
+    matched = _Matched(robot, model)
+    report.comparisons.update(_compare_dynamics(robot, matched, q, v, a, tolerance))
+    if robot.constraints:
+        tau = rng.normal(size=(samples, robot.nv))
+        for name, (actual, expected, floor, names) in constraint_values(robot, matched, q, v, tau).items():
+            report.comparisons[name] = _compare(actual, expected, tolerance, floor, names)
     return report
 
 
@@ -305,6 +317,7 @@ _DESCRIPTIONS = {
     "skew_pinocchio": "Mdot - 2C skew (Pinocchio, Mdot by finite differences)",
     "skew_reference": "Mdot - 2C skew (reference, analytic Mdot)",
     "joints": "joint names of the robot and the reference",
+    **CONSTRAINT_DESCRIPTIONS,
 }
 
 
