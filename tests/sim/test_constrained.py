@@ -1,0 +1,104 @@
+"""Simulation under constraints: a four-bar's passive swing stays closed (≤ 1e-9 m), follows
+Freudenstein's position solution (≤ 1e-8 rad) and keeps its energy; the step is a pure
+function; the result is a Trajectory; refusals."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from robodyn.constraints import PointAnchor
+from robodyn.exceptions import InputError
+from robodyn.sim.constrained import constrained_rk4_step, simulate_constrained
+from tests.constraints.linkages import closed_configuration, freudenstein, load_linkage, rocker_angle
+
+
+def rocker_errors(robot, trajectory, name: str, coupler: float | None = None) -> np.ndarray:
+    """|rocker angle − Freudenstein's| along a motion, in [rad] (``coupler``: a wrong length,
+    for the negative control)."""
+    crank = trajectory.q[:, robot.joint_names.index("crank_joint")]
+    rocker = trajectory.q[:, robot.joint_names.index("rocker_joint")]
+    expected = np.array([rocker_angle(name, c) for c in crank])
+    if coupler is not None:
+        from tests.constraints import linkages
+
+        saved = linkages.FOUR_BARS[name]
+        linkages.FOUR_BARS[name] = (saved[0], coupler, saved[2], saved[3])
+        try:
+            expected = np.array([rocker_angle(name, c) for c in crank])
+        finally:
+            linkages.FOUR_BARS[name] = saved
+    return np.abs((rocker - expected + math.pi) % (2 * math.pi) - math.pi)
+
+
+def energy(robot, trajectory) -> np.ndarray:
+    return np.array(
+        [robot.kinetic_energy(q, v) + robot.potential_energy(q) for q, v in zip(trajectory.q, trajectory.v, strict=True)]
+    )
+
+
+def swing(duration: float):
+    robot = load_linkage("four_bar")
+    run = simulate_constrained(robot, closed_configuration(robot, "four_bar", 0.3), duration=duration, dt=1e-3)
+    return robot, run
+
+
+def check_swing(robot, run) -> None:
+    trajectory = run.trajectory
+    assert run.residual.max() <= 1e-9
+    assert rocker_errors(robot, trajectory, "four_bar").max() <= 1e-8
+    crank, rocker = (trajectory.q[:, robot.joint_names.index(j)] for j in ("crank_joint", "rocker_joint"))
+    assert max(abs(freudenstein("four_bar", c, r)) for c, r in zip(crank, rocker, strict=True)) < 1e-8
+    total = energy(robot, trajectory)
+    scale = np.abs(total - total.min()).max() + abs(total[0])
+    assert np.abs(total - total[0]).max() <= 1e-6 * scale
+    assert np.ptp(crank) > 1.0  # it did swing
+
+
+def test_a_passive_four_bar_stays_closed_follows_freudenstein_and_keeps_its_energy():
+    robot, run = swing(0.6)
+    check_swing(robot, run)
+    assert run.initial_correction < 1e-12
+    assert rocker_errors(robot, run.trajectory, "four_bar", coupler=0.3501).max() > 1e-5  # the checker can fail
+
+
+@pytest.mark.slow
+def test_a_passive_four_bar_stays_closed_for_ten_seconds():
+    robot, run = swing(10.0)
+    check_swing(robot, run)
+
+
+@pytest.mark.parametrize("name", ["parallelogram", "slider_crank", "four_bar_3d"])
+def test_the_other_linkages_stay_closed(name, rng):
+    robot = load_linkage(name)
+    q0 = robot.neutral_configuration() + 0.3 * rng.normal(size=robot.nq)
+    if name == "parallelogram":
+        q0 = closed_configuration(robot, name, 0.9)
+    run = simulate_constrained(robot, q0, rng.normal(size=robot.nv), duration=0.1, dt=1e-3, tau=rng.normal(size=robot.nv))
+    assert run.residual.max() <= 1e-9
+    jacobian = robot.constraint_jacobian(run.trajectory.q)
+    assert np.abs(np.einsum("nij,nj->ni", jacobian, run.trajectory.v)).max() < 1e-9
+
+
+def test_the_step_is_a_pure_function_and_the_result_a_trajectory(tmp_path):
+    robot, run = swing(0.01)
+    q, v = run.trajectory.q[0].copy(), run.trajectory.v[0].copy()
+    first = constrained_rk4_step(robot, q, v, None, 1e-3)
+    assert np.array_equal(first[0], constrained_rk4_step(robot, q, v, None, 1e-3)[0])
+    assert np.array_equal(q, run.trajectory.q[0])
+    assert np.allclose(first[0], run.trajectory.q[1], atol=0, rtol=0)
+    run.trajectory.check(robot)
+    path = run.trajectory.save(tmp_path / "swing.npz")
+    assert path.exists()
+    assert run.multipliers.shape == (len(run.trajectory), 3)
+
+
+def test_bad_steps_and_unreachable_constraints_are_refused():
+    robot = load_linkage("four_bar")
+    with pytest.raises(InputError, match="dt"):
+        simulate_constrained(robot, np.zeros(3), duration=1.0, dt=0.0)
+    far = PointAnchor("coupler", (0.35, 0, 0), None, (5.0, 0.0, 0.0))
+    with pytest.raises(InputError, match="constraints"):
+        simulate_constrained(robot, np.zeros(3), constraints=[far], duration=0.01, dt=1e-3)
