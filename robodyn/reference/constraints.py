@@ -39,7 +39,7 @@ from robodyn.reference.numeric import ReferenceRobot, _base_bias, _quaternion_ma
 RCOND = 1e-11
 
 
-def _link_frames(model: ReferenceRobot) -> dict[str, tuple[int, np.ndarray]]:
+def link_frames(model: ReferenceRobot) -> dict[str, tuple[int, np.ndarray]]:
     """Every link: the body carrying it (−1: the fixed root) and its 4×4 pose in that body's frame."""
     body_of = {body.link: index for index, body in enumerate(model.tree.bodies) if not body.rotor}
     if model.floating_base:
@@ -125,7 +125,7 @@ def bound(model: ReferenceRobot, constraints: Sequence[Constraint] | object) -> 
     """The constraints with both ends resolved on the reference, and its link frames."""
     given = as_constraints(constraints)
     check_frames(given, list(model.spec.links), model.name)
-    frames = _link_frames(model)
+    frames = link_frames(model)
     neutral = np.zeros(model.nq)
     if model.floating_base:
         neutral[6] = 1.0
@@ -195,4 +195,4 @@ def constrained_forward_dynamics(model: ReferenceRobot, q, v, tau, constraints) 
     return np.array([r[0] for r in results]), np.array([r[1] for r in results])
 
 
-__all__ = ["RCOND", "bound", "constrained_forward_dynamics", "constraint_terms", "solve_kkt", "state_rows"]
+__all__ = ["RCOND", "bound", "constrained_forward_dynamics", "constraint_terms", "link_frames", "solve_kkt", "state_rows"]
