@@ -25,6 +25,7 @@ import copyreg
 import os
 import sys
 import tempfile
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
@@ -32,13 +33,14 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from robodyn.constraints import check_frames, from_equalities
+from robodyn.common.text import printable
+from robodyn.constraints import check_frames, equality_notes, from_equalities
 from robodyn.dynamics import pickling
 from robodyn.dynamics.joint_dynamics import apply_joint_dynamics
 from robodyn.dynamics.mimic import has_mimic, mimic_expansion
 from robodyn.dynamics.options import MAX_DOF, LoadOptions, load_options
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import URDFError
+from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.normalised import normalised_urdf
 from robodyn.urdf.sources import URDFSource, locked_source, resolve_source, with_file_dynamics
 from robodyn.urdf.validation import URDFSpec, parse_urdf
@@ -126,6 +128,7 @@ def load(
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
     resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict)
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
+    _report_equalities(resolved, strict)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
     options = load_options(
@@ -143,6 +146,15 @@ def load(
         constraints=constraints,
     )
     return build_robot(resolved, options)
+
+
+def _report_equalities(resolved: URDFSource, strict: bool) -> None:
+    """Say in one line each what of a file's ``<equality>`` elements robodyn does not model
+    (:func:`robodyn.constraints.equality_notes`); ``strict`` refuses it."""
+    for note in equality_notes(resolved.equalities):
+        if strict:
+            raise URDFError(resolved.label, note)
+        warnings.warn(printable(f"{resolved.label}: {note}"), RobodynWarning, stacklevel=3)
 
 
 def rebuild(robot: Robot, *, urdf: str | None = None, label: str | None = None) -> Robot:

@@ -104,3 +104,22 @@ def test_a_connect_record_holds_the_point_where_it_is_at_the_neutral_configurati
     robot = robodyn.load(DATA / "four_bar.urdf", constraints=[anchor])
     assert np.allclose(robot.constraint_residual(robot.neutral_configuration()), 0.0, atol=1e-15)
     assert not np.allclose(robot.constraint_residual(np.array([0.4, -0.2, 0.1])), 0.0, atol=1e-3)
+
+
+def test_what_of_a_files_equalities_is_not_modelled_is_reported_or_refused(monkeypatch):
+    from dataclasses import replace
+
+    from robodyn.dynamics import loading
+    from robodyn.exceptions import RobodynWarning, URDFError
+
+    resolve = loading.resolve_source
+    records = (
+        EqualityRecord("connect", "loop", "coupler", "rocker", (0.35, 0.0, 0.0)),
+        EqualityRecord("connect", "spare", "coupler", None, active=False),
+    )
+    monkeypatch.setattr(loading, "resolve_source", lambda *a, **k: replace(resolve(*a, **k), equalities=records))
+    with pytest.warns(RobodynWarning, match="'spare'.*inactive"):
+        robot = robodyn.load(DATA / "four_bar.urdf")
+    assert robot.constraints == (PointAnchor("coupler", (0.35, 0, 0), "rocker", None, name="loop"),)
+    with pytest.raises(URDFError, match="inactive"):
+        robodyn.load(DATA / "four_bar.urdf", strict=True)
