@@ -28,7 +28,7 @@ import pinocchio as pin
 
 from robodyn.constraints import Constraint, as_constraints, check_frames
 from robodyn.constraints.algebra import Bound, End, EndKinematics, bind, stack, world_end
-from robodyn.exceptions import InputError, SingularMassMatrixError
+from robodyn.exceptions import InputError, NonFiniteResultError, SingularMassMatrixError
 
 if TYPE_CHECKING:
     from robodyn.dynamics.robot import Robot
@@ -117,6 +117,19 @@ def _per_state(function: Callable[..., tuple[np.ndarray, ...]], batch: bool, *ar
     return tuple(np.array([result[k] for result in results]) for k in range(len(results[0]))) if results else ()
 
 
+def _finite(robot: Robot, what: str, compute: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, np.ndarray]:
+    """``compute()``'s two arrays, or a :class:`NonFiniteResultError` when finite inputs
+    overflowed (an eigendecomposition of non-finite numbers included): never a NaN."""
+    try:
+        with np.errstate(all="ignore"):  # an overflow is refused below, not warned about
+            first, second = compute()
+    except np.linalg.LinAlgError:
+        raise NonFiniteResultError(robot.name, what) from None
+    if not (np.isfinite(first).all() and np.isfinite(second).all()):
+        raise NonFiniteResultError(robot.name, what)
+    return first, second
+
+
 def constraint_residual(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
     """``Φ(q)``, shape (m,) or (N, m) (see :mod:`robodyn.constraints.algebra`), in [m] / [rad]."""
     bounds = bound(robot, constraints)
@@ -182,7 +195,11 @@ def forward_dynamics(
     if robot.massless_joints:
         raise SingularMassMatrixError(robot.name, robot.massless_joints)
 
-    return _per_state(lambda *state: forward_dynamics_unchecked(robot, bounds, *state), batch, q, v, tau)  # type: ignore[return-value]
+    return _finite(
+        robot,
+        "constrained dynamics",
+        lambda: _per_state(lambda *state: forward_dynamics_unchecked(robot, bounds, *state), batch, q, v, tau),
+    )
 
 
 def forward_dynamics_unchecked(
@@ -229,7 +246,7 @@ def contact_inverse_dynamics(
         tau[unactuated] = 0.0
         return tau, multipliers
 
-    return _per_state(one, batch, q, v, a)  # type: ignore[return-value]
+    return _finite(robot, "contact inverse dynamics", lambda: _per_state(one, batch, q, v, a))
 
 
 __all__ = [

@@ -152,3 +152,13 @@ def test_contact_inverse_dynamics_refuses_an_unreachable_acceleration():
     zero = np.zeros(robot.nv)
     with pytest.raises(InputError, match="unactuated"):
         robot.contact_inverse_dynamics(robot.neutral_configuration(), zero, zero, [])
+
+
+def test_an_overflow_is_refused_never_returned():
+    from robodyn.constraints import PointAnchor
+    from robodyn.exceptions import NonFiniteResultError
+
+    robot = load_linkage("four_bar")
+    huge = [PointAnchor("coupler", (1e308, 0, 0), "rocker", (0.3, 0, 0))]
+    with pytest.raises(NonFiniteResultError):
+        robot.constrained_forward_dynamics(np.zeros(3), np.ones(3), np.zeros(3), huge)
