@@ -11,7 +11,8 @@ import numpy as np
 import pinocchio as pin
 
 import robodyn
-from robodyn.constraints import PointAnchor
+from robodyn.common.rotations import rpy_matrix
+from robodyn.constraints import FrameAnchor, PointAnchor
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "constraints"
 #: Not the default gravity: tilted, and not in the mechanisms' planes or normal to them.
@@ -70,8 +71,29 @@ def closed_configuration(robot: robodyn.Robot, name: str, crank: float) -> np.nd
     return np.array([values[joint] for joint in robot.joint_names])
 
 
+def _pinocchio_constraint(model: pin.Model, anchor) -> pin.RigidConstraintModel:
+    """Pinocchio's constraint of a point anchor (both points given: CONTACT_3D) or a weld to
+    where it is at the neutral configuration (CONTACT_6D), world-aligned."""
+    first = model.frames[model.getFrameId(anchor.frame1)]
+    second = model.frames[model.getFrameId(anchor.frame2)]
+    if isinstance(anchor, FrameAnchor):
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, pin.neutral(model))
+        local = pin.SE3(rpy_matrix(np.array(anchor.origin1[3:])), np.array(anchor.origin1[:3]))
+        world = data.oMf[model.getFrameId(anchor.frame1)] * local
+        held = second.placement * (data.oMf[model.getFrameId(anchor.frame2)].inverse() * world)
+        kind, placement1, placement2 = pin.ContactType.CONTACT_6D, first.placement * local, held
+    else:
+        kind = pin.ContactType.CONTACT_3D
+        placement1 = first.placement * pin.SE3(np.eye(3), np.array(anchor.point1))
+        placement2 = second.placement * pin.SE3(np.eye(3), np.array(anchor.point2))
+    return pin.RigidConstraintModel(
+        kind, model, first.parentJoint, placement1, second.parentJoint, placement2, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    )
+
+
 def pinocchio_constraint_dynamics(robot: robodyn.Robot, anchors, q, v, tau) -> tuple[np.ndarray, np.ndarray]:
-    """Pinocchio's ``constraintDynamics`` with 3-D point constraints (world-aligned), called directly.
+    """Pinocchio's ``constraintDynamics`` with point anchors and welds (world-aligned), called directly.
 
     For a redundant set, Pinocchio's ``λ`` carries its rounding in the redundant direction
     amplified by ``1/μ`` (about 1e-8 here): ``λ`` is returned as the least-norm multipliers
@@ -81,19 +103,7 @@ def pinocchio_constraint_dynamics(robot: robodyn.Robot, anchors, q, v, tau) -> t
     data = model.createData()
     models = pin.StdVec_RigidConstraintModel()
     for anchor in anchors:
-        first = model.frames[model.getFrameId(anchor.frame1)]
-        second = model.frames[model.getFrameId(anchor.frame2)]
-        models.append(
-            pin.RigidConstraintModel(
-                pin.ContactType.CONTACT_3D,
-                model,
-                first.parentJoint,
-                first.placement * pin.SE3(np.eye(3), np.array(anchor.point1)),
-                second.parentJoint,
-                second.placement * pin.SE3(np.eye(3), np.array(anchor.point2)),
-                pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
-            )
-        )
+        models.append(_pinocchio_constraint(model, anchor))
     datas = pin.StdVec_RigidConstraintData()
     for constraint in models:
         datas.append(constraint.createData())

@@ -162,3 +162,21 @@ def test_an_overflow_is_refused_never_returned():
     huge = [PointAnchor("coupler", (1e308, 0, 0), "rocker", (0.3, 0, 0))]
     with pytest.raises(NonFiniteResultError):
         robot.constrained_forward_dynamics(np.zeros(3), np.ones(3), np.zeros(3), huge)
+
+
+def test_a_weld_agrees_with_pinocchios_six_dimensional_constraint_on_the_weld(rng):
+    """Pinocchio's 6-D constraint holds the relative twist at the first frame (and its
+    spatial acceleration), robodyn's the velocities of the two frames' origins: the same
+    where the weld holds (Φ = 0, J v = 0), which is where they are compared."""
+    from robodyn.constraints import FrameAnchor
+    from tests.constraints.linkages import DATA, GRAVITY
+
+    weld = FrameAnchor("coupler", (0.05, 0.01, 0.0, 0.2, 0.0, 0.1), "crank", None, name="weld")
+    robot = robodyn.load(DATA / "four_bar_3d.urdf", gravity=GRAVITY, constraints=[weld])
+    welded = robot.joint_names.index("coupler_joint")
+    for _ in range(3):
+        q, v, tau = robot.random_configuration(rng), rng.normal(size=3), rng.normal(size=3)
+        q[welded] = v[welded] = 0.0
+        assert np.abs(robot.constraint_residual(q)).max() < 1e-15
+        a, lam = robot.constrained_forward_dynamics(q, v, tau)
+        assert agreement(a, lam, *pinocchio_constraint_dynamics(robot, [weld], q, v, tau)) < TOLERANCE
