@@ -71,6 +71,7 @@ def info_dict(robot: Robot) -> dict:
             {"kind": constraint.kind, "name": constraint.name, "rows": constraint.rows, "description": str(constraint)}
             for constraint in robot.constraints
         ],
+        "constraint_rank_at_neutral": robot.constraint_rank(robot.neutral_configuration()) if robot.constraints else 0,
     }
 
 
@@ -136,7 +137,9 @@ def _constraint_lines(robot: Robot) -> list[str]:
     if not constraints:
         return []
     rows = sum(constraint.rows for constraint in constraints)
-    return ["", f"constraints ({rows} rows; docs/constraints.md):"] + [f"  {printable(str(c))}" for c in constraints]
+    rank = robot.constraint_rank(robot.neutral_configuration())
+    redundant = f"; {rows - rank} redundant at the neutral configuration (λ least-norm)" if rank < rows else ""
+    return ["", f"constraints ({rows} rows{redundant}; docs/constraints.md):"] + [f"  {printable(str(c))}" for c in constraints]
 
 
 def _dynamics_lines(robot: Robot) -> list[str]:

@@ -80,8 +80,11 @@ def test_load_adds_constraints_and_a_pickled_robot_keeps_them():
 
 def test_info_lists_the_constraints():
     robot = load_linkage("four_bar")
-    assert "constraints (3 rows" in info_text(robot) and "held on (0.3, 0, 0) of link 'rocker'" in info_text(robot)
-    assert info_dict(robot)["constraints"][0]["rows"] == 3
+    text = info_text(robot)
+    # at q = 0 every bar lies on the ground line: the loop's rows have rank 1 there
+    assert "constraints (3 rows; 2 redundant at the neutral configuration" in text
+    assert "held on (0.3, 0, 0) of link 'rocker'" in text
+    assert info_dict(robot)["constraints"][0]["rows"] == 3 and info_dict(robot)["constraint_rank_at_neutral"] == 1
 
 
 def test_equality_records_become_anchors():
