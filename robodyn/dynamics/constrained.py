@@ -109,12 +109,18 @@ def state_rows(robot: Robot, bounds: tuple[Bound, ...], q: np.ndarray, v: np.nda
     return stack(bounds, _end_kinematics(robot, v), robot.nv)
 
 
-def _per_state(function: Callable[..., tuple[np.ndarray, ...]], batch: bool, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
-    """``function`` of one state, or of each row of a batch (results stacked)."""
+def _per_state(
+    robot: Robot, function: Callable[..., tuple[np.ndarray, ...]], batch: bool, *arrays: np.ndarray
+) -> tuple[np.ndarray, ...]:
+    """``function`` of one state, or of each row of a batch (results stacked; an empty
+    batch gives empty stacks of the right shapes, from one call at the neutral state)."""
     if not batch:
         return function(*arrays)
     results = [function(*row) for row in zip(*arrays, strict=True)]
-    return tuple(np.array([result[k] for result in results]) for k in range(len(results[0]))) if results else ()
+    if not results:
+        neutral = [robot.neutral_configuration(), *(np.zeros(array.shape[1]) for array in arrays[1:])]
+        return tuple(np.zeros((0, *np.shape(value))) for value in function(*neutral))
+    return tuple(np.array([result[k] for result in results]) for k in range(len(results[0])))
 
 
 def _finite(robot: Robot, what: str, compute: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, np.ndarray]:
@@ -135,7 +141,7 @@ def constraint_residual(robot: Robot, q: np.ndarray, constraints: object = None)
     bounds = bound(robot, constraints)
     (q,), batch = robot.validate(q=q)
     zeros = np.zeros(robot.nv)
-    return _per_state(lambda qi: state_rows(robot, bounds, qi, zeros)[:1], batch, q)[0]
+    return _per_state(robot, lambda qi: state_rows(robot, bounds, qi, zeros)[:1], batch, q)[0]
 
 
 def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
@@ -143,14 +149,14 @@ def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None)
     bounds = bound(robot, constraints)
     (q,), batch = robot.validate(q=q)
     zeros = np.zeros(robot.nv)
-    return _per_state(lambda qi: state_rows(robot, bounds, qi, zeros)[1:2], batch, q)[0]
+    return _per_state(robot, lambda qi: state_rows(robot, bounds, qi, zeros)[1:2], batch, q)[0]
 
 
 def constraint_drift(robot: Robot, q: np.ndarray, v: np.ndarray, constraints: object = None) -> np.ndarray:
     """``J̇(q, v) v``, shape (m,) or (N, m): the rows' accelerations at ``v̇ = 0``."""
     bounds = bound(robot, constraints)
     (q, v), batch = robot.validate(q=q, v=v)
-    return _per_state(lambda qi, vi: state_rows(robot, bounds, qi, vi)[2:], batch, q, v)[0]
+    return _per_state(robot, lambda qi, vi: state_rows(robot, bounds, qi, vi)[2:], batch, q, v)[0]
 
 
 def constraint_rank(robot: Robot, q: np.ndarray, constraints: object = None) -> int:
@@ -198,7 +204,7 @@ def forward_dynamics(
     return _finite(
         robot,
         "constrained dynamics",
-        lambda: _per_state(lambda *state: forward_dynamics_unchecked(robot, bounds, *state), batch, q, v, tau),
+        lambda: _per_state(robot, lambda *state: forward_dynamics_unchecked(robot, bounds, *state), batch, q, v, tau),
     )
 
 
@@ -246,7 +252,7 @@ def contact_inverse_dynamics(
         tau[unactuated] = 0.0
         return tau, multipliers
 
-    return _finite(robot, "contact inverse dynamics", lambda: _per_state(one, batch, q, v, a))
+    return _finite(robot, "contact inverse dynamics", lambda: _per_state(robot, one, batch, q, v, a))
 
 
 __all__ = [

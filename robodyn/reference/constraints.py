@@ -167,6 +167,9 @@ def constraint_terms(model: ReferenceRobot, q, v, constraints) -> tuple[np.ndarr
     if not batch:
         return state_rows(model, bounds, frames, q, v)
     rows = [state_rows(model, bounds, frames, qi, vi) for qi, vi in zip(q, v, strict=True)]
+    m = sum(bound.rows for bound in bounds)
+    if not rows:
+        return np.zeros((0, m)), np.zeros((0, m, model.nv)), np.zeros((0, m))
     return tuple(np.array([row[k] for row in rows]) for k in range(3))  # type: ignore[return-value]
 
 
@@ -192,6 +195,8 @@ def constrained_forward_dynamics(model: ReferenceRobot, q, v, tau, constraints) 
         results.append(solve_kkt(model.mass_matrix(qi), ti - model.nonlinear_effects(qi, vi), jacobian, drift))
     if not batch:
         return results[0]
+    if not results:
+        return np.zeros((0, model.nv)), np.zeros((0, sum(bound.rows for bound in bounds)))
     return np.array([r[0] for r in results]), np.array([r[1] for r in results])
 
 

@@ -180,3 +180,12 @@ def test_a_weld_agrees_with_pinocchios_six_dimensional_constraint_on_the_weld(rn
         assert np.abs(robot.constraint_residual(q)).max() < 1e-15
         a, lam = robot.constrained_forward_dynamics(q, v, tau)
         assert agreement(a, lam, *pinocchio_constraint_dynamics(robot, [weld], q, v, tau)) < TOLERANCE
+
+
+def test_an_empty_batch_gives_empty_stacks():
+    robot = load_linkage("four_bar")
+    empty = np.zeros((0, 3))
+    a, lam = robot.constrained_forward_dynamics(empty, empty, empty)
+    assert a.shape == (0, 3) and lam.shape == (0, 3)
+    assert robot.constraint_jacobian(empty).shape == (0, 3, 3)
+    assert robodyn.check_robot(robot, samples=0).passed
