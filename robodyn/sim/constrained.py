@@ -122,7 +122,11 @@ def constrained_rk4_step(
         ``(q, v)`` at ``t + dt``, on the constraints.
     """
     bounds = constrained.bound(robot, constraints)
-    (q, v), _ = robot.validate(q=q, v=v)
+    (q, v), batch = robot.validate(q=q, v=v)
+    if batch:
+        raise InputError("q", "one state (1-D arrays): a step is of one state", f"shape {q.shape}")
+    if tau is not None and not callable(tau):
+        (tau,), _ = robot.validate(tau=tau)
     model = robot.model
 
     def rate(time: float, qi: np.ndarray, vi: np.ndarray) -> np.ndarray:
@@ -180,6 +184,8 @@ def simulate_constrained(
     steps = round(duration / dt)
     if steps > MAX_STEPS:
         raise InputError("duration", f"at most {MAX_STEPS} steps of dt", f"{steps} steps")
+    if np.ndim(q0) != 1:
+        raise InputError("q0", "one configuration (a 1-D array)", f"shape {np.shape(q0)}")
     (q, v), _ = robot.validate(q=q0, v=np.zeros(robot.nv) if v0 is None else v0)
     if not callable(tau) and tau is not None:
         (tau,), _ = robot.validate(tau=tau)

@@ -99,6 +99,10 @@ def test_bad_steps_and_unreachable_constraints_are_refused():
     robot = load_linkage("four_bar")
     with pytest.raises(InputError, match="dt"):
         simulate_constrained(robot, np.zeros(3), duration=1.0, dt=0.0)
+    with pytest.raises(InputError, match="q0"):
+        simulate_constrained(robot, np.zeros((2, 3)), duration=0.01)
+    with pytest.raises(InputError, match="tau"):
+        constrained_rk4_step(robot, np.zeros(3), np.zeros(3), [1.0, 2.0], 1e-3)
     far = PointAnchor("coupler", (0.35, 0, 0), None, (5.0, 0.0, 0.0))
     with pytest.raises(InputError, match="constraints"):
         simulate_constrained(robot, np.zeros(3), constraints=[far], duration=0.01, dt=1e-3)
