@@ -106,3 +106,18 @@ def test_bad_steps_and_unreachable_constraints_are_refused():
     far = PointAnchor("coupler", (0.35, 0, 0), None, (5.0, 0.0, 0.0))
     with pytest.raises(InputError, match="constraints"):
         simulate_constrained(robot, np.zeros(3), constraints=[far], duration=0.01, dt=1e-3)
+
+
+def test_solo12_held_by_its_feet_and_the_contact_torques_stands_still():
+    import robodyn
+    from robodyn.constraints import PointContact
+    from tests.dynamics.test_constrained import FEET
+
+    robot = robodyn.load("solo12", gravity=(0.3, -0.2, -9.7))
+    q = robot.floating_configuration([0.1, -0.2, 0.3], [0.05, -0.04, 0.7], np.tile([0.1, 0.8, -1.6], 4))
+    feet = [PointContact(foot, friction=0.7, plane_point=robot.frame_position(q, foot)) for foot in FEET]  # feet on the ground
+    zero = np.zeros(robot.nv)
+    tau, _ = robot.contact_inverse_dynamics(q, zero, zero, feet)
+    run = simulate_constrained(robot, q, constraints=feet, duration=0.03, dt=1e-3, tau=tau)
+    assert np.abs(run.trajectory.q - q).max() < 1e-9 and np.abs(run.trajectory.v).max() < 1e-9
+    assert abs(np.linalg.norm(run.trajectory.q[-1, 3:7]) - 1.0) < 1e-12
