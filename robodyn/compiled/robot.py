@@ -19,76 +19,46 @@ checked path. Batches run across rows on ``threads`` native threads, the GIL rel
 
 from __future__ import annotations
 
-import dataclasses
-from pathlib import Path
 from types import ModuleType
-from typing import cast
 
 import numpy as np
 
-from robodyn.compiled import build, codegen, derivatives
-from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
-from robodyn.compiled.kinematics import build_frame
+from robodyn.compiled import build
+from robodyn.compiled.cache import SNAP, robot_key
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.robot import Robot
-from robodyn.equations import c_printer, compact, newton_euler, program, sharing
-from robodyn.equations.compact import derive_compact
-from robodyn.equations.newton_euler import BaseSymbols, derive_newton_euler, floating_tree
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
-from robodyn.reference import symbolic as reference_symbolic
-from robodyn.reference import tree as reference_tree
-from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.tree import build_tree
 
 _ndarray = np.ndarray
-#: Rotation entries this close to 0, ±1, ±½, ... are taken as exact: float rounding only
-#: (cos(π/2) = 6e-17, sin(π) = 1.2e-16), so the compiled model is the URDF's. Not more: URDFs
-#: write π to 12 digits (kinova's 3.14159265359, sin = -2e-13), and snapping that to 0 moved
-#: kinova's M by 8e-14 and, through cond(M) ~ 1e4, its forward dynamics by 5e-10.
-SNAP = 1e-15
 _QUANTITIES = {"tau": "tau", "mass": "M", "nle": "C v + G", "gravity": "G", "fd": "a"}
 
 
-def _generator_source() -> str:
-    """The code that turns a URDF into kernels (part of the key: a change there, by anyone,
-    must not reuse kernels generated before it)."""
-    modules = (codegen, c_printer, program, sharing, newton_euler, compact, reference_tree, reference_symbolic)
-    # cast: these modules are loaded from source files, so __file__ is set
-    sources = [Path(cast(str, module.__file__)).read_text(encoding="utf-8") for module in modules]
-    return "".join(sources) + codegen.TRIG.read_text(encoding="utf-8")  # the kernels' own sin and cos
-
-
-def robot_key(robot: Robot) -> str:
-    """The cache key of a robot's generated kernels: its URDF text, gravity, the armature
-    given to :func:`robodyn.load` (the file's is in the text) and the generator."""
-    gravity = ",".join(repr(float(g)) for g in robot.gravity_vector)
-    armature = repr(tuple(robot.options.armature))
-    return build.digest(robot.urdf, gravity, armature, CODEGEN_VERSION, f"compact snap={SNAP}", _generator_source())
-
-
 def generate_kernels(robot: Robot) -> str:
-    """The C kernels of a robot (the slow part: a sympy derivation).
+    """The C kernels of a robot, printed from its programs
+    (:func:`robodyn.compiled.programs.dynamics_programs`: the slow part, a sympy derivation,
+    done once per robot key).
 
     A floating base is the tree's body 0, free (:func:`robodyn.equations.newton_euler.floating_tree`).
 
     Raises:
         CompileError: For joints the reference does not map.
     """
-    tree = build_tree(robot.spec, robot.urdf, floating_base=robot.floating_base)
-    base = BaseSymbols.make() if robot.floating_base else None
-    if robot.floating_base:
-        tree = floating_tree(tree)
-    names = [name for name in robot.joint_names if not (robot.floating_base and name == robot.joint_names[0])]
-    if sorted(tree.joint_names) != sorted(names):
-        raise CompileError(robot.name, "the reference tree and the Pinocchio model disagree on the joints")
-    column = [tree.joint_names.index(name) for name in names]
-    selection = tree.selection[:, column]  # bodies x robot coordinates
-    count = len(tree.bodies)
-    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
-    reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
-    equations = derive_compact(reference, snap=SNAP, free_base=base)
-    tau = derive_newton_euler(reference, snap=SNAP, free_base=base)
-    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), tau).source()
+    from robodyn.compiled.codegen import KernelWriter  # sympy and the generator: only now
+    from robodyn.compiled.programs import dynamics_programs, robot_bodies
+
+    bodies = robot_bodies(robot)
+    programs = dynamics_programs(robot)
+    return KernelWriter(programs.compact, bodies.selection, bodies.offset, coordinate_parents(robot), programs.tau).source()
+
+
+def robot_kernels(robot: Robot) -> str:
+    """The robot's kernels: cached under its key, else generated (and cached)."""
+    key = robot_key(robot)
+    kernels = build.cached_kernels(key)
+    if kernels is None:
+        kernels = generate_kernels(robot)
+        build.store_kernels(key, kernels)
+    return kernels
 
 
 def coordinate_parents(robot: Robot) -> list[int]:
@@ -132,14 +102,7 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     threads = check_threads(threads)
     if robot.nv == 0:
         raise CompileError(robot.name, "it has no moving joints")
-    build.find_compiler()  # fail early, before the slow derivation
-    key = robot_key(robot)
-    with build.locked(key):
-        kernels = build.cached_kernels(key)
-        if kernels is None:
-            kernels = generate_kernels(robot)
-            build.store_kernels(key, kernels)
-        module = build.build_module(kernels, label=robot.name)
+    module = build.robot_module(robot_key(robot), lambda: robot_kernels(robot), label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached kernels do not match the robot; clear the cache folder")
     return CompiledRobot(robot, module, threads=threads)
@@ -252,9 +215,9 @@ class CompiledRobot:
         module = self.__dict__.get("_derivative_module")
         if module is None:
             _fixed_base_only(self.robot, "derivatives")
-            key = robot_key(self.robot)
-            kernels = build.cached_kernels(key) or generate_kernels(self.robot)
-            module = derivatives.derivative_module(self.robot, key=key, kernels=kernels, snap=SNAP)
+            from robodyn.compiled import derivatives  # the generator: only when first asked for
+
+            module = derivatives.derivative_module(self.robot, kernels=robot_kernels(self.robot))
             self.__dict__["_derivative_module"] = module
         return module
 
@@ -279,7 +242,7 @@ class CompiledRobot:
         result = function(q, v, a, self.threads)
         if result.__class__ is tuple:
             return result
-        return derivatives.checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
+        return _derivatives_checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
 
     def forward_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
@@ -304,7 +267,7 @@ class CompiledRobot:
         result = function(q, v, tau, self.threads)
         if result.__class__ is tuple:
             return result
-        return derivatives.checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
+        return _derivatives_checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
 
     # ---- frame kinematics (robodyn.compiled.kinematics): one small module a frame ----------
 
@@ -317,6 +280,8 @@ class CompiledRobot:
         modules = self.__dict__.setdefault("_frames", {})
         if frame not in modules:
             _fixed_base_only(self.robot, "frame kinematics")
+            from robodyn.compiled.kinematics import build_frame  # the generator: only when first asked for
+
             modules[frame] = build_frame(self.robot, frame, robot_key(self.robot))
         return modules[frame]
 
@@ -355,7 +320,17 @@ class CompiledRobot:
         return bias if angular else bias[..., :3].copy()
 
 
+def _derivatives_checked(function, robot: Robot, threads: int, kind: str, **named: np.ndarray):
+    """:func:`robodyn.compiled.derivatives.checked` (its module imported only on this path)."""
+    from robodyn.compiled import derivatives
+
+    return derivatives.checked(function, robot, threads, kind, **named)
+
+
 def _fixed_base_only(robot: Robot, what: str) -> None:
     """Refuse a floating base for the compiled ``what`` (its kernels model fixed bases)."""
     if robot.floating_base:
         raise CompileError(robot.name, f"it has a floating base; the compiled {what} model fixed-base robots")
+
+
+__all__ = ["SNAP", "CompiledRobot", "compile", "coordinate_parents", "generate_kernels", "robot_kernels", "robot_key"]

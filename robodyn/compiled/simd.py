@@ -35,16 +35,14 @@ function the kernels call that the vector printer passes through, or kernels cal
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from pathlib import Path
 from types import ModuleType
 
-from robodyn.equations.c_printer import vector_lines
 from robodyn.exceptions import InputError
 
-#: Bumped whenever the generated vector code changes meaning (it is part of the module's source).
-SIMD_VERSION = "5"
 #: The environment variable that forces an instruction set.
 ENVIRONMENT = "ROBODYN_SIMD"
 #: (name, lanes, GCC target): the x86-64 variants, narrowest first.
@@ -53,7 +51,7 @@ _TEMPLATE = Path(__file__).with_name("simd.c")
 _KERNELS = ("gravity", "nle", "mass", "mass_nle", "tau")
 _HEADER = re.compile(r"^static void rd_(\w+)\((.*)\) \{$")
 _COMMON = """
-/* ---- SIMD blocks (robodyn.compiled.simd, version {version}) ---- */
+/* ---- SIMD blocks (robodyn.compiled.simd) ---- */
 #if defined(__x86_64__) && defined(__GNUC__)
 #define RD_SIMD 1
 #pragma STDC FP_CONTRACT OFF
@@ -162,6 +160,8 @@ def vector_trig(vector: str, lanes: int, attribute: str) -> list[str]:
 def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lanes: int, target: str) -> list[str] | None:
     """One instruction set's vector kernels and blocks, or None if a kernel has a statement
     the vector printer does not take."""
+    from robodyn.equations.c_printer import vector_lines  # sympy: only when a module is built
+
     vector = f"rds{lanes}"
     attribute = f'__attribute__((target("{target}")))'
     out = [f"typedef double {vector} __attribute__((vector_size({8 * lanes})));"]
@@ -211,13 +211,15 @@ def _wanted() -> str:
     return wanted
 
 
-def _cpu_flags() -> set[str] | None:
-    """The CPU's feature flags (Linux ``/proc/cpuinfo``), or None where they cannot be read."""
+@functools.lru_cache(maxsize=1)
+def _cpu_flags() -> frozenset[str] | None:
+    """The CPU's feature flags (Linux ``/proc/cpuinfo``, read once a process), or None where
+    they cannot be read."""
     try:
         with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
             for line in info:
                 if line.startswith("flags"):
-                    return set(line.split(":", 1)[1].split())
+                    return frozenset(line.split(":", 1)[1].split())
     except OSError:
         pass
     return None
@@ -255,7 +257,7 @@ def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | Non
     sizes = re.findall(r"^#define RD_N[QV] (\d+)$", kernels, flags=re.MULTILINE)
     if functions is None or parents is None or not variants or len(set(sizes)) != 1 or "RD_TRIG_DEFINE(" not in kernels:
         return ""  # the blocks read q with the stride of v: not for a configuration of another size
-    out = [_COMMON.format(version=SIMD_VERSION)]
+    out = [_COMMON.format()]
     for name, lanes, target in variants:
         variant = _variant(functions, parents, name, lanes, target)
         if variant is None:
