@@ -51,7 +51,9 @@ if TYPE_CHECKING:
 #: half the time.
 FLAGS = ("-O1", "-fPIC", "-shared", "-pthread", "-fno-math-errno", "-std=c99")
 _RUNTIME = Path(__file__).with_name("runtime.c")
-_PRELUDE = """#define PY_SSIZE_T_CLEAN
+#: The C every module shares (the tree LDLᵀ, the thread pool), placed before its kernels.
+CORE = Path(__file__).with_name("core.c")
+_INCLUDES = """#define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
@@ -59,6 +61,11 @@ _PRELUDE = """#define PY_SSIZE_T_CLEAN
 #include <pthread.h>
 #include <string.h>
 """
+
+
+def prelude() -> str:
+    """What precedes every module's kernels: the includes and ``core.c``."""
+    return _INCLUDES + CORE.read_text(encoding="utf-8") + "\n"
 
 
 def find_compiler() -> str:
@@ -94,7 +101,7 @@ def toolchain_key(compiler: str) -> str:
 def module_source(kernels: str, module_name: str) -> str:
     """The full C source: includes, the robot's kernels, the runtime and the module init."""
     init = f'PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module("{module_name}"); }}\n'
-    return _PRELUDE + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
+    return prelude() + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
 
 
 def _suffix() -> str:
@@ -208,7 +215,7 @@ def build_module(kernels: str, *, label: str, vector: bool = True) -> ModuleType
             return simd.configure(build_module(kernels + variants, label=label, vector=False))
     compiler = find_compiler()
     runtime = _RUNTIME.read_text(encoding="utf-8")
-    name = "rd_" + digest(kernels, runtime, toolchain_key(compiler))
+    name = "rd_" + digest(kernels, runtime, CORE.read_text(encoding="utf-8"), toolchain_key(compiler))
     target = cache_dir() / f"{name}{_suffix()}"
     if not target.exists():
         _compile(compiler, module_source(kernels, name), cache_dir(), target, label)
@@ -264,12 +271,12 @@ def build_extension(kernels: str, runtime: str, *, init: str, label: str, key: s
     """
     compiler = find_compiler()
     base = _RUNTIME.read_text(encoding="utf-8")
-    parts = (key, init) if key is not None else (kernels, base, runtime, init)
+    parts = (key, init) if key is not None else (kernels, base, runtime, init, prelude())
     name = "rd_" + digest(*parts, toolchain_key(compiler))
     target = cache_dir() / f"{name}{_suffix()}"
     if not target.exists():
         entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
-        source = _PRELUDE + kernels + "\n" + base + "\n" + runtime + "\n" + entry
+        source = prelude() + kernels + "\n" + base + "\n" + runtime + "\n" + entry
         _compile(compiler, source, cache_dir(), target, label)
     return _import(name, target)
 

@@ -272,6 +272,22 @@ class KernelWriter:
             *self._vector_lines(self._compact, "hb", "nle", nle),
         ]
 
+    def _tree_tables(self) -> list[str]:
+        """``rd_depth`` and ``rd_ancestor``: each coordinate's ancestors, nearest first (the
+        tree LDLᵀ's walk, ``core.c``)."""
+        ancestors = []
+        for i in range(self.size):
+            chain, j = [], self.parents[i]
+            while j >= 0:
+                chain.append(j)
+                j = self.parents[j]
+            ancestors.append(chain)
+        rows = ", ".join("{" + ", ".join(str(j) for j in chain or [0]) + "}" for chain in ancestors)
+        return [
+            f"static const int rd_depth[RD_NV] = {{{', '.join(str(len(chain)) for chain in ancestors)}}};",
+            f"static const int rd_ancestor[RD_NV][RD_NV] = {{{rows}}};",
+        ]
+
     def source(self) -> str:
         """The kernels' C source (no includes; ``runtime.c`` is appended after it)."""
         e, nb, n = self.equations, self.bodies, self.size
@@ -284,6 +300,7 @@ class KernelWriter:
             f"#define RD_NQ {n + (self.base is not None)}",
             f"#define RD_QUATERNION_TOLERANCE {c_number(QUATERNION_TOLERANCE)}",
             f"static const int rd_parent[RD_NV] = {{{', '.join(str(p) for p in self.parents)}}};",
+            *self._tree_tables(),
             trig_source(),
             "static void rd_gravity(const double *q, double *g) {",
             *self._body(list(e.G) + self._base_entries("G"), velocity=False),

@@ -128,7 +128,7 @@ def build_frame(robot: Robot, frame: str, robot_key: str) -> ModuleType:
                 kernels = frame_source(derive_frame(robot, frame))
                 build.store_kernels(key, kernels)
             init = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return rd_frame_module("{name}"); }}\n'
-            source = build._PRELUDE + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
+            source = build.prelude() + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
             build._compile(compiler, source, build.cache_dir(), target, robot.name)
     module = build._import(name, target)
     if module.info()["nv"] != robot.nv:

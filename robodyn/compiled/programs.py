@@ -21,14 +21,16 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import os
 import pickle
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TypeVar, cast
 
 import numpy as np
 
-from robodyn.common.files import atomic_write_bytes
 from robodyn.compiled.cache import SNAP, cache_dir, digest, robot_key
 from robodyn.dynamics.robot import Robot
 from robodyn.equations.compact import CompactDynamics, derive_compact
@@ -100,10 +102,27 @@ def derived(robot: Robot, name: str, derive: Callable[[], T]) -> T:
             value = pickle.load(handle)
     except Exception:
         value = derive()
-        with contextlib.suppress(OSError, pickle.PicklingError, RecursionError, TypeError, AttributeError):
-            atomic_write_bytes(path, pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
+        _store(path, value)
     _DERIVED[key] = value
     return cast(T, value)
+
+
+def _store(path: Path, value: object) -> None:
+    """Pickle ``value`` to ``path`` under a temporary name renamed into place (never half a
+    file); a read-only cache folder or an object that does not pickle is skipped."""
+    try:
+        data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(prefix=".prog-", dir=path.parent)
+    except (OSError, pickle.PicklingError, RecursionError, TypeError, AttributeError):
+        return
+    try:
+        with os.fdopen(handle, "wb") as file:
+            file.write(data)
+        os.replace(temporary, path)
+    except OSError:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
 
 
 def dynamics_programs(robot: Robot) -> DynamicsPrograms:

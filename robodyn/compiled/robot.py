@@ -26,6 +26,7 @@ import numpy as np
 from robodyn.compiled import build
 from robodyn.compiled.cache import SNAP, robot_key
 from robodyn.dynamics.batch import check_threads
+from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
 
@@ -85,7 +86,13 @@ def coordinate_parents(robot: Robot) -> list[int]:
 
 
 def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
-    """Compile a robot's dynamics to native code (cached: fast the second time).
+    """Compile a robot's dynamics to native code (cached: microseconds the second time).
+
+    The module is found by the robot's key (its URDF text, load options and the generator's
+    source), without generating any source: from this process's memory (about 10 µs), else
+    the cache folder (milliseconds, no sympy imported); only a robot never compiled is
+    derived (seconds) and built. ``robot.model`` is read-only to the compiled robot (see
+    :class:`CompiledRobot`).
 
     Args:
         robot: From :func:`robodyn.load` (mimic joints and a floating base are fine).
@@ -109,10 +116,15 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
 
 
 class CompiledRobot:
-    """A robot's dynamics in compiled C; the methods and shape rules of :class:`robodyn.Robot`.
+    """A robot's dynamics in compiled C; the methods and shape rules of :class:`robodyn.Robot`
+    (both satisfy :class:`robodyn.dynamics.protocol.Dynamics`, with the same signatures).
 
     Attributes:
-        robot: The Pinocchio-backed robot it was compiled from (names, limits, checks).
+        robot: The Pinocchio-backed robot it was compiled from (names, limits, checks). Its
+            ``model`` is read-only here: the kernels come from the robot's URDF text and load
+            options (its cache key, :func:`robodyn.compiled.cache.robot_key`), so a change
+            made to ``robot.model`` reaches neither the kernels nor the key; load the robot
+            again with the change (``robodyn.load(..., armature=..., gravity=...)``) instead.
         name, nq, nv, joint_names: As the robot's.
         threads: Native threads for batches.
         module: The loaded extension module (``tau``, ``mass``, ``nle``, ``gravity``, ``fd``,
@@ -152,21 +164,26 @@ class CompiledRobot:
             raise CompileError(self.name, f"the compiled {kind} refused checked inputs (status {result})")
         raise NonFiniteResultError(self.name, _QUANTITIES[kind])
 
-    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, joint_friction: bool = False) -> np.ndarray:
         """Joint torques ``tau = M(q) a + C(q, v) v + G(q)``.
 
         Args:
             q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
             v: Velocity, shape (nv,) or (N, nv).
             a: Acceleration, shape (nv,) or (N, nv).
+            joint_friction: Add the torques the joints' friction takes, ``b v + f sign(v)``
+                (as :meth:`robodyn.Robot.inverse_dynamics`, the same formula on the result).
 
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
         result = self._tau(q, v, a, self.threads)
-        if result.__class__ is _ndarray:
-            return result
-        return self._checked("tau", self._tau, result, q=q, v=v, a=a)
+        if result.__class__ is not _ndarray:
+            result = self._checked("tau", self._tau, result, q=q, v=v, a=a)
+        if joint_friction:
+            robot = self.robot
+            result = result - friction_torque(robot.joint_damping, robot.joint_friction, np.asarray(v, dtype=float))
+        return result
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """Joint-space inertia matrix ``M(q)``, symmetric, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg]."""
@@ -181,6 +198,12 @@ class CompiledRobot:
         if result.__class__ is _ndarray:
             return result
         return self._checked("nle", self._nle, result, q=q, v=v)
+
+    def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Coriolis and centrifugal matrix ``C(q, v)`` with ``dM/dt = C + Cᵀ``, shape (nv, nv)
+        or (N, nv, nv): the robot's own (:meth:`robodyn.Robot.coriolis_matrix`, Pinocchio; the
+        compiled programs give ``C v``, not ``C``)."""
+        return self.robot.coriolis_matrix(q, v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
         """Generalised gravity ``G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""

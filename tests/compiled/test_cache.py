@@ -28,23 +28,26 @@ def rp_arm():
 
 def test_the_key_hashes_every_module_the_generator_imports():
     """Found by walking the packages, not by a list: every robodyn module the code generator,
-    the derivatives, the frames and the export load is hashed, and the C files too."""
-    import robodyn.compiled.derivatives
-    import robodyn.compiled.kinematics
-    import robodyn.compiled.programs
-    import robodyn.export.source  # noqa: F401 - loads what the export prints with
-
+    the derivatives, the frames and the export load (in a fresh process) is hashed, and the
+    C files too."""
+    script = textwrap.dedent(
+        """
+        import sys
+        import robodyn.compiled.robot, robodyn.compiled.codegen, robodyn.compiled.programs
+        import robodyn.compiled.derivatives, robodyn.compiled.kinematics, robodyn.export.source
+        for name, module in sorted(sys.modules.items()):
+            if name.startswith("robodyn") and getattr(module, "__file__", None):
+                print(name, module.__file__)
+        """
+    )
+    output = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True, cwd=ROOT)
+    loaded = dict(line.split(" ", 1) for line in output.stdout.splitlines())
     hashed = set(cache.generator_files())
-    loaded = {
-        name: Path(module.__file__).resolve()
-        for name, module in sys.modules.items()
-        if name.startswith("robodyn") and getattr(module, "__file__", None)
-    }
-    missing = sorted(name for name, path in loaded.items() if path not in hashed and name not in _OUTSIDE)
+    missing = sorted(name for name, path in loaded.items() if Path(path).resolve() not in hashed and name not in _OUTSIDE)
     assert missing == []
     assert len(loaded) > 40  # negative control: the generator's imports were really loaded
     folder = Path(compiled_robot.__file__).parent
-    for c_file in ("runtime.c", "simd.c", "trig.c", "derivatives.c", "frames.c"):
+    for c_file in ("runtime.c", "simd.c", "trig.c", "derivatives.c", "frames.c", "core.c"):
         assert folder / c_file in hashed
 
 
