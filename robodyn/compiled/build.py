@@ -33,6 +33,7 @@ import subprocess
 import sys
 import sysconfig
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -258,44 +259,48 @@ def _import(name: str, path: Path) -> ModuleType:
     return module
 
 
-def build_extension(kernels: str, runtime: str, *, init: str, label: str, key: str | None = None) -> ModuleType:
-    """Like :func:`build_module`, for a module of its own: ``runtime`` (more C, with its own
-    method table) follows ``runtime.c``, and the module is made by the C function ``init``
-    (``PyObject *init(const char *name)``). Used by the derivative kernels
-    (:mod:`robodyn.compiled.derivatives`), built only when first asked for. With ``key``
-    (the kernels' cache key) the module is named by the key, else by the source.
+def keyed_extension(key: str, source: Callable[[], str], *, init: str, label: str, prefix: str = "rd_") -> ModuleType:
+    """A module of its own (the derivative kernels, a frame's kinematics) named by a cache
+    key: found by the key alone, ``source()`` (its C after the includes and ``core.c``) asked
+    for only to build it. The module is made by the C function ``init``
+    (``PyObject *init(const char *name)``).
 
     Raises:
         CompilerNotFoundError: No C compiler.
         CompileError: The compiler failed (its first error line is quoted).
     """
     compiler = find_compiler()
-    base = _RUNTIME.read_text(encoding="utf-8")
-    parts = (key, init) if key is not None else (kernels, base, runtime, init, prelude())
-    name = "rd_" + digest(*parts, toolchain_key(compiler))
+    name = prefix + digest(key, init, toolchain_key(compiler))
     target = cache_dir() / f"{name}{_suffix()}"
     if not target.exists():
-        entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
-        source = prelude() + kernels + "\n" + base + "\n" + runtime + "\n" + entry
-        _compile(compiler, source, cache_dir(), target, label)
+        with locked(key):
+            if not target.exists():
+                entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
+                _compile(compiler, prelude() + source() + "\n" + entry, cache_dir(), target, label)
     return _import(name, target)
+
+
+def runtime_source() -> str:
+    """``runtime.c``'s text (what follows a robot's kernels in every module of its dynamics)."""
+    return _RUNTIME.read_text(encoding="utf-8")
 
 
 __all__ = [
     "FLAGS",
-    "build_extension",
     "build_module",
     "cache_dir",
     "cached_kernels",
     "digest",
     "find_compiler",
     "is_compiled",
+    "keyed_extension",
     "loaded",
     "locked",
     "lookup",
     "module_path",
     "robot_key",
     "robot_module",
+    "runtime_source",
     "store_kernels",
     "toolchain_key",
 ]

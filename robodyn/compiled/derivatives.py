@@ -40,7 +40,7 @@ loops (``make bench``, sections ``compiled-derivatives-*``, has the numbers).
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import ModuleType
 from typing import cast
@@ -275,28 +275,32 @@ class TangentWriter:
         return results
 
 
-def derivative_module(robot: Robot, *, kernels: str) -> ModuleType:
-    """The robot's derivative module, generated and built on first use, then cached.
+def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType:
+    """The robot's derivative module: found by the robot's key, else generated, built and cached.
 
     The Newton–Euler program differentiated is the robot's cached one
     (:func:`robodyn.compiled.programs.dynamics_programs`, the one its ``tau`` kernel prints).
 
     Args:
         robot: A fixed-base robot the compiled engine took.
-        kernels: Its kernels' C source (the module calls ``rd_mass``, ``rd_mass_nle``).
+        kernels: Gives its kernels' C source (the module calls ``rd_mass``, ``rd_mass_nle``);
+            asked for only for a build.
 
     Raises:
         CompileError: If the build fails or the module does not match the robot.
     """
     own = "derivatives-" + robot_key(robot)
-    with build.locked(own):
-        source = build.cached_kernels(own)
-        if source is None:
+
+    def source() -> str:
+        derivative = build.cached_kernels(own)
+        if derivative is None:
             bodies = robot_bodies(robot)
-            source = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset).source()
-            build.store_kernels(own, source)
-        runtime = _RUNTIME.read_text(encoding="utf-8")
-        module = build.build_extension(kernels + "\n" + source, runtime, init="rdd_module", label=robot.name, key=own)
+            derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset).source()
+            build.store_kernels(own, derivative)
+        runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
+        return kernels() + "\n" + derivative + "\n" + runtime
+
+    module = build.keyed_extension(own, source, init="rdd_module", label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached derivative kernels do not match the robot; clear the cache folder")
     return module

@@ -18,7 +18,6 @@ controllers (:mod:`robodyn.compiled.controllers`).
 
 from __future__ import annotations
 
-import sysconfig
 from pathlib import Path
 from types import ModuleType
 
@@ -117,20 +116,16 @@ def build_frame(robot: Robot, frame: str, robot_key: str) -> ModuleType:
         FrameError: Unknown frame. CompileError, CompilerNotFoundError: As :func:`robodyn.compile`.
     """
     robot.frame_id(frame)  # refuse an unknown frame before any work
-    compiler = build.find_compiler()
     key = "frame-" + frame_key(robot_key, frame)
-    name = "rdf_" + build.digest(key, build.toolchain_key(compiler))
-    target = build.cache_dir() / f"{name}{sysconfig.get_config_var('EXT_SUFFIX') or '.so'}"
-    if not target.exists():  # the source is generated (or read) only for a build
-        with build.locked(key):
-            kernels = build.cached_kernels(key)
-            if kernels is None:
-                kernels = frame_source(derive_frame(robot, frame))
-                build.store_kernels(key, kernels)
-            init = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return rd_frame_module("{name}"); }}\n'
-            source = build.prelude() + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
-            build._compile(compiler, source, build.cache_dir(), target, robot.name)
-    module = build._import(name, target)
+
+    def source() -> str:  # asked for only to build the module
+        kernels = build.cached_kernels(key)
+        if kernels is None:
+            kernels = frame_source(derive_frame(robot, frame))
+            build.store_kernels(key, kernels)
+        return kernels + "\n" + _RUNTIME.read_text(encoding="utf-8")
+
+    module = build.keyed_extension(key, source, init="rd_frame_module", label=robot.name, prefix="rdf_")
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached frame kernels do not match the robot; clear the cache folder")
     return module

@@ -240,7 +240,7 @@ class CompiledRobot:
             _fixed_base_only(self.robot, "derivatives")
             from robodyn.compiled import derivatives  # the generator: only when first asked for
 
-            module = derivatives.derivative_module(self.robot, kernels=robot_kernels(self.robot))
+            module = derivatives.derivative_module(self.robot, kernels=lambda: robot_kernels(self.robot))
             self.__dict__["_derivative_module"] = module
         return module
 
