@@ -109,14 +109,14 @@ def _suffix() -> str:
     return sysconfig.get_config_var("EXT_SUFFIX") or ".so"
 
 
-def module_path(key: str, compiler: str, *, vector: bool = True) -> Path:
+def module_path(key: str, compiler: str) -> Path:
     """Where the module of a robot key is (or would be) for this compiler, flags, ABI and
     SIMD variants (:func:`robodyn.compiled.simd.build_variants`): no source needed.
 
     Raises:
         InputError: ``$ROBODYN_SIMD`` names no instruction set.
     """
-    variants = " ".join(name for name, _, _ in simd.build_variants()) if vector else ""
+    variants = " ".join(name for name, _, _ in simd.build_variants())
     return cache_dir() / f"rd_{digest(key, 'simd=' + variants, toolchain_key(compiler))}{_suffix()}"
 
 
@@ -156,7 +156,7 @@ def is_compiled(robot: Robot) -> bool:
     return lookup(robot) is not None
 
 
-def robot_module(key: str, kernels, *, label: str) -> ModuleType:
+def robot_module(key: str, kernels: Callable[[], str], *, label: str) -> ModuleType:
     """The module of a robot key: loaded by this process, else cached, else built from
     ``kernels()`` (called only then: the generated kernels, cached or derived). The SIMD
     variants' source is generated only for a build; a build whose variants the compiler
