@@ -24,7 +24,6 @@
 #define RD_NQ RD_NV /* a floating base's q has one entry more than v (its quaternion) */
 #endif
 #define RD_CAPSULE "robodyn.compiled.kernels"
-#define RD_MIN_ROWS_PER_THREAD 64
 
 typedef struct {
     int nv;
@@ -54,37 +53,10 @@ static int rd_q_ok(const double *q) {
     return 1;
 }
 
-/* M = Lᵀ D L in place, L following the tree (Featherstone's LTDL: no fill-in when parents
- * precede children): 3 if M is not positive definite. */
-static int rd_ldl_factor(double *M) {
-    const int n = RD_NV;
-    for (int k = n - 1; k >= 0; --k) {
-        const double d = M[k * n + k];
-        if (!(d > 0.0) || !isfinite(d)) return 3;
-        for (int i = rd_parent[k]; i >= 0; i = rd_parent[i]) {
-            const double x = M[k * n + i] / d;
-            for (int j = i; j >= 0; j = rd_parent[j]) M[i * n + j] -= M[k * n + j] * x;
-            M[k * n + i] = x;
-        }
-    }
-    return 0;
-}
-/* b -> M⁻¹ b with the factor of rd_ldl_factor. */
-static void rd_ldl_apply(const double *M, double *b) {
-    const int n = RD_NV;
-    for (int i = n - 1; i >= 0; --i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= M[i * n + j] * b[i];
-    for (int i = 0; i < n; ++i) b[i] /= M[i * n + i];
-    for (int i = 0; i < n; ++i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= M[i * n + j] * b[j];
-}
-
-/* Solve M x = b in place (b -> x), M destroyed; 3 if M is not positive definite. */
-static int rd_ldl_solve(double *M, double *b) {
-    if (rd_ldl_factor(M)) return 3;
-    rd_ldl_apply(M, b);
-    return 0;
-}
+/* The tree LDLᵀ on doubles (core.c's RD_LDL_DEFINE): rd_ldl_factor, rd_ldl_apply,
+ * rd_ldl_apply_columns, rd_ldl_solve. */
+static inline int rd_pivot_bad(double d) { return !(d > 0.0) || !isfinite(d); }
+RD_LDL_DEFINE(__attribute__((unused)) static, rd_, double)
 
 /* Forward dynamics of one state, no checks: 0, or 3 for a singular mass matrix. */
 static int rd_fd_raw(const double *q, const double *v, const double *tau, double *a) {
@@ -128,19 +100,18 @@ typedef struct {
     int nin, out_size;
     const double *in[3];
     double *out;
-    Py_ssize_t begin, end;
-    int status;
     rd_row block; /* SIMD: `lanes` rows at once (robodyn.compiled.simd), or NULL */
     int lanes;
 } rd_job;
 
-static void *rd_run(void *arg) {
-    rd_job *job = (rd_job *)arg;
+/* Rows [begin, end) of a batch (core.c's rd_range, run by its thread pool rd_parallel). */
+static int rd_rows(const void *work, Py_ssize_t begin, Py_ssize_t end) {
+    const rd_job *job = (const rd_job *)work;
     int worst = 0;
     const double *in[3] = {0, 0, 0};
-    Py_ssize_t r = job->begin;
+    Py_ssize_t r = begin;
     if (job->block) /* blocks of `lanes` rows; a failing block's rows again one by one (their exact statuses) */
-        for (; r + job->lanes <= job->end; r += job->lanes) {
+        for (; r + job->lanes <= end; r += job->lanes) {
             for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * (k ? RD_NV : RD_NQ);
             if (!job->block(in, job->out + r * job->out_size)) continue;
             for (Py_ssize_t s = r; s < r + job->lanes; ++s) {
@@ -149,40 +120,10 @@ static void *rd_run(void *arg) {
                 if (status > worst) worst = status;
             }
         }
-    for (; r < job->end; ++r) {
+    for (; r < end; ++r) {
         for (int k = 0; k < job->nin; ++k) in[k] = job->in[k] + r * (k ? RD_NV : RD_NQ);
         const int status = job->row(in, job->out + r * job->out_size);
         if (status > worst) worst = status;
-    }
-    job->status = worst;
-    return NULL;
-}
-
-#define RD_MAX_THREADS 256
-
-static int rd_parallel(rd_job *base, Py_ssize_t rows, long threads) {
-    if (threads > RD_MAX_THREADS) threads = RD_MAX_THREADS;
-    if (threads > rows / RD_MIN_ROWS_PER_THREAD) threads = (long)(rows / RD_MIN_ROWS_PER_THREAD);
-    if (threads < 1) threads = 1;
-    rd_job jobs[RD_MAX_THREADS];
-    pthread_t ids[RD_MAX_THREADS];
-    int started[RD_MAX_THREADS];
-    const Py_ssize_t unit = base->block ? base->lanes : 1, blocks = rows / unit; /* whole blocks a thread */
-    for (long k = 0; k < threads; ++k) {
-        jobs[k] = *base;
-        jobs[k].begin = blocks * k / threads * unit;
-        jobs[k].end = k + 1 == threads ? rows : blocks * (k + 1) / threads * unit;
-        started[k] = 0;
-    }
-    for (long k = 1; k < threads; ++k) started[k] = pthread_create(&ids[k], NULL, rd_run, &jobs[k]) == 0;
-    rd_run(&jobs[0]);
-    int worst = jobs[0].status;
-    for (long k = 1; k < threads; ++k) {
-        if (started[k])
-            pthread_join(ids[k], NULL);
-        else
-            rd_run(&jobs[k]); /* could not start a thread: do its rows here */
-        if (jobs[k].status > worst) worst = jobs[k].status;
     }
     return worst;
 }
@@ -245,7 +186,7 @@ static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_r
     if (matrix) dims[out_nd++] = RD_NV;
     PyObject *out = PyArray_SimpleNew(out_nd, dims, NPY_DOUBLE);
     if (!out) return NULL;
-    rd_job job = {row, nin, matrix ? RD_NV * RD_NV : RD_NV, {0, 0, 0}, (double *)PyArray_DATA((PyArrayObject *)out), 0, rows, 0};
+    rd_job job = {row, nin, matrix ? RD_NV * RD_NV : RD_NV, {0, 0, 0}, (double *)PyArray_DATA((PyArrayObject *)out), NULL, 1};
     for (int k = 0; k < nin; ++k) job.in[k] = (const double *)PyArray_DATA((PyArrayObject *)args[k]);
     rd_simd_block(&job);
     int status;
@@ -253,7 +194,7 @@ static PyObject *rd_entry(PyObject *const *args, Py_ssize_t nargs, int nin, rd_r
         status = row(job.in, job.out);
     } else {
         Py_BEGIN_ALLOW_THREADS
-        status = rd_parallel(&job, rows, threads);
+        status = rd_parallel(rd_rows, &job, rows, job.block ? job.lanes : 1, threads);
         Py_END_ALLOW_THREADS
     }
     if (status) {
