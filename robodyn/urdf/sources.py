@@ -15,52 +15,19 @@ import re
 import stat
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from robodyn.exceptions import RobodynWarning, UnknownRobotError, URDFError
 from robodyn.urdf import zoo
 from robodyn.urdf.edit import lock_joints
-from robodyn.urdf.equality import EqualityRecord
+from robodyn.urdf.mjcf import mjcf_source
 from robodyn.urdf.models import GENERATED
 from robodyn.urdf.packages import PackageLookup, package_lookup
+from robodyn.urdf.source_type import URDFSource
 from robodyn.urdf.validation import Problem, URDFSpec, lint_urdf, parse_urdf
 from robodyn.urdf.xacro_files import expand_xacro, is_xacro_text
 from robodyn.urdf.xmltext import parse_number
-
-
-@dataclass(frozen=True)
-class URDFSource:
-    """A URDF document and where it came from.
-
-    Attributes:
-        text: The URDF document.
-        name: A short name for the robot (zoo or generated name, file stem, ``"robot"``).
-        label: Where it came from, for messages: a path, a robot name or ``"<string>"``.
-        path: The file it was read from, if any.
-        floating_base: Whether the robot is floating by default (zoo robots that walk or fly).
-        package_dirs: Where ``package://`` paths resolve: the zoo's folders, or (files
-            and text) the package lookup (:class:`~robodyn.urdf.packages.PackageLookup`,
-            a tuple of folders that also knows ``packages=`` and ``$ROS_PACKAGE_PATH``).
-        file_format: What the user's file was: ``"urdf"``, ``"xacro"`` (``text`` is its
-            expansion) or ``"mjcf"`` (``text`` is the URDF robodyn's MJCF reader wrote).
-        equalities: Equality constraints the file declares (MJCF ``<equality>``), as
-            records :mod:`robodyn.constraints` turns into the robot's constraints.
-    """
-
-    text: str
-    name: str
-    label: str
-    path: Path | None = None
-    floating_base: bool = False
-    package_dirs: tuple[Path, ...] = field(default_factory=tuple)
-    file_format: str = "urdf"
-    equalities: tuple[EqualityRecord, ...] = ()
-
-    @property
-    def mesh_context(self) -> dict:
-        """Keyword arguments locating mesh files (for :func:`robodyn.urdf.validation.parse_urdf`)."""
-        return {"base_dir": self.path.parent if self.path is not None else None, "package_dirs": self.package_dirs}
 
 
 def robot_names() -> list[str]:
@@ -188,8 +155,6 @@ def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
             "first (e.g. 'gz sdf -p model.sdf > model.urdf')",
         )
     if tag == "mujoco":
-        from robodyn.urdf.mjcf import mjcf_source
-
         return mjcf_source(source, strict=reading.strict, lookup=reading.lookup)
     source = replace(source, package_dirs=reading.lookup)
     is_xacro = source.path is not None and source.path.suffix == ".xacro"
