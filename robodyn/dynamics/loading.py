@@ -117,7 +117,9 @@ def load(
         RobodynWarning: For what ``strict=True`` refuses.
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
-    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict)
+    resolved = resolve_source(
+        source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict, max_dof=max_dof
+    )
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)

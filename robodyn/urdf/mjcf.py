@@ -54,7 +54,7 @@ from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.mjcf_bodies import free_joint, read_body
 from robodyn.urdf.mjcf_geoms import set_total_mass
 from robodyn.urdf.mjcf_settings import check_option, read_compiler, read_defaults
-from robodyn.urdf.mjcf_state import MjcfRobot
+from robodyn.urdf.mjcf_state import DEFAULT_MAX_DOF, Census, MjcfRobot
 from robodyn.urdf.source_type import URDFSource
 from robodyn.urdf.xmltext import parse_xml
 
@@ -72,8 +72,15 @@ UNSUPPORTED = {
 REFUSED = ("include", "frame", "replicate", "attach")
 
 
-def mjcf_source(source: URDFSource, *, strict: bool, lookup: PackageLookup) -> URDFSource:
+def mjcf_source(source: URDFSource, *, strict: bool, lookup: PackageLookup, max_dof: int | None = None) -> URDFSource:
     """The source of an MJCF document, as the URDF robodyn reads it (see the module).
+
+    Args:
+        source: The MJCF document.
+        strict: Refuse what is otherwise reported.
+        lookup: The package lookup the robot's source carries.
+        max_dof: Most degrees of freedom (:class:`~robodyn.urdf.mjcf_state.Census`; default
+            :data:`~robodyn.urdf.mjcf_state.DEFAULT_MAX_DOF`), counted while parsing.
 
     Raises:
         URDFError: One sentence naming what cannot be read.
@@ -81,7 +88,8 @@ def mjcf_source(source: URDFSource, *, strict: bool, lookup: PackageLookup) -> U
     Warns:
         RobodynWarning: One line per kind of element the dynamics does not take.
     """
-    root = parse_xml(source.text, source.label, root="mujoco")
+    census = Census(source.label, DEFAULT_MAX_DOF if max_dof is None else max_dof)
+    root = parse_xml(source.text, source.label, root="mujoco", on_event=census)
     base_dir = source.path.parent if source.path is not None else None
     robot = read_mjcf(root, source.label, base_dir)
     for kind, names in robot.notes.items():
@@ -111,11 +119,10 @@ def read_mjcf(root: ET.Element, label: str, base_dir: Path | None) -> MjcfRobot:
         if root.find(f".//{tag}") is not None:
             raise URDFError(label, f"MJCF <{tag}> is not read by robodyn (expand it into one file first)")
     compiler = read_compiler(root, label, base_dir)
-    defaults: dict[str, dict[str, dict[str, str]]] = {}
-    for default in root.findall("default"):
-        read_defaults(default, "main", {}, defaults)
+    defaults = read_defaults(root, label)
     urdf = ET.Element("robot", name=root.get("model") or "mjcf")
     robot = MjcfRobot(label, compiler, defaults, urdf)
+    robot.bodies = {body.get("name", "") for body in root.iter("body")}
     for tag, kind in UNSUPPORTED.items():
         for section in root.findall(tag):
             for index, element in enumerate(section):

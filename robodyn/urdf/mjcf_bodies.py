@@ -16,7 +16,10 @@ import numpy as np
 from robodyn.exceptions import URDFError
 from robodyn.urdf.mjcf_geoms import write_link
 from robodyn.urdf.mjcf_state import MjcfRobot, attributes
-from robodyn.urdf.mjcf_values import angle, floats, number, pose, text, translation, unit, write_origin
+from robodyn.urdf.mjcf_values import AUTO, BOOLEAN, angle, floats, keyword, number, pose, text, translation, unit, write_origin
+
+#: MuJoCo's ``mjMINVAL``: the least mass of a moving body.
+MIN_MASS = 1e-15
 
 
 def free_joint(robot: MjcfRobot, body: ET.Element) -> ET.Element | None:
@@ -43,13 +46,16 @@ def read_body(robot: MjcfRobot, body: ET.Element, parent: str | None, placement:
     values = attributes(robot, body, childclass)
     name = robot.unique(body.get("name") or f"body{len(robot.names)}", "an MJCF body")
     where = f'body "{name}"'
-    if body.get("mocap") == "true":
+    if keyword(robot.label, where, "mocap", values.get("mocap", "false"), BOOLEAN) == "true":
         raise URDFError(robot.label, f"{where}: mocap bodies are not read by robodyn")
-    if float(values.get("gravcomp", "0") or 0) != 0:
+    if number(robot.label, f"{where}: gravcomp", values.get("gravcomp", "0")) != 0:
         robot.note("body gravcomp settings", name)
     frame = placement @ pose(robot, where, values) if parent is not None else np.eye(4)
     link, offset = _read_joints(robot, body, name, parent, frame, childclass)
-    write_link(robot, body, name, link, offset, childclass)
+    mass = write_link(robot, body, name, link, offset, childclass)
+    moves = parent is None or any(node.tag in ("joint", "freejoint") for node in body)
+    if moves and not mass >= MIN_MASS:
+        raise URDFError(robot.label, f"{where} moves and has no mass (MuJoCo refuses a moving body under {MIN_MASS} kg)")
     for child in body.findall("body"):
         read_body(robot, child, name, translation(-offset), childclass)
 
@@ -88,7 +94,7 @@ def _read_joints(
 
 def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: str, child: str, origin: np.ndarray) -> None:
     where = f'joint "{name}"'
-    kind = values.get("type", "hinge")
+    kind = keyword(robot.label, where, "type", values.get("type", "hinge"), ("hinge", "slide", "ball", "free"))
     if kind not in ("hinge", "slide"):
         reason = "ball joints are not read by robodyn" if kind == "ball" else f"a {kind} joint is not read here"
         raise URDFError(robot.label, f"{where}: {reason} (hinge, slide and a free top body are)")
@@ -118,7 +124,7 @@ def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: st
 
 
 def _range(robot: MjcfRobot, where: str, values: dict[str, str], kind: str) -> tuple[float, float]:
-    limited = values.get("limited", "auto")
+    limited = keyword(robot.label, where, "limited", values.get("limited", "auto"), AUTO)
     if limited == "auto":
         limited = "true" if robot.compiler.autolimits and "range" in values else "false"
     if limited != "true":

@@ -12,40 +12,44 @@ from pathlib import Path
 import numpy as np
 
 from robodyn.exceptions import URDFError
-from robodyn.urdf.mjcf_state import Compiler, MjcfRobot
-from robodyn.urdf.mjcf_values import floats, number
+from robodyn.urdf.mjcf_state import ACTUATOR_TAGS, Compiler, MjcfRobot
+from robodyn.urdf.mjcf_values import AUTO, BOOLEAN, floats, keyword, number
 
 
 def read_compiler(root: ET.Element, label: str, base_dir: Path | None) -> Compiler:
     """The ``<compiler>`` settings (the last element's value of each, as MuJoCo).
 
     Raises:
-        URDFError: For settings robodyn does not read.
+        URDFError: For settings robodyn does not read, and values MuJoCo refuses.
     """
     settings: dict[str, str] = {}
     for node in root.findall("compiler"):
         settings.update(node.attrib)
     for option in ("boundmass", "boundinertia"):
-        if option in settings and number(label, "compiler", settings[option]) > 0:
+        if option in settings and number(label, f"<compiler {option}>", settings[option]) > 0:
             raise URDFError(label, f"<compiler {option}> rescales masses or inertias: robodyn does not read it")
-    if settings.get("balanceinertia", "false") == "true" or settings.get("coordinate", "local") != "local":
+    balance = keyword(label, "<compiler>", "balanceinertia", settings.get("balanceinertia", "false"), BOOLEAN)
+    autolimits = keyword(label, "<compiler>", "autolimits", settings.get("autolimits", "true"), BOOLEAN)
+    coordinate = keyword(label, "<compiler>", "coordinate", settings.get("coordinate", "local"), ("local", "global"))
+    if balance == "true" or coordinate != "local":
         raise URDFError(label, "<compiler balanceinertia / coordinate=global> is not read by robodyn")
-    angle = settings.get("angle", "degree")
-    if angle not in ("degree", "radian"):
-        raise URDFError(label, f"<compiler angle={angle!r}> must be 'degree' or 'radian'")
+    angle = keyword(label, "<compiler>", "angle", settings.get("angle", "degree"), ("degree", "radian"))
     sequence = settings.get("eulerseq", "xyz")
     if len(sequence) != 3 or any(axis not in "xyzXYZ" for axis in sequence):
         raise URDFError(label, f"<compiler eulerseq={sequence!r}> must be three of x, y, z, X, Y, Z")
     meshdir = settings.get("meshdir", settings.get("assetdir"))
     folder = None if base_dir is None else (base_dir / meshdir if meshdir else base_dir)
+    groups = floats(label, "<compiler inertiagrouprange>", settings.get("inertiagrouprange", "0 5"), 2)
+    if any(group != int(group) for group in groups):
+        raise URDFError(label, f"<compiler inertiagrouprange={settings['inertiagrouprange']!r}> must be two integers")
     return Compiler(
         angle == "degree",
         sequence,
-        settings.get("autolimits", "true") == "true",
-        settings.get("inertiafromgeom", "auto"),
+        autolimits == "true",
+        keyword(label, "<compiler>", "inertiafromgeom", settings.get("inertiafromgeom", "auto"), AUTO),
         folder,
-        settings.get("inertiagrouprange", "0 5"),
-        number(label, "compiler settotalmass", settings.get("settotalmass", "-1")),
+        (int(groups[0]), int(groups[1])),
+        number(label, "<compiler settotalmass>", settings.get("settotalmass", "-1")),
     )
 
 
@@ -57,12 +61,41 @@ def check_option(root: ET.Element, robot: MjcfRobot) -> None:
             robot.note("<option gravity> settings", f"gravity {gravity.strip()} (pass gravity= instead)")
 
 
-def read_defaults(node: ET.Element, name: str, inherited: dict[str, dict[str, str]], table: dict) -> None:
-    """Every class of a ``<default>`` tree: attributes by element kind, inherited downwards."""
+def read_defaults(root: ET.Element, label: str) -> dict[str, dict[str, dict[str, str]]]:
+    """Every class of the ``<default>`` trees: attributes by element kind, inherited
+    downwards, as MuJoCo reads them.
+
+    The top ``<default>`` is the class ``main`` (several top elements add to it); a nested
+    class needs a name no other class has.
+
+    Raises:
+        URDFError: For a renamed top class, a nested class without a name, or a name
+            defined twice (MuJoCo refuses each).
+    """
+    table: dict[str, dict[str, dict[str, str]]] = {}
+    for top in root.findall("default"):
+        name = top.get("class", "main")
+        if name != "main":
+            raise URDFError(label, f"the top <default> is the class 'main' and cannot be renamed ({name!r}), as in MuJoCo")
+        _read_class(top, "main", table.get("main", {}), table, label)
+    return table
+
+
+def _read_class(node: ET.Element, name: str, inherited: dict[str, dict[str, str]], table: dict, label: str) -> None:
     own = {kind: dict(values) for kind, values in inherited.items()}
     for child in node:
         if child.tag != "default":
-            own.setdefault(child.tag, {}).update(child.attrib)
+            own.setdefault(_kind(child.tag), {}).update(child.attrib)
     table[name] = own
     for child in node.findall("default"):
-        read_defaults(child, child.get("class") or name, own, table)
+        nested = child.get("class")
+        if not nested:
+            raise URDFError(label, f"a <default> inside class {name!r} has no class name (MuJoCo refuses an empty one)")
+        if nested in table:
+            raise URDFError(label, f"the <default> class {nested!r} is defined twice (MuJoCo refuses a repeated name)")
+        _read_class(child, nested, own, table, label)
+
+
+def _kind(tag: str) -> str:
+    """The kind of defaults an element sets (every actuator element: ``general``)."""
+    return "general" if tag in ACTUATOR_TAGS else tag

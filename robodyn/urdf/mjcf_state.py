@@ -12,6 +12,56 @@ from pathlib import Path
 
 from robodyn.exceptions import URDFError
 
+#: Actuator elements (their defaults are one kind, ``general``, as in MuJoCo).
+ACTUATOR_TAGS = ("general", "motor", "position", "velocity", "intvelocity", "damper", "cylinder", "muscle", "adhesion")
+#: Most degrees of freedom read by default: robodyn's ``max_dof`` default
+#: (:data:`robodyn.dynamics.options.MAX_DOF`), for readers not given one.
+DEFAULT_MAX_DOF = 300
+#: Most bodies read per allowed degree of freedom (welded bodies have none).
+BODIES_PER_DOF = 20
+
+
+@dataclass
+class Census:
+    """Bodies and joints counted while the XML is parsed, refused above the caps before
+    the whole tree is built (a 50 MB file of bodies is refused in the first of them).
+
+    The caps: at most ``max_dof`` degrees of freedom (each joint in ``<worldbody>`` counts
+    at least one, a free joint six, a ball three) and at most
+    ``BODIES_PER_DOF * max_dof`` bodies.
+    """
+
+    label: str
+    max_dof: int
+    bodies: int = 0
+    dofs: int = 0
+    _world: int = 0
+    _default: int = 0
+
+    def __call__(self, event: str, element: ET.Element) -> None:
+        step = 1 if event == "start" else -1
+        if element.tag in ("worldbody", "default"):
+            self._world += step if element.tag == "worldbody" else 0
+            self._default += step if element.tag == "default" else 0
+            return
+        if event != "start" or not self._world or self._default:
+            return
+        if element.tag == "body":
+            self.bodies += 1
+            if self.bodies > BODIES_PER_DOF * self.max_dof:
+                limit = BODIES_PER_DOF * self.max_dof
+                raise URDFError(
+                    self.label,
+                    f"the MJCF has more than {limit} bodies ({BODIES_PER_DOF} × max_dof={self.max_dof}; max_dof= raises it)",
+                )
+        elif element.tag in ("joint", "freejoint"):
+            kind = "free" if element.tag == "freejoint" else element.get("type", "hinge")
+            self.dofs += {"free": 6, "ball": 3}.get(kind, 1)
+            if self.dofs > self.max_dof:
+                raise URDFError(
+                    self.label, f"the MJCF has more than {self.max_dof} degrees of freedom, above the limit (max_dof= raises it)"
+                )
+
 
 @dataclass(frozen=True)
 class Compiler:
@@ -22,7 +72,7 @@ class Compiler:
     autolimits: bool = True
     inertiafromgeom: str = "auto"
     meshdir: Path | None = None
-    inertiagroups: str = "0 5"
+    inertiagroups: tuple[int, int] = (0, 5)
     total_mass: float = -1.0
 
 
@@ -38,6 +88,7 @@ class MjcfRobot:
         names: Link and joint names used so far (each URDF name once).
         notes: What the dynamics leaves out, by kind: one warning line each.
         floating: Whether the top body has a free joint.
+        bodies: The names of every body of the file (sites with one of them are renamed).
     """
 
     label: str
@@ -47,6 +98,7 @@ class MjcfRobot:
     names: set[str] = field(default_factory=set)
     notes: dict[str, list[str]] = field(default_factory=dict)
     floating: bool = False
+    bodies: set[str] = field(default_factory=set)
 
     def note(self, kind: str, name: str) -> None:
         """Report ``name`` under ``kind`` (one warning line a kind)."""
@@ -73,6 +125,7 @@ def attributes(robot: MjcfRobot, node: ET.Element, childclass: str) -> dict[str,
     name = node.get("class") or childclass
     if name not in robot.defaults and name != "main":
         raise URDFError(robot.label, f"MJCF class {name!r} is not defined in <default>")
-    merged = dict(robot.defaults.get(name, {}).get(node.tag, {}))
+    kind = "general" if node.tag in ACTUATOR_TAGS else node.tag
+    merged = dict(robot.defaults.get(name, {}).get(kind, {}))
     merged.update(node.attrib)
     return merged

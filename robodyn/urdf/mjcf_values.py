@@ -34,6 +34,22 @@ def number(label: str, where: str, text: str) -> float:
     return value
 
 
+def keyword(label: str, where: str, attribute: str, text: str, allowed: tuple[str, ...]) -> str:
+    """A keyword spelled as MuJoCo spells it (case matters: ``"True"`` is not ``"true"``).
+
+    Raises:
+        URDFError: If ``text`` is not one of ``allowed``, naming the attribute.
+    """
+    if text not in allowed:
+        raise URDFError(label, f"{where}: {attribute}={text!r} must be one of {', '.join(allowed)} (as MuJoCo spells them)")
+    return text
+
+
+#: MuJoCo's boolean keywords, and those with ``auto``.
+BOOLEAN = ("true", "false")
+AUTO = ("true", "false", "auto")
+
+
 def floats(label: str, where: str, text: str, count: int) -> np.ndarray:
     """Exactly ``count`` finite numbers, shape (count,).
 

@@ -129,6 +129,7 @@ class _Reading:
     lookup: PackageLookup
     strict: bool
     interpret: bool = True
+    max_dof: int | None = None
 
 
 _ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
@@ -155,7 +156,7 @@ def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
             "first (e.g. 'gz sdf -p model.sdf > model.urdf')",
         )
     if tag == "mujoco":
-        return mjcf_source(source, strict=reading.strict, lookup=reading.lookup)
+        return mjcf_source(source, strict=reading.strict, lookup=reading.lookup, max_dof=reading.max_dof)
     source = replace(source, package_dirs=reading.lookup)
     is_xacro = source.path is not None and source.path.suffix == ".xacro"
     if is_xacro or (tag == "robot" and is_xacro_text(source.text)):
@@ -180,6 +181,7 @@ def resolve_source(
     packages: Mapping[str, str] | None = None,
     strict: bool = False,
     interpret: bool = True,
+    max_dof: int | None = None,
 ) -> URDFSource:
     """Find the URDF a source names.
 
@@ -194,6 +196,8 @@ def resolve_source(
         strict: Refuse MJCF elements robodyn cannot take instead of warning.
         interpret: Expand a xacro, convert an MJCF file and refuse SDF (``False``: the text
             as read, for telling reading errors from the document's own problems).
+        max_dof: Most degrees of freedom of an MJCF file, counted while it is read
+            (default 300, :data:`robodyn.dynamics.options.MAX_DOF`).
 
     Raises:
         URDFError: If a file cannot be read, is not a regular file or is too large, a
@@ -201,7 +205,7 @@ def resolve_source(
         UnknownRobotError: If a name is neither a robot nor an existing file.
     """
     limit = max_urdf_bytes(max_bytes)
-    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret)
+    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret, max_dof=max_dof)
     if isinstance(source, os.PathLike):
         return _read_file(Path(source), limit, reading)
     if not isinstance(source, str):
