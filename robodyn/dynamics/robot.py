@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from robodyn.dynamics import configurations, derivatives, energies, frames, kinematics
+from robodyn.dynamics import configurations, derivatives, energies, frames, kinematics, mujoco_state
 from robodyn.dynamics import regressor as identification
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
@@ -108,7 +108,7 @@ class Robot:
         self.joints: list[JointInfo] = joint_infos(model, spec)
         self.joint_names: list[str] = [joint.name for joint in self.joints]
         self.dofs: tuple[Dof, ...] = robot_dofs(
-            self.joints, damping=model.damping, friction=model.friction, armature=model.armature
+            self.joints, damping=model.damping, friction=model.friction, armature=model.armature, actuated=source.actuated
         )
         self.configuration_names: list[str] = configuration_names(self.joints)
 
@@ -512,6 +512,20 @@ class Robot:
     def inertial_parameters(self, *, friction: bool = False) -> np.ndarray:
         """The URDF's standard inertial parameters π, in :meth:`regressor`'s order."""
         return identification.inertial_parameters(self.handle, friction=friction)
+
+    # ----------------------------------------------------------------------------------
+    # MuJoCo's state (robodyn.dynamics.mujoco_state)
+    # ----------------------------------------------------------------------------------
+    def to_mujoco(self, q: np.ndarray, v: np.ndarray | None = None, *, joint_names=None) -> tuple:
+        """MuJoCo's ``(qpos, qvel)`` of ``(q, v)``: joints by name in MuJoCo's order, ``ref``
+        offsets, the free joint's w-first quaternion and world linear velocity. See
+        :mod:`robodyn.dynamics.mujoco_state` (``joint_names``: MuJoCo's order, needed
+        unless the robot was read from MJCF)."""
+        return mujoco_state.to_mujoco(self, q, v, joint_names=joint_names)
+
+    def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names=None) -> tuple:
+        """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`)."""
+        return mujoco_state.from_mujoco(self, qpos, qvel, joint_names=joint_names)
 
 
 def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:

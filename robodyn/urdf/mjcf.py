@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import warnings
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -53,7 +54,9 @@ from robodyn.common.text import printable
 from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.mjcf_bodies import free_joint, read_body
 from robodyn.urdf.mjcf_geoms import set_total_mass
-from robodyn.urdf.mjcf_settings import check_option, read_compiler, read_defaults
+from robodyn.urdf.mjcf_includes import expand_includes
+from robodyn.urdf.mjcf_physics import read_actuators, read_equalities, read_option
+from robodyn.urdf.mjcf_settings import read_compiler, read_defaults
 from robodyn.urdf.mjcf_state import DEFAULT_MAX_DOF, Census, MjcfRobot
 from robodyn.urdf.source_type import URDFSource
 from robodyn.urdf.xmltext import parse_xml
@@ -62,17 +65,20 @@ if TYPE_CHECKING:
     from robodyn.urdf.packages import PackageLookup
 
 #: Elements whose effect on the motion robodyn does not model: one warning line each.
-UNSUPPORTED = {
-    "tendon": "tendons",
-    "equality": "equality constraints",
-    "actuator": "actuators (their transmissions and gains)",
-    "contact": "contact pairs and excludes",
-}
+UNSUPPORTED = {"tendon": "tendons", "contact": "contact pairs and excludes"}
 #: Elements refused outright.
-REFUSED = ("include", "frame", "replicate", "attach")
+REFUSED = ("frame", "replicate", "attach")
 
 
-def mjcf_source(source: URDFSource, *, strict: bool, lookup: PackageLookup, max_dof: int | None = None) -> URDFSource:
+def mjcf_source(
+    source: URDFSource,
+    *,
+    strict: bool,
+    lookup: PackageLookup,
+    max_dof: int | None = None,
+    read_file: Callable[[Path], str] | None = None,
+    max_bytes: int = 64 * 1024 * 1024,
+) -> URDFSource:
     """The source of an MJCF document, as the URDF robodyn reads it (see the module).
 
     Args:
@@ -81,6 +87,8 @@ def mjcf_source(source: URDFSource, *, strict: bool, lookup: PackageLookup, max_
         lookup: The package lookup the robot's source carries.
         max_dof: Most degrees of freedom (:class:`~robodyn.urdf.mjcf_state.Census`; default
             :data:`~robodyn.urdf.mjcf_state.DEFAULT_MAX_DOF`), counted while parsing.
+        read_file: Reads an included file (regular files, the size cap); ``None``: no includes.
+        max_bytes: Most bytes of included text in all.
 
     Raises:
         URDFError: One sentence naming what cannot be read.
@@ -90,27 +98,39 @@ def mjcf_source(source: URDFSource, *, strict: bool, lookup: PackageLookup, max_
     """
     census = Census(source.label, DEFAULT_MAX_DOF if max_dof is None else max_dof)
     root = parse_xml(source.text, source.label, root="mujoco", on_event=census)
+    expand_includes(root, label=source.label, path=source.path, read_file=read_file, max_bytes=max_bytes, census=census)
     base_dir = source.path.parent if source.path is not None else None
     robot = read_mjcf(root, source.label, base_dir)
-    for kind, names in robot.notes.items():
-        shown = ", ".join(printable(name) for name in names[:8]) + (", ..." if len(names) > 8 else "")
-        message = f"{source.label}: MJCF {kind} are not part of robodyn's dynamics and are left out ({shown})"
-        if strict:
-            raise URDFError(source.label, f"MJCF {kind} are not part of robodyn's dynamics ({shown}); strict=True refuses")
-        warnings.warn(message, RobodynWarning, stacklevel=4)
-    text = ET.tostring(robot.urdf, encoding="unicode")
+    _report(robot, source.label, strict)
     return replace(
         source,
-        text=text,
+        text=ET.tostring(robot.urdf, encoding="unicode"),
         name=robot.urdf.get("name") or source.name,
         floating_base=robot.floating,
         package_dirs=lookup,
         file_format="mjcf",
+        equalities=robot.equalities,
+        gravity=robot.gravity,
+        actuated=None if robot.actuated is None else tuple(sorted(robot.actuated)),
+        joint_offsets=tuple(robot.refs.items()),
     )
 
 
+def _report(robot: MjcfRobot, label: str, strict: bool) -> None:
+    """One warning line per kind of what the dynamics leaves out, and per reading that
+    differs from MuJoCo's (``strict``: refused)."""
+    lines = [(f"MJCF {kind} are not part of robodyn's dynamics", names) for kind, names in robot.notes.items()]
+    lines += [(f"MJCF {sentence}", names) for sentence, names in robot.remarks.items()]
+    for text, names in lines:
+        shown = ", ".join(printable(name) for name in names[:8]) + (", ..." if len(names) > 8 else "")
+        if strict:
+            raise URDFError(label, f"{text} ({shown}); strict=True refuses")
+        left_out = " and are left out" if text.endswith("dynamics") else ""
+        warnings.warn(f"{label}: {text}{left_out} ({shown})", RobodynWarning, stacklevel=5)
+
+
 def read_mjcf(root: ET.Element, label: str, base_dir: Path | None) -> MjcfRobot:
-    """Read a ``<mujoco>`` element into the URDF of the same robot.
+    """Read a ``<mujoco>`` element (its includes expanded) into the URDF of the same robot.
 
     Raises:
         URDFError: For what cannot be read (see the module).
@@ -118,31 +138,42 @@ def read_mjcf(root: ET.Element, label: str, base_dir: Path | None) -> MjcfRobot:
     for tag in REFUSED:
         if root.find(f".//{tag}") is not None:
             raise URDFError(label, f"MJCF <{tag}> is not read by robodyn (expand it into one file first)")
-    compiler = read_compiler(root, label, base_dir)
-    defaults = read_defaults(root, label)
-    urdf = ET.Element("robot", name=root.get("model") or "mjcf")
-    robot = MjcfRobot(label, compiler, defaults, urdf)
+    robot = MjcfRobot(
+        label,
+        read_compiler(root, label, base_dir),
+        read_defaults(root, label),
+        ET.Element("robot", name=root.get("model") or "mjcf"),
+    )
     robot.bodies = {body.get("name", "") for body in root.iter("body")}
     for tag, kind in UNSUPPORTED.items():
         for section in root.findall(tag):
             for index, element in enumerate(section):
                 robot.note(kind, element.get("name") or f"<{element.tag}> #{index + 1}")
-    check_option(root, robot)
+    robot.gravity = read_option(root, robot)
+    read_actuators(root, robot)
+    _read_world(root, robot)
+    for joint in sorted(set(robot.efforts) - robot.joints):
+        raise URDFError(label, f"an MJCF actuator drives joint {joint!r}, which the model does not have")
+    robot.equalities = read_equalities(root, robot)
+    if robot.compiler.total_mass > 0:
+        set_total_mass(robot.urdf, robot.compiler.total_mass)
+    return robot
+
+
+def _read_world(root: ET.Element, robot: MjcfRobot) -> None:
+    """The bodies of ``<worldbody>``: one free top body, or bodies welded to the world."""
     world = root.find("worldbody")
     bodies = [] if world is None else world.findall("body")
     if not bodies:
-        raise URDFError(label, "the MJCF <worldbody> has no <body>: there is no robot to read")
+        raise URDFError(robot.label, "the MJCF <worldbody> has no <body>: there is no robot to read")
     free = [body for body in bodies if free_joint(robot, body) is not None]
     if free and len(bodies) > 1:
-        raise URDFError(label, "a free-floating MJCF body must be the only body in <worldbody> (robodyn reads one robot)")
+        raise URDFError(robot.label, "a free-floating MJCF body must be the only body in <worldbody> (robodyn reads one robot)")
     if free:
         robot.floating = True
         read_body(robot, bodies[0], None, np.eye(4), "main")
-    else:
-        robot.unique("world", "the MJCF worldbody")
-        ET.SubElement(urdf, "link", name="world")
-        for body in bodies:
-            read_body(robot, body, "world", np.eye(4), "main")
-    if compiler.total_mass > 0:
-        set_total_mass(urdf, compiler.total_mass)
-    return robot
+        return
+    robot.unique("world", "the MJCF worldbody")
+    ET.SubElement(robot.urdf, "link", name="world")
+    for body in bodies:
+        read_body(robot, body, "world", np.eye(4), "main")

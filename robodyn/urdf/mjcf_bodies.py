@@ -15,6 +15,7 @@ import numpy as np
 
 from robodyn.exceptions import URDFError
 from robodyn.urdf.mjcf_geoms import write_link
+from robodyn.urdf.mjcf_physics import joint_effort
 from robodyn.urdf.mjcf_state import MjcfRobot, attributes
 from robodyn.urdf.mjcf_values import AUTO, BOOLEAN, angle, floats, keyword, number, pose, text, translation, unit, write_origin
 
@@ -52,6 +53,7 @@ def read_body(robot: MjcfRobot, body: ET.Element, parent: str | None, placement:
         robot.note("body gravcomp settings", name)
     frame = placement @ pose(robot, where, values) if parent is not None else np.eye(4)
     link, offset = _read_joints(robot, body, name, parent, frame, childclass)
+    robot.offsets[name] = offset
     mass = write_link(robot, body, name, link, offset, childclass)
     moves = parent is None or any(node.tag in ("joint", "freejoint") for node in body)
     if moves and not mass >= MIN_MASS:
@@ -93,31 +95,38 @@ def _read_joints(
 
 
 def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: str, child: str, origin: np.ndarray) -> None:
+    """One hinge or slide joint; its ``ref`` kept as the offset of robodyn's coordinate
+    (q = qpos − ref: the body sits at its modelled pose at q = 0), its range shifted by it."""
     where = f'joint "{name}"'
     kind = keyword(robot.label, where, "type", values.get("type", "hinge"), ("hinge", "slide", "ball", "free"))
     if kind not in ("hinge", "slide"):
         reason = "ball joints are not read by robodyn" if kind == "ball" else f"a {kind} joint is not read here"
         raise URDFError(robot.label, f"{where}: {reason} (hinge, slide and a free top body are)")
-    if number(robot.label, where, values.get("ref", "0")) != 0:
-        raise URDFError(robot.label, f"{where}: a nonzero ref is not read by robodyn (move the body instead)")
-    if number(robot.label, where, values.get("stiffness", "0")) != 0:
+    ref = number(robot.label, f"{where}: ref", values.get("ref", "0"))
+    ref = angle(robot, ref) if kind == "hinge" else ref
+    if ref:
+        robot.refs[name] = ref
+    if number(robot.label, f"{where}: stiffness", values.get("stiffness", "0")) != 0:
         robot.note("joint stiffnesses (springs)", name)
     axis = unit(robot.label, where, floats(robot.label, where, values.get("axis", "0 0 1"), 3))
     lower, upper = _range(robot, where, values, kind)
     urdf_type = "prismatic" if kind == "slide" else ("revolute" if math.isfinite(lower) else "continuous")
     joint = ET.SubElement(robot.urdf, "joint", name=name, type=urdf_type)
+    robot.joints.add(name)
     write_origin(joint, origin)
     ET.SubElement(joint, "parent", link=parent)
     ET.SubElement(joint, "child", link=child)
     ET.SubElement(joint, "axis", xyz=text(axis))
-    if urdf_type != "continuous":
-        bounded = math.isfinite(lower)
-        if bounded:
-            ET.SubElement(joint, "limit", lower=repr(lower), upper=repr(upper))
-        else:  # Bullet's encoding of no position limit, marked as robodyn's own (no warning)
-            ET.SubElement(joint, "limit", lower="1.0", upper="-1.0", unlimited="true")
+    effort = joint_effort(robot, where, name, values)
+    limit = {} if math.isinf(effort) else {"effort": repr(effort)}
+    if math.isfinite(lower):
+        ET.SubElement(joint, "limit", {"lower": repr(lower - ref), "upper": repr(upper - ref), **limit})
+    elif urdf_type == "prismatic":  # Bullet's encoding of no position limit, marked as robodyn's own (no warning)
+        ET.SubElement(joint, "limit", {"lower": "1.0", "upper": "-1.0", "unlimited": "true", **limit})
+    elif limit:
+        ET.SubElement(joint, "limit", limit)
     damping, friction, armature = (
-        number(robot.label, where, values.get(key, "0")) for key in ("damping", "frictionloss", "armature")
+        number(robot.label, f"{where}: {key}", values.get(key, "0")) for key in ("damping", "frictionloss", "armature")
     )
     if damping or friction or armature:
         ET.SubElement(joint, "dynamics", damping=repr(damping), friction=repr(friction), armature=repr(armature))

@@ -10,7 +10,10 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from robodyn.exceptions import URDFError
+from robodyn.urdf.equality import EqualityRecord
 
 #: Actuator elements (their defaults are one kind, ``general``, as in MuJoCo).
 ACTUATOR_TAGS = ("general", "motor", "position", "velocity", "intvelocity", "damper", "cylinder", "muscle", "adhesion")
@@ -28,23 +31,25 @@ class Census:
 
     The caps: at most ``max_dof`` degrees of freedom (each joint in ``<worldbody>`` counts
     at least one, a free joint six, a ball three) and at most
-    ``BODIES_PER_DOF * max_dof`` bodies.
+    ``BODIES_PER_DOF * max_dof`` bodies. ``world`` and ``default`` count the
+    ``<worldbody>`` and ``<default>`` elements the parser is inside (an included file is
+    parsed with them set to where its ``<include>`` is).
     """
 
     label: str
     max_dof: int
     bodies: int = 0
     dofs: int = 0
-    _world: int = 0
-    _default: int = 0
+    world: int = 0
+    default: int = 0
 
     def __call__(self, event: str, element: ET.Element) -> None:
         step = 1 if event == "start" else -1
         if element.tag in ("worldbody", "default"):
-            self._world += step if element.tag == "worldbody" else 0
-            self._default += step if element.tag == "default" else 0
+            self.world += step if element.tag == "worldbody" else 0
+            self.default += step if element.tag == "default" else 0
             return
-        if event != "start" or not self._world or self._default:
+        if event != "start" or not self.world or self.default:
             return
         if element.tag == "body":
             self.bodies += 1
@@ -87,8 +92,17 @@ class MjcfRobot:
         urdf: The ``<robot>`` element being written.
         names: Link and joint names used so far (each URDF name once).
         notes: What the dynamics leaves out, by kind: one warning line each.
+        remarks: Readings that differ from MuJoCo's, by sentence: one warning line each.
         floating: Whether the top body has a free joint.
         bodies: The names of every body of the file (sites with one of them are renamed).
+        offsets: Each body's link frame in the body frame (its last joint's ``pos``), (3,) in [m].
+        joints: The names of the joints written.
+        refs: Each joint's nonzero ``ref`` (MuJoCo's qpos = robodyn's q + ref), in [rad] or [m].
+        efforts: Each actuated joint's actuator force range, in [N m] or [N].
+        actuated: The joints actuators drive (``None``: every joint; no ``<actuator>``
+            section, or a transmission other than a joint).
+        gravity: The file's gravity in [m/s²] (``None``: it states none).
+        equalities: The ``connect`` / ``weld`` records.
     """
 
     label: str
@@ -97,12 +111,26 @@ class MjcfRobot:
     urdf: ET.Element
     names: set[str] = field(default_factory=set)
     notes: dict[str, list[str]] = field(default_factory=dict)
+    remarks: dict[str, list[str]] = field(default_factory=dict)
     floating: bool = False
     bodies: set[str] = field(default_factory=set)
+    offsets: dict[str, np.ndarray] = field(default_factory=dict)
+    joints: set[str] = field(default_factory=set)
+    refs: dict[str, float] = field(default_factory=dict)
+    efforts: dict[str, tuple[float, float]] = field(default_factory=dict)
+    actuated: set[str] | None = None
+    gravity: tuple[float, float, float] | None = None
+    equalities: tuple[EqualityRecord, ...] = ()
 
     def note(self, kind: str, name: str) -> None:
-        """Report ``name`` under ``kind`` (one warning line a kind)."""
+        """Report ``name`` under ``kind``, a kind of what the dynamics leaves out (one
+        warning line a kind)."""
         self.notes.setdefault(kind, []).append(name)
+
+    def remark(self, sentence: str, name: str) -> None:
+        """Report ``name`` under ``sentence``, a reading that differs from MuJoCo's (one
+        warning line a sentence)."""
+        self.remarks.setdefault(sentence, []).append(name)
 
     def unique(self, name: str, what: str) -> str:
         """``name``, claimed for one link or joint of the URDF.

@@ -30,6 +30,13 @@ class URDFSource:
             expansion) or ``"mjcf"`` (``text`` is the URDF robodyn's MJCF reader wrote).
         equalities: Equality constraints the file declares (MJCF ``<equality>``), as
             records :mod:`robodyn.constraints` turns into the robot's constraints.
+        gravity: The gravity the file states, in [m/s²] (MJCF ``<option gravity>``, zero
+            under ``<flag gravity="disable"/>``), or ``None``: the robot's gravity unless
+            ``gravity=`` is given.
+        actuated: The joints the file's actuators drive (MJCF ``<actuator>``), or ``None``
+            when the file does not say (every joint is actuated).
+        joint_offsets: ``(joint, offset)`` pairs: the file's coordinate is robodyn's plus
+            the offset (MJCF ``ref``: MuJoCo's qpos = q + ref), in [rad] or [m].
     """
 
     text: str
@@ -40,6 +47,9 @@ class URDFSource:
     package_dirs: tuple[Path, ...] = field(default_factory=tuple)
     file_format: str = "urdf"
     equalities: tuple[EqualityRecord, ...] = ()
+    gravity: tuple[float, float, float] | None = None
+    actuated: tuple[str, ...] | None = None
+    joint_offsets: tuple[tuple[str, float], ...] = ()
 
     @property
     def mesh_context(self) -> dict:

@@ -156,7 +156,14 @@ def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
             "first (e.g. 'gz sdf -p model.sdf > model.urdf')",
         )
     if tag == "mujoco":
-        return mjcf_source(source, strict=reading.strict, lookup=reading.lookup, max_dof=reading.max_dof)
+        return mjcf_source(
+            source,
+            strict=reading.strict,
+            lookup=reading.lookup,
+            max_dof=reading.max_dof,
+            read_file=lambda path: read_text(path, reading.limit),
+            max_bytes=reading.limit,
+        )
     source = replace(source, package_dirs=reading.lookup)
     is_xacro = source.path is not None and source.path.suffix == ".xacro"
     if is_xacro or (tag == "robot" and is_xacro_text(source.text)):
@@ -293,19 +300,28 @@ def lint_source(
     A document that is not even well-formed XML gives one error problem, and so does one
     robodyn cannot read as a robot (SDF, a xacro that does not expand, an MJCF element it
     refuses). A xacro is linted as its expansion, an MJCF file as the URDF robodyn reads it
-    into.
+    into; what the import reports (MJCF elements left out) is among the warnings.
 
     Raises:
         UnknownRobotError, URDFError: If the source cannot be found or read.
     """
     resolve_source(source, interpret=False)  # a file that cannot be read is an error, not a problem
     try:
-        resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
+        with warnings.catch_warnings(record=True) as caught:  # what the import reports is reported here
+            warnings.simplefilter("always", RobodynWarning)
+            resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
     except URDFError as error:
         return [Problem(error.element, error.rule)]
+    reported = [_import_problem(str(item.message)) for item in caught if issubclass(item.category, RobodynWarning)]
     floating = resolved.floating_base if floating_base is None else floating_base
     try:
         _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, strict=True, **resolved.mesh_context)
     except URDFError as error:
-        return [Problem(error.element, error.rule)]
-    return problems
+        return [*reported, Problem(error.element, error.rule)]
+    return [*reported, *problems]
+
+
+def _import_problem(message: str) -> Problem:
+    """A warning of the import (``"label: what"``) as a warning problem."""
+    element, _, rule = message.partition(": ")
+    return Problem(element, rule or message, "warning")
