@@ -12,31 +12,29 @@ equations) reads that URDF (:attr:`~robodyn.urdf.sources.URDFSource.text`). A jo
 armature>`` (``armature`` is robodyn's extension of URDF:
 :func:`robodyn.urdf.sources.with_file_dynamics` reads it).
 
-The reading, as MuJoCo's compiler does it:
+The reading, as MuJoCo's compiler does it (docs/robot-files.md states every rule):
 
-- ``<compiler angle>`` (MuJoCo's default: **degree**), ``eulerseq`` (lower case: axes that
-  move with the frame, upper case: fixed axes), ``autolimits``;
+- ``<include file>`` expanded first (:mod:`~robodyn.urdf.mjcf_includes`);
+- ``<compiler angle>`` (MuJoCo's default: **degree**), ``eulerseq``, ``autolimits``,
+  ``inertiafromgeom``, ``settotalmass``; ``<default>`` classes (nested; ``class``,
+  ``childclass``);
 - orientations ``quat`` (**w x y z**), ``axisangle``, ``euler``, ``xyaxes``, ``zaxis``;
-- ``<default>`` classes (nested; ``class``, ``childclass``);
-- bodies: a body's joints act in order at their ``pos`` (a body with several joints becomes
-  a chain through massless links); the link's frame sits at its last joint's position,
-  everything in the body is placed relative to it; a body without joints is welded;
-- joints ``hinge`` (revolute / continuous), ``slide`` (prismatic), ``free`` (on the one
-  top body only: a floating base); ``range`` with ``limited`` / ``autolimits``;
-- ``<inertial>`` (``diaginertia`` or ``fullinertia``, with its own frame), or, where
-  MuJoCo's ``inertiafromgeom`` would, the inertia of the body's solid geoms (sphere,
-  capsule, cylinder, ellipsoid, box; ``density`` / ``mass``; :mod:`robodyn.urdf.geom_inertia`);
-- ``<site>`` s become frames (massless links on fixed joints, named as the site);
-- ``box``, ``sphere``, ``capsule``, ``cylinder``, ``ellipsoid`` and ``mesh`` geoms become
-  visuals (drawings only).
+- bodies: a body's joints act in order at their ``pos`` (a chain through massless links);
+  a body without joints is welded; ``hinge``, ``slide`` and a ``free`` top body; a joint's
+  ``ref`` is the offset q = qpos − ref (the body in its modelled pose at q = 0, limits
+  shifted); ``<site>`` s are frames (``site:NAME`` where a body has the name);
+- ``<inertial>`` or the inertia of the body's solid geoms (:mod:`robodyn.urdf.geom_inertia`);
+- ``<option gravity>`` / ``<flag gravity>``, actuators (effort limits, the actuated set),
+  ``<equality connect/weld>`` records (:mod:`~robodyn.urdf.mjcf_physics`).
 
-Refused with one sentence: ``ball`` joints, a ``free`` joint below the top, a nonzero joint
-``ref``, a body whose inertia would come from a mesh geom or a shell, ``<include>``,
-``<frame>``, ``<replicate>``, ``<attach>``, ``boundmass`` / ``boundinertia``
-(``settotalmass`` is read: masses and inertias scaled as MuJoCo does). Reported
-in one :class:`~robodyn.exceptions.RobodynWarning` line per kind (``strict=True`` refuses):
-tendons, equality constraints, actuators, contact pairs / excludes, joint stiffness,
-``gravcomp``, a non-default ``<option gravity>``.
+Values are read as MuJoCo validates them; bodies and degrees of freedom are counted while
+parsing (:class:`~robodyn.urdf.mjcf_state.Census`). Refused with one sentence: ``ball``
+joints, a ``free`` joint below the top, a body whose inertia would come from a mesh geom
+or a shell, ``<frame>``, ``<replicate>``, ``<attach>``, ``boundmass`` / ``boundinertia``.
+Reported in one :class:`~robodyn.exceptions.RobodynWarning` line per kind (``strict=True``
+refuses): tendons, equality constraints (read as records, not in the free dynamics), servo
+gains, contact pairs / excludes, joint stiffness, ``gravcomp``, fluid forces, ``<flag>``
+settings.
 """
 
 from __future__ import annotations

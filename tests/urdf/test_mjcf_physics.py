@@ -1,0 +1,146 @@
+"""What an MJCF file states beside its bodies, against MuJoCo: its gravity (<option gravity>,
+<flag gravity="disable"/>), its actuators (effort limits, the actuated set), its equality
+constraints (records), and what the dynamics leaves out reported in one line a kind."""
+
+from __future__ import annotations
+
+import pickle
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robodyn
+from robodyn.dynamics.loading import rebuild
+from robodyn.exceptions import RobodynWarning, URDFError
+from robodyn.urdf.sources import lint_source
+from tests.conftest import ROOT
+from tests.urdf.mujoco_compare import largest_differences, mujoco_effort_limits, mujoco_state, rigid_model
+
+mujoco = pytest.importorskip("mujoco")
+
+DATA = ROOT / "tests" / "data" / "mjcf"
+FILES = ["included.xml", "no_gravity.xml", "floating_ref.xml", "arm.xml", "floating.xml", "geoms.xml", "extras.xml"]
+
+
+def quiet_load(path, **options) -> robodyn.Robot:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RobodynWarning)
+        return robodyn.load(path, **options)
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_every_test_file_equals_mujoco_with_the_files_own_gravity(name):
+    robot = quiet_load(DATA / name)
+    assert max(largest_differences(robot, rigid_model(DATA / name))) < 1e-12
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_effort_limits_equal_mujocos_actuator_limits(name):
+    robot = quiet_load(DATA / name)
+    limits = mujoco_effort_limits(mujoco.MjModel.from_xml_path(str(DATA / name)))
+    for dof in robot.dofs:
+        if not dof.is_base:
+            assert dof.effort_limit == pytest.approx(limits[dof.name], abs=1e-12)
+
+
+def test_a_tilted_option_gravity_is_the_robots_and_survives_rebuild_and_pickle():
+    robot = quiet_load(DATA / "included.xml")
+    assert tuple(robot.gravity_vector) == (0.8, -0.5, -9.7)
+    assert robot.options.gravity == (0.8, -0.5, -9.7)
+    for copy in (rebuild(robot), pickle.loads(pickle.dumps(robot))):
+        assert tuple(copy.gravity_vector) == (0.8, -0.5, -9.7)
+
+
+def test_gravity_given_overrides_the_files():
+    assert tuple(quiet_load(DATA / "included.xml", gravity=(0, 0, -3)).gravity_vector) == (0, 0, -3)
+
+
+def test_a_disabled_gravity_flag_gives_zero_gravity_as_in_mujoco():
+    robot = quiet_load(DATA / "no_gravity.xml")
+    model = mujoco.MjModel.from_xml_path(str(DATA / "no_gravity.xml"))
+    data = mujoco.MjData(model)
+    q = robot.random_configuration(np.random.default_rng(1))
+    data.qpos[:] = mujoco_state(robot, model, q, np.zeros(robot.nv), np.zeros(robot.nv))[0]
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.qfrc_bias).max() == 0 and np.abs(robot.gravity(q)).max() == 0
+    assert tuple(robot.gravity_vector) == (0, 0, 0)
+
+
+def test_a_file_without_option_keeps_the_standard_gravity():
+    assert tuple(quiet_load(DATA / "arm.xml").gravity_vector) == (0, 0, -9.81)
+
+
+def test_fluid_forces_and_flags_are_one_warning_line_each():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robodyn.load(DATA / "no_gravity.xml")
+    lines = [str(item.message) for item in caught if issubclass(item.category, RobodynWarning)]
+    assert len(lines) == 2 and all("\n" not in line for line in lines)
+    assert any("fluid forces" in line and "density=1000" in line and "viscosity=0.001" in line for line in lines)
+    assert any("<flag>" in line and "contact=disable" in line for line in lines)
+    with pytest.raises(URDFError, match="strict=True refuses"):
+        robodyn.load(DATA / "no_gravity.xml", strict=True)
+
+
+def test_the_actuated_set_is_the_joints_the_actuators_drive():
+    robot = quiet_load(DATA / "included.xml")
+    assert {dof.name: dof.actuated for dof in robot.dofs} == {
+        "yaw": True,
+        "shoulder": True,
+        "shoulder_slide": True,
+        "elbow": True,
+        "passive": False,
+    }
+    floating = robodyn.load(DATA / "floating_ref.xml", strict=True)  # motors only: nothing to report
+    assert [dof.name for dof in floating.dofs if dof.actuated] == ["hip_a", "hip_b"]
+    assert all(dof.actuated for dof in quiet_load(DATA / "arm.xml").dofs)  # no <actuator>: every joint
+
+
+def test_an_actuator_of_a_joint_the_model_does_not_have_is_refused():
+    text = (DATA / "extras.xml").read_text().replace('joint="swing" gear="10"', 'joint="nowhere" gear="10"')
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
+    with pytest.raises(URDFError, match="'nowhere'"):
+        quiet_load(text)
+
+
+def world_pose(robot, data, frame: str) -> pin.SE3:
+    return data.oMf[robot.frame_id(frame)]
+
+
+def test_equality_records_anchor_the_points_mujoco_anchors():
+    robot = quiet_load(DATA / "included.xml")
+    model = mujoco.MjModel.from_xml_path(str(DATA / "included.xml"))
+    data = mujoco.MjData(model)
+    q = robot.random_configuration(np.random.default_rng(6))
+    data.qpos[:] = mujoco_state(robot, model, q, np.zeros(robot.nv), np.zeros(robot.nv))[0]
+    mujoco.mj_kinematics(model, data)
+    ours = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, ours, q)
+    records = {record.name: record for record in robot.source.equalities}
+    assert set(records) == {"loop", "grip"}
+    loop = records["loop"]
+    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "hand")
+    theirs = data.xpos[index] + data.xmat[index].reshape(3, 3) @ model.eq_data[0, :3]
+    assert np.abs(world_pose(robot, ours, loop.body1).act(np.array(loop.anchor)) - theirs).max() < 1e-12
+    grip = records["grip"]  # body1's pose implied by the weld, in the world: robodyn's link against MuJoCo's body
+    body1, body2 = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for name in ("tip", "upper"))
+    pose = lambda position, wxyz: pin.SE3(pin.Quaternion(*wxyz).normalized().matrix(), np.array(position))  # noqa: E731
+    mujoco_body1 = pin.SE3(data.xmat[body1].reshape(3, 3), data.xpos[body1])
+    link_in_body = mujoco_body1.inverse() * world_pose(robot, ours, "tip")
+    theirs_implied = (
+        pin.SE3(data.xmat[body2].reshape(3, 3), data.xpos[body2])
+        * pose(model.eq_data[1, 3:6], model.eq_data[1, 6:10])
+        * link_in_body
+    )
+    ours_implied = world_pose(robot, ours, grip.body2) * pose(grip.relpose[:3], grip.relpose[3:])
+    assert np.abs(ours_implied.homogeneous - theirs_implied.homogeneous).max() < 1e-12
+
+
+def test_lint_reports_what_the_import_reported():
+    problems = lint_source(str(DATA / "no_gravity.xml"))
+    warned = [problem for problem in problems if problem.severity == "warning"]
+    assert any("fluid forces" in problem.rule for problem in warned)
+    assert any("contact=disable" in problem.rule for problem in warned)
