@@ -120,11 +120,17 @@ def _resolve(context: _Including, name: str, here: Path, where: str) -> Path:
     inside the main file's folder tree."""
     if "\x00" in name:
         raise URDFError(context.label, f"{where}: a file name cannot contain a NUL character")
-    candidates = [(folder / name).resolve() for folder in dict.fromkeys((context.top, here))]
+    try:
+        candidates = [(folder / name).resolve() for folder in dict.fromkeys((context.top, here))]
+    except (OSError, RuntimeError) as error:  # a name too long for the file system, a symlink loop
+        raise URDFError(context.label, f"{where}: the file name cannot be resolved ({error.__class__.__name__})") from None
     inside = [path for path in candidates if path.is_relative_to(context.top)]
     if not inside:
         raise URDFError(context.label, f"{where}: the file is outside the model's folder {printable(str(context.top))!r}")
     for path in inside:
-        if path.exists():
-            return path
+        try:
+            if path.exists():
+                return path
+        except OSError:
+            continue
     return inside[0]

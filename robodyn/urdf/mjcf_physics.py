@@ -88,7 +88,10 @@ def _read_actuator(robot: MjcfRobot, node: ET.Element, name: str) -> None:
     force = _force_range(robot, where, node.tag, values, name)
     low, high = sorted((gear * force[0], gear * force[1])) if gear else (0.0, 0.0)
     previous = robot.efforts.get(joint, (0.0, 0.0))
-    robot.efforts[joint] = (previous[0] + low, previous[1] + high)
+    total = (previous[0] + low, previous[1] + high)
+    if all(math.isfinite(value) for value in (*force, *previous)) and not all(math.isfinite(value) for value in total):
+        raise URDFError(robot.label, f"{where}: gear × its force range overflows; robodyn reads finite effort limits")
+    robot.efforts[joint] = total
 
 
 def _force_range(robot: MjcfRobot, where: str, tag: str, values: dict[str, str], name: str) -> Interval:
@@ -99,14 +102,26 @@ def _force_range(robot: MjcfRobot, where: str, tag: str, values: dict[str, str],
     gain = number(robot.label, f"{where}: gainprm", (split_numbers(values.get("gainprm", "1")) or ["1"])[0]) if general else 1.0
     if tag == "motor" or general:
         if _limited(robot, where, values, "ctrl"):
-            ctrl = floats(robot.label, f"{where}: ctrlrange", values.get("ctrlrange", "0 0"), 2)
+            ctrl = _bounds(robot, f"{where}: ctrlrange", values.get("ctrlrange", "0 0"))
             low, high = sorted((gain * float(ctrl[0]), gain * float(ctrl[1])))
     else:
         robot.note("actuator gains and biases (servos: robodyn reads their force range only)", name)
     if _limited(robot, where, values, "force"):
-        force = floats(robot.label, f"{where}: forcerange", values.get("forcerange", "0 0"), 2)
+        force = _bounds(robot, f"{where}: forcerange", values.get("forcerange", "0 0"))
         low, high = max(low, float(force[0])), min(high, float(force[1]))
     return low, high
+
+
+def _bounds(robot: MjcfRobot, where: str, text: str) -> np.ndarray:
+    """A range ``lower upper`` of two finite numbers.
+
+    Raises:
+        URDFError: If they are not, or if ``lower > upper`` (no clamp robodyn could state).
+    """
+    bounds = floats(robot.label, where, text, 2)
+    if bounds[0] > bounds[1]:
+        raise URDFError(robot.label, f"{where}: {text.strip()!r} has lower > upper")
+    return bounds
 
 
 def _limited(robot: MjcfRobot, where: str, values: dict[str, str], kind: str) -> bool:
@@ -123,7 +138,7 @@ def joint_effort(robot: MjcfRobot, where: str, name: str, values: dict[str, str]
     ``actuatorfrcrange`` (inf when nothing bounds it)."""
     low, high = robot.efforts.get(name, (-math.inf, math.inf))
     if _limited(robot, where, values, "actuatorfrc"):
-        bound = floats(robot.label, f"{where}: actuatorfrcrange", values.get("actuatorfrcrange", "0 0"), 2)
+        bound = _bounds(robot, f"{where}: actuatorfrcrange", values.get("actuatorfrcrange", "0 0"))
         low, high = max(low, float(bound[0])), min(high, float(bound[1]))
     if math.isfinite(low) and math.isfinite(high) and not math.isclose(-low, high):
         robot.remark(

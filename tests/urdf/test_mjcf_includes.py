@@ -100,6 +100,11 @@ def test_what_robodyns_file_reader_refuses_is_refused_in_an_include(tmp_path):
         robodyn.load(big, max_bytes=4000)
 
 
+def test_a_name_the_file_system_cannot_take_is_one_sentence(tmp_path):
+    assert "cannot be" in refusal(write_model(tmp_path, "x" * 5000))  # resolved or read: the system says which
+    assert "not a regular file" in refusal(write_model(tmp_path / "dot", "."))
+
+
 def test_an_include_in_text_is_refused_and_a_wrong_root_too(tmp_path):
     with pytest.raises(URDFError, match="given as text cannot <include>"):
         robodyn.load(f'<mujoco><include file="a.xml"/><worldbody>{BODY}</worldbody></mujoco>')

@@ -144,3 +144,24 @@ def test_lint_reports_what_the_import_reported():
     warned = [problem for problem in problems if problem.severity == "warning"]
     assert any("fluid forces" in problem.rule for problem in warned)
     assert any("contact=disable" in problem.rule for problem in warned)
+
+
+MOTOR = """<mujoco><compiler angle="radian"/><worldbody><body name="b"><joint name="j" {joint}/>
+<geom size="0.1"/></body></worldbody><actuator><motor joint="j" {motor}/></actuator></mujoco>"""
+
+
+@pytest.mark.parametrize(
+    ("joint", "motor", "words"),
+    [
+        ("", 'gear="abc" ctrlrange="-1 1"', "gear: 'abc' is not a finite number"),
+        ("", 'ctrllimited="True" ctrlrange="-1 1"', "ctrllimited='True'"),
+        ("", 'ctrlrange="1"', "must be 2 numbers"),
+        ("", 'ctrlrange="1 -1"', "lower > upper"),
+        ("", 'gear="1e308" ctrlrange="-1e308 1e308"', "overflows"),
+        ('actuatorfrcrange="a b"', "", "actuatorfrcrange: 'a' is not a finite number"),
+    ],
+)
+def test_a_hostile_actuator_is_one_sentence(joint, motor, words):
+    with pytest.raises(URDFError) as raised:
+        robodyn.load(MOTOR.format(joint=joint, motor=motor))
+    assert words in str(raised.value) and "\n" not in str(raised.value)
