@@ -14,6 +14,7 @@ import pytest
 import robodyn
 from robodyn.dynamics.loading import rebuild
 from robodyn.exceptions import RobodynWarning, URDFError
+from robodyn.reference import load as load_reference
 from robodyn.urdf.sources import lint_source
 from tests.conftest import ROOT
 from tests.urdf.mujoco_compare import largest_differences, mujoco_effort_limits, mujoco_state, rigid_model
@@ -51,6 +52,13 @@ def test_a_tilted_option_gravity_is_the_robots_and_survives_rebuild_and_pickle()
     assert robot.options.gravity == (0.8, -0.5, -9.7)
     for copy in (rebuild(robot), pickle.loads(pickle.dumps(robot))):
         assert tuple(copy.gravity_vector) == (0.8, -0.5, -9.7)
+
+
+def test_the_reference_takes_the_files_gravity_too():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RobodynWarning)
+        reference = load_reference(DATA / "included.xml")
+    assert tuple(reference.gravity_vector) == (0.8, -0.5, -9.7)
 
 
 def test_gravity_given_overrides_the_files():
