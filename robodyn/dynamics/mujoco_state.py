@@ -26,6 +26,7 @@ import numpy as np
 from robodyn.common.inputs import as_state
 from robodyn.common.text import quoted
 from robodyn.dynamics.dofs import Dof
+from robodyn.dynamics.options import LoadOptions
 from robodyn.exceptions import InputError
 from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
@@ -41,6 +42,7 @@ class Robot(Protocol):
     configuration_names: list[str]
     source: URDFSource
     spec: URDFSpec
+    options: LoadOptions
 
 
 def mujoco_joint_order(robot: Robot, joint_names: Sequence[str] | None = None) -> list[str]:
@@ -58,6 +60,9 @@ def mujoco_joint_order(robot: Robot, joint_names: Sequence[str] | None = None) -
     if joint_names is None:
         if robot.source.file_format != "mjcf":
             raise InputError("joint_names", "MuJoCo's joint names in its order (the robot was not read from MJCF)", "None")
+        if robot.options.lock:
+            locked = ", ".join(quoted(name) for name, _ in robot.options.lock)
+            raise InputError("joint_names", f"given for a robot with locked joints (MuJoCo's model moves {locked})", "None")
         written = [node.get("name") for node in robot.spec.xml.findall("joint") if node.get("type") != "fixed"]
         joint_names = [name for name in written if name in moving]
     names = [str(name) for name in joint_names]

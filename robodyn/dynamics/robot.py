@@ -23,6 +23,7 @@ the functions of the handle in :mod:`~robodyn.dynamics.kinematics`,
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import cached_property
 from pathlib import Path
 
@@ -516,14 +517,14 @@ class Robot:
     # ----------------------------------------------------------------------------------
     # MuJoCo's state (robodyn.dynamics.mujoco_state)
     # ----------------------------------------------------------------------------------
-    def to_mujoco(self, q: np.ndarray, v: np.ndarray | None = None, *, joint_names=None) -> tuple:
+    def to_mujoco(self, q: np.ndarray, v: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
         """MuJoCo's ``(qpos, qvel)`` of ``(q, v)``: joints by name in MuJoCo's order, ``ref``
         offsets, the free joint's w-first quaternion and world linear velocity. See
         :mod:`robodyn.dynamics.mujoco_state` (``joint_names``: MuJoCo's order, needed
         unless the robot was read from MJCF)."""
         return mujoco_state.to_mujoco(self, q, v, joint_names=joint_names)
 
-    def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names=None) -> tuple:
+    def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
         """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`)."""
         return mujoco_state.from_mujoco(self, qpos, qvel, joint_names=joint_names)
 

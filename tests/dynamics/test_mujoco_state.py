@@ -124,3 +124,9 @@ def test_a_robot_not_read_from_mjcf_needs_mujocos_joint_order():
     assert list(qpos) == list(reversed(range(robot.nq)))
     with pytest.raises(InputError, match="joint_names"):
         robot.to_mujoco(np.zeros(robot.nq), joint_names=order[:1])
+
+
+def test_a_robot_with_locked_joints_needs_the_order_given():
+    robot = robodyn.load(PATH, lock={"knee_b": 0.1})
+    with pytest.raises(InputError, match="locked"):
+        robot.from_mujoco(np.zeros(robot.nq))
