@@ -22,7 +22,16 @@ from tests.urdf.mujoco_compare import largest_differences, mujoco_effort_limits,
 mujoco = pytest.importorskip("mujoco")
 
 DATA = ROOT / "tests" / "data" / "mjcf"
-FILES = ["included.xml", "no_gravity.xml", "floating_ref.xml", "arm.xml", "floating.xml", "geoms.xml", "extras.xml"]
+FILES = [
+    "included.xml",
+    "no_gravity.xml",
+    "floating_ref.xml",
+    "planar_walker.xml",
+    "arm.xml",
+    "floating.xml",
+    "geoms.xml",
+    "extras.xml",
+]
 
 
 def quiet_load(path, **options) -> robodyn.Robot:
@@ -104,6 +113,8 @@ def test_the_actuated_set_is_the_joints_the_actuators_drive():
     floating = robodyn.load(DATA / "floating_ref.xml", strict=True)  # motors only: nothing to report
     assert [dof.name for dof in floating.dofs if dof.actuated] == ["hip_a", "hip_b"]
     assert all(dof.actuated for dof in quiet_load(DATA / "arm.xml").dofs)  # no <actuator>: every joint
+    walker = robodyn.load(DATA / "planar_walker.xml", strict=True)  # the planar root is not actuated
+    assert [dof.name for dof in walker.dofs if not dof.actuated] == ["rootx", "rootz", "rooty"]
 
 
 def test_an_actuator_of_a_joint_the_model_does_not_have_is_refused():
