@@ -184,3 +184,22 @@ def test_a_hostile_actuator_is_one_sentence(joint, motor, words):
     with pytest.raises(URDFError) as raised:
         robodyn.load(MOTOR.format(joint=joint, motor=motor))
     assert words in str(raised.value) and "\n" not in str(raised.value)
+
+
+@pytest.mark.parametrize("name", ["included.xml", "planar_walker.xml", "floating_ref.xml"])
+def test_effort_limits_are_the_largest_force_mujocos_actuators_apply(name):
+    """MuJoCo's own clamping, observed: every corner of the control ranges, qfrc_actuator."""
+    robot = quiet_load(DATA / name)
+    model = mujoco.MjModel.from_xml_path(str(DATA / name))
+    data = mujoco.MjData(model)
+    largest = np.zeros(model.nv)
+    for corner in np.ndindex(*(2,) * model.nu):
+        data.ctrl[:] = [model.actuator_ctrlrange[i, side] for i, side in enumerate(corner)]
+        mujoco.mj_forward(model, data)
+        largest = np.maximum(largest, np.abs(data.qfrc_actuator))
+    for joint in range(model.njnt):
+        if model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_FREE:
+            continue
+        dof = next(d for d in robot.dofs if d.name == mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, joint))
+        driven = any(model.actuator_trnid[i, 0] == joint for i in range(model.nu))
+        assert dof.effort_limit == (pytest.approx(largest[model.jnt_dofadr[joint]], abs=1e-12) if driven else np.inf)
