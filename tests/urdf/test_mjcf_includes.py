@@ -123,3 +123,18 @@ def test_the_suite_layout_copied_elsewhere_still_loads(tmp_path, monkeypatch):
     shutil.copytree(DATA, tmp_path / "copy")
     monkeypatch.chdir(tmp_path)
     assert robodyn.load(tmp_path / "copy" / "included.xml").nv == 5
+
+
+def test_a_chain_of_more_than_100_includes_is_refused(tmp_path):
+    for index in range(102):
+        (tmp_path / f"f{index}.xml").write_text(f'<mujoco><include file="f{index + 1}.xml"/></mujoco>')
+    (tmp_path / "f102.xml").write_text("<mujoco/>")
+    assert "more than 100 included files" in refusal(write_model(tmp_path, "f0.xml"))
+
+
+def test_includes_nesting_elements_too_deep_together_are_refused(tmp_path):
+    for index in range(60):
+        nested = f'<default class="a{index}"><default class="b{index}"><include file="f{index + 1}.xml"/></default></default>'
+        (tmp_path / f"f{index}.xml").write_text(f"<mujoco>{nested}</mujoco>")
+    (tmp_path / "f60.xml").write_text("<mujoco/>")
+    assert "deeper than 100 levels" in refusal(write_model(tmp_path, "f0.xml"))
