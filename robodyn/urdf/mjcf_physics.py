@@ -32,6 +32,8 @@ from robodyn.urdf.mjcf_state import ACTUATOR_TAGS, MjcfRobot, attributes
 from robodyn.urdf.mjcf_values import AUTO, floats, keyword, number, quaternion_matrix
 from robodyn.urdf.xmltext import split_numbers
 
+#: MuJoCo's actuator activation dynamics.
+DYNTYPES = ("none", "integrator", "filter", "filterexact", "muscle", "user")
 #: An interval of effort in [N m] or [N] (±inf: unbounded).
 Interval = tuple[float, float]
 
@@ -96,14 +98,23 @@ def _read_actuator(robot: MjcfRobot, node: ET.Element, name: str) -> None:
 
 def _force_range(robot: MjcfRobot, where: str, tag: str, values: dict[str, str], name: str) -> Interval:
     """An actuator's force before its gear: the control range where the force is the
-    control (a ``motor``; a ``general`` of fixed gain without bias), within the force range."""
+    control (a ``motor``; a ``general`` of fixed gain without bias, whose activation is the
+    control or a filter of it, from 0), within the force range."""
     low, high = -math.inf, math.inf
-    general = tag == "general" and values.get("gaintype", "fixed") == "fixed" and values.get("biastype", "none") == "none"
+    dynamics = keyword(robot.label, where, "dyntype", values.get("dyntype", "none"), DYNTYPES)
+    general = (
+        tag == "general"
+        and values.get("gaintype", "fixed") == "fixed"
+        and values.get("biastype", "none") == "none"
+        and dynamics in ("none", "filter", "filterexact")
+    )
     gain = number(robot.label, f"{where}: gainprm", (split_numbers(values.get("gainprm", "1")) or ["1"])[0]) if general else 1.0
     if tag == "motor" or general:
         if _limited(robot, where, values, "ctrl"):
             ctrl = _bounds(robot, f"{where}: ctrlrange", values.get("ctrlrange", "0 0"))
             low, high = sorted((gain * float(ctrl[0]), gain * float(ctrl[1])))
+            if dynamics != "none":  # a filtered activation starts at 0
+                low, high = min(low, 0.0), max(high, 0.0)
     else:
         robot.note("actuator gains and biases (servos: robodyn reads their force range only)", name)
     if _limited(robot, where, values, "force"):

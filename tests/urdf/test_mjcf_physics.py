@@ -203,3 +203,17 @@ def test_effort_limits_are_the_largest_force_mujocos_actuators_apply(name):
         dof = next(d for d in robot.dofs if d.name == mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, joint))
         driven = any(model.actuator_trnid[i, 0] == joint for i in range(model.nu))
         assert dof.effort_limit == (pytest.approx(largest[model.jnt_dofadr[joint]], abs=1e-12) if driven else np.inf)
+
+
+def test_an_integrated_control_is_not_bounded_by_its_control_range():
+    """MuJoCo integrates the control into the activation: ctrlrange does not bound the force."""
+    text = MOTOR.format(joint="", motor='gear="2"').replace("<motor", '<general dyntype="integrator" ctrlrange="-1 1"')
+    model = mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(model)
+    data.ctrl[:] = 1
+    for _ in range(1500):  # 3 s: the activation reaches 3
+        mujoco.mj_step(model, data)
+    assert abs(data.qfrc_actuator[0]) > 2  # past gear × ctrlrange
+    with pytest.warns(RobodynWarning, match="servos"):
+        robot = robodyn.load(text)
+    assert robot.dofs[0].effort_limit == np.inf
