@@ -106,7 +106,7 @@ def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: st
     ref = angle(robot, ref) if kind == "hinge" else ref
     if ref:
         robot.refs[name] = ref
-    if number(robot.label, f"{where}: stiffness", values.get("stiffness", "0")) != 0:
+    if number(robot.label, f"{where}: stiffness", values.get("stiffness", "0")) != 0 and "spring" not in robot.disabled:
         robot.note("joint stiffnesses (springs)", name)
     axis = unit(robot.label, where, floats(robot.label, where, values.get("axis", "0 0 1"), 3))
     lower, upper = _range(robot, where, values, kind)
@@ -128,6 +128,8 @@ def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: st
     damping, friction, armature = (
         number(robot.label, f"{where}: {key}", values.get(key, "0")) for key in ("damping", "frictionloss", "armature")
     )
+    damping = 0.0 if "damper" in robot.disabled else damping  # <flag damper="disable"/>, as MuJoCo
+    friction = 0.0 if "frictionloss" in robot.disabled else friction
     if damping or friction or armature:
         ET.SubElement(joint, "dynamics", damping=repr(damping), friction=repr(friction), armature=repr(armature))
 

@@ -4,8 +4,10 @@ fluid), ``<actuator>`` (effort limits and the actuated set) and ``<equality>`` (
 - Gravity: ``<option gravity>`` (MuJoCo's default (0, 0, −9.81)), zero under
   ``<flag gravity="disable"/>``; carried on the source, the robot's gravity unless
   ``gravity=`` is given.
-- Fluid forces (``density``, ``viscosity``, ``wind``) and the other ``<flag>`` settings
-  are reported, one line each; the simulator's numerics (``timestep``, ``integrator``,
+- ``<flag damper|frictionloss|spring="disable">`` zero the joints' damping, Coulomb
+  friction and springs as MuJoCo does; flags that change nothing robodyn models
+  (:data:`SILENT_FLAGS`: contacts, the constraint solver, numerics) are not reported;
+  fluid forces (``density``, ``viscosity``, ``wind``) and the other flags are, one line each; the simulator's numerics (``timestep``, ``integrator``,
   solver settings) are not the model and are not reported.
 - Actuators with a joint transmission: the force range of each (``gear`` × ``ctrlrange``
   where the force is the control — ``motor``, a ``general`` of fixed gain and no bias —
@@ -32,6 +34,29 @@ from robodyn.urdf.mjcf_state import ACTUATOR_TAGS, MjcfRobot, attributes
 from robodyn.urdf.mjcf_values import AUTO, floats, keyword, number, quaternion_matrix
 from robodyn.urdf.xmltext import split_numbers
 
+#: ``<flag>`` s robodyn honours when disabled: gravity (zero), joint damping, Coulomb
+#: friction (``frictionloss``) and springs (``stiffness``, then not reported).
+HONOURED_FLAGS = ("gravity", "damper", "frictionloss", "spring")
+#: ``<flag>`` s that change nothing robodyn models (contacts, constraint solver, numerics,
+#: diagnostics): not reported.
+SILENT_FLAGS = (
+    "contact",
+    "constraint",
+    "warmstart",
+    "filterparent",
+    "energy",
+    "fwdinv",
+    "invdiscrete",
+    "multiccd",
+    "sensor",
+    "midphase",
+    "eulerdamp",
+    "autoreset",
+    "nativeccd",
+    "island",
+    "sleep",
+    "refsafe",
+)
 #: MuJoCo's actuator activation dynamics.
 DYNTYPES = ("none", "integrator", "filter", "filterexact", "muscle", "user")
 #: An interval of effort in [N m] or [N] (±inf: unbounded).
@@ -39,7 +64,9 @@ Interval = tuple[float, float]
 
 
 def read_option(root: ET.Element, robot: MjcfRobot) -> tuple[float, float, float] | None:
-    """The file's gravity in [m/s²] (``None`` if it states none), reporting fluid forces and flags."""
+    """The file's gravity in [m/s²] (``None`` if it states none); the ``<flag>`` s robodyn
+    honours into ``robot.disabled``; fluid forces and the other flags that change the
+    motion reported."""
     gravity: tuple[float, float, float] | None = None
     for option in root.findall("option"):
         if "gravity" in option.attrib:
@@ -53,10 +80,14 @@ def read_option(root: ET.Element, robot: MjcfRobot) -> tuple[float, float, float
         for flag in option.findall("flag"):
             for key, value in flag.attrib.items():
                 keyword(robot.label, "<flag>", key, value, ("enable", "disable"))
-                if key == "gravity":
-                    gravity = (0.0, 0.0, 0.0) if value == "disable" else (gravity or (0.0, 0.0, -9.81))
-                else:
+                if key in HONOURED_FLAGS and value == "disable":
+                    robot.disabled.add(key)
+                elif key in HONOURED_FLAGS:
+                    robot.disabled.discard(key)
+                elif key not in SILENT_FLAGS:
                     robot.note("<flag> settings", f"{key}={value}")
+    if "gravity" in robot.disabled:
+        return (0.0, 0.0, 0.0)
     return gravity
 
 

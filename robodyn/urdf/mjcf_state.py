@@ -102,6 +102,7 @@ class MjcfRobot:
         actuated: The joints actuators drive (``None``: every joint; no ``<actuator>``
             section, or a transmission other than a joint).
         gravity: The file's gravity in [m/s²] (``None``: it states none).
+        disabled: The ``<flag>`` s the file disables that robodyn honours (``damper``, ...).
         equalities: The ``connect`` / ``weld`` records.
     """
 
@@ -120,6 +121,7 @@ class MjcfRobot:
     efforts: dict[str, tuple[float, float]] = field(default_factory=dict)
     actuated: set[str] | None = None
     gravity: tuple[float, float, float] | None = None
+    disabled: set[str] = field(default_factory=set)
     equalities: tuple[EqualityRecord, ...] = ()
 
     def note(self, kind: str, name: str) -> None:

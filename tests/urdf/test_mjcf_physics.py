@@ -85,6 +85,19 @@ def test_a_disabled_gravity_flag_gives_zero_gravity_as_in_mujoco():
     assert tuple(robot.gravity_vector) == (0, 0, 0)
 
 
+def test_a_disabled_damper_flag_leaves_the_joints_undamped_as_in_mujoco():
+    robot = quiet_load(DATA / "no_gravity.xml")
+    model = mujoco.MjModel.from_xml_path(str(DATA / "no_gravity.xml"))
+    assert model.dof_damping.max() > 0 and model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_DAMPER
+    model.opt.density, model.opt.viscosity = 0.0, 0.0  # the fluid forces (reported) out of the way
+    data = mujoco.MjData(model)
+    data.qvel[:] = 1.0
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.qfrc_passive).max() == 0  # MuJoCo applies no damping
+    assert robot.joint_damping.max() == 0
+    assert quiet_load((DATA / "no_gravity.xml").read_text().replace(' damper="disable"', "")).joint_damping.max() == 0.5
+
+
 def test_a_file_without_option_keeps_the_standard_gravity():
     assert tuple(quiet_load(DATA / "arm.xml").gravity_vector) == (0, 0, -9.81)
 
@@ -96,7 +109,7 @@ def test_fluid_forces_and_flags_are_one_warning_line_each():
     lines = [str(item.message) for item in caught if issubclass(item.category, RobodynWarning)]
     assert len(lines) == 2 and all("\n" not in line for line in lines)
     assert any("fluid forces" in line and "density=1000" in line and "viscosity=0.001" in line for line in lines)
-    assert any("<flag>" in line and "contact=disable" in line for line in lines)
+    assert any("<flag>" in line and "(limit=disable)" in line for line in lines)  # contact: nothing robodyn models
     with pytest.raises(URDFError, match="strict=True refuses"):
         robodyn.load(DATA / "no_gravity.xml", strict=True)
 
@@ -162,7 +175,7 @@ def test_lint_reports_what_the_import_reported():
     problems = lint_source(str(DATA / "no_gravity.xml"))
     warned = [problem for problem in problems if problem.severity == "warning"]
     assert any("fluid forces" in problem.rule for problem in warned)
-    assert any("contact=disable" in problem.rule for problem in warned)
+    assert any("limit=disable" in problem.rule for problem in warned)
 
 
 MOTOR = """<mujoco><compiler angle="radian"/><worldbody><body name="b"><joint name="j" {joint}/>
