@@ -26,8 +26,12 @@ def vector(text: str) -> list[float]:
         raise argparse.ArgumentTypeError(f"not a list of numbers: {text!r}") from None
 
 
+#: What the model argument takes (every command that reads a robot).
+MODEL_HELP = "a URDF, .xacro or MJCF file path, a robot name (see 'robodyn list'), or URDF/xacro/MJCF text"
+
+
 def add_model_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("model", help="URDF path, robot name (see 'robodyn list') or URDF text")
+    parser.add_argument("model", help=MODEL_HELP)
     base = parser.add_mutually_exclusive_group()
     base.add_argument(
         "--floating-base", dest="floating_base", action="store_true", default=None, help="give the root a free-flyer joint"
@@ -37,7 +41,10 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
         "--no-check-inertia", dest="check_inertia", action="store_false", help="accept physically impossible link inertias"
     )
     parser.add_argument(
-        "--gravity", type=vector, metavar="GX,GY,GZ", help="gravity in the world frame, in [m/s²] (default 0,0,-9.81)"
+        "--gravity",
+        type=vector,
+        metavar="GX,GY,GZ",
+        help="gravity in the world frame, in [m/s²] (default: the file's, else 0,0,-9.81)",
     )
     parser.add_argument(
         "--strict", action="store_true", help="refuse what robodyn otherwise loads with a warning (e.g. the triangle inequality)"

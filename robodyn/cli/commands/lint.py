@@ -5,14 +5,14 @@ from __future__ import annotations
 import argparse
 import json
 
-from robodyn.cli.common import add_file_arguments, package_arguments, xacro_arguments
+from robodyn.cli.common import MODEL_HELP, add_file_arguments, package_arguments, xacro_arguments
 from robodyn.common.text import printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("lint", help="every problem of a URDF at once (exit 1 if any error)")
-    parser.add_argument("model", help="URDF path, robot name or URDF text")
+    parser.add_argument("model", help=MODEL_HELP)
     parser.add_argument(
         "--floating-base", dest="floating_base", action="store_true", default=None, help="check as a floating-base robot"
     )
