@@ -106,10 +106,18 @@ def digest(*parts: str) -> str:
     return hasher.hexdigest()[:24]
 
 
+def runtime_source() -> str:
+    """``runtime.c`` after the controllers' generated constants (kinds, parameter layouts:
+    :func:`robodyn.compiled.controllers.c_constants`)."""
+    from robodyn.compiled.controllers import c_constants
+
+    return c_constants() + _RUNTIME.read_text(encoding="utf-8")
+
+
 def module_source(kernels: str, module_name: str) -> str:
     """The full C source: includes, the robot's kernels, the runtime and the module init."""
     init = f'PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module("{module_name}"); }}\n'
-    return _PRELUDE + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
+    return _PRELUDE + kernels + "\n" + runtime_source() + "\n" + init
 
 
 def cached_kernels(key: str) -> str | None:
@@ -167,7 +175,7 @@ def build_module(kernels: str, *, label: str, vector: bool = True) -> ModuleType
         with contextlib.suppress(CompileError):
             return simd.configure(build_module(kernels + variants, label=label, vector=False))
     compiler = find_compiler()
-    runtime = _RUNTIME.read_text(encoding="utf-8")
+    runtime = runtime_source()
     name = "rd_" + digest(kernels, runtime, toolchain_key(compiler))
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
     folder = cache_dir()
@@ -224,7 +232,7 @@ def build_extension(kernels: str, runtime: str, *, init: str, label: str) -> Mod
         CompileError: The compiler failed (its first error line is quoted).
     """
     compiler = find_compiler()
-    base = _RUNTIME.read_text(encoding="utf-8")
+    base = runtime_source()
     name = "rd_" + digest(kernels, base, runtime, init, toolchain_key(compiler))
     target = cache_dir() / f"{name}{sysconfig.get_config_var('EXT_SUFFIX') or '.so'}"
     if not target.exists():
