@@ -14,10 +14,11 @@ from dataclasses import dataclass
 from time import perf_counter
 from typing import Literal
 
-from robodyn.exceptions import CompileError, InputError, JointLimitWarning
+from robodyn.exceptions import CompileError, InputError, JointLimitWarning, RobodynWarning
 from robodyn.sim import compiled_backend, pinocchio_loop
 from robodyn.sim.limits import JointLimits, warning_text
 from robodyn.sim.plan import Outcome, RunPlan
+from robodyn.sim.stability import step_warning
 from robodyn.trajectory import Trajectory
 
 
@@ -74,8 +75,12 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
         SingularMassMatrixError, SimulationError: As :func:`robodyn.simulate`.
 
     Warns:
+        RobodynWarning: At the start, when the step exceeds the largest stable step of the
+            fastest mode (:func:`robodyn.sim.stability.step_warning`).
         JointLimitWarning: With ``limits="warn"``, for the limits the run broke.
     """
+    if sentence := step_warning(plan):  # stack level 4: the caller of simulate / simulate_run
+        warnings.warn(RobodynWarning(sentence), stacklevel=4)
     began = perf_counter()
     engine, reason = choose(plan)
     outcome: Outcome | None = None

@@ -64,6 +64,21 @@ def task_target(values: list[float] | np.ndarray) -> np.ndarray:
     raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
 
 
+def _check_planar(robot: Robot, frame: str, q: np.ndarray, size: int) -> None:
+    """Refuse an ``X,Z`` target for a frame that does not stay in the plane ``Y = 0``
+    (a planar arm in the XY plane, or any 3-D arm): the target would leave ``Y`` at 0."""
+    if size != 2:
+        return
+    sideways = np.abs(robot.frame_jacobian(q, frame)[1]).max(initial=0.0)
+    offset = abs(float(robot.frame_position(q, frame)[1]))
+    if sideways > 1e-9 or offset > 1e-9:
+        raise InputError(
+            "target",
+            f"3 values X,Y,Z in [m] ({frame!r} moves along or sits off Y = 0; X,Z fits arms in the XZ plane)",
+            "2 values",
+        )
+
+
 def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """A pose target from ``X,Y,Z`` (position only) or ``X,Y,Z,ROLL,PITCH,YAW``.
 
@@ -335,6 +350,7 @@ def _control_law(
         assert target is not None  # checked by _check_request
         task = task_target(target)
         controlled = robot.task_frame(frame, "task-space control")
+        _check_planar(robot, controlled, start, len(target))
         check_reach(robot, controlled, task, parameter="target")
         law = TaskSpace(controller_model(robot), controlled, task)
     elif controller in POSE_CONTROLLERS:

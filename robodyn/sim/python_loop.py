@@ -39,6 +39,15 @@ Forward = Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 CHECK_EVERY = 64
 
 
+class StageDivergedError(Exception):
+    """An integrator stage reached a non-finite state (a divergence inside the step), before
+    the controller was asked for a torque there."""
+
+    def __init__(self, joint: str) -> None:
+        super().__init__(joint)
+        self.joint = joint
+
+
 class Stepper:
     """One integration step of ``(q, v)`` under a controller: RK4 or semi-implicit Euler.
 
@@ -74,7 +83,13 @@ class Stepper:
             self.accelerate = self.forward
         else:
             plant = self.forward
-            self.accelerate = lambda t, q, v, tau: plant(t, q, v, np.asarray(controller(t, q, v), dtype=float))
+
+            def accelerate(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+                if not (np.isfinite(q).all() and np.isfinite(v).all()):  # blew up within the step
+                    raise StageDivergedError(failing_joint(robot.joint_names, q, v))
+                return plant(t, q, v, np.asarray(controller(t, q, v), dtype=float))
+
+            self.accelerate = accelerate
         # Fixed base: q moves by plain addition (no call); floating base: on SE(3).
         self.integrate = robot.integrate if robot.floating_base else None
         self.rk4 = rk4
@@ -143,6 +158,8 @@ def integrate(
             q, v = stepper.advance(t, dt, q, v, tau, a)
             if stops is not None:
                 q, v = stops.stop(q, v)
+        except StageDivergedError as diverged:  # a divergence, not the controller's input
+            raise SimulationError(t, step, diverged.joint) from None
         except InputError:  # a non-finite state reached a controller's checked call
             check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
