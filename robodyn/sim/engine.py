@@ -18,7 +18,7 @@ from robodyn.exceptions import CompileError, InputError, JointLimitWarning, Robo
 from robodyn.sim import compiled_backend, pinocchio_loop
 from robodyn.sim.limits import JointLimits, warning_text
 from robodyn.sim.plan import Outcome, RunPlan
-from robodyn.sim.stability import step_warning
+from robodyn.sim.stability import step_warning, task_warning
 from robodyn.trajectory import Trajectory
 
 
@@ -76,11 +76,13 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
 
     Warns:
         RobodynWarning: At the start, when the step exceeds the largest stable step of the
-            fastest mode (:func:`robodyn.sim.stability.step_warning`).
+            fastest mode, or an operational-space task starts near a singularity
+            (:mod:`robodyn.sim.stability`).
         JointLimitWarning: With ``limits="warn"``, for the limits the run broke.
     """
-    if sentence := step_warning(plan):  # stack level 4: the caller of simulate / simulate_run
-        warnings.warn(RobodynWarning(sentence), stacklevel=4)
+    for sentence in (step_warning(plan), task_warning(plan)):  # stack level 4: the caller of simulate
+        if sentence:
+            warnings.warn(RobodynWarning(sentence), stacklevel=4)
     began = perf_counter()
     engine, reason = choose(plan)
     outcome: Outcome | None = None

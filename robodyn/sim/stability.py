@@ -19,12 +19,15 @@ import numpy as np
 from robodyn.compiled.controllers import HasTwin
 from robodyn.exceptions import RobodynError
 from robodyn.sim.linearize import linearize
+from robodyn.sim.operational_space import OperationalSpace
 from robodyn.sim.plan import RunPlan
 
 #: ``|λ| dt`` at the edge of each integrator's stability region (RK4: the real-axis limit).
 STABLE_RATE = {"rk4": 2.78, "semi-implicit-euler": 2.0}
 #: Relative step of the central differences of a controller.
 _DIFFERENCE = 1e-6
+#: A task direction whose singular value is below this fraction of the largest is near-singular.
+NEAR_SINGULAR = 1e-3
 
 
 def largest_stable_step(plan: RunPlan) -> tuple[float, str, str] | None:
@@ -89,3 +92,25 @@ def _feedback(plan: RunPlan, tau: np.ndarray) -> np.ndarray:
                 plus, minus = controller(0.0, q, v + step), controller(0.0, q, v - step)
             columns.append((np.asarray(plus, dtype=float) - np.asarray(minus, dtype=float)) / (2 * h))
     return np.array(columns).T
+
+
+def task_warning(plan: RunPlan) -> str | None:
+    """One sentence when an operational-space task starts at (or near) a singularity: the
+    frame's position Jacobian loses a direction there that it has at other configurations
+    (a stretched or folded arm), where the task inertia grows without bound unless damped."""
+    law = plan.controller
+    if not isinstance(law, OperationalSpace) or law.frame is None:
+        return None
+    model = law.model
+    start = np.linalg.svd(model.frame_jacobian(plan.q0, law.frame)[:3], compute_uv=False)
+    elsewhere = np.linalg.svd(
+        model.frame_jacobian(model.random_configuration(np.random.default_rng(0)), law.frame)[:3], compute_uv=False
+    )
+    rank = int((elsewhere > 1e-9 * elsewhere[0]).sum())  # the directions the frame can move in at all
+    if rank == 0 or start[rank - 1] >= NEAR_SINGULAR * start[0]:
+        return None
+    return (
+        f"{plan.robot.name}: the operational-space task of {law.frame!r} starts near a singularity (a direction "
+        f"{start[rank - 1] / start[0]:.1g} of the others: a stretched or folded arm); its task inertia is damped "
+        f"by damping={law.damping:g} only, so torques can grow without bound: give damping=1e-3 or start elsewhere"
+    )
