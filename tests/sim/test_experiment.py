@@ -13,9 +13,10 @@ import pytest
 
 import robodyn
 from robodyn.exceptions import InputError
-from robodyn.sim.experiment import parse_push, run_simulation
+from robodyn.sim.experiment import run_simulation
 from robodyn.sim.observer import MomentumObserver, estimate_external_torques
 from robodyn.sim.report import Push
+from robodyn.sim.requests import parse_push
 
 RP_TARGET = [0.9, 0.0, 0.5]
 RP_START = [0.5, 0.13]
