@@ -160,14 +160,17 @@ def integrate(
                 q, v = stops.stop(q, v)
         except StageDivergedError as diverged:  # a divergence, not the controller's input
             raise SimulationError(t, step, diverged.joint) from None
+        except SingularMassMatrixError:  # a blown-up stage state; M was regular at the start
+            if _moderate(qs[-1], vs[-1]) and singular(robot, qs[-1]):
+                raise
+            raise SimulationError(t, step, _fastest(robot, vs[-1])[0]) from None
         except InputError:  # a non-finite state reached a controller's checked call
             check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
             raise
         except (np.linalg.LinAlgError, FloatingPointError, NonFiniteResultError) as error:  # a controller's numerics failed
             check_finite(robot, qs[:-1], vs[:-1], qs[-1], vs[-1], dt)
-            fastest = int(np.argmax(np.abs(vs[-1])))
-            joint = robot.joint_names[max(0, min(fastest - (robot.nv - len(robot.joint_names)), len(robot.joint_names) - 1))]
-            raise ControllerFailedError(t, step, joint, float(vs[-1][fastest]), str(error)) from None
+            joint, speed = _fastest(robot, vs[-1])
+            raise ControllerFailedError(t, step, joint, speed, str(error)) from None
         if step % CHECK_EVERY == 0 or step == steps - 1:
             check_finite(robot, qs, vs, q, v, dt)
     qs.append(q)
@@ -190,6 +193,13 @@ def check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: np
             if offset > 0 and _moderate(*states[offset - 1]) and singular(robot, states[offset - 1][0]):
                 raise SingularMassMatrixError(robot.name, robot.massless_joints)
             raise SimulationError(step * dt, step, failing_joint(robot.joint_names, q_i, v_i))
+
+
+def _fastest(robot: Robot, v: np.ndarray) -> tuple[str, float]:
+    """The joint with the largest speed and that speed (a floating base's six: its root joint)."""
+    fastest = int(np.argmax(np.abs(v)))
+    names = robot.joint_names
+    return names[max(0, min(fastest - (robot.nv - len(names)), len(names) - 1))], float(v[fastest])
 
 
 def _moderate(q: np.ndarray, v: np.ndarray) -> bool:

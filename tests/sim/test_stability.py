@@ -115,3 +115,24 @@ def test_an_operational_space_task_starting_at_a_singularity_is_warned_about():
     rp_arm = robodyn.load("rp_arm")
     planar = OperationalSpace(rp_arm, None, [0.7, 0.0, 0.7])
     assert task_warning(plan(rp_arm, np.array([0.3, 0.1]), np.zeros(2), 0.01, 1e-3, controller=planar)) is None
+
+
+def test_a_checked_call_failing_on_a_blown_up_state_is_a_divergence_not_a_singular_mass_matrix():
+    """A law whose checked dynamics call fails on a state that blew up (here: it raises what
+    such a call raises) while M was regular: the run reports a divergence, naming the time and
+    the fastest joint, never a singular mass matrix."""
+    from robodyn.exceptions import SingularMassMatrixError
+
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+
+    def law(t, q, v):
+        if np.abs(v).max() > 50.0:
+            raise SingularMassMatrixError(robot.name, [])
+        return 1e7 * (q0 + 0.1 - q) - 20.0 * v
+
+    with pytest.raises(SimulationError) as raised, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robodyn.simulate(robot, q0, np.zeros(2), 0.1, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    assert type(raised.value) is SimulationError and "diverged" in str(raised.value)
+    assert not isinstance(raised.value, SingularMassMatrixError)
