@@ -112,5 +112,6 @@ def task_warning(plan: RunPlan) -> str | None:
     return (
         f"{plan.robot.name}: the operational-space task of {law.frame!r} starts near a singularity (a direction "
         f"{start[rank - 1] / start[0]:.1g} of the others: a stretched or folded arm); its task inertia is damped "
-        f"by damping={law.damping:g} only, so torques can grow without bound: give damping=1e-3 or start elsewhere"
+        f"by only {law.damping:g} of its largest eigenvalue, so torques can grow without bound: start away from it, "
+        "or raise the OperationalSpace damping (1e-3 keeps them bounded)"
     )
