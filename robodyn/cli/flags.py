@@ -50,6 +50,8 @@ FLAGS: dict[str, str] = {
     "reference": "--reference",
     "engine": "--engine",
     "control_period": "--control-period",
+    "kp": "--kp",
+    "kd": "--kd",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.
@@ -80,6 +82,13 @@ def error_text(error: RobodynError) -> str:
     text = str(error)
     if isinstance(error, InputError) and error.argument in FLAGS:
         text = printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
+    return command_line_text(text)
+
+
+def command_line_text(text: str) -> str:
+    """A library sentence as the command line says it: a keyword argument it suggests
+    (``engine='compiled'``) becomes the flag (``--engine compiled``), a boolean one
+    (``joint_friction=False``) its switch (``--no-joint-friction``)."""
     for keyword, switch in SWITCHES.items():
         text = text.replace(keyword, switch)
     return _KEYWORD.sub(_keyword_flag, text)

@@ -30,6 +30,7 @@ from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
+from robodyn.sim.gains import computed_torque_gains, pd_gains
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
@@ -134,13 +135,15 @@ def run_simulation(
     reference: Trajectory | None = None,
     control_period: float | None = None,
     joint_friction: bool = True,
+    kp: float | list[float] | None = None,
+    kd: float | list[float] | None = None,
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
     Args:
         robot: The plant.
-        controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target; a floating
-            robot's gains from its joints' inertia, :func:`free_base_gains`),
+        controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target, gains scaled
+            to each joint's inertia (its largest at ``q0`` and the target), :func:`robodyn.sim.gains.pd_gains`),
             ``"computed-torque"`` (quintic from ``q0`` to a joint target in half the
             duration), ``"task-space"`` (drive ``frame`` to a position target), ``"osc"``
             (operational-space control of ``frame``'s position or pose) or
@@ -171,6 +174,10 @@ def run_simulation(
             torque (zero-order hold; the summary says so); ``None``: every stage.
         joint_friction: As for :func:`robodyn.simulate`: the joints' damping and friction
             act (``False``: the rigid-body motion). The controllers' models are rigid-body.
+        kp, kd: pd: stiffness and damping, a scalar or one value a joint, in [N m/rad] and
+            [N m s/rad] (default: scaled to each joint's inertia,
+            :func:`~robodyn.sim.gains.pd_gains`); computed-torque: in [1/s²] and [1/s]
+            (default 400 and 40). Refused with the other controllers.
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -190,6 +197,11 @@ def run_simulation(
     if actuated is not None and controller != "lqr":
         raise InputError("actuated", "given only with the lqr controller", f"{len(actuated)} joints")
     options["actuated"] = actuated
+    if (kp is not None or kd is not None) and controller not in ("pd", "computed-torque"):
+        raise InputError(
+            "kp" if kp is not None else "kd", "given only with the pd or computed-torque controller", repr(controller)
+        )
+    options["gains"] = {"kp": kp, "kd": kd}
     law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
     if reference is not None:
         law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
@@ -323,12 +335,14 @@ def _control_law(
     if controller in ("pd", "computed-torque", "lqr"):  # the joints' positions (a floating base stays free)
         assert target is not None  # checked by _check_request
         joints = joint_target(robot, target, controller)
-    if controller == "pd" and robot.floating_base:
-        law = PDGravity(controller_model(robot), joints, *free_base_gains(robot, start))
-    elif controller == "pd":
-        law = PDGravity(controller_model(robot), joints)
+    gains = options["gains"]
+    if controller == "pd":
+        goal = start.copy()
+        goal[robot.nq - joints.size :] = joints  # the inertia at the start and at the target
+        law = PDGravity(controller_model(robot), joints, *pd_gains(robot, np.array([start, goal]), **gains))
     elif controller == "computed-torque":
-        law = ComputedTorque(controller_model(robot), quintic_reference(start[robot.nq - joints.size :], joints, duration / 2))
+        reference = quintic_reference(start[robot.nq - joints.size :], joints, duration / 2)
+        law = ComputedTorque(controller_model(robot), reference, *computed_torque_gains(joints.size, **gains))
     elif controller == "lqr":
         law = _lqr_law(robot, joints, options["actuated"])
     elif controller == "task-space":
@@ -344,17 +358,6 @@ def _control_law(
         check_reach(robot, controlled, task, parameter="target")
         law = _pose_law(robot, controller, controlled, task, rpy, options)
     return law, task, controlled
-
-
-def free_base_gains(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """PD gains for a floating robot's joints: ``100 m`` and ``20 m`` (a critically damped
-    10 rad/s) with ``m`` each joint's inertia at ``q`` with the base free (the diagonal of
-    ``M_jj − M_jb M_bb⁻¹ M_bj``), in [N m/rad] and [N m s/rad]. A legged robot's light
-    legs (solo12's knees: 3e-4 kg m²) make the fixed-base defaults (100, 20) unstable at
-    any practical step."""
-    mass = robot.mass_matrix(q)
-    inertia = np.diag(mass[6:, 6:] - mass[6:, :6] @ np.linalg.solve(mass[:6, :6], mass[:6, 6:]))
-    return 100.0 * inertia, 20.0 * inertia
 
 
 #: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 
 from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector, warn
+from robodyn.cli.flags import command_line_text
 from robodyn.common.text import json_text, printable
 from robodyn.exceptions import InputError
 
@@ -94,13 +96,16 @@ def run(arguments: argparse.Namespace) -> int:
         observer_gain=arguments.observer_gain,
         actuated=None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")],
         joint_friction=arguments.joint_friction,
+        kp=arguments.kp,
+        kd=arguments.kd,
         out=arguments.out,
         plot=arguments.plot,
         record=arguments.record,
         png=arguments.png,
         **_reference(arguments),
     )
-    summary = summary.with_startup(startup)
+    # the library's summary names its parameters (engine='compiled'); the command line, its flags
+    summary = replace(summary.with_startup(startup), engine_reason=command_line_text(summary.engine_reason))
     warn(summary.warnings())
     if summary.task is not None and not summary.task.reached and summary.task.deflection is None:
         warn([
@@ -136,6 +141,18 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         dest="observer_gain",
         type=float,
         help="run a momentum observer of this gain [1/s]; --out then has tau_ext[<joint>] columns",
+    )
+    parser.add_argument(
+        "--kp",
+        type=vector,
+        help="pd: stiffness, one value or one a joint, in [N m/rad] / [N/m] (default: 100 x each joint's inertia, a "
+        "critically damped 10 rad/s); computed-torque: in [1/s^2] (default 400)",
+    )
+    parser.add_argument(
+        "--kd",
+        type=vector,
+        help="pd: damping in [N m s/rad] / [N s/m] (default: 20 x each joint's inertia, or critical for a given --kp); "
+        "computed-torque: in [1/s] (default 40)",
     )
     parser.add_argument("--actuated", help="lqr: the actuated joints, comma-separated (default all; the others get no torque)")
 
