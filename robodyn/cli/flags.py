@@ -63,6 +63,9 @@ SWITCHES: dict[str, str] = {
     "joint_friction=False": "--no-joint-friction",
 }
 
+#: Boolean parameters whose switch turns them off: an error asking for ``False`` names the switch.
+OFF_SWITCHES: dict[str, str] = {"joint_friction": "--no-joint-friction"}
+
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.
 _KEYWORD = re.compile(r"\b(" + "|".join(map(re.escape, FLAGS)) + r")=(?:'(\w+)'(?!\w))?")
 
@@ -82,6 +85,9 @@ def error_text(error: RobodynError) -> str:
     text = str(error)
     if isinstance(error, InputError) and error.argument in FLAGS:
         text = printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
+    elif isinstance(error, InputError) and error.argument in OFF_SWITCHES and error.expected.startswith("False "):
+        needed = error.expected.removeprefix("False ")
+        text = printable(f"{OFF_SWITCHES[error.argument]} is needed {needed}, got {error.received}.")
     return command_line_text(text)
 
 
