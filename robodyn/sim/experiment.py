@@ -26,6 +26,7 @@ from typing import Any, Literal
 import numpy as np
 import pinocchio as pin
 
+from robodyn.common.text import counted
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
@@ -62,7 +63,7 @@ def task_target(values: list[float] | np.ndarray) -> np.ndarray:
         return np.array([values[0], 0.0, values[1]])
     if values.shape == (3,):
         return values
-    raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
+    raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", counted(values.size, "value"))
 
 
 def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
@@ -74,7 +75,7 @@ def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarra
     """
     values = np.asarray(values, dtype=float)
     if values.shape not in ((3,), (6,)) or not np.isfinite(values).all():
-        raise InputError("target", "X,Y,Z in [m] or X,Y,Z,ROLL,PITCH,YAW (rad) for pose control", f"{values.size} values")
+        raise InputError("target", "X,Y,Z in [m] or X,Y,Z,ROLL,PITCH,YAW (rad) for pose control", counted(values.size, "value"))
     return values[:3], (values[3:] if values.size == 6 else None)
 
 
@@ -271,7 +272,7 @@ def _tracked(
     if controller != "computed-torque":
         raise InputError("reference", "given only with the computed-torque controller", repr(controller))
     if target is not None:
-        raise InputError("target", "left out with a reference (its last sample is the target)", f"{np.size(target)} values")
+        raise InputError("target", "left out with a reference (its last sample is the target)", counted(np.size(target), "value"))
     reference = reference.for_robot(robot)
     if robot.floating_base or len(reference) < 2:
         raise InputError("reference", "a fixed-base robot's motion of at least two samples", f"{len(reference)} samples")
@@ -306,17 +307,19 @@ def _check_request(robot: Robot, controller: str, target: list[float] | None, fr
     if controller != "passive" and target is None:
         raise InputError("target", f"given for the {controller} controller", "nothing")
     if controller == "passive" and target is not None:
-        raise InputError("target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
+        raise InputError(
+            "target", "given only with a controller (the passive run has no target)", counted(np.size(target), "value")
+        )
     # Under the other controllers a frame names only the path a recording draws (checked by it).
 
 
 def _check_pose_options(controller: str, posture: Any, stiffness: Any, damping: Any) -> None:
     """Refuse a posture without osc, and impedance gains without the impedance controller."""
     if posture is not None and controller != "osc":
-        raise InputError("posture", "given only with the osc controller", f"{np.size(posture)} values")
+        raise InputError("posture", "given only with the osc controller", counted(np.size(posture), "value"))
     for name, value in (("stiffness", stiffness), ("damping", damping)):
         if value is not None and controller != "impedance":
-            raise InputError(name, "given only with the impedance controller", f"{np.size(value)} values")
+            raise InputError(name, "given only with the impedance controller", counted(np.size(value), "value"))
 
 
 def _control_law(
@@ -399,7 +402,7 @@ def _pose_law(
     if controller == "osc":
         posture = options["posture"]
         if posture is not None and np.size(posture) != robot.nq:
-            raise InputError("posture", f"{robot.nq} joint values", f"{np.size(posture)} values")
+            raise InputError("posture", f"{robot.nq} joint values", counted(np.size(posture), "value"))
         return OperationalSpace(
             controller_model(robot),
             frame,
@@ -410,7 +413,7 @@ def _pose_law(
     gains: dict[str, Any] = {n: np.asarray(options[n], float) for n in ("stiffness", "damping") if options[n] is not None}
     for name, values in gains.items():
         if values.size not in (1, 3, 6):
-            raise InputError(name, "1, 3 or 6 values", f"{values.size} values")
+            raise InputError(name, "1, 3 or 6 values", counted(values.size, "value"))
     return Impedance(controller_model(robot), frame, position, orientation=rpy, **gains)
 
 

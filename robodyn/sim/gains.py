@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn.common.text import counted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 
@@ -91,6 +92,6 @@ def gain_values(value: float | list[float] | np.ndarray, name: str, size: int) -
     if array.size == 1:
         array = np.full(size, array[0])
     if array.size != size or not np.isfinite(array).all() or (array < 0).any():
-        got = f"{array.size} values" if array.size != size else np.array2string(array, precision=4)
+        got = counted(array.size, "value") if array.size != size else np.array2string(array, precision=4)
         raise InputError(name, f"one finite value >= 0, or {size} (one a joint)", got)
     return array

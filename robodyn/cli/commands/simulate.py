@@ -44,8 +44,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--compiled",
         action="store_true",
-        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD, computed torque, task-space, osc and"
-        " impedance run in C too (the same as --engine compiled)",
+        help="integrate in C (robodyn.compile; a C compiler needed; fixed or floating base, the joints' damping "
+        "included, Coulomb friction refused); PD, computed torque, lqr run in C too, and task-space, osc and impedance "
+        "on a fixed base (the same as --engine compiled)",
     )
     _add_engine_arguments(parser)
     no_friction = "leave out the joints' damping and friction (<dynamics>): the rigid-body motion"
