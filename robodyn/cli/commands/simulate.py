@@ -58,7 +58,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
     parser.add_argument("--record", help="HTML animation (meshcat, self-contained, plays on open)")
-    parser.add_argument("--png", help="with --record: a still of the first frame (needs Chromium)")
+    parser.add_argument(
+        "--png", help="with --record: a poster of the motion, its final frame with the path drawn (needs Chromium)"
+    )
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.set_defaults(run=run)
 
