@@ -33,11 +33,13 @@ from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
 from robodyn.sim.gains import computed_torque_gains, pd_gains
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
+from robodyn.sim.linearize import actuation_matrix
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
 from robodyn.sim.reach import check_reach
 from robodyn.sim.report import ObserverOutcome, Push, SimulationSummary, TaskOutcome
 from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate_run
+from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
@@ -167,7 +169,10 @@ def run_simulation(
         force_at: Pushes, each a :class:`~robodyn.sim.report.Push` or ``T:FX,FY,FZ[@FRAME]``
             (default frame: the controlled frame, or the end effector).
         observer_gain: ``K_O`` in [1/s]: run a momentum observer along (``None``: none).
-        actuated: lqr only: the actuated joints (default all; the others get zero torque).
+        actuated: pd, computed-torque and lqr: the actuated joints (default: those whose
+            :attr:`~robodyn.dynamics.dofs.Dof.actuated`, i.e. the file's actuators, else all);
+            the others get zero torque (pd and computed torque then hold or drive the
+            actuated joints with the others free, :mod:`robodyn.sim.underactuated`).
         reference: computed-torque only: a motion to track instead of the quintic
             (:class:`TrajectoryReference`; e.g. ``robodyn optimize``'s); it starts at its first
             sample (unless ``q0`` is given) and its last configuration is the target.
@@ -195,8 +200,9 @@ def run_simulation(
         raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
     options: dict[str, Any] = {"posture": posture, "stiffness": stiffness, "damping": damping}
-    if actuated is not None and controller != "lqr":
-        raise InputError("actuated", "given only with the lqr controller", f"{len(actuated)} joints")
+    if actuated is not None and controller not in ("pd", "computed-torque", "lqr"):
+        raise InputError("actuated", "given only with the pd, computed-torque or lqr controller", f"{len(actuated)} joints")
+    options["driven"] = driven_dofs(robot, actuated)
     options["actuated"] = actuated
     if (kp is not None or kd is not None) and controller not in ("pd", "computed-torque"):
         raise InputError(
@@ -236,8 +242,11 @@ def run_simulation(
         return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
     if controller != "passive":
         joints = np.asarray(target, float)
-        error = float(np.abs(trajectory.q[-1][robot.nq - joints.size :] - joints).max())
-        return trajectory, replace(summary, final_joint_error=error)
+        missed = np.abs(trajectory.q[-1][robot.nq - joints.size :] - joints)
+        driven = options["driven"][6:] if robot.floating_base else options["driven"]
+        if driven.size == missed.size and driven.any():  # the joints no actuator drives have no target to reach
+            missed = missed[driven]
+        return trajectory, replace(summary, final_joint_error=float(missed.max()))
     return trajectory, summary
 
 
@@ -338,16 +347,25 @@ def _control_law(
     if controller in ("pd", "computed-torque", "lqr"):  # the joints' positions (a floating base stays free)
         assert target is not None  # checked by _check_request
         joints = joint_target(robot, target, controller)
-    gains = options["gains"]
+    gains, driven = options["gains"], options["driven"]
+    every_joint = bool(driven[6:].all() if robot.floating_base else driven.all())
     if controller == "pd":
         goal = start.copy()
         goal[robot.nq - joints.size :] = joints  # the inertia at the start and at the target
-        law = PDGravity(controller_model(robot), joints, *pd_gains(robot, np.array([start, goal]), **gains))
+        pd = pd_gains(robot, np.array([start, goal]), driven=driven, **gains)
+        model = controller_model(robot)
+        law = PDGravity(model, joints, *pd) if every_joint else UnderactuatedPD(model, joints, *pd, driven=driven)
     elif controller == "computed-torque":
         reference = quintic_reference(start[robot.nq - joints.size :], joints, duration / 2)
-        law = ComputedTorque(controller_model(robot), reference, *computed_torque_gains(joints.size, **gains))
+        ct, model = computed_torque_gains(joints.size, **gains), controller_model(robot)
+        law = (
+            ComputedTorque(model, reference, *ct)
+            if every_joint
+            else UnderactuatedComputedTorque(model, reference, *ct, driven=driven)
+        )
     elif controller == "lqr":
-        law = _lqr_law(robot, joints, options["actuated"])
+        names = [dof.joint for dof in robot.dofs if driven[dof.index]]
+        law = _lqr_law(robot, joints, options["actuated"] if every_joint or options["actuated"] else names)
     elif controller == "task-space":
         assert target is not None  # checked by _check_request
         task = task_target(target)
@@ -387,6 +405,20 @@ def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = Non
         if dof.joint in chosen
     ]
     return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))
+
+
+def driven_dofs(robot: Robot, actuated: list[str] | None) -> np.ndarray:
+    """Which degrees of freedom an actuator drives, shape (nv,): those of the ``actuated``
+    joints, or by default those whose :attr:`~robodyn.dynamics.dofs.Dof.actuated` (never a
+    floating base's six).
+
+    Raises:
+        InputError: ``actuated`` naming an unknown joint, one twice, or none.
+    """
+    if actuated is None:
+        return np.array([dof.actuated and not dof.is_base for dof in robot.dofs])
+    actuation_matrix(robot, actuated)  # checks the names
+    return np.array([dof.joint in actuated and not dof.is_base for dof in robot.dofs])
 
 
 def _lqr_law(robot: Robot, target: np.ndarray, actuated: list[str] | None) -> LQR:

@@ -18,23 +18,34 @@ from robodyn.exceptions import InputError
 PD_FREQUENCY = 10.0
 
 
-def joint_inertia(robot: Robot, q: np.ndarray) -> np.ndarray:
+def joint_inertia(robot: Robot, q: np.ndarray, driven: np.ndarray | None = None) -> np.ndarray:
     """Each joint's inertia at ``q``, in [kg m²] or [kg], shape (n,), the joints only; ``q``
     of shape (k, nq), several configurations: each joint's largest over them.
 
-    Fixed base: the diagonal of ``M(q)``. Floating base: with the base free, the diagonal
-    of ``M_jj − M_jb M_bb⁻¹ M_bj`` (what a joint's torque accelerates when the base gives way).
+    What a driven joint's torque accelerates when the degrees of freedom no actuator drives
+    give way: the diagonal of ``M_dd − M_du M_uu⁻¹ M_ud`` (a fixed base with every joint
+    driven: the diagonal of ``M(q)``; a floating base: its six are not driven).
+
+    Args:
+        robot: The robot.
+        q: Configuration(s), shape (nq,) or (k, nq).
+        driven: Which degrees of freedom an actuator drives, shape (nv,); ``None``: every
+            joint (not a floating base's six). An undriven joint's entry is its ``M_jj``.
     """
+    mask = np.array([not dof.is_base for dof in robot.dofs]) if driven is None else np.asarray(driven, dtype=bool)
     rows = np.atleast_2d(np.asarray(q, dtype=float))
-    return np.max([_diagonal(robot, row) for row in rows], axis=0)
+    return np.max([_diagonal(robot, row, mask) for row in rows], axis=0)
 
 
-def _diagonal(robot: Robot, q: np.ndarray) -> np.ndarray:
+def _diagonal(robot: Robot, q: np.ndarray, driven: np.ndarray) -> np.ndarray:
     """The joints' inertias at one configuration (see :func:`joint_inertia`)."""
     mass = robot.mass_matrix(q)
-    if not robot.floating_base:
-        return np.diag(mass).copy()
-    return np.diag(mass[6:, 6:] - mass[6:, :6] @ np.linalg.solve(mass[:6, :6], mass[:6, 6:]))
+    out, free = np.diag(mass).copy(), ~driven
+    if free.any():
+        coupling = mass[np.ix_(driven, free)]
+        schur = mass[np.ix_(driven, driven)] - coupling @ np.linalg.solve(mass[np.ix_(free, free)], coupling.T)
+        out[driven] = np.diag(schur)
+    return out[6:] if robot.floating_base else out
 
 
 def pd_gains(
@@ -43,6 +54,7 @@ def pd_gains(
     *,
     kp: float | list[float] | np.ndarray | None = None,
     kd: float | list[float] | np.ndarray | None = None,
+    driven: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """PD gains per joint, in [N m/rad] and [N m s/rad] (prismatic: [N/m], [N s/m]), shape (n,)
     each (n: the joints, a floating base's six left out).
@@ -58,11 +70,12 @@ def pd_gains(
             each joint's largest inertia over them (a run's start and target).
         kp: Stiffness: a scalar or one value a joint; ``None``: the default.
         kd: Damping: a scalar or one value a joint; ``None``: the default.
+        driven: As for :func:`joint_inertia`.
 
     Raises:
         InputError: A gain that is not finite and ≥ 0, or of another size than the joints.
     """
-    inertia = joint_inertia(robot, q)
+    inertia = joint_inertia(robot, q, driven)
     stiffness = PD_FREQUENCY**2 * inertia if kp is None else gain_values(kp, "kp", inertia.size)
     if kd is not None:
         damping = gain_values(kd, "kd", inertia.size)

@@ -157,7 +157,11 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         help="pd: damping in [N m s/rad] / [N s/m] (default: 20 x each joint's inertia, or critical for a given --kp); "
         "computed-torque: in [1/s] (default 40)",
     )
-    parser.add_argument("--actuated", help="lqr: the actuated joints, comma-separated (default all; the others get no torque)")
+    parser.add_argument(
+        "--actuated",
+        help="pd, computed-torque, lqr: the actuated joints, comma-separated (default: the file's actuated joints, else "
+        "all); the others get no torque",
+    )
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
