@@ -31,15 +31,15 @@ from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
-from robodyn.sim.gains import computed_torque_gains, pd_gains
+from robodyn.sim.gains import LQR_ACCELERATION as LQR_ACCELERATION
+from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_gains
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
-from robodyn.sim.linearize import actuation_matrix
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
 from robodyn.sim.reach import check_reach
 from robodyn.sim.report import ObserverOutcome, Push, SimulationSummary, TaskOutcome
 from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate_run
-from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD
+from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_dofs
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
@@ -379,46 +379,6 @@ def _control_law(
         check_reach(robot, controlled, task, parameter="target")
         law = _pose_law(robot, controller, controlled, task, rpy, options)
     return law, task, controlled
-
-
-#: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.
-LQR_ACCELERATION = 100.0
-
-
-def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The LQR weights ``simulate --controller lqr`` uses (Bryson's rule): ``Q`` with
-    1 / (0.3 rad)² per position and 1 / (1 rad/s)² per velocity (prismatic: 0.03 m,
-    0.1 m/s); ``R`` with 1 / u_j² per actuated joint, ``u_j`` the smaller of its effort
-    limit and ``M_jj(q_eq)`` × :data:`LQR_ACCELERATION` (so light distal joints are not
-    given gains too stiff for a millisecond step).
-    """
-    positions = [1 / 0.03**2 if dof.linear else 1 / 0.3**2 for dof in robot.dofs]
-    velocities = [100.0 if dof.linear else 1.0 for dof in robot.dofs]
-    chosen = robot.joint_names if actuated is None else actuated
-    inertia = np.diag(robot.mass_matrix(q_eq))
-    scales = [
-        min(
-            dof.effort_limit if np.isfinite(dof.effort_limit) and dof.effort_limit > 0 else np.inf,
-            inertia[dof.index] * LQR_ACCELERATION,
-        )
-        for dof in robot.dofs
-        if dof.joint in chosen
-    ]
-    return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))
-
-
-def driven_dofs(robot: Robot, actuated: list[str] | None) -> np.ndarray:
-    """Which degrees of freedom an actuator drives, shape (nv,): those of the ``actuated``
-    joints, or by default those whose :attr:`~robodyn.dynamics.dofs.Dof.actuated` (never a
-    floating base's six).
-
-    Raises:
-        InputError: ``actuated`` naming an unknown joint, one twice, or none.
-    """
-    if actuated is None:
-        return np.array([dof.actuated and not dof.is_base for dof in robot.dofs])
-    actuation_matrix(robot, actuated)  # checks the names
-    return np.array([dof.joint in actuated and not dof.is_base for dof in robot.dofs])
 
 
 def _lqr_law(robot: Robot, target: np.ndarray, actuated: list[str] | None) -> LQR:

@@ -108,3 +108,29 @@ def gain_values(value: float | list[float] | np.ndarray, name: str, size: int) -
         got = counted(array.size, "value") if array.size != size else np.array2string(array, precision=4)
         raise InputError(name, f"one finite value >= 0, or {size} (one a joint)", got)
     return array
+
+
+#: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.
+LQR_ACCELERATION = 100.0
+
+
+def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The LQR weights ``simulate --controller lqr`` uses (Bryson's rule): ``Q`` with
+    1 / (0.3 rad)² per position and 1 / (1 rad/s)² per velocity (prismatic: 0.03 m,
+    0.1 m/s); ``R`` with 1 / u_j² per actuated joint, ``u_j`` the smaller of its effort
+    limit and ``M_jj(q_eq)`` × :data:`LQR_ACCELERATION` (so light distal joints are not
+    given gains too stiff for a millisecond step).
+    """
+    positions = [1 / 0.03**2 if dof.linear else 1 / 0.3**2 for dof in robot.dofs]
+    velocities = [100.0 if dof.linear else 1.0 for dof in robot.dofs]
+    chosen = robot.joint_names if actuated is None else actuated
+    inertia = np.diag(robot.mass_matrix(q_eq))
+    scales = [
+        min(
+            dof.effort_limit if np.isfinite(dof.effort_limit) and dof.effort_limit > 0 else np.inf,
+            inertia[dof.index] * LQR_ACCELERATION,
+        )
+        for dof in robot.dofs
+        if dof.joint in chosen
+    ]
+    return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))

@@ -25,6 +25,7 @@ import numpy as np
 
 from robodyn.dynamics.robot import Robot
 from robodyn.sim.control import ComputedTorque, PDGravity
+from robodyn.sim.linearize import actuation_matrix
 
 
 def driven_torques(model: Robot, q: np.ndarray, v: np.ndarray, accelerations: np.ndarray, driven: np.ndarray) -> np.ndarray:
@@ -43,6 +44,20 @@ def driven_torques(model: Robot, q: np.ndarray, v: np.ndarray, accelerations: np
     torques = mass @ acceleration + effects
     torques[free] = 0.0
     return torques
+
+
+def driven_dofs(robot: Robot, actuated: list[str] | None) -> np.ndarray:
+    """Which degrees of freedom an actuator drives, shape (nv,): those of the ``actuated``
+    joints, or by default those whose :attr:`~robodyn.dynamics.dofs.Dof.actuated` (never a
+    floating base's six).
+
+    Raises:
+        InputError: ``actuated`` naming an unknown joint, one twice, or none.
+    """
+    if actuated is None:
+        return np.array([dof.actuated and not dof.is_base for dof in robot.dofs])
+    actuation_matrix(robot, actuated)  # checks the names
+    return np.array([dof.joint in actuated and not dof.is_base for dof in robot.dofs])
 
 
 def _joint_rows(model: Robot) -> slice:

@@ -19,9 +19,9 @@ import pytest
 
 import robodyn
 from robodyn.exceptions import InputError
-from robodyn.sim.experiment import driven_dofs, run_simulation
+from robodyn.sim.experiment import run_simulation
 from robodyn.sim.gains import joint_inertia
-from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_torques
+from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_dofs, driven_torques
 
 WALKER = Path(__file__).parents[1] / "data" / "robots" / "planar_walker.urdf"
 Q0 = [0.0, 0.0, 0.1, 0.3, -0.6]
