@@ -34,27 +34,44 @@ if TYPE_CHECKING:
     from robodyn.compiled.robot import CompiledRobot
 
 
+class Reason(str):
+    """One thing the compiled engine does not model in a plan: a phrase (a ``str``) that
+    knows the plan parameter asking for it (``parameter``), so ``engine="compiled"`` is
+    refused naming that parameter."""
+
+    parameter: str
+
+    def __new__(cls, text: str, parameter: str) -> Reason:
+        reason = super().__new__(cls, text)
+        reason.parameter = parameter
+        return reason
+
+
 def unsupported(plan: RunPlan) -> list[str]:
-    """What the compiled engine does not model in a plan, each one phrase (empty: it runs it)."""
+    """What the compiled engine does not model in a plan, each one phrase (a :class:`Reason`
+    naming its parameter; empty: it runs it)."""
     controller, robot = plan.controller, plan.robot
-    reasons = []
+    reasons: list[str] = []
     if robot.floating_base and fixed_base_only(controller) and plan.every in (None, 1):
-        reasons.append(f"a floating base under {type(controller).__name__} (its compiled twin models fixed bases)")
+        reasons.append(
+            Reason(f"a floating base under {type(controller).__name__} (its compiled twin models fixed bases)", "controller")
+        )
     refusals = [
-        (bool(plan.external), "external wrenches"),
-        (plan.observer is not None, "a momentum observer"),
-        (plan.limits == "enforce", "limits enforced"),
+        (bool(plan.external), "external wrenches", "external"),
+        (plan.observer is not None, "a momentum observer", "observer"),
+        (plan.limits == "enforce", "limits enforced", "limits"),
     ]
-    reasons += [f"{what} (the compiled engine models none)" for refused, what in refusals if refused]
+    reasons += [Reason(f"{what} (the compiled engine models none)", name) for refused, what, name in refusals if refused]
     if plan.coulomb:
         joints = [dof.name for dof in robot.dofs if dof.friction]
         listed = ", ".join(quoted(name) for name in joints[:8]) + (", …" if len(joints) > 8 else "")
-        reasons.append(
+        text = (
             f"joint Coulomb friction ({listed}: the compiled loop has the damping, not stick-slip; "
             "joint_friction=False simulates the rigid-body motion compiled)"
         )
+        reasons.append(Reason(text, "joint_friction"))
     if robot.massless_joints or robot.nv == 0:
-        reasons.append("no moving mass to compile (the compiled engine models none)")
+        reasons.append(Reason("no moving mass to compile (the compiled engine models none)", "engine"))
     return reasons
 
 

@@ -58,7 +58,11 @@ def choose(plan: RunPlan) -> tuple[Literal["pinocchio", "compiled"], str]:
     reasons = compiled_backend.unsupported(plan)
     if plan.engine == "compiled":
         if reasons:
-            raise InputError("engine", f"'pinocchio' or 'auto' for a run with {reasons[0]}", "'compiled'")
+            first = reasons[0]
+            parameter = getattr(first, "parameter", "engine")
+            if parameter == "engine":
+                raise InputError("engine", f"'pinocchio' or 'auto' for a run with {first}", "'compiled'")
+            raise InputError(parameter, f"left out for engine='compiled': {first}", "given")
         return "compiled", "asked for (engine='compiled')"
     reasons += compiled_backend.not_ready(plan)
     if reasons:

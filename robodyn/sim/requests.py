@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from robodyn.common.text import counted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.plan import ExternalWrench
@@ -29,7 +30,7 @@ def task_target(values: list[float] | np.ndarray) -> np.ndarray:
         return np.array([values[0], 0.0, values[1]])
     if values.shape == (3,):
         return values
-    raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
+    raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", counted(values.size, "value"))
 
 
 def check_planar(robot: Robot, frame: str, q: np.ndarray, size: int) -> None:
@@ -56,7 +57,7 @@ def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarra
     """
     values = np.asarray(values, dtype=float)
     if values.shape not in ((3,), (6,)) or not np.isfinite(values).all():
-        raise InputError("target", "X,Y,Z in [m] or X,Y,Z,ROLL,PITCH,YAW (rad) for pose control", f"{values.size} values")
+        raise InputError("target", "X,Y,Z in [m] or X,Y,Z,ROLL,PITCH,YAW (rad) for pose control", counted(values.size, "value"))
     return values[:3], (values[3:] if values.size == 6 else None)
 
 
@@ -127,8 +128,8 @@ def tracked(
     if controller != "computed-torque":
         raise InputError("reference", "given only with the computed-torque controller", repr(controller))
     if target is not None:
-        raise InputError("target", "left out with a reference (its last sample is the target)", f"{np.size(target)} values")
+        raise InputError("target", "left out with a reference (its last sample is the target)", counted(np.size(target), "value"))
     reference = reference.for_robot(robot)
     if robot.floating_base or len(reference) < 2:
-        raise InputError("reference", "a fixed-base robot's motion of at least two samples", f"{len(reference)} samples")
+        raise InputError("reference", "a fixed-base robot's motion of at least two samples", counted(len(reference), "sample"))
     return reference, list(reference.q[-1]), list(reference.q[0]) if q0 is None else q0

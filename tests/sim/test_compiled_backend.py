@@ -29,7 +29,7 @@ def test_unsupported_lists_every_reason_in_order_and_the_engines_use_the_first()
     assert engine.choose(plan(robot, q0, np.zeros(2), 0.01, 1e-3, engine="auto", **options)) == ("pinocchio", reasons[0])
     with pytest.raises(InputError, match="external wrenches") as refused:
         engine.choose(plan(robot, q0, np.zeros(2), 0.01, 1e-3, engine="compiled", **options))
-    assert refused.value.argument == "engine"
+    assert refused.value.argument == "external"  # the parameter that asks for what it lacks
     assert compiled_backend.unsupported(plan(robot, q0, np.zeros(2), 0.01, 1e-3)) == []  # negative control
 
 

@@ -143,10 +143,10 @@ def test_pose_options_are_refused_where_they_do_not_apply(rp_arm):
 def test_the_compiled_engine_refuses_pushes_and_observers_by_name(rp_arm):
     with pytest.raises(InputError, match="external wrenches") as raised:
         run_simulation(rp_arm, force_at=["0:1,0,0"], duration=0.01, engine="compiled")
-    assert raised.value.argument == "engine"
+    assert raised.value.argument == "external"
     with pytest.raises(InputError, match="momentum observer") as raised:
         run_simulation(rp_arm, observer_gain=10.0, duration=0.01, engine="compiled")
-    assert raised.value.argument == "engine"
+    assert raised.value.argument == "observer"
 
 
 def test_a_robot_without_a_default_end_effector_still_simulates_and_its_pushes_need_a_frame():

@@ -9,6 +9,7 @@ the reason is one sentence. Adding a controller without a twin (or a stated reas
 from __future__ import annotations
 
 import ast
+import importlib
 import inspect
 
 import numpy as np
@@ -16,7 +17,6 @@ import pytest
 
 import robodyn
 from robodyn.compiled.controllers import TWINS, HasTwin, c_constants, check_layout, size
-from robodyn.sim import control, operational_space
 from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace
 from robodyn.sim.experiment import CONTROLLERS, run_simulation
 from tests.conftest import ROOT
@@ -34,8 +34,7 @@ def library_controllers() -> list[type]:
                 calls = [f for f in node.body if isinstance(f, ast.FunctionDef) and f.name == "__call__"]
                 if calls and [a.arg for a in calls[0].args.args] == ["self", "t", "q", "v"]:
                     found.append((path.stem, node.name))
-    modules = {"control": control, "operational_space": operational_space}
-    return [getattr(modules[module], name) for module, name in found]
+    return [getattr(importlib.import_module(f"robodyn.sim.{module}"), name) for module, name in found]
 
 
 def test_every_library_controller_owns_a_twin_or_states_why_not():
