@@ -59,6 +59,7 @@ SWITCHES: dict[str, str] = {
     "check_inertia=False": "--no-check-inertia",
     "strict=True": "--strict",
     "joint_friction=False": "--no-joint-friction",
+    "xacro_env=True": "--xacro-env",
 }
 
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.

@@ -73,6 +73,7 @@ def load(
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str | os.PathLike] | None = None,
     armature: Mapping[str, float] | None = None,
+    xacro_env: bool = False,
 ) -> Robot:
     """Load a robot.
 
@@ -103,6 +104,9 @@ def load(
             and ``$(find name)`` resolve, before ``$ROS_PACKAGE_PATH`` and the zoo's folders.
         armature: Rotor inertia reflected to joints, ``{joint name: value in [kg m²] or
             [kg]}``, added to what the file says.
+        xacro_env: Let a xacro source read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); without it they are refused. See docs/robot-files.md for
+            everything a xacro may do.
 
     Returns:
         The robot.
@@ -117,7 +121,9 @@ def load(
         RobodynWarning: For what ``strict=True`` refuses.
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
-    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict)
+    resolved = resolve_source(
+        source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict, xacro_env=xacro_env
+    )
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
@@ -133,6 +139,7 @@ def load(
         xacro_args=xacro_args,
         packages=folders,
         armature=armature,
+        xacro_env=xacro_env,
     )
     return build_robot(resolved, options)
 

@@ -48,6 +48,8 @@ class LoadOptions:
             ``(package name, folder)`` pairs, before ``$ROS_PACKAGE_PATH`` and the zoo's.
         armature: Rotor inertia added at joints, as ``(joint name, value in [kg m²] or
             [kg])`` pairs (on top of what the file says).
+        xacro_env: Whether a xacro source could read environment variables (the source
+            carries the expanded text).
     """
 
     floating_base: bool
@@ -61,6 +63,7 @@ class LoadOptions:
     xacro_args: tuple[tuple[str, str], ...] = ()
     packages: tuple[tuple[str, str], ...] = ()
     armature: tuple[tuple[str, float], ...] = ()
+    xacro_env: bool = False
 
 
 def load_options(
@@ -76,6 +79,7 @@ def load_options(
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
     armature: Mapping[str, float] | None = None,
+    xacro_env: bool = False,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 
@@ -97,6 +101,7 @@ def load_options(
         xacro_args=tuple((str(name), str(value)) for name, value in (xacro_args or {}).items()),
         packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
         armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
+        xacro_env=bool(xacro_env),
     )
 
 

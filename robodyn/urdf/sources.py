@@ -162,6 +162,7 @@ class _Reading:
     lookup: PackageLookup
     strict: bool
     interpret: bool = True
+    xacro_env: bool = False
 
 
 _ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
@@ -195,12 +196,14 @@ def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
     is_xacro = source.path is not None and source.path.suffix == ".xacro"
     if is_xacro or (tag == "robot" and is_xacro_text(source.text)):
         text = expand_xacro(
-            path=source.path if source.path is not None else None,
+            path=source.path,
             text=source.text,
             label=source.label,
             args=reading.xacro_args,
             lookup=reading.lookup,
             read_file=lambda path: read_text(path, reading.limit),
+            limit=reading.limit,
+            env=reading.xacro_env,
         )
         name = source.name.removesuffix(".urdf") if is_xacro else source.name
         return replace(source, text=text, name=name, file_format="xacro")
@@ -215,6 +218,7 @@ def resolve_source(
     packages: Mapping[str, str] | None = None,
     strict: bool = False,
     interpret: bool = True,
+    xacro_env: bool = False,
 ) -> URDFSource:
     """Find the URDF a source names.
 
@@ -229,6 +233,8 @@ def resolve_source(
         strict: Refuse MJCF elements robodyn cannot take instead of warning.
         interpret: Expand a xacro, convert an MJCF file and refuse SDF (``False``: the text
             as read, for telling reading errors from the document's own problems).
+        xacro_env: Let a xacro read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); refused otherwise.
 
     Raises:
         URDFError: If a file cannot be read, is not a regular file or is too large, a
@@ -236,7 +242,7 @@ def resolve_source(
         UnknownRobotError: If a name is neither a robot nor an existing file.
     """
     limit = max_urdf_bytes(max_bytes)
-    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret)
+    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret, bool(xacro_env))
     if isinstance(source, os.PathLike):
         return _read_file(Path(source), limit, reading)
     if not isinstance(source, str):
@@ -318,6 +324,7 @@ def lint_source(
     floating_base: bool | None = None,
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
+    xacro_env: bool = False,
 ) -> list[Problem]:
     """Every problem of a robot file (a path, text or robot name), errors and warnings.
 
@@ -331,7 +338,7 @@ def lint_source(
     """
     resolve_source(source, interpret=False)  # a file that cannot be read is an error, not a problem
     try:
-        resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
+        resolved = resolve_source(source, xacro_args=xacro_args, packages=packages, xacro_env=xacro_env)
     except URDFError as error:
         return [Problem(error.element, error.rule)]
     floating = resolved.floating_base if floating_base is None else floating_base

@@ -84,10 +84,12 @@ def test_find_resolves_through_ros_package_path(monkeypatch):
     assert robot.package_dirs.find("robodyn_test_arm") == PACKAGE
 
 
-def test_xacro_text_is_expanded_too():
+def test_xacro_text_is_expanded_too_its_includes_inside_a_named_package():
     text = ARM.read_text().replace("$(find robodyn_test_arm)", str(PACKAGE))
-    robot = robodyn.load(text, xacro_args={"prefix": "r_"})
+    robot = robodyn.load(text, xacro_args={"prefix": "r_"}, packages=PACKAGES)
     assert robot.joint_names == ["r_shoulder", "r_slide", "r_wrist_roll"]
+    with pytest.raises(URDFError, match=r"xacro: the include '.*macros\.xacro' is outside the file's folder tree"):
+        robodyn.load(text)  # XML text has no folder: an include must be inside a package or the zoo
 
 
 def test_the_reference_reads_the_same_expansion():
