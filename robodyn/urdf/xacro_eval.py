@@ -71,7 +71,7 @@ class Namespace(dict):
 def size(value: Any, budget: int = MAX_SIZE) -> int:
     """About how many characters ``str(value)`` has, counting at most past ``budget``."""
     if isinstance(value, str):
-        return len(value) + 2
+        return len(value)
     if isinstance(value, bool) or value is None or isinstance(value, float):
         return 24
     if isinstance(value, int):
