@@ -188,10 +188,15 @@ def _symbols(xacro: Any, guard: XacroGuard) -> dict[str, Any]:
         except KeyError:
             raise ExpressionError(f"undefined argument {name!r} (xacro_args= gives its value)") from None
 
+    def tokenize(text: str, sep: str = ",; ", skip_empty: bool = True) -> list[str]:
+        """xacro.tokenize, its separators taken as characters (never as a pattern)."""
+        parts = re.split(f"[{re.escape(str(sep))}]", str(text)) if sep else [str(text)]
+        return [part for part in parts if part] if skip_empty else parts
+
     functions: dict[str, Callable[..., Any]] = {
         "arg": arg,
         "load_yaml": load_yaml,
-        "tokenize": lambda text, sep=",; ", skip_empty=True: xacro.tokenize(str(text), str(sep), bool(skip_empty)),
+        "tokenize": tokenize,
         "dotify": lambda mapping: dict(mapping),
         "message": say(xacro.message),
         "warning": say(xacro.warning),

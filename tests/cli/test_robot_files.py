@@ -131,3 +131,11 @@ def test_xacro_env_lets_a_xacro_read_the_environment_and_the_refusal_names_the_f
     assert status == 2 and "'ROBODYN_TEST_PREFIX'" in err and "unless --xacro-env" in err and "xacro_env=True" not in err
     status, out, _ = run(capsys, "info", *model, "--xacro-env", "--json")
     assert status == 0 and json.loads(out)["joint_dynamics"][0]["joint"] == "env_shoulder"
+
+
+def test_lint_names_a_urdf_holding_xacro_by_its_path_however_long(capsys, tmp_path):
+    path = tmp_path / ("a_long_robot_description_name_" * 3 + ".urdf")
+    text = (PACKAGE / "urdf" / "arm.urdf.xacro").read_text()
+    path.write_text(text.replace("$(find robodyn_test_arm)/urdf", str(PACKAGE / "urdf")))
+    status, out, _ = run(capsys, "lint", str(path), *PACKAGE_FLAG)
+    assert status == 0 and out.splitlines()[-1] == f"{path}: 0 errors, 0 warnings" and len(str(path)) > 80
