@@ -42,6 +42,9 @@ MAX_SIZE = 1_000_000
 MAX_DEPTH = 100
 #: Longest expression, in characters.
 MAX_EXPRESSION = 100_000
+#: Most characters one expression may build in all (strings and lists it computes), so a
+#: long list of ``len('x' * 999999)`` cannot keep the evaluator busy.
+MAX_BUILT = 20 * MAX_SIZE
 
 
 class ExpressionError(ValueError):
@@ -178,6 +181,15 @@ class _Evaluator:
     def __init__(self, lookup: Callable[[str], Any]):
         self.lookup = lookup
         self.depth = 0
+        self.built = 0
+
+    def _count(self, value: Any) -> Any:
+        """``value``, its size counted towards :data:`MAX_BUILT` if it is text or a container."""
+        if isinstance(value, str | list | tuple | dict) and not isinstance(value, Namespace):
+            self.built += len(value) if isinstance(value, str) else size(value)
+            if self.built > MAX_BUILT:
+                raise ExpressionError(f"the expression builds more than {MAX_BUILT} characters in all")
+        return value
 
     def value(self, node: ast.AST) -> Any:
         self.depth += 1
@@ -231,7 +243,7 @@ class _Evaluator:
         operation = _BINARY.get(type(node.op))
         if operation is None:
             raise ExpressionError(f"the operator {type(node.op).__name__} is not in the language")
-        return operation(self.value(node.left), self.value(node.right))
+        return self._count(operation(self.value(node.left), self.value(node.right)))
 
     def _UnaryOp(self, node: ast.UnaryOp) -> Any:
         operation = _UNARY.get(type(node.op))
@@ -278,7 +290,7 @@ class _Evaluator:
             raise ExpressionError("'**' arguments are not in the language")
         args = [self.value(item) for item in _plain(node.args)]
         kwargs = {str(keyword.arg): self.value(keyword.value) for keyword in node.keywords}
-        return function(*args, **kwargs)
+        return self._count(function(*args, **kwargs))
 
 
 def _plain(items: list[ast.expr]) -> list[ast.expr]:

@@ -39,7 +39,7 @@ MAX_MACRO_DEPTH = 50
 #: Deepest nesting of includes.
 MAX_INCLUDE_DEPTH = 20
 #: Longest expansion, in seconds (a backstop behind the counts above).
-MAX_SECONDS = 20.0
+MAX_SECONDS = 10.0
 #: Largest YAML file ``xacro.load_yaml`` reads, in bytes.
 MAX_YAML_BYTES = 1 << 20
 
@@ -63,6 +63,7 @@ class XacroGuard:
         self.roots = tuple(_resolved(root) for root in roots)
         self.elements = 0
         self.produced = 0
+        self.texts = 0
         self.started = time.monotonic()
 
     def refuse(self, rule: str) -> URDFError:
@@ -91,6 +92,9 @@ class XacroGuard:
             URDFError: If the expansion's text passes the size cap.
         """
         self.produced += len(value) if isinstance(value, str) else size(value)
+        self.texts += 1
+        if self.texts % 64 == 0 and time.monotonic() - self.started > MAX_SECONDS:
+            raise self.refuse(f"the expansion took more than {MAX_SECONDS:g} s")
         if self.produced > self.limit:
             raise self.refuse(
                 f"the expansion is more than the limit of {self.limit} bytes (max_bytes= or $ROBODYN_MAX_URDF_BYTES raises it)"

@@ -133,6 +133,7 @@ def test_negative_control_xacros_own_evaluator_lets_each_escape_through(expressi
         ("-" * 5000 + "1", "RecursionError"),
         ("(" * 500 + "1" + ")" * 500, "not valid"),
         ("+".join(["1"] * 300), "nested more than 100 deep"),
+        ("[" + ", ".join(["len('x' * 999999)"] * 40) + "]", "builds more than 20000000 characters"),
     ],
 )
 def test_values_past_the_bounds_are_refused_before_they_are_computed(expression, reason):

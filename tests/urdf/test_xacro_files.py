@@ -300,6 +300,7 @@ def attacks(tmp_path) -> dict[str, tuple[str, str]]:
             f"<link name=\"${{xacro.load_yaml('{outside / 'secret.yaml'}')['token']}}\"/>",
             "secret.yaml' is outside the file's folder tree",
         ),
+        "$(eval) of a builtin": ('<link name="$(eval open)"/>', "the name 'open' is not defined"),
         "$(optenv HOME)": ('<link name="x$(optenv HOME)"/>', "environment variable 'HOME'"),
         "$(env PATH)": ('<link name="x$(env PATH)"/>', "environment variable 'PATH'"),
         "an absolute include": (f'<xacro:include filename="{outside / "evil.xacro"}"/>', "evil.xacro' is outside"),
@@ -319,6 +320,7 @@ ATTACK_NAMES = [
     "a format string",
     "load_yaml of /etc/passwd",
     "load_yaml outside the tree",
+    "$(eval) of a builtin",
     "$(optenv HOME)",
     "$(env PATH)",
     "an absolute include",
@@ -367,3 +369,13 @@ def test_a_mesh_in_package_dot_dot_is_refused(tmp_path):
     text = robot_document(body).replace('<link name="base"/>', "")
     with pytest.raises(URDFError, match=r"package '\.\.'.*is not a package name"):
         robodyn.load(text)
+
+
+def test_the_time_bound_stops_an_expansion_that_runs_long(monkeypatch):
+    from robodyn.urdf import xacro_guard
+
+    monkeypatch.setattr(xacro_guard, "MAX_SECONDS", 0.0)
+    with pytest.raises(URDFError, match=r"xacro: the expansion took more than 0 s"):
+        robodyn.load(RICH_ARM)
+    monkeypatch.undo()
+    assert robodyn.load(RICH_ARM).nv == 3
