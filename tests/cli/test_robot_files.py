@@ -131,6 +131,8 @@ def test_xacro_env_lets_a_xacro_read_the_environment_and_the_refusal_names_the_f
     assert status == 2 and "'ROBODYN_TEST_PREFIX'" in err and "unless --xacro-env" in err and "xacro_env=True" not in err
     status, out, _ = run(capsys, "info", *model, "--xacro-env", "--json")
     assert status == 0 and json.loads(out)["joint_dynamics"][0]["joint"] == "env_shoulder"
+    status, out, _ = run(capsys, "equations", *model, "--xacro-env", "--symbolic", "--format", "json")
+    assert status == 0 and json.loads(out)["joint_names"][0] == "env_shoulder"
 
 
 def test_lint_names_a_urdf_holding_xacro_by_its_path_however_long(capsys, tmp_path):
