@@ -62,6 +62,7 @@ SWITCHES: dict[str, str] = {
     "check_inertia=False": "--no-check-inertia",
     "strict=True": "--strict",
     "joint_friction=False": "--no-joint-friction",
+    "xacro_env=True": "--xacro-env",
 }
 
 #: Boolean parameters whose switch turns them off: an error asking for ``False`` names the switch.

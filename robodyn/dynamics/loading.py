@@ -77,6 +77,7 @@ def load(
     packages: Mapping[str, str | os.PathLike] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
+    xacro_env: bool = False,
 ) -> Robot:
     """Load a robot.
 
@@ -112,6 +113,9 @@ def load(
             ``FrameAnchor``, ``PointContact`` or a list of them), after those the file
             declares (MJCF ``<equality>``); :attr:`Robot.constraints` lists them all. See
             docs/constraints.md.
+        xacro_env: Let a xacro source read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); without it they are refused. See docs/robot-files.md for
+            everything a xacro may do.
 
     Returns:
         The robot.
@@ -128,7 +132,13 @@ def load(
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
     resolved = resolve_source(
-        source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict, max_dof=max_dof
+        source,
+        max_bytes=max_bytes,
+        xacro_args=xacro_args,
+        packages=folders,
+        strict=strict,
+        max_dof=max_dof,
+        xacro_env=xacro_env,
     )
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     _report_equalities(resolved, strict)
@@ -147,6 +157,7 @@ def load(
         packages=folders,
         armature=armature,
         constraints=constraints,
+        xacro_env=xacro_env,
     )
     return build_robot(resolved, options)
 

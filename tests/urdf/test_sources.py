@@ -175,3 +175,28 @@ def test_the_memory_estimate_bounds_what_pinocchio_takes(joints):
 
 def test_errors_of_this_family_are_robodyn_errors():
     assert issubclass(URDFError, RobodynError)
+
+
+@pytest.mark.parametrize(
+    ("text", "is_xacro"),
+    [
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a"/></robot>', False),
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="p" value="1"/></robot>', True),
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${1}"/></robot>', True),
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="$(arg a)"/></robot>', True),
+        ('<robot name="r"><link name="${1}"/></robot>', False),  # no namespace: a plain URDF (its name is odd)
+        ('\n\n<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:if value="1"/></robot>', True),
+    ],
+)
+def test_xacro_is_expanded_where_the_namespace_and_xacro_use_meet(text, is_xacro):
+    from robodyn.urdf.xacro_files import is_xacro_text
+
+    assert is_xacro_text(text) is is_xacro
+
+
+def test_a_urdf_file_holding_xacro_is_named_by_its_path_in_a_refusal(tmp_path):
+    path = tmp_path / "plain.urdf"
+    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${().__class__}"/></robot>')
+    with pytest.raises(URDFError) as raised:
+        robodyn.load(path)
+    assert str(raised.value).startswith(f"{path}: xacro: the expression '().__class__'")
