@@ -29,13 +29,13 @@ from tests.conftest import ROOT
 INERTIA = 0.5
 
 
-def rotor(*, effort: float = 0.0, upper: float = 10.0, friction: float = 0.0) -> robodyn.Robot:
+def rotor(*, effort: float = 0.0, upper: float = 10.0, friction: float = 0.0, lower: float = -10.0) -> robodyn.Robot:
     dynamics = f'<dynamics friction="{friction}"/>' if friction else ""
     return robodyn.load(
         f"""<robot name="rotor"><link name="base"/><link name="disc"><inertial><mass value="1"/>
         <inertia ixx="0.3" iyy="0.3" izz="{INERTIA}" ixy="0" ixz="0" iyz="0"/></inertial></link>
         <joint name="spin" type="revolute"><parent link="base"/><child link="disc"/><axis xyz="0 0 1"/>
-        <limit lower="-10" upper="{upper}" velocity="0" effort="{effort}"/>{dynamics}</joint></robot>"""
+        <limit lower="{lower}" upper="{upper}" velocity="0" effort="{effort}"/>{dynamics}</joint></robot>"""
     )
 
 
@@ -127,3 +127,43 @@ def test_the_observer_detects_a_push_just_above_its_threshold_and_not_just_below
     assert detect_collision(robot, recorded.t, residual, 2.1) is None  # just above the push: nothing
     # Thresholds per joint: the shoulder's slack, the elbow's low: no joint crosses its own.
     assert detect_collision(robot, recorded.t, residual, np.array([2.1, 0.05])) is None
+
+
+def two_rotors() -> robodyn.Robot:
+    """Two rotors on one base, about parallel vertical axes: independent motions (diagonal
+    M, no gravity torque); the first has a stop at 0.5 rad, the second stops far away."""
+    disc = '<inertial><mass value="1"/><inertia ixx="0.3" iyy="0.3" izz="0.5" ixy="0" ixz="0" iyz="0"/></inertial>'
+    return robodyn.load(
+        f"""<robot name="two_rotors"><link name="base"/><link name="a">{disc}</link><link name="b">{disc}</link>
+        <joint name="first" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-10" upper="0.5" velocity="0" effort="0"/></joint>
+        <joint name="second" type="revolute"><parent link="base"/><child link="b"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/>
+        <limit lower="-10" upper="10" velocity="0" effort="0"/></joint></robot>"""
+    )
+
+
+@pytest.mark.parametrize("pull", [-1.0, 1.0], ids=["second-moving-away", "second-moving-along"])
+def test_a_stop_holds_its_own_joint_only(pull):
+    """The first rotor rests on its stop, pushed into it; the second moves freely either way:
+    its velocity is never touched by the other joint's stop."""
+    robot = two_rotors()
+    run = robodyn.simulate(
+        robot, np.zeros(2), np.zeros(2), 1.5, 1e-3, controller=constant_pair(1.0, pull), limits="enforce", hold=True
+    )
+    assert run.q[:, 0].max() == 0.5 and np.all(run.v[run.t > 0.75, 0] == 0.0)
+    np.testing.assert_allclose(run.q[:, 1], pull * run.t**2 / (2 * INERTIA), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run.v[:, 1], pull * run.t / INERTIA, rtol=0, atol=1e-12)
+
+
+def constant_pair(first: float, second: float):
+    return lambda t, q, v: np.array([first, second])
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0], ids=["upper", "lower"])
+def test_a_joint_started_beyond_its_stop_keeps_its_speed_back_into_the_range(side):
+    """Put back on the stop after the first step, the velocity away from it is kept."""
+    robot = rotor(upper=0.5, lower=-0.5)
+    with pytest.warns(exceptions.JointLimitWarning, match="spin position"):  # the start itself is beyond
+        run = robodyn.simulate(robot, np.array([0.52 * side]), np.array([-0.4 * side]), 0.5, 1e-3, limits="enforce")
+    assert run.q[1, 0] == 0.5 * side and run.v[1, 0] == -0.4 * side  # back on the stop, the speed away kept
+    np.testing.assert_allclose(run.q[2:, 0], side * (0.5 - 0.4 * (run.t[2:] - run.t[1])), atol=1e-12)
