@@ -76,12 +76,24 @@ def test_a_value_within_the_tolerance_is_no_violation_and_just_past_it_is():
 
 
 def test_a_stop_on_one_side_only_is_enforced():
-    """A placeholder lower limit (−2000 m: unspecified) and a real upper one: the stop holds."""
-    robot = arm(lower=-2000.0)
+    """A slider alone, its lower limit a placeholder (−2000 m: unspecified), its upper one
+    real: the stop holds."""
+    box = '<inertial><mass value="1.5"/><inertia ixx="0.02" iyy="0.03" izz="0.025" ixy="0" ixz="0" iyz="0"/></inertial>'
+    robot = robodyn.load(
+        f"""<robot name="slider"><link name="base"/><link name="carriage">{box}</link>
+        <joint name="slide" type="prismatic"><parent link="base"/><child link="carriage"/><axis xyz="1 0 0"/>
+        <limit lower="-2000" upper="0.5" velocity="0" effort="0"/></joint></robot>"""
+    )
     run = robodyn.simulate(
-        robot, np.zeros(2), np.zeros(2), 1.0, 1e-3, controller=lambda t, q, v: np.array([10.0, 0.0]), limits="enforce"
+        robot, np.zeros(1), np.zeros(1), 1.0, 1e-3, controller=lambda t, q, v: np.array([10.0]), limits="enforce"
     )
     assert run.q[:, 0].max() == 0.5 and run.q[-1, 0] == 0.5
+
+
+def test_a_position_limit_keeps_its_own_sign_whatever_the_worst_value():
+    robot = arm(lower=0.2)  # a lower limit above zero, broken by a negative position
+    (found,) = limit_violations(robot, motion(robot, np.array([0.3, -0.3]), np.zeros(2), None))
+    assert (found.side, found.worst, found.limit) == ("lower", -0.3, 0.2)
 
 
 def test_an_unknown_limits_mode_is_refused_naming_the_parameter_and_the_value():
