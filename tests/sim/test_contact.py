@@ -1,0 +1,130 @@
+"""Contact simulation against physical laws: a box at rest, on slopes, sliding to a stop; solo12 standing."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn.sim import contact
+from robodyn.sim.contact_run import free_fall_note, simulate_contact
+from robodyn.sim.ground import Ground, contact_points
+
+DATA = Path(__file__).parents[1] / "data" / "contact"
+G = 9.81
+MASS = 2.5  # tests/data/contact/box.urdf
+HALF_HEIGHT = 0.05
+
+
+@pytest.fixture(scope="module")
+def box() -> robodyn.Robot:
+    return robodyn.load(DATA / "box.urdf", floating_base=True)
+
+
+def _on_slope(box: robodyn.Robot, ground: Ground, lift: float = 0.0, v0: np.ndarray | None = None) -> np.ndarray:
+    """The box resting flat on ``ground`` (its bottom face on the plane, raised by ``lift``)."""
+    n = np.array(ground.normal)
+    angle = math.atan2(n[0], n[2])
+    q = box.neutral_configuration()
+    q[:3] = ground.point + (HALF_HEIGHT + lift) * n
+    q[3:7] = (0.0, math.sin(angle / 2), 0.0, math.cos(angle / 2))  # x, y, z, w: about y
+    return q
+
+
+def _energy(box: robodyn.Robot, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.array([box.kinetic_energy(qi, vi) + box.potential_energy(qi) for qi, vi in zip(q, v, strict=True)])
+
+
+def test_a_box_dropped_flat_comes_to_rest_carrying_its_weight(box):
+    ground = Ground(friction=0.5)
+    run = simulate_contact(box, ground=ground, duration=0.5, dt=1e-3, q0=_on_slope(box, ground, lift=0.2))
+    total = run.normal_forces.sum(axis=1)
+    assert abs(total[-1] / (MASS * G) - 1) < 1e-6
+    assert run.active[-1].sum() == 4  # the four bottom corners
+    assert -run.gaps.min() < 1e-9  # speculative contact: no penetration on a flat landing
+    assert np.abs(run.trajectory.v[-1]).max() < 1e-9
+    landed = int(np.argmax(total > 0))
+    energy = _energy(box, run.trajectory.q, run.trajectory.v)[landed:]
+    assert np.all(np.diff(energy) <= 1e-9 * MASS * G)  # never increases after the impact
+    assert energy[0] - energy[-1] > 0.5 * MASS * G * 0.19  # the impact took the fall's energy
+
+
+def test_a_box_on_a_slope_below_the_friction_angle_stays_put(box):
+    ground = Ground.tilted(math.radians(20), friction=0.5)  # atan(0.5) = 26.6°
+    q0 = _on_slope(box, ground)
+    run = simulate_contact(box, ground=ground, duration=0.3, dt=1e-3, q0=q0)
+    assert np.abs(run.trajectory.q[-1, :3] - q0[:3]).max() < 1e-9
+    total = run.forces[-1].sum(axis=0)
+    assert np.allclose(total, (0, 0, MASS * G), rtol=0, atol=1e-6 * MASS * G)  # the plane carries the weight
+
+
+@pytest.mark.parametrize(("degrees", "friction"), [(35.0, 0.5), (20.0, 0.0), (5.0, 0.0)])
+def test_a_box_above_the_friction_angle_slides_with_g_sin_minus_mu_g_cos(box, degrees, friction):
+    theta = math.radians(degrees)
+    ground = Ground.tilted(theta, friction=friction)
+    run = simulate_contact(box, ground=ground, duration=0.2, dt=1e-3, q0=_on_slope(box, ground))
+    along = np.array([math.cos(theta), 0.0, -math.sin(theta)])  # down the slope
+    position = run.trajectory.q[:, :3] @ along
+    t = run.trajectory.t
+    acceleration = np.polyfit(t[10:], position[10:], 2)[0] * 2
+    expected = G * (math.sin(theta) - friction * math.cos(theta))
+    assert abs(acceleration / expected - 1) < 1e-3
+    assert abs(run.trajectory.q[:, :3] @ np.array(ground.normal) - HALF_HEIGHT).max() < 1e-9  # stays on the plane
+
+
+def test_a_dropped_friction_row_breaks_the_slope_law(box, monkeypatch):
+    theta, friction = math.radians(35.0), 0.5
+    ground = Ground.tilted(theta, friction=friction)
+    original = contact._local_jacobian
+    monkeypatch.setattr(contact, "_local_jacobian", lambda axes, linear: original(axes, linear) * [[0.0], [1.0], [1.0]])
+    run = simulate_contact(box, ground=ground, duration=0.2, dt=1e-3, q0=_on_slope(box, ground))
+    along = np.array([math.cos(theta), 0.0, -math.sin(theta)])
+    acceleration = np.polyfit(run.trajectory.t[10:], (run.trajectory.q[:, :3] @ along)[10:], 2)[0] * 2
+    assert abs(acceleration / (G * (math.sin(theta) - friction * math.cos(theta))) - 1) > 0.1
+
+
+def test_a_block_sliding_with_friction_stops_after_v_squared_over_two_mu_g(box):
+    ground, speed, mu = Ground(friction=0.4), 1.5, 0.4
+    v0 = np.zeros(box.nv)
+    v0[0] = speed  # the base's linear velocity is in its own frame: flat, that is world x
+    run = simulate_contact(box, ground=ground, duration=0.5, dt=1e-4, q0=_on_slope(box, ground), v0=v0)
+    distance = run.trajectory.q[-1, 0]
+    assert abs(distance / (speed**2 / (2 * mu * G)) - 1) < 1e-3
+    assert abs(run.trajectory.v[-1]).max() < 1e-9
+
+
+def test_a_floating_robot_with_no_ground_says_its_base_falls_freely(box):
+    assert free_fall_note(box, None) == "no ground: the base falls freely"
+    assert free_fall_note(box, Ground()) is None
+
+
+@pytest.fixture(scope="module")
+def solo_standing():
+    robot = robodyn.load("solo12")
+    feet = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+    q0 = robot.neutral_configuration()
+    gaps, _ = contact.contact_kinematics(robot, q0, Ground(), contact_points(robot, feet).points)
+    q0[2] = -gaps.min() + 0.05  # feet 5 cm above the ground
+    target = q0[7:].copy()
+
+    def hold(t, q, v):
+        tau = np.zeros(robot.nv)
+        tau[6:] = 5.0 * (target - q[7:]) - 0.1 * v[6:]
+        return tau
+
+    ground = Ground(friction=0.8)
+    return robot, ground, simulate_contact(robot, ground=ground, contacts=feet, controller=hold, duration=0.6, q0=q0)
+
+
+def test_solo12_dropped_on_its_feet_settles_carrying_its_weight_inside_the_cones(solo_standing):
+    robot, ground, run = solo_standing
+    normal = run.normal_forces
+    assert abs(normal[-1].sum() / (robot.total_mass * G) - 1) < 1e-6
+    assert run.active[-1].all()
+    tangential = np.linalg.norm(run.forces - normal[..., None] * np.array(ground.normal), axis=2)
+    assert np.all(tangential <= ground.friction * normal + 1e-9 * robot.total_mass * G)
+    assert np.abs(run.trajectory.v[-1]).max() < 1e-6
+    assert -run.gaps.min() < 1e-6
