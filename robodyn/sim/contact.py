@@ -5,7 +5,9 @@ MuJoCo, Drake's TAMSI and Pinocchio's simulators do): with ``M``, ``h = C v + G`
 start of the step and the contacts' Jacobian ``J`` (3 rows a contact, in its axes
 ``(t₁, t₂, n)``),
 
-    v⁺ = v + dt M⁻¹ (τ − h) + M⁻¹ Jᵀ p,        q⁺ = q ⊕ dt v⁺,
+    v⁺ = v + dt M⁻¹ (τ − h) + M⁻¹ Jᵀ p,        q⁺ = q ⊕ dt v⁺
+
+(a floating base's ``⊕`` on ``R³ × SO(3)``, :func:`integrate`),
 
 where the impulses ``p`` [N s] solve the **nonlinear complementarity problem** of the
 Coulomb cone (not a pyramid): for each contact ``i``, ``pᵢ ∈ K_μ = {‖p_t‖ ≤ μ p_n}``, its
@@ -89,6 +91,21 @@ def contact_kinematics(
     return gaps, np.vstack(rows) if rows else np.zeros((0, nv))
 
 
+def integrate(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+    """``q ⊕ dq`` with a floating base on ``R³ × SO(3)``: its origin moves along the world
+    velocity ``R v`` in a straight line, its rotation by ``exp(ω dt)`` (MuJoCo's rule).
+
+    Pinocchio's ``integrate`` moves the base along the screw of ``SE(3)``'s exponential: a
+    rolling ball's body twist is a rotation about its contact point, so its centre would
+    dip by ``r (1 − cos ω dt)`` into the plane every step.
+    """
+    moved = pin.integrate(robot.model, q, dq)
+    if robot.floating_base:
+        rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
+        moved[:3] = q[:3] + rotation @ dq[:3]
+    return moved
+
+
 def _local_jacobian(axes: np.ndarray, linear: np.ndarray) -> np.ndarray:
     """A point's linear Jacobian (3, nv) in the contact axes (rows ``t₁, t₂, n``)."""
     return axes @ linear
@@ -140,7 +157,7 @@ def contact_step(
     local = impulses.reshape(-1, 3)
     after = (jacobian @ v_next).reshape(-1, 3)
     return ContactStep(
-        pin.integrate(robot.model, q, dt * v_next),
+        integrate(robot, q, dt * v_next),
         v_next,
         local,
         local @ ground.frame() / dt,
@@ -151,4 +168,4 @@ def contact_step(
     )
 
 
-__all__ = ["ACTIVE_FORCE", "ContactSettings", "ContactStep", "contact_kinematics", "contact_step"]
+__all__ = ["ACTIVE_FORCE", "ContactSettings", "ContactStep", "contact_kinematics", "contact_step", "integrate"]
