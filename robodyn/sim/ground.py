@@ -15,6 +15,7 @@ Where the points come from (:func:`contact_points`):
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import xml.etree.ElementTree as ET
@@ -68,6 +69,10 @@ class Ground:
 
     def frame(self) -> np.ndarray:
         """The contact axes as rows ``(t₁, t₂, n)``: two tangents and the normal, shape (3, 3)."""
+        return self._axes.copy()
+
+    @functools.cached_property
+    def _axes(self) -> np.ndarray:
         n = np.array(self.normal)
         seed = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
         t1 = seed - (seed @ n) * n
