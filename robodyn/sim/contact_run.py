@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -21,6 +22,8 @@ from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.contact import ACTIVE_FORCE, ContactSettings, contact_step
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.trajectory import Trajectory
+from robodyn.trajectory.columns import contact_header
+from robodyn.trajectory.io import write_csv
 
 #: Most steps of one run (100 s at 1 ms).
 MAX_STEPS = 100_000
@@ -62,6 +65,24 @@ class ContactSimulation:
     def active(self) -> np.ndarray:
         """Which contacts push (normal force above :data:`ACTIVE_FORCE`), shape (N, k)."""
         return self.normal_forces > ACTIVE_FORCE
+
+    def save(self, path: str | Path) -> Path:
+        """Write the motion and its contacts as a CSV trajectory: the trajectory's columns,
+        then ``f[<contact>].x/.y/.z`` [N] and ``contact[<contact>]`` (1: active), which
+        trajectory readers skip (docs/trajectory-format.md).
+
+        Raises:
+            InputError: For a file name that does not end in ``.csv``.
+        """
+        path = Path(path)
+        if path.suffix != ".csv":
+            raise InputError("path", "a .csv file name (contact columns are written to CSV)", repr(str(path)))
+        count = len(self.contacts)
+        table = np.column_stack(
+            [self.trajectory.table(), self.forces.reshape(len(self.forces), 3 * count), self.active.astype(float)]
+        )
+        write_csv(path, self.trajectory.robot, self.trajectory.header() + contact_header(self.contacts), table)
+        return path
 
     def summary_lines(self) -> list[str]:
         """The run's contact summary: peak normal force, slip and penetration."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import math
 from pathlib import Path
 
@@ -9,9 +10,11 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn.exceptions import InputError
 from robodyn.sim import contact
 from robodyn.sim.contact_run import free_fall_note, simulate_contact
 from robodyn.sim.ground import Ground, contact_points
+from robodyn.trajectory.columns import contact_columns
 
 DATA = Path(__file__).parents[1] / "data" / "contact"
 G = 9.81
@@ -128,3 +131,18 @@ def test_solo12_dropped_on_its_feet_settles_carrying_its_weight_inside_the_cones
     assert np.all(tangential <= ground.friction * normal + 1e-9 * robot.total_mass * G)
     assert np.abs(run.trajectory.v[-1]).max() < 1e-6
     assert -run.gaps.min() < 1e-6
+
+
+def test_a_contact_run_saves_its_forces_as_columns_trajectory_readers_skip(box, tmp_path):
+    ground = Ground(friction=0.5)
+    run = simulate_contact(box, ground=ground, duration=0.05, dt=1e-3, q0=_on_slope(box, ground, lift=0.001))
+    path = run.save(tmp_path / "box.csv")
+    again = robodyn.Trajectory.load(path)
+    assert np.array_equal(again.q, run.trajectory.q)
+    lines = path.read_text().splitlines()
+    header = next(csv.reader([lines[1]]))
+    assert "f[box.box0.corner0].z" in header and "contact[box.box0.corner7]" in header
+    forces, active = contact_columns(header, np.loadtxt(lines[2:], delimiter=","), run.contacts)
+    assert np.array_equal(forces, run.forces) and np.array_equal(active, run.active)
+    with pytest.raises(InputError, match="csv"):
+        run.save(tmp_path / "box.npz")
