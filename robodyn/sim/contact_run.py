@@ -21,6 +21,7 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.contact import ACTIVE_FORCE, ContactSettings, contact_step
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
+from robodyn.sim.simulation import ExternalWrench
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import contact_header
 from robodyn.trajectory.io import write_csv
@@ -45,6 +46,7 @@ class ContactSimulation:
         ground: The plane.
         iterations: ADMM iterations of each step, shape (N,).
         notes: What the run does not model, one line each.
+        frames: The frame each contact point belongs to, in the order of ``contacts``.
     """
 
     trajectory: Trajectory
@@ -55,6 +57,7 @@ class ContactSimulation:
     ground: Ground
     iterations: np.ndarray
     notes: tuple[str, ...] = ()
+    frames: tuple[str, ...] = ()
 
     @property
     def normal_forces(self) -> np.ndarray:
@@ -65,6 +68,23 @@ class ContactSimulation:
     def active(self) -> np.ndarray:
         """Which contacts push (normal force above :data:`ACTIVE_FORCE`), shape (N, k)."""
         return self.normal_forces > ACTIVE_FORCE
+
+    def force_arrows(self) -> tuple[ExternalWrench, ...]:
+        """The contact forces as :class:`robodyn.ExternalWrench` es for a recording's arrows
+        (``robodyn.viz.recording.record(..., forces=run.force_arrows())``): one a frame,
+        the sum of its contacts' forces (zero while none is active) at the frame's origin,
+        held over each step (a box's eight corners: one arrow, the total, at its origin).
+        """
+        frames: dict[str, list[int]] = {}
+        for index, frame in enumerate(self.frames):
+            frames.setdefault(frame, []).append(index)
+        t = self.trajectory.t
+
+        def held(indices: list[int]) -> Callable[[float], np.ndarray]:
+            total = self.forces[:, indices].sum(axis=1)
+            return lambda time: total[int(np.clip(np.searchsorted(t, time, side="right") - 1, 0, len(t) - 1))]
+
+        return tuple(ExternalWrench(frame, held(indices)) for frame, indices in frames.items())
 
     def save(self, path: str | Path) -> Path:
         """Write the motion and its contacts as a CSV trajectory: the trajectory's columns,
@@ -159,7 +179,15 @@ def simulate_contact(
     if np.any(robot.joint_friction):
         notes.append("joint Coulomb friction of the file is not applied in contact runs")
     return ContactSimulation(
-        trajectory, found.names, samples["forces"], samples["gaps"], samples["slip"], ground, samples["iterations"], tuple(notes)
+        trajectory,
+        found.names,
+        samples["forces"],
+        samples["gaps"],
+        samples["slip"],
+        ground,
+        samples["iterations"],
+        tuple(notes),
+        tuple(point.link for point in found.points),
     )
 
 

@@ -15,6 +15,7 @@ from robodyn.sim import contact
 from robodyn.sim.contact_run import free_fall_note, simulate_contact
 from robodyn.sim.ground import Ground, contact_points
 from robodyn.trajectory.columns import contact_columns
+from robodyn.viz.recording import motion_commands
 
 DATA = Path(__file__).parents[1] / "data" / "contact"
 G = 9.81
@@ -146,3 +147,15 @@ def test_a_contact_run_saves_its_forces_as_columns_trajectory_readers_skip(box, 
     assert np.array_equal(forces, run.forces) and np.array_equal(active, run.active)
     with pytest.raises(InputError, match="csv"):
         run.save(tmp_path / "box.npz")
+
+
+def test_a_recording_draws_the_contact_forces_as_arrows(solo_standing, tmp_path):
+    robot, _, run = solo_standing
+    arrows = run.force_arrows()
+    assert [arrow.frame for arrow in arrows] == ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+    total = sum(arrow.value(run.trajectory.t[-1]) for arrow in arrows)
+    assert np.allclose(total, run.forces[-1].sum(axis=0))
+    assert not arrows[0].value(0.0).any()  # in the air at the start
+    commands, _, _ = motion_commands(robot, run.trajectory, forces=arrows)
+    paths = [str(command.get("path", "")) for command in commands]
+    assert any("force03" in path for path in paths) and not any("force04" in path for path in paths)  # one a foot
