@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, RobodynError
 from robodyn.sim import contact
 from robodyn.sim.contact_run import free_fall_note, simulate_contact
-from robodyn.sim.ground import Ground, contact_points
+from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.trajectory.columns import contact_columns
 from robodyn.viz.recording import motion_commands
 
@@ -159,3 +159,37 @@ def test_a_recording_draws_the_contact_forces_as_arrows(solo_standing, tmp_path)
     commands, _, _ = motion_commands(robot, run.trajectory, forces=arrows)
     paths = [str(command.get("path", "")) for command in commands]
     assert any("force03" in path for path in paths) and not any("force04" in path for path in paths)  # one a foot
+
+
+def test_a_mimic_arm_resting_its_tip_on_a_table_balances_gravity_with_the_contact_force():
+    """Mimic joints (robodyn's M, which Pinocchio's constraint algorithms refuse), oblique gravity."""
+    arm = robodyn.load(DATA.parent / "mimic_arm.urdf", gravity=(0.4, -0.3, -7.5))
+    tip = ContactPoint("fingertip", "tip", (0.1, 0.0, 0.0))
+    height = contact.contact_kinematics(arm, np.zeros(arm.nq), Ground(), (tip,))[0][0]
+    ground = Ground(height=height - 0.03, friction=0.6)
+    run = simulate_contact(
+        arm, ground=ground, contacts=[tip], duration=1.0, q0=np.zeros(arm.nq), controller=lambda t, q, v: -0.5 * v
+    )
+    q, force = run.trajectory.q[-1], run.forces[-1, 0]
+    _, jacobian = contact.contact_kinematics(arm, q, ground, (tip,))
+    assert run.active[-1].all() and np.abs(run.trajectory.v[-1]).max() < 1e-9
+    assert np.abs(arm.gravity(q) - jacobian.T @ (ground.frame() @ force)).max() < 1e-9  # G(q) = Jᵀ f at rest
+    tangential = np.linalg.norm(force[:2])
+    assert tangential <= 0.6 * force[2]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "named"),
+    [
+        ({"dt": 0.0}, "dt"),
+        ({"duration": -1.0}, "duration"),
+        ({"ground": "floor"}, "ground"),
+        ({"controller": lambda t, q, v: np.zeros(3)}, "controller"),
+        ({"q0": np.zeros((2, 7))}, "q0"),
+        ({"contacts": []}, "contacts"),
+    ],
+)
+def test_impossible_contact_runs_are_refused_by_name(box, arguments, named):
+    options = {"ground": Ground(), "duration": 0.01, "dt": 1e-3} | arguments
+    with pytest.raises(RobodynError, match=named):
+        simulate_contact(box, **options)
