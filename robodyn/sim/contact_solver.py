@@ -110,22 +110,23 @@ def polish(delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses
     p, u = impulses.reshape(-1, 3), (delassus @ impulses + velocity).reshape(-1, 3)
     scale_p = max(float(np.abs(p).max()), 1e-300)
     scale_u = max(float(np.abs(velocity).max()), 1e-300)
-    columns, rows = [], []
-    for i in range(len(p)):
-        if p[i, 2] <= 1e-6 * scale_p:
-            continue  # open
-        slip = float(np.linalg.norm(u[i, :2]))
-        if friction == 0.0 or slip > 1e-6 * scale_u:  # slipping (frictionless: normal row only)
-            direction = u[i, :2] / slip if slip > 0 else np.zeros(2)
-            column = np.zeros(3 * len(p))
-            column[3 * i : 3 * i + 3] = (-friction * direction[0], -friction * direction[1], 1.0)
-            columns.append(column)
-            rows.append(3 * i + 2)
-        else:  # sticking
-            columns.extend(np.eye(3 * len(p))[3 * i : 3 * i + 3])
-            rows.extend(range(3 * i, 3 * i + 3))
-    basis = np.array(columns).T if columns else np.zeros((len(velocity), 0))
-    solution = basis @ np.linalg.lstsq((delassus @ basis)[rows], -velocity[rows], rcond=1e-10)[0] if columns else 0 * velocity
+    slip = np.hypot(u[:, 0], u[:, 1])
+    closed = p[:, 2] > 1e-6 * scale_p  # the others are open
+    slipping = closed & ((friction == 0.0) | (slip > 1e-6 * scale_u))  # frictionless: the normal row only
+    sticking, sliding = np.flatnonzero(closed & ~slipping), np.flatnonzero(slipping)
+    stuck_rows = (3 * sticking[:, None] + np.arange(3)).ravel()
+    rows = np.concatenate([stuck_rows, 3 * sliding + 2])
+    if not len(rows):
+        solution = np.zeros_like(velocity)
+    else:
+        basis = np.zeros((len(velocity), len(rows)))
+        basis[stuck_rows, np.arange(len(stuck_rows))] = 1.0
+        columns = len(stuck_rows) + np.arange(len(sliding))
+        direction = u[sliding, :2] / np.maximum(slip[sliding], 1e-300)[:, None]
+        basis[3 * sliding, columns] = -friction * direction[:, 0]
+        basis[3 * sliding + 1, columns] = -friction * direction[:, 1]
+        basis[3 * sliding + 2, columns] = 1.0
+        solution = basis @ np.linalg.lstsq((delassus @ basis)[rows], -velocity[rows], rcond=1e-10)[0]
     return solution if _solves(delassus, velocity, friction, solution, u) else None
 
 
