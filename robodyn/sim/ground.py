@@ -141,12 +141,12 @@ def collision_points(robot: Robot) -> Contacts:
             shape = None if geometry is None or not len(geometry) else geometry[0]
             if shape is not None and shape.tag == "sphere":
                 radius = float(_numbers(shape.get("radius"), 1, 0.0)[0])
-                points.append(ContactPoint(f"{name}.sphere{index}", name, tuple(offset), radius))
+                points.append(ContactPoint(f"{name}.sphere{index}", name, tuple(float(x) for x in offset), radius))
             elif shape is not None and shape.tag == "box":
                 half = 0.5 * _numbers(shape.get("size"), 3, 0.0)
                 for corner, signs in enumerate(itertools.product((-1.0, 1.0), repeat=3)):
                     where = offset + rotation @ (half * np.array(signs))
-                    points.append(ContactPoint(f"{name}.box{index}.corner{corner}", name, tuple(where)))
+                    points.append(ContactPoint(f"{name}.box{index}.corner{corner}", name, tuple(float(x) for x in where)))
             else:
                 kind = "no geometry" if shape is None else f"a {shape.tag}"
                 skipped.append(f"link {name!r}: collision {index} is {kind}: not a contact (spheres and boxes are)")

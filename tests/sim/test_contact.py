@@ -193,3 +193,22 @@ def test_impossible_contact_runs_are_refused_by_name(box, arguments, named):
     options = {"ground": Ground(), "duration": 0.01, "dt": 1e-3} | arguments
     with pytest.raises(RobodynError, match=named):
         simulate_contact(box, **options)
+
+
+@pytest.mark.slow
+def test_anymal_stands_on_its_four_collision_sphere_feet():
+    robot = robodyn.load("anymal")
+    feet = tuple(point for point in contact_points(robot, "collision").points if point.radius > 0)
+    assert [point.link for point in feet] == ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"]
+    q0 = robot.neutral_configuration()
+    q0[2] = -contact.contact_kinematics(robot, q0, Ground(), feet)[0].min() + 0.05
+    target = q0[7:].copy()
+
+    def hold(t, q, v):
+        tau = np.zeros(robot.nv)
+        tau[6:] = 200.0 * (target - q[7:]) - 5.0 * v[6:]
+        return tau
+
+    run = simulate_contact(robot, ground=Ground(friction=0.8), contacts=feet, controller=hold, duration=2.0, q0=q0)
+    assert abs(run.normal_forces[-1].sum() / (robot.total_mass * G) - 1) < 1e-6
+    assert np.abs(run.gaps[-1]).max() < 1e-9  # each sphere resting on the plane
