@@ -126,6 +126,10 @@ def _numbers(text: str | None, count: int, default: float) -> np.ndarray:
     return np.array(values)
 
 
+def _triple(values: np.ndarray) -> tuple[float, float, float]:
+    return float(values[0]), float(values[1]), float(values[2])
+
+
 def collision_points(robot: Robot) -> Contacts:
     """Contact points from the URDF's ``<collision>`` spheres and boxes (module docstring)."""
     root = ET.fromstring(robot.urdf)
@@ -141,12 +145,12 @@ def collision_points(robot: Robot) -> Contacts:
             shape = None if geometry is None or not len(geometry) else geometry[0]
             if shape is not None and shape.tag == "sphere":
                 radius = float(_numbers(shape.get("radius"), 1, 0.0)[0])
-                points.append(ContactPoint(f"{name}.sphere{index}", name, tuple(float(x) for x in offset), radius))
+                points.append(ContactPoint(f"{name}.sphere{index}", name, _triple(offset), radius))
             elif shape is not None and shape.tag == "box":
                 half = 0.5 * _numbers(shape.get("size"), 3, 0.0)
                 for corner, signs in enumerate(itertools.product((-1.0, 1.0), repeat=3)):
                     where = offset + rotation @ (half * np.array(signs))
-                    points.append(ContactPoint(f"{name}.box{index}.corner{corner}", name, tuple(float(x) for x in where)))
+                    points.append(ContactPoint(f"{name}.box{index}.corner{corner}", name, _triple(where)))
             else:
                 kind = "no geometry" if shape is None else f"a {shape.tag}"
                 skipped.append(f"link {name!r}: collision {index} is {kind}: not a contact (spheres and boxes are)")
