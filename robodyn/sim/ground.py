@@ -46,7 +46,8 @@ class Ground:
     def __post_init__(self) -> None:
         if not math.isfinite(self.height):
             raise InputError("height", "a finite height in [m]", repr(self.height))
-        if not (isinstance(self.friction, int | float) and math.isfinite(self.friction) and self.friction >= 0):
+        friction = self.friction
+        if isinstance(friction, bool) or not (isinstance(friction, int | float) and math.isfinite(friction) and friction >= 0):
             raise InputError("friction", "a finite coefficient μ ≥ 0", repr(self.friction))
         normal = np.asarray(self.normal, dtype=float).reshape(-1)
         size = float(np.linalg.norm(normal)) if normal.shape == (3,) and np.isfinite(normal).all() else 0.0
@@ -99,6 +100,19 @@ class ContactPoint:
     link: str
     position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     radius: float = 0.0
+
+    def __post_init__(self) -> None:
+        for argument in ("name", "link"):
+            if not (isinstance(getattr(self, argument), str) and getattr(self, argument)):
+                raise InputError(argument, "a non-empty name", repr(getattr(self, argument))[:80])
+        position = np.asarray(self.position, dtype=float).reshape(-1) if np.size(self.position) == 3 else None
+        if position is None or not np.isfinite(position).all():
+            raise InputError("position", "3 finite coordinates in [m]", repr(self.position)[:80])
+        radius = self.radius
+        if isinstance(radius, bool) or not (isinstance(radius, int | float) and math.isfinite(radius) and radius >= 0):
+            raise InputError("radius", "a finite radius ≥ 0 in [m]", repr(radius))
+        object.__setattr__(self, "position", _triple(position))
+        object.__setattr__(self, "radius", float(radius))
 
 
 @dataclass(frozen=True)

@@ -196,6 +196,7 @@ def test_impossible_contact_runs_are_refused_by_name(box, arguments, named):
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:anymal:UserWarning")  # its file's base inertia (reported by loading)
 def test_anymal_stands_on_its_four_collision_sphere_feet():
     robot = robodyn.load("anymal")
     feet = tuple(point for point in contact_points(robot, "collision").points if point.radius > 0)

@@ -91,3 +91,18 @@ def test_unknown_contact_frames_and_robots_without_simple_collisions_are_refused
     assert found.names == ["FL_FOOT", "heel"]
     with pytest.raises(InputError, match="twice"):
         contact_points(solo, ["FL_FOOT", "FL_FOOT"])
+
+
+@pytest.mark.parametrize(
+    ("arguments", "named"),
+    [
+        ({"radius": -0.01}, "radius"),
+        ({"radius": math.nan}, "radius"),
+        ({"position": (0.0, math.inf, 0.0)}, "position"),
+        ({"position": (0.0, 0.0)}, "position"),
+        ({"link": ""}, "link"),
+    ],
+)
+def test_an_impossible_contact_point_is_refused_by_name(arguments, named):
+    with pytest.raises(InputError, match=named):
+        ContactPoint(**({"name": "heel", "link": "HL_FOOT"} | arguments))
