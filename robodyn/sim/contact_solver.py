@@ -9,7 +9,8 @@ velocity ``c`` (3k,) (each contact's rows ``t₁, t₂, n``), find the impulses 
    correction, so the true Coulomb problem rather than its convex relaxation) over
    ``DelassusOperatorDense(A)``, warm-started with the previous step's impulses. On a
    redundant contact set (a box's 4 resting corners have 12 rows for 6 degrees of freedom)
-   its iterations converge slowly in the directions ``A`` does not see.
+   its iterations converge slowly in the directions ``A`` does not see. ADMM runs only when
+   the previous step's contact modes, polished (below), no longer solve the problem.
 2. **Polish** (as OSQP polishes a QP): ADMM's answer names each contact *open* (no
    force), *sticking* (``u = 0``) or *slipping* (``u_n = 0``, ``p_t = −μ p_n s`` along its
    slip direction ``s``); those equalities are solved exactly (least-norm, the
@@ -86,6 +87,10 @@ def solve_impulses(
     """The impulses ``p`` (3k,) of the cone complementarity problem ``u = A p + c``
     (module docstring), with ADMM's iterations and whether it converged."""
     count = len(velocity) // 3
+    if settings.polish and guess is not None and count:  # the previous step's modes may still hold: no ADMM
+        kept = polish(delassus, velocity, friction, np.asarray(guess, dtype=float).reshape(-1))
+        if kept is not None:
+            return kept, 0, True
     key = (count, friction, settings)
     if key not in _WORKSPACES:
         _WORKSPACES[key] = _Workspace(count, friction, settings)
