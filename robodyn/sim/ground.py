@@ -171,6 +171,15 @@ def collision_points(robot: Robot) -> Contacts:
     return Contacts(tuple(points), tuple(skipped))
 
 
+def _moving(robot: Robot, found: Contacts) -> Contacts:
+    """The points some joint moves; those fixed to the world are left out, one line each."""
+    frames, model = robot.frame_ids, robot.model
+    kept = [point for point in found.points if model.frames[frames[point.link]].parentJoint != 0]
+    fixed = sorted({point.link for point in found.points} - {point.link for point in kept})
+    lines = [f"link {link!r} is fixed to the world: its collision geometry is not a contact" for link in fixed]
+    return Contacts(tuple(kept), (*found.skipped, *lines))
+
+
 def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -> Contacts:
     """The robot's contact points: ``"collision"`` (its collision spheres and boxes) or a
     list of frame names and :class:`ContactPoint` values.
@@ -180,7 +189,7 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
         InputError: For no points at all, or a duplicated name.
     """
     if isinstance(contacts, str) and contacts == "collision":
-        found = collision_points(robot)
+        found = _moving(robot, collision_points(robot))
     else:
         if isinstance(contacts, str):
             contacts = [contacts]
@@ -191,6 +200,7 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
             if point.link not in frames:
                 close = [name for name in frames if point.link.lower() in name.lower()][:5]
                 raise FrameError(point.link, robot.name, close)
+            robot.task_frame(point.link, "a contact point")  # StaticFrameError: fixed to the world
             chosen.append(point)
         found = Contacts(tuple(chosen))
     if not found.points:

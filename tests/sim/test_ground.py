@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 
 import robodyn
-from robodyn.exceptions import FrameError, InputError
+from robodyn.exceptions import FrameError, InputError, StaticFrameError
 from robodyn.sim.contact import contact_kinematics
 from robodyn.sim.contact_run import simulate_contact
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
@@ -106,3 +106,23 @@ def test_unknown_contact_frames_and_robots_without_simple_collisions_are_refused
 def test_an_impossible_contact_point_is_refused_by_name(arguments, named):
     with pytest.raises(InputError, match=named):
         ContactPoint(**({"name": "heel", "link": "HL_FOOT"} | arguments))
+
+
+def test_a_fixed_robots_world_fixed_links_are_no_contacts():
+    arm = robodyn.load(DATA.parent / "mimic_arm.urdf")
+    with pytest.raises(StaticFrameError, match="contact point"):
+        contact_points(arm, ["base"])
+    assert contact_points(arm, ["tip"]).names == ["tip"]
+
+
+def test_collision_geometry_fixed_to_the_world_is_left_out_and_said():
+    urdf = """<robot name="post">
+      <link name="base"><collision><geometry><box size="1 1 0.1"/></geometry></collision></link>
+      <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+        <collision><origin xyz="0.5 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+        <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+    </robot>"""
+    found = contact_points(robodyn.load(urdf), "collision")
+    assert found.names == ["arm.sphere0"]
+    assert found.skipped == ("link 'base' is fixed to the world: its collision geometry is not a contact",)
