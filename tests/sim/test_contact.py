@@ -12,6 +12,7 @@ import pytest
 import robodyn
 from robodyn.exceptions import InputError, RobodynError
 from robodyn.sim import contact
+from robodyn.sim.contact import ContactSettings
 from robodyn.sim.contact_run import free_fall_note, simulate_contact
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.trajectory.columns import contact_columns
@@ -213,3 +214,22 @@ def test_anymal_stands_on_its_four_collision_sphere_feet():
     run = simulate_contact(robot, ground=Ground(friction=0.8), contacts=feet, controller=hold, duration=2.0, q0=q0)
     assert abs(run.normal_forces[-1].sum() / (robot.total_mass * G) - 1) < 1e-6
     assert np.abs(run.gaps[-1]).max() < 1e-9  # each sphere resting on the plane
+
+
+def test_the_polished_steps_agree_with_pinocchios_admm_alone_at_a_tight_tolerance():
+    """solo12 landing from a bent pose with μ = 0.5 (feet slipping up to 0.5 m/s)."""
+    robot = robodyn.load("solo12")
+    feet = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+    q0 = robot.neutral_configuration()
+    q0[2], q0[7:] = 0.37, q0[7:] + 0.1 * np.sin(np.arange(12))
+    target = q0[7:].copy()
+
+    def hold(t, q, v):
+        return np.r_[np.zeros(6), 5.0 * (target - q[7:]) - 0.1 * v[6:]]
+
+    options = {"ground": Ground(friction=0.5), "contacts": feet, "controller": hold, "duration": 0.3, "q0": q0}
+    polished = simulate_contact(robot, **options)
+    alone = simulate_contact(robot, **options, settings=ContactSettings(polish=False, tolerance=1e-12, max_iterations=5000))
+    assert polished.slip[polished.active].max() > 0.1  # slipping, not only sticking
+    assert np.abs(polished.trajectory.q - alone.trajectory.q).max() < 1e-8
+    assert np.abs(polished.forces - alone.forces).max() < 1e-5 * np.abs(polished.forces).max()
