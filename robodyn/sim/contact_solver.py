@@ -131,8 +131,22 @@ def polish(delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses
         basis[3 * sliding, columns] = -friction * direction[:, 0]
         basis[3 * sliding + 1, columns] = -friction * direction[:, 1]
         basis[3 * sliding + 2, columns] = 1.0
-        solution = basis @ np.linalg.lstsq((delassus @ basis)[rows], -velocity[rows], rcond=1e-10)[0]
+        solution = basis @ _least_norm((delassus @ basis)[rows], -velocity[rows], impulses)
     return solution if _solves(delassus, velocity, friction, solution, u) else None
+
+
+def _least_norm(matrix: np.ndarray, target: np.ndarray, impulses: np.ndarray) -> np.ndarray:
+    """``matrix⁻¹ target`` by one LU solve when ``matrix`` is regular (the answer no larger
+    than 10⁶ times the impulses' scale), else the least-norm solution (redundant rows)."""
+    bound = 1e6 * max(float(np.abs(impulses).max()), float(np.abs(target).max()), 1e-300)
+    try:
+        with np.errstate(all="ignore"):
+            solution = np.linalg.solve(matrix, target)
+        if np.isfinite(solution).all() and float(np.abs(solution).max()) <= bound:
+            return solution
+    except np.linalg.LinAlgError:
+        pass
+    return np.linalg.lstsq(matrix, target, rcond=1e-10)[0]
 
 
 def _solves(delassus: np.ndarray, velocity: np.ndarray, friction: float, solution: np.ndarray, before: np.ndarray) -> bool:
@@ -141,14 +155,14 @@ def _solves(delassus: np.ndarray, velocity: np.ndarray, friction: float, solutio
     p, u = solution.reshape(-1, 3), (delassus @ solution + velocity).reshape(-1, 3)
     size_p = POLISH_TOLERANCE * max(float(np.abs(p).max()), 1e-12)
     size_u = POLISH_TOLERANCE * max(float(np.abs(velocity).max()), 1e-12)
-    tangential = np.linalg.norm(p[:, :2], axis=1)
-    if (p[:, 2] < -size_p).any() or (tangential > friction * p[:, 2] + size_p).any():
-        return False  # outside a cone
-    if (u[:, 2] < -size_u).any() or (np.abs(u[:, 2]) * np.abs(p[:, 2]) > size_u * size_p / POLISH_TOLERANCE).any():
-        return False  # penetrating, or pushing while separating
-    slipping = np.linalg.norm(u[:, :2], axis=1) > size_u
-    aligned = np.einsum("ij,ij->i", u[:, :2], before[:, :2]) > 0
-    return bool(not (slipping & (p[:, 2] > size_p) & ~aligned).any())
+    normal, speed = p[:, 2], u[:, 2]
+    bad = (normal < -size_p) | (np.hypot(p[:, 0], p[:, 1]) > friction * normal + size_p)  # outside a cone
+    bad |= (speed < -size_u) | (
+        np.abs(speed) * np.abs(normal) > size_u * size_p / POLISH_TOLERANCE
+    )  # penetrating, or pushing apart
+    turned = u[:, 0] * before[:, 0] + u[:, 1] * before[:, 1] <= 0
+    bad |= (np.hypot(u[:, 0], u[:, 1]) > size_u) & (normal > size_p) & turned  # a slip that changed direction
+    return not bool(bad.any())
 
 
 __all__ = ["POLISH_TOLERANCE", "ContactSettings", "polish", "solve_impulses"]
