@@ -44,7 +44,9 @@ class ContactSimulation:
         gaps: Each point's height above the plane, shape (N, k), in [m] (< 0: penetration).
         slip: Each point's tangential speed after the step, shape (N, k), in [m/s].
         ground: The plane.
-        iterations: ADMM iterations of each step, shape (N,).
+        iterations: ADMM iterations of each step, shape (N,) (0: the previous modes held).
+        converged: Whether each step's impulses solve the contact problem to the solver's
+            tolerance (polished, or ADMM converged), shape (N,).
         notes: What the run does not model, one line each.
         frames: The frame each contact point belongs to, in the order of ``contacts``.
     """
@@ -56,6 +58,7 @@ class ContactSimulation:
     slip: np.ndarray
     ground: Ground
     iterations: np.ndarray
+    converged: np.ndarray
     notes: tuple[str, ...] = ()
     frames: tuple[str, ...] = ()
 
@@ -118,6 +121,12 @@ class ContactSimulation:
             f"deepest penetration: {max(0.0, -float(self.gaps.min(initial=0.0))):.3g} m",
             f"contacts active at the end: {int(self.active[-1].sum())} of {len(self.contacts)}",
         ]
+        unsolved = int((~self.converged).sum())
+        if unsolved:
+            lines.append(
+                f"contact solver: {unsolved} of {len(self.converged)} steps stopped before ADMM's tolerance "
+                f"(the first at t = {self.trajectory.t[int(np.argmin(self.converged))]:.6g} s): their forces are approximate"
+            )
         return [printable(line) for line in (*lines, *self.notes)]
 
 
@@ -186,6 +195,7 @@ def simulate_contact(
         samples["slip"],
         ground,
         samples["iterations"],
+        samples["converged"],
         tuple(notes),
         tuple(point.link for point in found.points),
     )
@@ -206,15 +216,15 @@ def _run(
     robot: Robot, ground: Ground, points: tuple[ContactPoint, ...], controller: Controller,
     q: np.ndarray, v: np.ndarray, steps: int, dt: float, settings: ContactSettings,
 ) -> dict[str, np.ndarray]:  # fmt: skip
-    """Samples ``t, q, v, a, tau, forces, gaps, slip, iterations`` of ``steps`` steps."""
-    keys = ("q", "v", "a", "tau", "forces", "gaps", "slip", "iterations")
+    """Samples ``t, q, v, a, tau, forces, gaps, slip, iterations, converged`` of ``steps`` steps."""
+    keys = ("q", "v", "a", "tau", "forces", "gaps", "slip", "iterations", "converged")
     samples: dict[str, list] = {key: [] for key in keys}
     damping, guess = robot.joint_damping, None
     for step in range(steps + 1):
         t = step * dt
         tau = _torque(controller, t, q, v, robot.nv)
         result = contact_step(robot, q, v, tau - damping * v, dt, ground, points, settings=settings, guess=guess)
-        values = (q, v, (result.v - v) / dt, tau, result.forces, result.gaps, result.slip, result.iterations)
+        values = (q, v, (result.v - v) / dt, tau, result.forces, result.gaps, result.slip, result.iterations, result.converged)
         for key, value in zip(keys, values, strict=True):
             samples[key].append(value)
         q, v, guess = result.q, result.v, result.impulses

@@ -233,3 +233,13 @@ def test_the_polished_steps_agree_with_pinocchios_admm_alone_at_a_tight_toleranc
     assert polished.slip[polished.active].max() > 0.1  # slipping, not only sticking
     assert np.abs(polished.trajectory.q - alone.trajectory.q).max() < 1e-8
     assert np.abs(polished.forces - alone.forces).max() < 1e-5 * np.abs(polished.forces).max()
+
+
+def test_steps_whose_solver_stopped_early_are_said_in_the_summary(box):
+    ground = Ground(friction=0.5)
+    tight = ContactSettings(polish=False, tolerance=1e-14, max_iterations=2)
+    run = simulate_contact(box, ground=ground, duration=0.3, q0=_on_slope(box, ground, lift=0.05), settings=tight)
+    assert not run.converged.all()
+    assert any("their forces are approximate" in line for line in run.summary_lines())
+    exact = simulate_contact(box, ground=ground, duration=0.3, q0=_on_slope(box, ground, lift=0.05))
+    assert exact.converged.all() and not any("approximate" in line for line in exact.summary_lines())
