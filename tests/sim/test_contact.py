@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import robodyn
@@ -243,3 +244,17 @@ def test_steps_whose_solver_stopped_early_are_said_in_the_summary(box):
     assert any("their forces are approximate" in line for line in run.summary_lines())
     exact = simulate_contact(box, ground=ground, duration=0.3, q0=_on_slope(box, ground, lift=0.05))
     assert exact.converged.all() and not any("approximate" in line for line in exact.summary_lines())
+
+
+def test_a_box_thrown_tumbling_loses_energy_at_every_step_and_rests_on_a_face(box):
+    q0 = box.neutral_configuration()
+    q0[2], q0[3:7] = 0.3, pin.Quaternion(pin.rpy.rpyToMatrix(0.35, 0.2, 0.1)).coeffs()
+    v0 = np.zeros(6)
+    v0[3] = 1.0  # spinning about its x axis
+    run = simulate_contact(box, ground=Ground(friction=0.5), duration=1.5, q0=q0, v0=v0)
+    energy = _energy(box, run.trajectory.q, run.trajectory.v)
+    landed = int(np.argmax(run.normal_forces.sum(axis=1) > 0))
+    assert np.diff(energy[landed:]).max() < 1e-9  # [J]: 5.5e-11 measured, 6.1 J dissipated
+    assert run.slip[run.active].max() > 0.1  # it slid and rolled over edges on the way
+    assert run.active[-1].sum() == 4 and abs(run.normal_forces[-1].sum() / (MASS * G) - 1) < 1e-6
+    assert run.trajectory.q[-1, 2] == pytest.approx(HALF_HEIGHT, abs=1e-9)
