@@ -6,24 +6,25 @@ not ctypes or cffi: on this machine a ctypes call passing four arrays costs 4.6 
 ``pin.rnea`` itself, most of it in ``ndarray.ctypes``; a METH_FASTCALL function reads the
 arrays' buffers and allocates the result in C, and is the thinnest binding there is.
 
-The cache (``$ROBODYN_CACHE``, else ``$XDG_CACHE_HOME/robodyn``, else
-``~/.cache/robodyn``; subfolder ``compiled/``) holds:
+The cache (:mod:`robodyn.compiled.cache`: ``$ROBODYN_CACHE``, else
+``$XDG_CACHE_HOME/robodyn``, else ``~/.cache/robodyn``; subfolder ``compiled/``) holds:
 
-- ``src-<key>.c``: the generated kernels, keyed by a hash of the URDF text, gravity and the
-  code generator's version (the sympy derivation is the slow part);
-- ``rd_<hash>.<ext>``: the module, keyed by a hash of the full source, the compiler's
-  version, the flags and the Python/numpy ABI.
+- ``src-<key>.c``: the generated kernels, under the robot's key
+  (:func:`robodyn.compiled.cache.robot_key`: its URDF text and options, and the hash of the
+  generator's source; the sympy derivation is the slow part);
+- ``rd_<hash>.<ext>``: the module, named by a hash of the robot's key, the SIMD variants
+  built (:mod:`robodyn.compiled.simd`), the compiler's version, the flags and the
+  Python/numpy ABI — all known without generating any source, so finding a compiled robot
+  (:func:`lookup`) neither derives nor prints anything, and imports no sympy;
 
-Every file is written under a temporary name and renamed into place (``os.replace``), so
-two processes compiling the same robot at once both succeed and the cache never holds a
-half-written file.
+and a process keeps every module it loaded (:func:`loaded`): a second ``compile`` of the same
+robot costs microseconds.
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
-import hashlib
 import importlib.machinery
 import importlib.util
 import os
@@ -32,22 +33,28 @@ import subprocess
 import sys
 import sysconfig
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robodyn.common.files import atomic_write_text
 from robodyn.compiled import simd
+from robodyn.compiled.cache import cache_dir, cached_kernels, digest, locked, robot_key, store_kernels
 from robodyn.exceptions import CompileError, CompilerNotFoundError
+
+if TYPE_CHECKING:
+    from robodyn.dynamics.robot import Robot
 
 #: Compiler flags. No -ffast-math: results must match Pinocchio to 1e-12. -O1, not -O2/-O3:
 #: on the generated straight-line code it runs as fast (measured, panda arm) and compiles in
 #: half the time.
 FLAGS = ("-O1", "-fPIC", "-shared", "-pthread", "-fno-math-errno", "-std=c99")
 _RUNTIME = Path(__file__).with_name("runtime.c")
-_PRELUDE = """#define PY_SSIZE_T_CLEAN
+#: The C every module shares (the tree LDLᵀ, the thread pool), placed before its kernels.
+CORE = Path(__file__).with_name("core.c")
+_INCLUDES = """#define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
@@ -57,14 +64,9 @@ _PRELUDE = """#define PY_SSIZE_T_CLEAN
 """
 
 
-def cache_dir() -> Path:
-    """Where compiled robots are kept: ``$ROBODYN_CACHE``, else ``$XDG_CACHE_HOME/robodyn``,
-    else ``~/.cache/robodyn`` (subfolder ``compiled``)."""
-    root = os.environ.get("ROBODYN_CACHE")
-    if not root:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        root = str(Path(xdg) / "robodyn") if xdg else str(Path.home() / ".cache" / "robodyn")
-    return Path(root).expanduser() / "compiled"
+def prelude() -> str:
+    """What precedes every module's kernels: the includes and ``core.c``."""
+    return _INCLUDES + CORE.read_text(encoding="utf-8") + "\n"
 
 
 def find_compiler() -> str:
@@ -97,60 +99,114 @@ def toolchain_key(compiler: str) -> str:
     return "\n".join([identity, " ".join(FLAGS), sysconfig.get_config_var("EXT_SUFFIX") or "", np.__version__, sys.version])
 
 
-def digest(*parts: str) -> str:
-    """A short SHA-256 of text parts."""
-    hasher = hashlib.sha256()
-    for part in parts:
-        hasher.update(part.encode("utf-8"))
-        hasher.update(b"\0")
-    return hasher.hexdigest()[:24]
+def runtime_source() -> str:
+    """``runtime.c`` after the controllers' generated constants (kinds, parameter layouts:
+    :func:`robodyn.compiled.controllers.c_constants`)."""
+    from robodyn.compiled.controllers import c_constants
+
+    return c_constants() + _RUNTIME.read_text(encoding="utf-8")
 
 
 def module_source(kernels: str, module_name: str) -> str:
     """The full C source: includes, the robot's kernels, the runtime and the module init."""
     init = f'PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module("{module_name}"); }}\n'
-    return _PRELUDE + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
+    return prelude() + kernels + "\n" + runtime_source() + "\n" + init
 
 
-def cached_kernels(key: str) -> str | None:
-    """The generated kernels stored under a robot key, if any."""
-    path = cache_dir() / f"src-{key}.c"
+def _suffix() -> str:
+    return sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+
+
+def module_path(key: str, compiler: str) -> Path:
+    """Where the module of a robot key is (or would be) for this compiler, flags, ABI and
+    SIMD variants (:func:`robodyn.compiled.simd.build_variants`): no source needed.
+
+    Raises:
+        InputError: ``$ROBODYN_SIMD`` names no instruction set.
+    """
+    variants = " ".join(name for name, _, _ in simd.build_variants())
+    return cache_dir() / f"rd_{digest(key, 'simd=' + variants, toolchain_key(compiler))}{_suffix()}"
+
+
+#: The modules this process loaded, by robot key and the environment that chose them.
+_LOADED: dict[tuple[str, tuple[str | None, ...]], ModuleType] = {}
+_ENVIRONMENT = ("CC", "ROBODYN_CACHE", "XDG_CACHE_HOME", "HOME", simd.ENVIRONMENT)
+
+
+def _memo(key: str) -> tuple[str, tuple[str | None, ...]]:
+    environ = os.environ
+    return key, tuple(environ.get(name) for name in _ENVIRONMENT)
+
+
+def loaded(robot: Robot) -> ModuleType | None:
+    """The robot's module if this process loaded it already (under the same compiler, cache
+    folder and ``$ROBODYN_SIMD``): a dictionary look-up, microseconds."""
+    return _LOADED.get(_memo(robot_key(robot)))
+
+
+def lookup(robot: Robot) -> Path | None:
+    """The robot's compiled module in the cache, or None if it is not compiled (or there is no
+    C compiler). Computes the key only: imports no sympy and no code generator, generates no
+    source (the engine choice of :func:`robodyn.simulate` asks this).
+
+    Raises:
+        InputError: ``$ROBODYN_SIMD`` names no instruction set.
+    """
     try:
-        return path.read_text(encoding="utf-8")
-    except OSError:
+        path = module_path(robot_key(robot), find_compiler())
+    except CompilerNotFoundError:
         return None
+    return path if path.exists() else None
 
 
-@contextlib.contextmanager
-def locked(key: str) -> Iterator[None]:
-    """Hold an exclusive lock on a robot key (``lock-<key>`` in the cache, ``flock``) while
-    deriving and building it: a second process compiling the same robot waits, then finds it
-    cached, instead of deriving and building it a second time. No lock where the cache is read-only or
-    the platform has no ``fcntl``."""
-    try:
-        import fcntl
-
-        folder = cache_dir()
-        folder.mkdir(parents=True, exist_ok=True)
-        handle = open(folder / f"lock-{key}", "a")  # noqa: SIM115 - held across the yield
-    except (ImportError, OSError):
-        yield
-        return
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        yield
-    finally:
-        handle.close()  # releases the lock
+def is_compiled(robot: Robot) -> bool:
+    """Whether :func:`robodyn.compiled.compile` would find the robot's module cached (:func:`lookup`)."""
+    return lookup(robot) is not None
 
 
-def store_kernels(key: str, kernels: str) -> None:
-    """Keep the generated kernels for a robot key (atomically; a read-only cache is skipped)."""
-    with contextlib.suppress(OSError):
-        atomic_write_text(cache_dir() / f"src-{key}.c", kernels)
+def robot_module(key: str, kernels: Callable[[], str], *, label: str) -> ModuleType:
+    """The module of a robot key: loaded by this process, else cached, else built from
+    ``kernels()`` (called only then: the generated kernels, cached or derived). The SIMD
+    variants' source is generated only for a build; a build whose variants the compiler
+    rejects is the scalar kernels' (batches then run scalar rows).
+
+    Raises:
+        CompilerNotFoundError: No C compiler.
+        CompileError: The compiler failed (its first error line is quoted).
+        InputError: ``$ROBODYN_SIMD`` names an instruction set the module cannot run here.
+    """
+    memo = _memo(key)
+    module = _LOADED.get(memo)
+    if module is not None:
+        return module
+    compiler = find_compiler()
+    target = module_path(key, compiler)
+    name = target.name.split(".")[0]
+    if not target.exists():
+        with locked(key):
+            if not target.exists():
+                _build_robot(compiler, kernels(), target, label)
+    module = _import(name, target)
+    if hasattr(module, "simd"):
+        simd.configure(module)
+    _LOADED[memo] = module
+    return module
+
+
+def _build_robot(compiler: str, kernels: str, target: Path, label: str) -> None:
+    """Compile a robot's module with its SIMD variants, or, if the compiler rejects them, without."""
+    name = target.name.split(".")[0]
+    variants = simd.vector_source(kernels)
+    if variants:
+        with contextlib.suppress(CompileError):
+            _compile(compiler, module_source(kernels + variants, name), cache_dir(), target, label)
+            return
+    _compile(compiler, module_source(kernels, name), cache_dir(), target, label)
 
 
 def build_module(kernels: str, *, label: str, vector: bool = True) -> ModuleType:
-    """Compile (or find in the cache) and import the extension module for some kernels.
+    """Compile (or find in the cache) and import the extension module for some kernels, named
+    by a hash of their source (a robot's modules go through :func:`robot_module`, by key).
 
     Args:
         kernels: The robot's generated kernels (:mod:`robodyn.compiled.codegen`).
@@ -168,12 +224,10 @@ def build_module(kernels: str, *, label: str, vector: bool = True) -> ModuleType
             return simd.configure(build_module(kernels + variants, label=label, vector=False))
     compiler = find_compiler()
     runtime = _RUNTIME.read_text(encoding="utf-8")
-    name = "rd_" + digest(kernels, runtime, toolchain_key(compiler))
-    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    folder = cache_dir()
-    target = folder / f"{name}{suffix}"
+    name = "rd_" + digest(kernels, runtime, CORE.read_text(encoding="utf-8"), toolchain_key(compiler))
+    target = cache_dir() / f"{name}{_suffix()}"
     if not target.exists():
-        _compile(compiler, module_source(kernels, name), folder, target, label)
+        _compile(compiler, module_source(kernels, name), cache_dir(), target, label)
     return _import(name, target)
 
 
@@ -213,22 +267,43 @@ def _import(name: str, path: Path) -> ModuleType:
     return module
 
 
-def build_extension(kernels: str, runtime: str, *, init: str, label: str) -> ModuleType:
-    """Like :func:`build_module`, for a module of its own: ``runtime`` (more C, with its own
-    method table) follows ``runtime.c``, and the module is made by the C function ``init``
-    (``PyObject *init(const char *name)``). Used by the derivative kernels
-    (:mod:`robodyn.compiled.derivatives`), built only when first asked for.
+def keyed_extension(key: str, source: Callable[[], str], *, init: str, label: str, prefix: str = "rd_") -> ModuleType:
+    """A module of its own (the derivative kernels, a frame's kinematics) named by a cache
+    key: found by the key alone, ``source()`` (its C after the includes and ``core.c``) asked
+    for only to build it. The module is made by the C function ``init``
+    (``PyObject *init(const char *name)``).
 
     Raises:
         CompilerNotFoundError: No C compiler.
         CompileError: The compiler failed (its first error line is quoted).
     """
     compiler = find_compiler()
-    base = _RUNTIME.read_text(encoding="utf-8")
-    name = "rd_" + digest(kernels, base, runtime, init, toolchain_key(compiler))
-    target = cache_dir() / f"{name}{sysconfig.get_config_var('EXT_SUFFIX') or '.so'}"
+    name = prefix + digest(key, init, toolchain_key(compiler))
+    target = cache_dir() / f"{name}{_suffix()}"
     if not target.exists():
-        entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
-        source = _PRELUDE + kernels + "\n" + base + "\n" + runtime + "\n" + entry
-        _compile(compiler, source, cache_dir(), target, label)
+        with locked(key):
+            if not target.exists():
+                entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
+                _compile(compiler, prelude() + source() + "\n" + entry, cache_dir(), target, label)
     return _import(name, target)
+
+
+__all__ = [
+    "FLAGS",
+    "build_module",
+    "cache_dir",
+    "cached_kernels",
+    "digest",
+    "find_compiler",
+    "is_compiled",
+    "keyed_extension",
+    "loaded",
+    "locked",
+    "lookup",
+    "module_path",
+    "robot_key",
+    "robot_module",
+    "runtime_source",
+    "store_kernels",
+    "toolchain_key",
+]

@@ -11,63 +11,8 @@
  * the GIL released.
  */
 
-/* M = Lᵀ D L in place, L following the tree (the runtime's factorisation, kept for several
- * solves): 3 if not positive definite. */
-static int rdd_factor(double *M) {
-    const int n = RD_NV;
-    for (int k = n - 1; k >= 0; --k) {
-        const double d = M[k * n + k];
-        if (!(d > 0.0) || !isfinite(d)) return 3;
-        for (int i = rd_parent[k]; i >= 0; i = rd_parent[i]) {
-            const double x = M[k * n + i] / d;
-            for (int j = i; j >= 0; j = rd_parent[j]) M[i * n + j] -= M[k * n + j] * x;
-            M[k * n + i] = x;
-        }
-    }
-    return 0;
-}
-
-/* B_k <- M⁻¹ B_k for a factored M and three (RD_NV, RD_NV) row-major matrices, by row
- * operations (one pass over the factor for the three). */
-static void rdd_solve3(const double *L, double *B0, double *B1, double *B2) {
-    const int n = RD_NV;
-    for (int i = n - 1; i >= 0; --i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
-            const double l = L[i * n + j];
-            for (int c = 0; c < RD_NV; ++c) {
-                B0[j * n + c] -= l * B0[i * n + c];
-                B1[j * n + c] -= l * B1[i * n + c];
-                B2[j * n + c] -= l * B2[i * n + c];
-            }
-        }
-    for (int i = 0; i < n; ++i) {
-        const double d = 1.0 / L[i * n + i];
-        for (int c = 0; c < RD_NV; ++c) {
-            B0[i * n + c] *= d;
-            B1[i * n + c] *= d;
-            B2[i * n + c] *= d;
-        }
-    }
-    for (int i = 0; i < n; ++i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) {
-            const double l = L[i * n + j];
-            for (int c = 0; c < RD_NV; ++c) {
-                B0[i * n + c] -= l * B0[j * n + c];
-                B1[i * n + c] -= l * B1[j * n + c];
-                B2[i * n + c] -= l * B2[j * n + c];
-            }
-        }
-}
-
-/* b <- M⁻¹ b for a factored M (the runtime's substitutions). */
-static void rdd_solve(const double *L, double *b) {
-    const int n = RD_NV;
-    for (int i = n - 1; i >= 0; --i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[j] -= L[i * n + j] * b[i];
-    for (int i = 0; i < n; ++i) b[i] /= L[i * n + i];
-    for (int i = 0; i < n; ++i)
-        for (int j = rd_parent[i]; j >= 0; j = rd_parent[j]) b[i] -= L[i * n + j] * b[j];
-}
+/* The LDLᵀ is the runtime's (core.c's RD_LDL_DEFINE on doubles): rd_ldl_factor, rd_ldl_apply,
+ * rd_ldl_apply_columns; the thread pool too (core.c's rd_parallel). */
 
 typedef int (*rdd_row)(const double *const *in, double *const *out);
 
@@ -86,8 +31,8 @@ static int rdd_fd_start(const double *const *in, double *M, double *a) {
     if (!rd_finite(in[0], n) || !rd_finite(in[1], n) || !rd_finite(in[2], n)) return 1;
     rd_mass_nle(in[0], in[1], M, a);
     for (int i = 0; i < n; ++i) a[i] = in[2][i] - a[i];
-    if (rdd_factor(M)) return 3;
-    rdd_solve(M, a);
+    if (rd_ldl_factor(M)) return 3;
+    rd_ldl_apply(M, a);
     return 0;
 }
 
@@ -95,7 +40,7 @@ static int rdd_fd_start(const double *const *in, double *M, double *a) {
 static int rdd_fd_finish(const double *M, double *const *out) {
     const int n = RD_NV;
     for (int i = 0; i < n * n; ++i) out[2][i] = (i % (n + 1)) == 0 ? 1.0 : 0.0;
-    rdd_solve3(M, out[0], out[1], out[2]);
+    for (int k = 0; k < 3; ++k) rd_ldl_apply_columns(M, out[k], n);
     for (int i = 0; i < n * n; ++i) {
         out[0][i] = -out[0][i];
         out[1][i] = -out[1][i];
@@ -144,19 +89,18 @@ typedef struct {
     rdd_pair pair; /* NULL: one row at a time */
     const double *in[3];
     double *out[3];
-    Py_ssize_t begin, end;
-    int status;
 } rdd_job;
 
-static void *rdd_run(void *arg) {
-    rdd_job *job = (rdd_job *)arg;
+/* Rows [begin, end) of a batch, two at a time where the kernel has pairs (core.c's rd_range). */
+static int rdd_rows(const void *work, Py_ssize_t begin, Py_ssize_t end) {
+    const rdd_job *job = (const rdd_job *)work;
     int worst = 0;
     const Py_ssize_t size = RD_NV * RD_NV;
-    for (Py_ssize_t r = job->begin; r < job->end;) {
+    for (Py_ssize_t r = begin; r < end;) {
         const double *in[3] = {job->in[0] + r * RD_NV, job->in[1] + r * RD_NV, job->in[2] + r * RD_NV};
         double *out[3] = {job->out[0] + r * size, job->out[1] + r * size, job->out[2] + r * size};
         int status;
-        if (job->pair && r + 1 < job->end) {
+        if (job->pair && r + 1 < end) {
             const double *in1[3] = {in[0] + RD_NV, in[1] + RD_NV, in[2] + RD_NV};
             double *out1[3] = {out[0] + size, out[1] + size, out[2] + size};
             status = job->pair(in, in1, out, out1);
@@ -166,33 +110,6 @@ static void *rdd_run(void *arg) {
             r += 1;
         }
         if (status > worst) worst = status;
-    }
-    job->status = worst;
-    return NULL;
-}
-
-static int rdd_parallel(const rdd_job *base, Py_ssize_t rows, long threads) {
-    if (threads > RD_MAX_THREADS) threads = RD_MAX_THREADS;
-    if (threads > rows / RD_MIN_ROWS_PER_THREAD) threads = (long)(rows / RD_MIN_ROWS_PER_THREAD);
-    if (threads < 1) threads = 1;
-    rdd_job jobs[RD_MAX_THREADS];
-    pthread_t ids[RD_MAX_THREADS];
-    int started[RD_MAX_THREADS];
-    for (long k = 0; k < threads; ++k) {
-        jobs[k] = *base;
-        jobs[k].begin = rows * k / threads;
-        jobs[k].end = rows * (k + 1) / threads;
-        started[k] = 0;
-    }
-    for (long k = 1; k < threads; ++k) started[k] = pthread_create(&ids[k], NULL, rdd_run, &jobs[k]) == 0;
-    rdd_run(&jobs[0]);
-    int worst = jobs[0].status;
-    for (long k = 1; k < threads; ++k) {
-        if (started[k])
-            pthread_join(ids[k], NULL);
-        else
-            rdd_run(&jobs[k]); /* could not start a thread: do its rows here */
-        if (jobs[k].status > worst) worst = jobs[k].status;
     }
     return worst;
 }
@@ -211,7 +128,7 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
     npy_intp dims[3] = {rows, RD_NV, RD_NV};
     PyObject *result = PyTuple_New(3);
     if (!result) return NULL;
-    rdd_job job = {row, pair, {0, 0, 0}, {0, 0, 0}, 0, rows, 0};
+    rdd_job job = {row, pair, {0, 0, 0}, {0, 0, 0}};
     for (int k = 0; k < 3; ++k) {
         PyObject *out = PyArray_SimpleNew(ndim + 1, ndim == 2 ? dims : dims + 1, NPY_DOUBLE);
         if (!out) {
@@ -227,7 +144,7 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         status = row(job.in, job.out);
     } else {
         Py_BEGIN_ALLOW_THREADS
-        status = rdd_parallel(&job, rows, threads);
+        status = rd_parallel(rdd_rows, &job, rows, 1, threads);
         Py_END_ALLOW_THREADS
     }
     if (status) {

@@ -39,9 +39,8 @@ loops (``make bench``, sections ``compiled-derivatives-*``, has the numbers).
 
 from __future__ import annotations
 
-import dataclasses
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import ModuleType
 from typing import cast
@@ -50,41 +49,17 @@ import numpy as np
 import sympy as sp
 
 from robodyn.compiled import build
+from robodyn.compiled.cache import robot_key
+from robodyn.compiled.programs import dynamics_programs, robot_bodies
 from robodyn.dynamics.robot import Robot
 from robodyn.equations.c_printer import CPrinter, c_combination, c_number
-from robodyn.equations.newton_euler import derive_newton_euler
 from robodyn.equations.program import Program, needed
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
-from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.tree import build_tree
 
-#: Bumped whenever the generated derivative code changes meaning (part of its cache key).
-DERIVATIVES_VERSION = "1"
 _RUNTIME = Path(__file__).with_name("derivatives.c")
 
 #: A value in the generated code: ``coefficient * name`` (``name`` None: the constant).
 Term = tuple[float, str | None]
-
-
-def bodies_program(robot: Robot, snap: float) -> tuple[Program, np.ndarray, np.ndarray]:
-    """The Newton–Euler program over the reference's bodies, and the map to the robot.
-
-    Returns:
-        ``(program, selection, offset)``: body ``b``'s coordinate is
-        ``selection[b] @ q + offset[b]``; ``selection`` has shape (n_bodies, nv).
-
-    Raises:
-        CompileError: If the reference tree and the Pinocchio model disagree on the joints.
-    """
-    tree = build_tree(robot.spec, robot.urdf, floating_base=False)
-    names = list(robot.joint_names)
-    if sorted(tree.joint_names) != sorted(names):
-        raise CompileError(robot.name, "the reference tree and the Pinocchio model disagree on the joints")
-    selection = tree.selection[:, [tree.joint_names.index(name) for name in names]]
-    count = len(tree.bodies)
-    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
-    reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
-    return derive_newton_euler(reference, snap=snap), selection, np.asarray(tree.offset, float)
 
 
 def _diff(expr: sp.Expr, symbol: sp.Symbol) -> sp.Expr:
@@ -300,33 +275,32 @@ class TangentWriter:
         return results
 
 
-def derivative_key(robot_key: str) -> str:
-    """The cache key of a robot's derivative kernels (its kernels' key, this generator)."""
-    generator = Path(__file__).read_text(encoding="utf-8") + _RUNTIME.read_text(encoding="utf-8")
-    return build.digest(robot_key, "derivatives", DERIVATIVES_VERSION, generator)
+def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType:
+    """The robot's derivative module: found by the robot's key, else generated, built and cached.
 
-
-def derivative_module(robot: Robot, *, key: str, kernels: str, snap: float) -> ModuleType:
-    """The robot's derivative module, generated and built on first use, then cached.
+    The Newton–Euler program differentiated is the robot's cached one
+    (:func:`robodyn.compiled.programs.dynamics_programs`, the one its ``tau`` kernel prints).
 
     Args:
         robot: A fixed-base robot the compiled engine took.
-        key: The cache key of its kernels (:func:`robodyn.compiled.robot.robot_key`).
-        kernels: Its kernels' C source (the module calls ``rd_mass``, ``rd_mass_nle``).
-        snap: The tolerance its kernels were generated with.
+        kernels: Gives its kernels' C source (the module calls ``rd_mass``, ``rd_mass_nle``);
+            asked for only for a build.
 
     Raises:
         CompileError: If the build fails or the module does not match the robot.
     """
-    own = derivative_key(key)
-    with build.locked(own):
-        source = build.cached_kernels(own)
-        if source is None:
-            program, selection, offset = bodies_program(robot, snap)
-            source = TangentWriter(program, selection, offset).source()
-            build.store_kernels(own, source)
-        runtime = _RUNTIME.read_text(encoding="utf-8")
-        module = build.build_extension(kernels + "\n" + source, runtime, init="rdd_module", label=robot.name)
+    own = "derivatives-" + robot_key(robot)
+
+    def source() -> str:
+        derivative = build.cached_kernels(own)
+        if derivative is None:
+            bodies = robot_bodies(robot)
+            derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset).source()
+            build.store_kernels(own, derivative)
+        runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
+        return kernels() + "\n" + derivative + "\n" + runtime
+
+    module = build.keyed_extension(own, source, init="rdd_module", label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached derivative kernels do not match the robot; clear the cache folder")
     return module

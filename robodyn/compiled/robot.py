@@ -19,76 +19,47 @@ checked path. Batches run across rows on ``threads`` native threads, the GIL rel
 
 from __future__ import annotations
 
-import dataclasses
-from pathlib import Path
 from types import ModuleType
-from typing import cast
 
 import numpy as np
 
-from robodyn.compiled import build, codegen, derivatives
-from robodyn.compiled.codegen import CODEGEN_VERSION, KernelWriter
-from robodyn.compiled.kinematics import build_frame
+from robodyn.compiled import build
+from robodyn.compiled.cache import SNAP, robot_key
 from robodyn.dynamics.batch import check_threads
+from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.robot import Robot
-from robodyn.equations import c_printer, compact, newton_euler, program, sharing
-from robodyn.equations.compact import derive_compact
-from robodyn.equations.newton_euler import BaseSymbols, derive_newton_euler, floating_tree
 from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassMatrixError
-from robodyn.reference import symbolic as reference_symbolic
-from robodyn.reference import tree as reference_tree
-from robodyn.reference.numeric import ReferenceRobot
-from robodyn.reference.tree import build_tree
 
 _ndarray = np.ndarray
-#: Rotation entries this close to 0, ±1, ±½, ... are taken as exact: float rounding only
-#: (cos(π/2) = 6e-17, sin(π) = 1.2e-16), so the compiled model is the URDF's. Not more: URDFs
-#: write π to 12 digits (kinova's 3.14159265359, sin = -2e-13), and snapping that to 0 moved
-#: kinova's M by 8e-14 and, through cond(M) ~ 1e4, its forward dynamics by 5e-10.
-SNAP = 1e-15
 _QUANTITIES = {"tau": "tau", "mass": "M", "nle": "C v + G", "gravity": "G", "fd": "a"}
 
 
-def _generator_source() -> str:
-    """The code that turns a URDF into kernels (part of the key: a change there, by anyone,
-    must not reuse kernels generated before it)."""
-    modules = (codegen, c_printer, program, sharing, newton_euler, compact, reference_tree, reference_symbolic)
-    # cast: these modules are loaded from source files, so __file__ is set
-    sources = [Path(cast(str, module.__file__)).read_text(encoding="utf-8") for module in modules]
-    return "".join(sources) + codegen.TRIG.read_text(encoding="utf-8")  # the kernels' own sin and cos
-
-
-def robot_key(robot: Robot) -> str:
-    """The cache key of a robot's generated kernels: its URDF text, gravity, the armature
-    given to :func:`robodyn.load` (the file's is in the text) and the generator."""
-    gravity = ",".join(repr(float(g)) for g in robot.gravity_vector)
-    armature = repr(tuple(robot.options.armature))
-    return build.digest(robot.urdf, gravity, armature, CODEGEN_VERSION, f"compact snap={SNAP}", _generator_source())
-
-
 def generate_kernels(robot: Robot) -> str:
-    """The C kernels of a robot (the slow part: a sympy derivation).
+    """The C kernels of a robot, printed from its programs
+    (:func:`robodyn.compiled.programs.dynamics_programs`: the slow part, a sympy derivation,
+    done once per robot key).
 
     A floating base is the tree's body 0, free (:func:`robodyn.equations.newton_euler.floating_tree`).
 
     Raises:
         CompileError: For joints the reference does not map.
     """
-    tree = build_tree(robot.spec, robot.urdf, floating_base=robot.floating_base)
-    base = BaseSymbols.make() if robot.floating_base else None
-    if robot.floating_base:
-        tree = floating_tree(tree)
-    names = [name for name in robot.joint_names if not (robot.floating_base and name == robot.joint_names[0])]
-    if sorted(tree.joint_names) != sorted(names):
-        raise CompileError(robot.name, "the reference tree and the Pinocchio model disagree on the joints")
-    column = [tree.joint_names.index(name) for name in names]
-    selection = tree.selection[:, column]  # bodies x robot coordinates
-    count = len(tree.bodies)
-    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
-    reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
-    equations = derive_compact(reference, snap=SNAP, free_base=base)
-    tau = derive_newton_euler(reference, snap=SNAP, free_base=base)
-    return KernelWriter(equations, selection, tree.offset, coordinate_parents(robot), tau).source()
+    from robodyn.compiled.codegen import KernelWriter  # sympy and the generator: only now
+    from robodyn.compiled.programs import dynamics_programs, robot_bodies
+
+    bodies = robot_bodies(robot)
+    programs = dynamics_programs(robot)
+    return KernelWriter(programs.compact, bodies.selection, bodies.offset, coordinate_parents(robot), programs.tau).source()
+
+
+def robot_kernels(robot: Robot) -> str:
+    """The robot's kernels: cached under its key, else generated (and cached)."""
+    key = robot_key(robot)
+    kernels = build.cached_kernels(key)
+    if kernels is None:
+        kernels = generate_kernels(robot)
+        build.store_kernels(key, kernels)
+    return kernels
 
 
 def coordinate_parents(robot: Robot) -> list[int]:
@@ -115,7 +86,13 @@ def coordinate_parents(robot: Robot) -> list[int]:
 
 
 def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
-    """Compile a robot's dynamics to native code (cached: fast the second time).
+    """Compile a robot's dynamics to native code (cached: microseconds the second time).
+
+    The module is found by the robot's key (its URDF text, load options and the generator's
+    source), without generating any source: from this process's memory (about 10 µs), else
+    the cache folder (milliseconds, no sympy imported); only a robot never compiled is
+    derived (seconds) and built. ``robot.model`` is read-only to the compiled robot (see
+    :class:`CompiledRobot`).
 
     Args:
         robot: From :func:`robodyn.load` (mimic joints and a floating base are fine).
@@ -132,24 +109,22 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     threads = check_threads(threads)
     if robot.nv == 0:
         raise CompileError(robot.name, "it has no moving joints")
-    build.find_compiler()  # fail early, before the slow derivation
-    key = robot_key(robot)
-    with build.locked(key):
-        kernels = build.cached_kernels(key)
-        if kernels is None:
-            kernels = generate_kernels(robot)
-            build.store_kernels(key, kernels)
-        module = build.build_module(kernels, label=robot.name)
+    module = build.robot_module(robot_key(robot), lambda: robot_kernels(robot), label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached kernels do not match the robot; clear the cache folder")
     return CompiledRobot(robot, module, threads=threads)
 
 
 class CompiledRobot:
-    """A robot's dynamics in compiled C; the methods and shape rules of :class:`robodyn.Robot`.
+    """A robot's dynamics in compiled C; the methods and shape rules of :class:`robodyn.Robot`
+    (both satisfy :class:`robodyn.dynamics.protocol.Dynamics`, with the same signatures).
 
     Attributes:
-        robot: The Pinocchio-backed robot it was compiled from (names, limits, checks).
+        robot: The Pinocchio-backed robot it was compiled from (names, limits, checks). Its
+            ``model`` is read-only here: the kernels come from the robot's URDF text and load
+            options (its cache key, :func:`robodyn.compiled.cache.robot_key`), so a change
+            made to ``robot.model`` reaches neither the kernels nor the key; load the robot
+            again with the change (``robodyn.load(..., armature=..., gravity=...)``) instead.
         name, nq, nv, joint_names: As the robot's.
         threads: Native threads for batches.
         module: The loaded extension module (``tau``, ``mass``, ``nle``, ``gravity``, ``fd``,
@@ -189,21 +164,26 @@ class CompiledRobot:
             raise CompileError(self.name, f"the compiled {kind} refused checked inputs (status {result})")
         raise NonFiniteResultError(self.name, _QUANTITIES[kind])
 
-    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, joint_friction: bool = False) -> np.ndarray:
         """Joint torques ``tau = M(q) a + C(q, v) v + G(q)``.
 
         Args:
             q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
             v: Velocity, shape (nv,) or (N, nv).
             a: Acceleration, shape (nv,) or (N, nv).
+            joint_friction: Add the torques the joints' friction takes, ``b v + f sign(v)``
+                (as :meth:`robodyn.Robot.inverse_dynamics`, the same formula on the result).
 
         Returns:
             Torques in [N m] / [N], shape (nv,) or (N, nv).
         """
         result = self._tau(q, v, a, self.threads)
-        if result.__class__ is _ndarray:
-            return result
-        return self._checked("tau", self._tau, result, q=q, v=v, a=a)
+        if result.__class__ is not _ndarray:
+            result = self._checked("tau", self._tau, result, q=q, v=v, a=a)
+        if joint_friction:
+            robot = self.robot
+            result = result - friction_torque(robot.joint_damping, robot.joint_friction, np.asarray(v, dtype=float))
+        return result
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """Joint-space inertia matrix ``M(q)``, symmetric, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg]."""
@@ -218,6 +198,12 @@ class CompiledRobot:
         if result.__class__ is _ndarray:
             return result
         return self._checked("nle", self._nle, result, q=q, v=v)
+
+    def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Coriolis and centrifugal matrix ``C(q, v)`` with ``dM/dt = C + Cᵀ``, shape (nv, nv)
+        or (N, nv, nv): the robot's own (:meth:`robodyn.Robot.coriolis_matrix`, Pinocchio; the
+        compiled programs give ``C v``, not ``C``)."""
+        return self.robot.coriolis_matrix(q, v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
         """Generalised gravity ``G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
@@ -252,9 +238,9 @@ class CompiledRobot:
         module = self.__dict__.get("_derivative_module")
         if module is None:
             _fixed_base_only(self.robot, "derivatives")
-            key = robot_key(self.robot)
-            kernels = build.cached_kernels(key) or generate_kernels(self.robot)
-            module = derivatives.derivative_module(self.robot, key=key, kernels=kernels, snap=SNAP)
+            from robodyn.compiled import derivatives  # the generator: only when first asked for
+
+            module = derivatives.derivative_module(self.robot, kernels=lambda: robot_kernels(self.robot))
             self.__dict__["_derivative_module"] = module
         return module
 
@@ -279,7 +265,7 @@ class CompiledRobot:
         result = function(q, v, a, self.threads)
         if result.__class__ is tuple:
             return result
-        return derivatives.checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
+        return _derivatives_checked(function, self.robot, self.threads, "tau", q=q, v=v, a=a)
 
     def forward_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
@@ -304,7 +290,7 @@ class CompiledRobot:
         result = function(q, v, tau, self.threads)
         if result.__class__ is tuple:
             return result
-        return derivatives.checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
+        return _derivatives_checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
 
     # ---- frame kinematics (robodyn.compiled.kinematics): one small module a frame ----------
 
@@ -317,6 +303,8 @@ class CompiledRobot:
         modules = self.__dict__.setdefault("_frames", {})
         if frame not in modules:
             _fixed_base_only(self.robot, "frame kinematics")
+            from robodyn.compiled.kinematics import build_frame  # the generator: only when first asked for
+
             modules[frame] = build_frame(self.robot, frame, robot_key(self.robot))
         return modules[frame]
 
@@ -355,7 +343,17 @@ class CompiledRobot:
         return bias if angular else bias[..., :3].copy()
 
 
+def _derivatives_checked(function, robot: Robot, threads: int, kind: str, **named: np.ndarray):
+    """:func:`robodyn.compiled.derivatives.checked` (its module imported only on this path)."""
+    from robodyn.compiled import derivatives
+
+    return derivatives.checked(function, robot, threads, kind, **named)
+
+
 def _fixed_base_only(robot: Robot, what: str) -> None:
     """Refuse a floating base for the compiled ``what`` (its kernels model fixed bases)."""
     if robot.floating_base:
         raise CompileError(robot.name, f"it has a floating base; the compiled {what} model fixed-base robots")
+
+
+__all__ = ["SNAP", "CompiledRobot", "compile", "coordinate_parents", "generate_kernels", "robot_kernels", "robot_key"]

@@ -75,9 +75,9 @@ static RDS_TARGET int rdsT_block_gravity(const double *const *in, double *out) {
     return 0;
 }
 
-/* rdsT_ldl_solve(M, b), written by simd.py before this text: the runtime's rd_ldl_solve on
- * every lane at once, unrolled along the tree (the same operations in the same order; 3 if
- * a pivot of any lane is not positive and finite). */
+/* rdsT_ldl_solve(M, b), instantiated by simd.py before this text from core.c's RD_LDL_DEFINE:
+ * the runtime's rd_ldl_solve on every lane at once (the same operations in the same order; 3
+ * if a pivot of any lane is not positive and finite). */
 
 static RDS_TARGET int rdsT_block_fd(const double *const *in, double *out) {
     rdsT q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], a[RD_NV];

@@ -35,16 +35,14 @@ function the kernels call that the vector printer passes through, or kernels cal
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from pathlib import Path
 from types import ModuleType
 
-from robodyn.equations.c_printer import vector_lines
 from robodyn.exceptions import InputError
 
-#: Bumped whenever the generated vector code changes meaning (it is part of the module's source).
-SIMD_VERSION = "5"
 #: The environment variable that forces an instruction set.
 ENVIRONMENT = "ROBODYN_SIMD"
 #: (name, lanes, GCC target): the x86-64 variants, narrowest first.
@@ -53,7 +51,7 @@ _TEMPLATE = Path(__file__).with_name("simd.c")
 _KERNELS = ("gravity", "nle", "mass", "mass_nle", "tau")
 _HEADER = re.compile(r"^static void rd_(\w+)\((.*)\) \{$")
 _COMMON = """
-/* ---- SIMD blocks (robodyn.compiled.simd, version {version}) ---- */
+/* ---- SIMD blocks (robodyn.compiled.simd) ---- */
 #if defined(__x86_64__) && defined(__GNUC__)
 #define RD_SIMD 1
 #pragma STDC FP_CONTRACT OFF
@@ -106,43 +104,6 @@ def _lanes(lanes: int, value: str) -> str:
     return f"for (int l = 0; l < {lanes}; ++l) r[l] = {value}; return r;"
 
 
-def _parents(kernels: str) -> list[int] | None:
-    """``rd_parent`` of the kernels (each coordinate's parent, -1 at a root), or None."""
-    match = re.search(r"static const int rd_parent\[RD_NV\] = \{([-0-9, ]*)\};", kernels)
-    return None if match is None else [int(p) for p in match.group(1).split(",") if p.strip()]
-
-
-def _ancestors(parents: list[int], i: int) -> list[int]:
-    """``i``, its parent, its parent's parent, ... (the runtime's ``j = rd_parent[j]`` walk)."""
-    chain = []
-    while i >= 0:
-        chain.append(i)
-        i = parents[i]
-    return chain
-
-
-def _ldl(parents: list[int], vector: str, attribute: str) -> list[str]:
-    """``{vector}_ldl_solve``: ``runtime.c``'s ``rd_ldl_solve`` unrolled along the tree, on
-    vectors (the loops' operations in their order, each a statement)."""
-    n = len(parents)
-    out = [f"static inline __attribute__((always_inline)) {attribute} int {vector}_ldl_solve({vector} *M, {vector} *b) {{"]
-    out.append("    int bad = 0;")
-    for k in reversed(range(n)):
-        out.append(
-            f"    for (int l = 0; l < {vector}_lanes; ++l) bad |= !(M[{k * n + k}][l] > 0.0) || !isfinite(M[{k * n + k}][l]);"
-        )
-        for i in _ancestors(parents, parents[k]):
-            updates = " ".join(f"M[{i * n + j}] -= M[{k * n + j}] * x;" for j in _ancestors(parents, i))
-            out.append(f"    {{ const {vector} x = M[{k * n + i}] / M[{k * n + k}]; {updates} M[{k * n + i}] = x; }}")
-    out.append("    if (bad) return 3;")
-    for i in reversed(range(n)):
-        out += [f"    b[{j}] -= M[{i * n + j}] * b[{i}];" for j in _ancestors(parents, parents[i])]
-    out += [f"    b[{i}] /= M[{i * n + i}];" for i in range(n)]
-    for i in range(n):
-        out += [f"    b[{i}] -= M[{i * n + j}] * b[{j}];" for j in _ancestors(parents, parents[i])]
-    return [*out, "    return 0;", "}"]
-
-
 def vector_trig(vector: str, lanes: int, attribute: str) -> list[str]:
     """``{vector}_sin``, ``_cos``, ``_sincos``: the kernels' own ``RD_TRIG_DEFINE`` (``trig.c``,
     defined in the kernels' text) on vectors, with its helpers (bit casts; libm's sin and cos
@@ -159,9 +120,11 @@ def vector_trig(vector: str, lanes: int, attribute: str) -> list[str]:
     ]
 
 
-def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lanes: int, target: str) -> list[str] | None:
+def _variant(functions: dict[str, list[str]], name: str, lanes: int, target: str) -> list[str] | None:
     """One instruction set's vector kernels and blocks, or None if a kernel has a statement
     the vector printer does not take."""
+    from robodyn.equations.c_printer import vector_lines  # sympy: only when a module is built
+
     vector = f"rds{lanes}"
     attribute = f'__attribute__((target("{target}")))'
     out = [f"typedef double {vector} __attribute__((vector_size({8 * lanes})));"]
@@ -186,7 +149,11 @@ def _variant(functions: dict[str, list[str]], parents: list[int], name: str, lan
         out += [f"static {attribute} void {vector}_{kernel}({arguments}) {{", *body, "}"]
     template = _TEMPLATE.read_text(encoding="utf-8")
     out.append(f"enum {{ {vector}_lanes = {lanes} }};")
-    out += _ldl(parents, vector, attribute)
+    # The runtime's tree LDLᵀ (core.c's RD_LDL_DEFINE) on vectors: 1 if a lane's pivot is bad.
+    out.append(
+        f"{inline} int {vector}_pivot_bad({vector} d) {{ int bad = 0; for (int l = 0; l < {lanes}; ++l) bad |= !(d[l] > 0.0) || !isfinite(d[l]); return bad; }}"
+    )
+    out.append(f"RD_LDL_DEFINE({inline}, {vector}_, {vector})")
     scatter = " ".join(f"rows[{lane} * n + j] = x[{lane}];" for lane in range(lanes))
     template = (
         template.replace("RDS_SCATTER", scatter)
@@ -211,13 +178,15 @@ def _wanted() -> str:
     return wanted
 
 
-def _cpu_flags() -> set[str] | None:
-    """The CPU's feature flags (Linux ``/proc/cpuinfo``), or None where they cannot be read."""
+@functools.lru_cache(maxsize=1)
+def _cpu_flags() -> frozenset[str] | None:
+    """The CPU's feature flags (Linux ``/proc/cpuinfo``, read once a process), or None where
+    they cannot be read."""
     try:
         with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
             for line in info:
                 if line.startswith("flags"):
-                    return set(line.split(":", 1)[1].split())
+                    return frozenset(line.split(":", 1)[1].split())
     except OSError:
         pass
     return None
@@ -251,13 +220,19 @@ def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | Non
         variants: Which of :data:`VARIANTS`; default :func:`build_variants`.
     """
     variants = build_variants() if variants is None else variants
-    functions, parents = _functions(kernels), _parents(kernels)
+    functions = _functions(kernels)
     sizes = re.findall(r"^#define RD_N[QV] (\d+)$", kernels, flags=re.MULTILINE)
-    if functions is None or parents is None or not variants or len(set(sizes)) != 1 or "RD_TRIG_DEFINE(" not in kernels:
+    if (
+        functions is None
+        or "static const int rd_ancestor[RD_NV][RD_NV]" not in kernels
+        or not variants
+        or len(set(sizes)) != 1
+        or "RD_TRIG_DEFINE(" not in kernels
+    ):
         return ""  # the blocks read q with the stride of v: not for a configuration of another size
-    out = [_COMMON.format(version=SIMD_VERSION)]
+    out = [_COMMON.format()]
     for name, lanes, target in variants:
-        variant = _variant(functions, parents, name, lanes, target)
+        variant = _variant(functions, name, lanes, target)
         if variant is None:
             return ""
         out += variant

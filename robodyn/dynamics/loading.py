@@ -86,8 +86,9 @@ def load(
             (``"rp_arm"``); ``robodyn list`` prints the names. See docs/robot-files.md.
         floating_base: Give the root link a free-flyer joint. ``None``: true for zoo
             robots that walk, swim or fly, false otherwise.
-        gravity: Gravity acceleration in the world frame, in [m/s²]; default
-            ``(0, 0, -9.81)``.
+        gravity: Gravity acceleration in the world frame, in [m/s²]; default the
+            file's (MJCF ``<option gravity>``, zero under ``<flag gravity="disable"/>``),
+            else ``(0, 0, -9.81)``.
         check_inertia: Refuse inertias that are not positive semi-definite on moving links
             (set false to load published models that have them).
         strict: Refuse what loads with a :class:`~robodyn.exceptions.RobodynWarning`
@@ -126,14 +127,16 @@ def load(
         RobodynWarning: For what ``strict=True`` refuses.
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
-    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict)
+    resolved = resolve_source(
+        source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict, max_dof=max_dof
+    )
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     _report_equalities(resolved, strict)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
     options = load_options(
         floating_base=floating,
-        gravity=gravity,
+        gravity=resolved.gravity if gravity is None else gravity,
         check_inertia=check_inertia,
         strict=strict,
         lock=lock,

@@ -33,7 +33,8 @@ class LoadOptions:
 
     Attributes:
         floating_base: Whether the root got a free-flyer joint.
-        gravity: Gravity in the world frame, in [m/s²].
+        gravity: Gravity in the world frame, in [m/s²]: ``gravity=`` if given, else the
+            file's (MJCF ``<option gravity>``), else (0, 0, −9.81).
         check_inertia: Whether impossible inertias on moving links were refused.
         threads: Native threads for batches (``None``: every available core).
         strict: Whether warnings of the validator were treated as errors.

@@ -1,8 +1,10 @@
 """``casadi_functions``, ``jax_functions`` and ``module_source``: a robot's dynamics for optimisers.
 
-Each derives the robot's programs (:mod:`robodyn.export.programs`), prints them as the
-standalone module (:mod:`robodyn.export.source`) and, for the functions, runs that module's
-``functions()``: the library's functions and a written module are the same code.
+Each derives the robot's programs (:mod:`robodyn.export.programs`, once per robot: the
+compiled engine's derivation), prints them as the standalone module
+(:mod:`robodyn.export.source`, once per robot and options, kept in the compiled cache) and,
+for the functions, runs that module's ``functions()`` (once per process): the library's
+functions and a written module are the same code.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from robodyn.common.extras import require
+from robodyn.compiled.programs import derived
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.export.programs import export_programs
@@ -45,14 +48,29 @@ def module_source(
     """
     if backend not in ("casadi", "jax"):
         raise InputError("backend", "casadi or jax", repr(backend))
-    return module_text(export_programs(robot, frames=frames, keep_params=keep_params, progress=progress), backend)
+    names = None if frames is None else [str(frame) for frame in frames]
+
+    def text() -> str:
+        return module_text(export_programs(robot, frames=names, keep_params=keep_params, progress=progress), backend)
+
+    # Printed once per robot, backend, frames and keep_params (robodyn.compiled.programs: kept
+    # in memory and in the compiled cache under the robot's key, like the programs).
+    return derived(robot, f"export text {backend} keep_params={keep_params} frames={names!r}", text)
+
+
+#: The functions this process built, by the module text they ran (CasADi functions are immutable).
+_BUILT: dict[str, dict[str, Any]] = {}
 
 
 def _run(source: str) -> dict[str, Any]:
-    """The module's ``functions()`` (the text is generated: names only as ``ascii()`` literals)."""
-    namespace: dict[str, Any] = {"__name__": "robodyn_export"}
-    exec(compile(source, "<robodyn export>", "exec"), namespace)
-    return namespace["functions"]()
+    """The module's ``functions()`` (the text is generated: names only as ``ascii()`` literals),
+    built once per text in a process (a new dictionary of the same functions each call)."""
+    built = _BUILT.get(source)
+    if built is None:
+        namespace: dict[str, Any] = {"__name__": "robodyn_export"}
+        exec(compile(source, "<robodyn export>", "exec"), namespace)
+        built = _BUILT[source] = namespace["functions"]()
+    return dict(built)
 
 
 def casadi_functions(robot: Robot, *, frames: Sequence[str] | None = None, keep_params: bool = False) -> dict[str, Any]:

@@ -1,6 +1,8 @@
 """The straight-line programs a robot's exported functions are printed from.
 
-The equations layer derives them, as for the compiled engine (:mod:`robodyn.compiled.codegen`):
+The equations layer derives them, once per robot for the compiled engine and the export
+alike (:mod:`robodyn.compiled.programs`: kept in memory and pickled in the compiled cache,
+under the robot's key; kept parameters are derived at each call):
 the compact program (:func:`robodyn.equations.compact.derive_compact`: ``M``, ``C v``, ``G``)
 and the Newton–Euler program (:func:`robodyn.equations.newton_euler.derive_newton_euler`:
 ``tau`` in O(n); at zero acceleration and shortened, ``C v + G`` in one pass: smaller than
@@ -18,13 +20,14 @@ Jacobians are the ones :meth:`robodyn.Robot.frame_position` and
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
+from robodyn.compiled.cache import SNAP
+from robodyn.compiled.programs import Bodies, derived, dynamics_programs, robot_bodies
 from robodyn.compiled.robot import coordinate_parents
 from robodyn.dynamics.robot import Robot
 from robodyn.equations.compact import derive_compact
@@ -34,11 +37,6 @@ from robodyn.equations.sharing import shortened
 from robodyn.exceptions import InputError
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, exact_matrix, joint_symbols
-from robodyn.reference.tree import build_tree
-
-#: Rotation entries this close to 0, ±1, ±½, ... are exact: float rounding only (as the
-#: compiled engine, :data:`robodyn.compiled.robot.SNAP`).
-SNAP = 1e-15
 
 
 @dataclass(frozen=True)
@@ -94,8 +92,10 @@ def export_programs(
     keep_params: bool = False,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> ExportPrograms:
-    """Derive the programs of a fixed-base robot's exported functions (a sympy derivation:
-    seconds for a 7-joint arm).
+    """The programs of a fixed-base robot's exported functions: derived once per robot (a sympy
+    derivation: seconds for a 7-joint arm), shared with :func:`robodyn.compiled.compile` and
+    kept in the compiled cache (:mod:`robodyn.compiled.programs`), so a second call or one
+    after ``compile`` reads them; kept parameters (``keep_params``) are derived each call.
 
     Args:
         robot: From :func:`robodyn.load` (fixed base; mimic and locked joints as loaded).
@@ -112,32 +112,26 @@ def export_programs(
     names = list(robot.frame_names) if frames is None else [str(frame) for frame in frames]
     for frame in names:
         robot.frame_id(frame)  # FrameError with the closest names
-    tree = build_tree(robot.spec, robot.urdf, floating_base=False)
-    column = [tree.joint_names.index(name) for name in robot.joint_names]
-    count = len(tree.bodies)
-    free = dataclasses.replace(tree, selection=np.eye(count), offset=np.zeros(count), joint_names=[f"b{i}" for i in range(count)])
-    reference = ReferenceRobot(free, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
-    symbols = joint_symbols(free.joint_names)
-    dynamics = derive_compact(reference, snap=SNAP, keep_params=keep_params, symbols=symbols, progress=progress).program()
-    tau = derive_newton_euler(reference, snap=SNAP, keep_params=keep_params, symbols=symbols)
+    bodies = robot_bodies(robot)
+    dynamics, tau, symbols = _dynamics(robot, bodies, keep_params, progress)
     if progress:
         progress("Newton-Euler", 0, 1)
-    still = {symbol: sp.Integer(0) for symbol in symbols[2]}
-    nle = shortened(
-        Program(
-            tau.inputs,
-            tuple((symbol, expr.xreplace(still)) for symbol, expr in tau.assignments),
-            {"tau": tuple(expr.xreplace(still) for expr in tau.outputs["tau"])},
-        )
-    )
-    placements = [_placement(robot, frame, tree) for frame in names]
-    kinematics = frame_program(reference, symbols[0], placements, keep_params=keep_params)
+    placements = [_placement(robot, frame, bodies.tree) for frame in names]
+
+    def kinematics_program() -> Program:
+        return frame_program(bodies.reference, symbols[0], placements, keep_params=keep_params)
+
+    if keep_params:
+        nle, kinematics = _at_rest(tau, symbols[2]), kinematics_program()
+    else:  # derived once per robot, as its dynamics
+        nle = derived(robot, "export nle", lambda: _at_rest(tau, symbols[2]))
+        kinematics = derived(robot, "export frames\0" + "\0".join(names), kinematics_program)
     parameters = {**dynamics.parameters, **tau.parameters, **kinematics.parameters}
     return ExportPrograms(
         robot=robot.name,
         joint_names=list(robot.joint_names),
-        selection=tree.selection[:, column],
-        offset=np.asarray(tree.offset, float),
+        selection=bodies.selection,
+        offset=bodies.offset,
         parents=coordinate_parents(robot),
         symbols=symbols,
         dynamics=dynamics,
@@ -146,6 +140,32 @@ def export_programs(
         frames=kinematics,
         frame_names=names,
         parameters=dict(sorted(parameters.items(), key=lambda item: str(item[0]))),
+    )
+
+
+def _dynamics(
+    robot: Robot, bodies: Bodies, keep_params: bool, progress: Callable[[str, int, int], None] | None
+) -> tuple[Program, Program, tuple[list[sp.Symbol], list[sp.Symbol], list[sp.Symbol]]]:
+    """The compact program, the Newton–Euler program and their ``(q, q̇, q̈)`` symbols: the
+    compiled engine's, derived once per robot (:func:`robodyn.compiled.programs.dynamics_programs`),
+    or, with kept parameters, derived here."""
+    if not keep_params:
+        shared = dynamics_programs(robot)
+        return shared.compact.program(), shared.tau, (shared.compact.q, shared.compact.qd, shared.compact.qdd)
+    symbols = joint_symbols(bodies.reference.joint_names)
+    dynamics = derive_compact(bodies.reference, snap=SNAP, keep_params=True, symbols=symbols, progress=progress)
+    return dynamics.program(), derive_newton_euler(bodies.reference, snap=SNAP, keep_params=True, symbols=symbols), symbols
+
+
+def _at_rest(tau: Program, accelerations: Sequence[sp.Symbol]) -> Program:
+    """``tau`` at zero acceleration (``C v + G`` in one pass), shortened."""
+    still = {symbol: sp.Integer(0) for symbol in accelerations}
+    return shortened(
+        Program(
+            tau.inputs,
+            tuple((symbol, expr.xreplace(still)) for symbol, expr in tau.assignments),
+            {"tau": tuple(expr.xreplace(still) for expr in tau.outputs["tau"])},
+        )
     )
 
 

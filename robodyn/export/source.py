@@ -4,11 +4,11 @@ One module text for both backends: the programs of :mod:`robodyn.export.programs
 as Python functions of lists of scalars (the expressions through the one C printer,
 :class:`robodyn.equations.c_printer.CPrinter`, whose output — sums, products, ``(a/b)``,
 ``(x*x)``, ``pow``, ``sin``, ``cos`` — is Python too), the projections onto the robot's
-coordinates and the tree LDLᵀ of the compiled engine (``runtime.c``'s ``rd_ldl_solve``,
-unrolled: parents before children, no fill-in), then a backend tail that builds CasADi SX
-functions or plain ``jax.numpy`` functions. :func:`robodyn.export.casadi_functions` and
-:func:`robodyn.export.jax_functions` run exactly this text, so the module a user writes and
-the functions the library gives are the same.
+coordinates and the tree LDLᵀ of the compiled engine (``core.c``'s ``RD_LDL_DEFINE``: the
+same operations, unrolled, on symbolic values; parents before children, no fill-in), then a
+backend tail that builds CasADi SX functions or plain ``jax.numpy`` functions.
+:func:`robodyn.export.casadi_functions` and :func:`robodyn.export.jax_functions` run exactly
+this text, so the module a user writes and the functions the library gives are the same.
 
 No name from the URDF reaches the code: coordinates are ``th[b]``, ``q[i]``, intermediate
 variables ``tN``/``rN``/``kN``, kept parameters ``p[i]``; names appear only in the docstring
@@ -76,7 +76,7 @@ def _joints_matrix(mb):
 
 
 def _ldl_solve(M, b):
-    """M x = b by M = L^T D L along the tree (robodyn.compiled's runtime.c, unrolled)."""
+    """M x = b by M = L^T D L along the tree (robodyn.compiled's core.c, unrolled)."""
     M, b, parent = [list(row) for row in M], list(b), _PARENTS
     for k in reversed(range(NV)):
         d, i = M[k][k], parent[k]

@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from pathlib import Path
 
 import numpy as np
 
 import robodyn
 from robodyn.compiled.codegen import KernelWriter
-from robodyn.compiled.robot import SNAP, _generator_source, coordinate_parents
-from robodyn.equations import c_printer, compact, newton_euler, program, sharing
+from robodyn.compiled.robot import SNAP, coordinate_parents
 from robodyn.equations.compact import derive_compact
 from robodyn.equations.newton_euler import derive_newton_euler
 from robodyn.equations.program import needed
@@ -46,17 +44,6 @@ def test_the_tau_kernel_is_the_newton_euler_program_printed():
     # The mimic body's coordinate is made of its leader's, in every array.
     assert re.search(r"const double th\d+ = [-0-9.e]+\*q\[\d\]", source)
     assert robot.nv == len(re.findall(r"    tau\[\d\] = ", kernel))
-
-
-def test_the_cache_key_covers_the_one_program_and_the_one_printer():
-    """A change to the Newton–Euler program, the passes or the C printer never reuses kernels
-    generated before it."""
-    source = _generator_source()
-    for module in (newton_euler, program, sharing, compact, c_printer):
-        assert Path(module.__file__).read_text(encoding="utf-8") in source
-    from robodyn.compiled import codegen
-
-    assert codegen.TRIG.read_text(encoding="utf-8") in source  # the kernels' own sin and cos
 
 
 def test_a_long_program_splits_mass_and_nle_into_calls_with_the_same_numbers(monkeypatch, tmp_path, rng):

@@ -223,6 +223,8 @@ def test_generated_code_has_no_urdf_names(mimic_tree):
         "RD_NQ",
         "RD_QUATERNION_TOLERANCE",
         "rd_parent",
+        "rd_depth",
+        "rd_ancestor",
         "q",
         "v",
         "a",
