@@ -20,8 +20,8 @@ from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.contact import ACTIVE_FORCE, ContactSettings, contact_step
-from robodyn.sim.ground import ContactPoint, Ground, contact_points
-from robodyn.sim.simulation import ExternalWrench
+from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
+from robodyn.sim.plan import ExternalWrench
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import contact_header
 from robodyn.trajectory.io import write_csv
@@ -180,25 +180,26 @@ def simulate_contact(
     (q, v), _ = robot.validate(q=q, v=np.zeros(robot.nv) if v0 is None else v0)
     if controller is not None and not callable(controller):
         (controller,), _ = robot.validate(tau=controller)
-    samples = _run(robot, ground, found.points, controller, q, v, steps, dt, settings or ContactSettings())
+    return run_contacts(robot, ground, found, controller, q, v, steps, dt, settings=settings)
+
+
+def run_contacts(
+    robot: Robot, ground: Ground, found: Contacts, controller: Controller, q: np.ndarray, v: np.ndarray,
+    steps: int, dt: float, *, settings: ContactSettings | None = None, joint_friction: bool = True,
+) -> ContactSimulation:  # fmt: skip
+    """:func:`simulate_contact` of checked arguments (``joint_friction=False``: no joint damping)."""
+    damping = robot.joint_damping if joint_friction else np.zeros(robot.nv)
+    samples = _run(robot, ground, found.points, controller, q, v, steps, dt, settings or ContactSettings(), damping)
     trajectory = Trajectory(
         samples["t"], samples["q"], samples["v"], samples["a"], samples["tau"], list(robot.joint_names), robot.name
     )
     notes = list(found.skipped)
-    if np.any(robot.joint_friction):
+    if joint_friction and np.any(robot.joint_friction):
         notes.append("joint Coulomb friction of the file is not applied in contact runs")
     return ContactSimulation(
-        trajectory,
-        found.names,
-        samples["forces"],
-        samples["gaps"],
-        samples["slip"],
-        ground,
-        samples["iterations"],
-        samples["converged"],
-        tuple(notes),
-        tuple(point.link for point in found.points),
-    )
+        trajectory, found.names, samples["forces"], samples["gaps"], samples["slip"], ground, samples["iterations"],
+        samples["converged"], tuple(notes), tuple(point.link for point in found.points),
+    )  # fmt: skip
 
 
 def _torque(controller: Controller, t: float, q: np.ndarray, v: np.ndarray, nv: int) -> np.ndarray:
@@ -214,12 +215,12 @@ def _torque(controller: Controller, t: float, q: np.ndarray, v: np.ndarray, nv: 
 
 def _run(
     robot: Robot, ground: Ground, points: tuple[ContactPoint, ...], controller: Controller,
-    q: np.ndarray, v: np.ndarray, steps: int, dt: float, settings: ContactSettings,
+    q: np.ndarray, v: np.ndarray, steps: int, dt: float, settings: ContactSettings, damping: np.ndarray,
 ) -> dict[str, np.ndarray]:  # fmt: skip
     """Samples ``t, q, v, a, tau, forces, gaps, slip, iterations, converged`` of ``steps`` steps."""
     keys = ("q", "v", "a", "tau", "forces", "gaps", "slip", "iterations", "converged")
     samples: dict[str, list] = {key: [] for key in keys}
-    damping, guess = robot.joint_damping, None
+    guess = None
     for step in range(steps + 1):
         t = step * dt
         tau = _torque(controller, t, q, v, robot.nv)
@@ -240,4 +241,4 @@ def free_fall_note(robot: Robot, ground: Ground | None) -> str | None:
     return "no ground: the base falls freely" if robot.floating_base and ground is None else None
 
 
-__all__ = ["ContactSimulation", "free_fall_note", "simulate_contact"]
+__all__ = ["ContactSimulation", "free_fall_note", "run_contacts", "simulate_contact"]
