@@ -89,9 +89,10 @@ class ContactSimulation:
 
         return tuple(ExternalWrench(frame, held(indices)) for frame, indices in frames.items())
 
-    def save(self, path: str | Path) -> Path:
+    def save(self, path: str | Path, extras: dict[str, np.ndarray] | None = None) -> Path:
         """Write the motion and its contacts as a CSV trajectory: the trajectory's columns,
-        then ``f[<contact>].x/.y/.z`` [N] and ``contact[<contact>]`` (1: active), which
+        ``extras`` (kind -> (N, nv), e.g. ``tau_env``, named like ``v``), then
+        ``f[<contact>].x/.y/.z`` [N] and ``contact[<contact>]`` (1: active), which
         trajectory readers skip (docs/trajectory-format.md).
 
         Raises:
@@ -99,12 +100,14 @@ class ContactSimulation:
         """
         path = Path(path)
         if path.suffix != ".csv":
-            raise InputError("path", "a .csv file name (contact columns are written to CSV)", repr(str(path)))
+            raise InputError("path", "a .csv file name for a run on the ground (its contact forces are columns)", repr(str(path)))
+        extras = extras or {}
+        _, v_names = self.trajectory.coordinate_names
+        header = self.trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names]
         count = len(self.contacts)
-        table = np.column_stack(
-            [self.trajectory.table(), self.forces.reshape(len(self.forces), 3 * count), self.active.astype(float)]
-        )
-        write_csv(path, self.trajectory.robot, self.trajectory.header() + contact_header(self.contacts), table)
+        forces = self.forces.reshape(len(self.forces), 3 * count)
+        table = np.column_stack([self.trajectory.table(), *extras.values(), forces, self.active.astype(float)])
+        write_csv(path, self.trajectory.robot, header + contact_header(self.contacts), table)
         return path
 
     def summary_lines(self) -> list[str]:
@@ -236,9 +239,18 @@ def _run(
     return out
 
 
+def ground_lines(robot: Robot, contact: ContactSimulation | None) -> tuple[str, ...]:
+    """A run's ground lines for its summary: the contact summary, or for a floating robot
+    without a ground ``"no ground: the base falls freely"`` (nothing for a fixed one)."""
+    if contact is not None:
+        return tuple(contact.summary_lines())
+    note = free_fall_note(robot, None)
+    return (note,) if note else ()
+
+
 def free_fall_note(robot: Robot, ground: Ground | None) -> str | None:
     """The one summary line of a floating robot simulated without a ground, else ``None``."""
     return "no ground: the base falls freely" if robot.floating_base and ground is None else None
 
 
-__all__ = ["ContactSimulation", "free_fall_note", "run_contacts", "simulate_contact"]
+__all__ = ["ContactSimulation", "free_fall_note", "ground_lines", "run_contacts", "simulate_contact"]

@@ -215,7 +215,7 @@ def plan(
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     for item in external:
         robot.task_frame(item.frame, "an external wrench")
-    found = check_contact_run(robot, ground, contacts, integrator=integrator, every=every, limits=limits, observer=observer)
+    found = check_contact_run(robot, ground, contacts, q0=q, integrator=integrator, every=every, limits=limits, observer=observer)
     return RunPlan(
         robot, q, v, float(dt), steps, integrator, controller, every, limits, joint_friction and has_joint_friction(robot),
         tuple(external), observer, engine, ground, found,
