@@ -204,7 +204,8 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
             chosen.append(point)
         found = Contacts(tuple(chosen))
     if not found.points:
-        raise InputError("contacts", "at least one contact point (frame names, or collision spheres/boxes)", "none")
+        received = f"no collision sphere or box ({len(found.skipped)} other collision elements)" if found.skipped else "none"
+        raise InputError("contacts", "at least one contact point: name the frames that touch the ground", received)
     names = found.names
     duplicated = sorted({name for name in names if names.count(name) > 1})
     if duplicated:
