@@ -11,6 +11,8 @@ Where the points come from (:func:`contact_points`):
 - **the URDF's collision geometry** (``contacts="collision"``): each ``<sphere>`` is one
   point (its centre, its radius), each ``<box>`` its 8 corners; cylinders, capsules and
   meshes are not modelled and are reported in one line each (:attr:`Contacts.skipped`).
+  With no sphere or box at all, the links named ``*foot`` (solo12's feet are meshes),
+  said in one line.
 """
 
 from __future__ import annotations
@@ -121,7 +123,7 @@ class Contacts:
 
     Attributes:
         points: The points, in order.
-        skipped: One line per collision element not modelled (cylinder, mesh, capsule).
+        skipped: What is not modelled, one line a kind (cylinders, meshes, …).
     """
 
     points: tuple[ContactPoint, ...]
@@ -148,7 +150,7 @@ def collision_points(robot: Robot) -> Contacts:
     """Contact points from the URDF's ``<collision>`` spheres and boxes (module docstring)."""
     root = ET.fromstring(robot.urdf)
     points: list[ContactPoint] = []
-    skipped: list[str] = []
+    skipped: dict[str, list[str]] = {}  # kind -> the links with one
     for link in root.findall("link"):
         name = link.get("name") or ""
         for index, element in enumerate(link.findall("collision")):
@@ -166,9 +168,13 @@ def collision_points(robot: Robot) -> Contacts:
                     where = offset + rotation @ (half * np.array(signs))
                     points.append(ContactPoint(f"{name}.box{index}.corner{corner}", name, _triple(where)))
             else:
-                kind = "no geometry" if shape is None else f"a {shape.tag}"
-                skipped.append(f"link {name!r}: collision {index} is {kind}: not a contact (spheres and boxes are)")
-    return Contacts(tuple(points), tuple(skipped))
+                skipped.setdefault("no geometry" if shape is None else str(shape.tag), []).append(name)
+    lines = []
+    for kind, links in skipped.items():
+        named = list(dict.fromkeys(links))  # each link once, in order
+        shown = ", ".join(repr(link) for link in named[:3]) + (", …" if len(named) > 3 else "")
+        lines.append(f"collision geometry not modelled as contacts (spheres and boxes are): {kind} × {len(links)} ({shown})")
+    return Contacts(tuple(points), tuple(lines))
 
 
 def _moving(robot: Robot, found: Contacts) -> Contacts:
@@ -180,6 +186,18 @@ def _moving(robot: Robot, found: Contacts) -> Contacts:
     return Contacts(tuple(kept), (*found.skipped, *lines))
 
 
+def _feet(robot: Robot, found: Contacts) -> Contacts:
+    """Without a collision sphere or box, the links named ``*foot`` (solo12's meshes), said."""
+    if found.points:
+        return found
+    feet = [name for name in robot.spec.links if name.lower().endswith("foot")]
+    feet = [name for name in feet if name in robot.frame_ids and robot.model.frames[robot.frame_ids[name]].parentJoint != 0]
+    if not feet:
+        return found
+    line = f"contacts: the links named *foot ({len(feet)}), the collision geometry has no sphere or box"
+    return Contacts(tuple(ContactPoint(name, name) for name in feet), (*found.skipped, line))
+
+
 def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -> Contacts:
     """The robot's contact points: ``"collision"`` (its collision spheres and boxes) or a
     list of frame names and :class:`ContactPoint` values.
@@ -189,7 +207,7 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
         InputError: For no points at all, or a duplicated name.
     """
     if isinstance(contacts, str) and contacts == "collision":
-        found = _moving(robot, collision_points(robot))
+        found = _feet(robot, _moving(robot, collision_points(robot)))
     else:
         if isinstance(contacts, str):
             contacts = [contacts]

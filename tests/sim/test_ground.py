@@ -85,8 +85,6 @@ def test_unknown_contact_frames_and_robots_without_simple_collisions_are_refused
     solo = robodyn.load("solo12")
     with pytest.raises(FrameError, match="FL_FOOTX"):
         contact_points(solo, ["FL_FOOTX"])
-    with pytest.raises(InputError, match="contacts"):
-        contact_points(solo, "collision")  # meshes only
     found = contact_points(solo, ["FL_FOOT", ContactPoint("heel", "HL_FOOT", (0.0, 0.0, -0.01), 0.01)])
     assert found.names == ["FL_FOOT", "heel"]
     with pytest.raises(InputError, match="twice"):
@@ -126,3 +124,21 @@ def test_collision_geometry_fixed_to_the_world_is_left_out_and_said():
     found = contact_points(robodyn.load(urdf), "collision")
     assert found.names == ["arm.sphere0"]
     assert found.skipped == ("link 'base' is fixed to the world: its collision geometry is not a contact",)
+
+
+def test_without_a_collision_sphere_or_box_the_links_named_foot_are_the_contacts_and_said():
+    found = contact_points(robodyn.load("solo12"), "collision")
+    assert found.names == ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+    assert found.skipped[-1] == "contacts: the links named *foot (4), the collision geometry has no sphere or box"
+
+
+def test_a_robot_with_no_simple_collision_geometry_and_no_feet_is_refused_naming_contacts():
+    urdf = """<robot name="rod">
+      <link name="base"/>
+      <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+        <collision><geometry><cylinder radius="0.05" length="0.5"/></geometry></collision></link>
+      <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+        <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+    </robot>"""
+    with pytest.raises(InputError, match=r"contacts.*no collision sphere or box"):
+        contact_points(robodyn.load(urdf), "collision")
