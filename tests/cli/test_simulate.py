@@ -23,9 +23,9 @@ def test_solo12_lands_on_its_feet_and_stands_under_a_pd_hold(capsys, tmp_path):
     out = tmp_path / "solo.csv"
     status, text, _ = run(
         capsys, "simulate", "solo12", "--ground", "--contact", FEET, "--controller", "pd", "--target", ",".join(["0"] * 12),
-        "--kp", "5", "--kd", "0.1", "--duration", "0.6", "--out", str(out),
+        "--kp", "5", "--kd", "0.1", "--duration", "0.6", "--out", str(out), "--record", str(tmp_path / "solo.html"),
     )  # fmt: skip
-    assert status == 0
+    assert status == 0 and (tmp_path / "solo.html").stat().st_size > 0  # with each foot's force as an arrow
     assert "engine: pinocchio (contact with a ground (the compiled engine models none))" in text
     assert "integrator semi-implicit-euler" in text and "contacts active at the end: 4 of 4" in text
     assert "final total 24.525 N" in text  # m g of solo12's 2.5 kg
