@@ -14,6 +14,11 @@ from robodyn.exceptions import InputError, RobodynError
 
 #: Library parameter name -> the flag that sets it.
 FLAGS: dict[str, str] = {
+    "ground": "--ground",
+    "height": "--ground",
+    "friction": "--friction",
+    "contacts": "--contact",
+    "integrator": "--integrator",
     "target": "--target",
     "frame": "--frame",
     "q0": "--q0",
