@@ -1,0 +1,109 @@
+"""Issue 42, the whole-body controller on contacts: solo12 standing on four sticking feet
+(simulated as bilateral contacts; the measured forces are the constraints' ``λ``). Laws:
+the feet carry ``m g`` at rest, every foot force stays inside its friction cone, the base
+returns to its pose after a kick, a commanded 2 cm sideways shift of the centre of mass is
+reached; the negative control drops the cone from the QP and its forces leave the cone."""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn.constraints import PointContact
+from robodyn.exceptions import InputError
+from robodyn.sim.constrained import simulate_constrained
+from robodyn.sim.whole_body import Stand, friction_cone_margin
+
+FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+LEGS = np.array([0.0, 0.8, -1.6, 0.0, 0.8, -1.6, 0.0, -0.8, 1.6, 0.0, -0.8, 1.6])
+GRAVITY = 9.81
+
+
+@cache
+def standing(friction: float = 0.7) -> tuple[robodyn.Robot, np.ndarray, tuple[PointContact, ...]]:
+    """solo12 with its feet on the ground ``z = 0``, at rest, base level at 0.3 m above them."""
+    robot = robodyn.load("solo12")
+    q = robot.floating_configuration([0.0, 0.0, 0.3], [0.0, 0.0, 0.0], LEGS)
+    height = np.mean([robot.frame_position(q, foot)[2] for foot in FEET])
+    q = robot.floating_configuration([0.0, 0.0, 0.3 - height], [0.0, 0.0, 0.0], LEGS)
+    feet = tuple(PointContact(foot, friction=friction, plane_point=(0, 0, 0)) for foot in FEET)
+    return robot, q, feet
+
+
+def kicked(robot: robodyn.Robot) -> np.ndarray:
+    v = np.zeros(robot.nv)
+    v[:6] = [0.05, -0.03, 0.02, 0.1, 0.2, -0.1]  # projected onto the feet's constraints by the simulation
+    return v
+
+
+def test_at_rest_the_qps_forces_carry_the_weight_inside_the_cones_and_are_what_the_robot_feels():
+    robot, q, feet = standing()
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    zero = np.zeros(robot.nv)
+    acceleration, _, forces = control.solve(q, zero)
+    weight = robot.total_mass * GRAVITY
+    assert abs(forces.reshape(4, 3)[:, 2].sum() - weight) <= 1e-6 * weight
+    assert (friction_cone_margin(feet, forces) > 0).all()
+    assert np.abs(acceleration).max() <= 1e-6
+    # the torques it returns, applied to the robot on its feet: the forces the QP planned
+    felt_acceleration, multipliers = robot.constrained_forward_dynamics(q, zero, control(0.0, q, zero), feet)
+    np.testing.assert_allclose(multipliers, forces, atol=1e-6 * weight)
+    assert np.abs(felt_acceleration).max() <= 1e-6
+
+
+def test_a_short_kicked_stand_keeps_every_foot_force_inside_its_cone():
+    robot, q, feet = standing()
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    run = simulate_constrained(robot, q, kicked(robot), constraints=feet, duration=0.1, dt=2e-3, tau=control)
+    assert friction_cone_margin(feet, run.multipliers).min() > 0
+    assert run.residual.max() <= 1e-12
+
+
+def test_without_the_cone_in_the_qp_the_forces_leave_the_cone():
+    """Negative control: a hard sideways push of the centre of mass on slippery ground
+    (μ = 0.1): the QP with the cones keeps the forces inside them, the one without does not."""
+    robot, q, feet = standing(friction=0.1)
+    target = robot.center_of_mass(q) + np.array([0.0, 0.05, 0.0])
+    zero = np.zeros(robot.nv)
+    with_cone = Stand(robot, feet, target, np.eye(3), q).solve(q, zero)[2]
+    without = Stand(robot, feet, target, np.eye(3), q, margin=None).solve(q, zero)[2]
+    assert friction_cone_margin(feet, with_cone).min() >= -1e-9
+    assert friction_cone_margin(feet, without).min() < -0.1
+
+
+@pytest.mark.slow
+def test_solo12_kicked_returns_to_its_pose_and_carries_its_weight_at_rest():
+    robot, q, feet = standing()
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    run = simulate_constrained(robot, q, kicked(robot), constraints=feet, duration=2.0, dt=2e-3, tau=control)
+    last = run.trajectory.q[-1]
+    assert np.abs(last[:3] - q[:3]).max() < 1e-6
+    attitude = robot.floating_configuration([0, 0, 0], [0, 0, 0], LEGS)[3:7]
+    assert 2 * np.arccos(min(1.0, abs(float(last[3:7] @ attitude)))) < 1e-6
+    weight = robot.total_mass * GRAVITY
+    assert abs(run.multipliers[-1].reshape(4, 3)[:, 2].sum() - weight) <= 1e-6 * weight
+    assert friction_cone_margin(feet, run.multipliers).min() > 0
+
+
+@pytest.mark.slow
+def test_a_two_centimetre_sideways_shift_of_the_centre_of_mass_is_reached():
+    robot, q, feet = standing()
+    target = robot.center_of_mass(q) + np.array([0.0, 0.02, 0.0])
+    control = Stand(robot, feet, target, np.eye(3), q)
+    run = simulate_constrained(robot, q, constraints=feet, duration=2.0, dt=2e-3, tau=control)
+    assert np.abs(robot.center_of_mass(run.trajectory.q[-1]) - target).max() < 1e-4
+    assert friction_cone_margin(feet, run.multipliers).min() > 0
+
+
+def test_a_fixed_robot_or_a_contact_that_slides_is_refused():
+    robot, q, feet = standing()
+    with pytest.raises(InputError, match="model"):
+        Stand(robodyn.load("ur5"), feet, np.zeros(3), np.eye(3), np.zeros(6))
+    sliding = [PointContact("FL_FOOT", friction=0.0)]
+    with pytest.raises(InputError, match="contacts"):
+        Stand(robot, sliding, np.zeros(3), np.eye(3), q)
+    with pytest.raises(InputError, match="orientation"):
+        Stand(robot, feet, np.zeros(3), 2 * np.eye(3), q)
