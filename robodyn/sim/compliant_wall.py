@@ -35,7 +35,7 @@ import pinocchio as pin
 
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
-from robodyn.sim.force_control import unit_normal
+from robodyn.sim.force_control import scalar, unit_normal, vector
 
 #: Most steps of one simulation.
 MAX_STEPS = 100_000
@@ -73,13 +73,11 @@ class CompliantWall:
     def __post_init__(self) -> None:
         self._frame_id = self.robot.frame_id(self.frame)
         self._normal = unit_normal(self.normal)
-        self._point = np.asarray(self.plane_point, float)
-        if self._point.shape != (3,) or not np.isfinite(self._point).all():
-            raise InputError("plane_point", "3 finite values in [m]", f"shape {self._point.shape}")
-        if not (math.isfinite(self.stiffness) and self.stiffness > 0):
+        self._point = vector(self.plane_point, "plane_point")
+        self.stiffness = scalar(self.stiffness, "stiffness", "a finite stiffness > 0 in [N/m]")
+        if not self.stiffness > 0:
             raise InputError("stiffness", "a finite stiffness > 0 in [N/m]", repr(self.stiffness))
-        if not (math.isfinite(self.damping) and self.damping >= 0):
-            raise InputError("damping", "a finite damping >= 0 in [N s/m]", repr(self.damping))
+        self.damping = scalar(self.damping, "damping", "a finite damping >= 0 in [N s/m]")
 
     def penetration(self, q: np.ndarray) -> float:
         """``p = −n·(x − c)`` in [m] (> 0: inside the wall)."""
@@ -135,11 +133,10 @@ class ExplicitForce:
         self.frame = self.model.task_frame(self.frame, "explicit force control")
         self._frame_id = self.model.frame_id(self.frame)
         self._normal = unit_normal(self.normal)
-        self._motion = np.asarray(self.motion, float)
-        if self._motion.shape != (3,) or not np.isfinite(self._motion).all():
-            raise InputError("motion", "3 finite values in [m]", f"shape {self._motion.shape}")
-        if not (math.isfinite(self.force) and self.force >= 0):
-            raise InputError("force", "a finite normal force >= 0 in [N] (pressing)", repr(self.force))
+        self._motion = vector(self.motion, "motion")
+        self.force = scalar(self.force, "force", "a finite normal force >= 0 in [N] (pressing)")
+        for name in ("force_gain", "integral_gain", "normal_damping", "kp", "kd"):
+            setattr(self, name, scalar(getattr(self, name), name, "a finite gain >= 0"))
 
     def integral_rate(self, q: np.ndarray, v: np.ndarray) -> float:
         """``d∫/dt = F − f_m`` in [N]."""

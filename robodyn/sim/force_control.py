@@ -48,9 +48,9 @@ def unit_normal(normal: np.ndarray | Sequence[float], name: str = "normal") -> n
     Raises:
         InputError: For another shape, non-finite values or a zero vector.
     """
-    value = np.asarray(normal, dtype=float)
-    if value.shape != (3,) or not np.isfinite(value).all() or not np.linalg.norm(value) > 1e-12:
-        raise InputError(name, "a non-zero 3-vector in world axes", f"shape {value.shape}")
+    value = vector(normal, name, 3, "world axes")
+    if not np.linalg.norm(value) > 1e-12:
+        raise InputError(name, "a non-zero 3-vector in world axes", "a zero vector")
     return value / np.linalg.norm(value)
 
 
@@ -62,8 +62,43 @@ def _reference(motion: np.ndarray | TaskReference, t: float) -> tuple[np.ndarray
     return np.asarray(motion, float), np.zeros(3), np.zeros(3)
 
 
+def vector(value: object, name: str, size: int = 3, unit: str = "[m]") -> np.ndarray:
+    """``value`` as ``size`` finite floats.
+
+    Raises:
+        InputError: Naming ``name``, for anything else.
+    """
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(name, f"{size} finite numbers in {unit}", repr(value)[:80]) from None
+    if array.shape != (size,) or not np.isfinite(array).all():
+        raise InputError(
+            name, f"{size} finite numbers in {unit}", f"shape {array.shape}" if array.shape != (size,) else "non-finite values"
+        )
+    return array
+
+
+def scalar(value: object, name: str, expected: str) -> float:
+    """``value`` as a finite float ≥ 0.
+
+    Raises:
+        InputError: Naming ``name``, for anything else.
+    """
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InputError(name, expected, repr(value)[:80]) from None
+    if not (np.isfinite(number) and number >= 0):
+        raise InputError(name, expected, repr(value)[:80])
+    return number
+
+
 def _checked_motion(motion: np.ndarray | TaskReference) -> np.ndarray | TaskReference:
-    start = _reference(motion, 0.0)
+    try:
+        start = _reference(motion, 0.0)
+    except (TypeError, ValueError):
+        raise InputError("motion", "3 finite values in [m] (or a function t -> (x_d, ẋ_d, ẍ_d))", repr(motion)[:80]) from None
     if any(part.shape != (3,) or not np.isfinite(part).all() for part in start):
         raise InputError("motion", "3 finite values in [m] (or a function t -> (x_d, ẋ_d, ẍ_d))", "another value")
     return motion if callable(motion) else start[0]
@@ -122,12 +157,10 @@ class HybridForceMotion:
         self._frame_id = self.model.frame_id(self.frame)
         self._normal = unit_normal(self.normal)
         self.normal = self._normal
-        if not (np.isfinite(self.force) and self.force >= 0):
-            raise InputError("force", "a finite normal force >= 0 in [N] (pressing)", repr(self.force))
+        self.force = scalar(self.force, "force", "a finite normal force >= 0 in [N] (pressing)")
         self.motion = _checked_motion(self.motion)
         for name in ("kp", "kd", "posture_kp", "posture_kd"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
-                raise InputError(name, "a finite gain >= 0", repr(getattr(self, name)))
+            setattr(self, name, scalar(getattr(self, name), name, "a finite gain >= 0"))
         if self.posture is not None:
             (self.posture,), batch = self.model.validate(q=self.posture)
             if batch:
@@ -193,15 +226,15 @@ def circle(
         ``t -> (x_d, ẋ_d, ẍ_d)``, each (3,).
     """
     axis = unit_normal(normal)
-    if not (np.isfinite(radius) and radius > 0):
+    if not scalar(radius, "radius", "a finite radius > 0 in [m]") > 0:
         raise InputError("radius", "a finite radius > 0 in [m]", repr(radius))
-    if not (np.isfinite(period) and period > 0):
+    if not scalar(period, "period", "a finite time > 0 in [s]") > 0:
         raise InputError("period", "a finite time > 0 in [s]", repr(period))
     seed = np.eye(3)[int(np.argmin(np.abs(axis)))]
     u = np.cross(axis, seed)
     u /= np.linalg.norm(u)
     w = np.cross(axis, u)
-    middle, rate = np.asarray(center, float), 2 * np.pi / period
+    middle, rate = vector(center, "center"), 2 * np.pi / float(period)
 
     def reference(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         c, s = np.cos(rate * t), np.sin(rate * t)
@@ -214,4 +247,4 @@ def circle(
     return reference
 
 
-__all__ = ["DIRECTION_TOLERANCE", "HybridForceMotion", "circle", "unit_normal"]
+__all__ = ["DIRECTION_TOLERANCE", "HybridForceMotion", "circle", "scalar", "unit_normal", "vector"]

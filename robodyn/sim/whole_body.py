@@ -39,6 +39,7 @@ from robodyn.constraints import PointContact
 from robodyn.dynamics import constrained
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.force_control import scalar, vector
 
 #: The controller's cone is this fraction of each contact's friction coefficient.
 CONE_MARGIN = 0.9
@@ -119,12 +120,20 @@ class Stand:
         self.contacts = tuple(self.contacts)
         if not self.contacts or not all(isinstance(c, PointContact) and c.friction > 0 for c in self.contacts):
             raise InputError("contacts", "sticking PointContacts (friction > 0)", repr(self.contacts)[:80])
-        self.com = np.asarray(self.com, float)
-        if self.com.shape != (3,) or not np.isfinite(self.com).all():
-            raise InputError("com", "3 finite values in [m]", f"shape {self.com.shape}")
-        rotation = np.asarray(self.orientation, float)
-        if rotation.shape != (3, 3) or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-9):
-            raise InputError("orientation", "a rotation matrix (3, 3)", f"shape {rotation.shape}")
+        self.com = vector(self.com, "com")
+        try:
+            rotation = np.asarray(self.orientation, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("orientation", "a rotation matrix (3, 3)", repr(self.orientation)[:80]) from None
+        if not (
+            rotation.shape == (3, 3)
+            and np.isfinite(rotation).all()
+            and np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-9)
+            and np.linalg.det(rotation) > 0
+        ):
+            raise InputError("orientation", "a rotation matrix (3, 3)", f"an array of shape {rotation.shape}, not a rotation")
+        for name in ("kp", "kd", "posture_kp", "posture_kd"):
+            setattr(self, name, scalar(getattr(self, name), name, "a finite gain >= 0"))
         self.orientation = rotation
         (self.posture,), batch = model.validate(q=self.posture)
         if batch:

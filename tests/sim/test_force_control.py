@@ -113,3 +113,16 @@ def test_bad_normals_forces_and_motions_are_refused():
         HybridForceMotion(robot, None, (1, 0, 0), 1.0, np.array([0.0, np.nan, 0.0]))
     with pytest.raises(InputError, match="radius"):
         circle(np.zeros(3), 0.0, (0, 0, 1), 1.0)
+
+
+@pytest.mark.parametrize(("field", "value"), [("normal", "down"), ("force", "ten"), ("motion", "up"), ("kp", np.inf)])
+def test_hostile_values_are_refused_in_one_sentence(field, value):
+    robot = robodyn.load("rp_arm")
+    arguments = {"normal": (1, 0, 0), "force": 1.0, "motion": np.zeros(3)}
+    options = {}
+    if field in arguments:
+        arguments[field] = value
+    else:
+        options[field] = value
+    with pytest.raises(InputError, match=field):
+        HybridForceMotion(robot, None, arguments["normal"], arguments["force"], arguments["motion"], **options)

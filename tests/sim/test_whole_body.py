@@ -107,3 +107,18 @@ def test_a_fixed_robot_or_a_contact_that_slides_is_refused():
         Stand(robot, sliding, np.zeros(3), np.eye(3), q)
     with pytest.raises(InputError, match="orientation"):
         Stand(robot, feet, np.zeros(3), 2 * np.eye(3), q)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"), [("com", "north"), ("com", [0.0, np.nan, 0.0]), ("orientation", "up"), ("kp", -1.0), ("kd", "x")]
+)
+def test_hostile_targets_and_gains_are_refused_in_one_sentence(field, value):
+    robot, q, feet = standing()
+    arguments = {"com": np.zeros(3), "orientation": np.eye(3)}
+    options = {}
+    if field in arguments:
+        arguments[field] = value
+    else:
+        options[field] = value
+    with pytest.raises(InputError, match=field):
+        Stand(robot, feet, arguments["com"], arguments["orientation"], q, **options)
