@@ -75,6 +75,65 @@ def friction_cone_margin(contacts: Sequence[PointContact], forces: np.ndarray) -
     return mu * normal - tangential
 
 
+def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The z component of ``a × b`` for 2-D vectors (last axis)."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """Convex hull of 2-D points, counter-clockwise (Andrew's monotone chain), (k, 2)."""
+    ordered = sorted(map(tuple, np.round(points, 15)))
+
+    def half(sequence: list) -> list:
+        chain: list = []
+        for point in sequence:
+            while len(chain) >= 2 and _cross2(np.subtract(chain[-1], chain[-2]), np.subtract(point, chain[-2])) <= 0:
+                chain.pop()
+            chain.append(point)
+        return chain[:-1]
+
+    return np.array(half(ordered) + half(ordered[::-1]))
+
+
+def _ground_axes(robot: Robot) -> np.ndarray:
+    """Two unit vectors spanning the plane normal to gravity, right-handed about the upward
+    direction: the world's x and y for gravity along −z, (2, 3)."""
+    up = -robot.gravity_vector / np.linalg.norm(robot.gravity_vector)
+    seed = np.eye(3)[0] if abs(up[0]) < 0.9 else np.eye(3)[1]
+    first = seed - (seed @ up) * up
+    first /= np.linalg.norm(first)
+    return np.stack([first, np.cross(up, first)])
+
+
+def support_polygon(robot: Robot, q: np.ndarray, contacts: Sequence[PointContact]) -> np.ndarray:
+    """The support polygon: the convex hull of the contact points seen along gravity.
+
+    Args:
+        robot: The robot. q: Its configuration (nq,).
+        contacts: The contacts (their points on their links).
+
+    Returns:
+        Its vertices counter-clockwise seen from above, shape (k, 2), in [m], in two axes
+        normal to gravity (for gravity along −z: world x, y), the axes
+        :func:`support_margin` uses.
+    """
+    pin.framesForwardKinematics(robot.model, robot.data, q)
+    world = [robot.data.oMf[robot.frame_id(c.frame)].act(np.asarray(c.point, float)) for c in contacts]
+    return _hull(np.array(world) @ _ground_axes(robot).T)
+
+
+def support_margin(robot: Robot, q: np.ndarray, contacts: Sequence[PointContact], point: np.ndarray) -> float:
+    """How far ``point`` (3,) seen along gravity lies inside the support polygon, in [m]
+    (negative: outside; −inf for fewer than three contact points not on one line)."""
+    polygon = support_polygon(robot, q, contacts)
+    if len(polygon) < 3:
+        return -np.inf
+    flat = np.asarray(point, float) @ _ground_axes(robot).T
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    lengths = np.linalg.norm(edges, axis=1)
+    return float(np.min(_cross2(edges, flat - polygon) / lengths))
+
+
 @dataclass
 class Stand:
     """Hold a floating robot on sticking contacts at a centre of mass and base attitude.
@@ -146,6 +205,15 @@ class Stand:
         self._tangent_rows = [_tangents(np.asarray(contact.normal)) for contact in self.contacts]
         self.last_forces = np.zeros(3 * len(self.contacts))
         self._bounds = constrained.bound(model, self.contacts)
+        margin = support_margin(model, self.posture, self.contacts, self.com)
+        if not margin > 0:
+            raise InputError(
+                "com",
+                "a centre of mass over the support polygon of the contacts (at the posture)",
+                f"{-margin:.3g} m outside it"
+                if np.isfinite(margin)
+                else "contacts with no polygon (fewer than three points off one line)",
+            )
 
     def _tasks(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The stacked weighted task rows ``(A, b)`` over ``v̇``."""
@@ -236,4 +304,4 @@ class Stand:
         return tau
 
 
-__all__ = ["CONE_MARGIN", "Stand", "friction_cone_margin"]
+__all__ = ["CONE_MARGIN", "Stand", "friction_cone_margin", "support_margin", "support_polygon"]

@@ -15,7 +15,7 @@ import robodyn
 from robodyn.constraints import PointContact
 from robodyn.exceptions import InputError
 from robodyn.sim.constrained import simulate_constrained
-from robodyn.sim.whole_body import Stand, friction_cone_margin
+from robodyn.sim.whole_body import Stand, friction_cone_margin, support_margin, support_polygon
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 LEGS = np.array([0.0, 0.8, -1.6, 0.0, 0.8, -1.6, 0.0, -0.8, 1.6, 0.0, -0.8, 1.6])
@@ -122,3 +122,21 @@ def test_hostile_targets_and_gains_are_refused_in_one_sentence(field, value):
         options[field] = value
     with pytest.raises(InputError, match=field):
         Stand(robot, feet, arguments["com"], arguments["orientation"], q, **options)
+
+
+def test_the_support_polygon_is_the_feet_seen_from_above_and_a_target_outside_it_is_refused():
+    robot, q, feet = standing()
+    polygon = support_polygon(robot, q, feet)
+    feet_xy = np.array([robot.frame_position(q, foot)[:2] for foot in FEET])
+    assert len(polygon) == 4
+    assert all(np.abs(polygon - foot).sum(axis=1).min() < 1e-12 for foot in feet_xy)
+    area = 0.5 * np.sum(polygon[:, 0] * np.roll(polygon[:, 1], -1) - np.roll(polygon[:, 0], -1) * polygon[:, 1])
+    assert area > 0  # counter-clockwise seen from above
+    half_width = feet_xy[:, 1].max()
+    centre = robot.center_of_mass(q)
+    assert support_margin(robot, q, feet, centre) == pytest.approx(min(half_width - centre[1], half_width + centre[1]), abs=1e-3)
+    assert support_margin(robot, q, feet, centre + np.array([0.0, 2 * half_width, 0.0])) < 0
+    with pytest.raises(InputError, match="outside"):
+        Stand(robot, feet, centre + np.array([0.0, 2 * half_width, 0.0]), np.eye(3), q)
+    with pytest.raises(InputError, match="polygon"):
+        Stand(robot, feet[:2], centre, np.eye(3), q)
