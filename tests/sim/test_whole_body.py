@@ -140,3 +140,31 @@ def test_the_support_polygon_is_the_feet_seen_from_above_and_a_target_outside_it
         Stand(robot, feet, centre + np.array([0.0, 2 * half_width, 0.0]), np.eye(3), q)
     with pytest.raises(InputError, match="polygon"):
         Stand(robot, feet[:2], centre, np.eye(3), q)
+
+
+def push_run(margin: float | None):
+    """solo12 standing, pushed sideways at its base with 8 N from 0.1 s to 0.3 s (the
+    controller does not know): 1.2 s at 2 ms."""
+    robot, q, feet = standing()
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q, margin=margin)
+    push = np.array([0.0, 8.0, 0.0, 0.0, 0.0, 0.0])
+
+    def pushed(t: float, qi: np.ndarray, vi: np.ndarray) -> np.ndarray:
+        tau = control(t, qi, vi)
+        return tau + robot.wrench_torques(qi, "base_link", push) if 0.1 <= t < 0.3 else tau
+
+    return robot, q, feet, simulate_constrained(robot, q, constraints=feet, duration=1.2, dt=2e-3, tau=pushed)
+
+
+@pytest.mark.slow  # two 1.2 s runs, about a minute
+def test_a_pushed_robot_recovers_with_its_feet_inside_their_cones_and_without_the_cone_they_would_slip():
+    """With sticking (bilateral) feet, a foot slips exactly where its force would have to
+    leave its cone. (20 N, the issue's push, is more than solo12's feet can carry sideways:
+    μ m g = 0.7 × 2.5 kg × 9.81 = 17 N.)"""
+    robot, q, feet, run = push_run(0.9)
+    assert friction_cone_margin(feet, run.multipliers).min() > 0
+    moved = np.abs(robot.center_of_mass(run.trajectory.q) - robot.center_of_mass(q)).max()
+    assert moved > 0.01  # the push did move it
+    assert np.abs(robot.center_of_mass(run.trajectory.q[-1]) - robot.center_of_mass(q)).max() < 1e-4
+    _, _, _, loose = push_run(None)
+    assert friction_cone_margin(feet, loose.multipliers).min() < -0.1
