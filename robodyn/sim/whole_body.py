@@ -134,6 +134,22 @@ def support_margin(robot: Robot, q: np.ndarray, contacts: Sequence[PointContact]
     return float(np.min(_cross2(edges, flat - polygon) / lengths))
 
 
+def _rotation(value: object) -> np.ndarray:
+    """A rotation matrix (3, 3), or an :class:`InputError` naming ``orientation``."""
+    try:
+        rotation = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("orientation", "a rotation matrix (3, 3)", repr(value)[:80]) from None
+    if not (
+        rotation.shape == (3, 3)
+        and np.isfinite(rotation).all()
+        and np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-9)
+        and np.linalg.det(rotation) > 0
+    ):
+        raise InputError("orientation", "a rotation matrix (3, 3)", f"an array of shape {rotation.shape}, not a rotation")
+    return rotation
+
+
 @dataclass
 class Stand:
     """Hold a floating robot on sticking contacts at a centre of mass and base attitude.
@@ -180,26 +196,26 @@ class Stand:
         if not self.contacts or not all(isinstance(c, PointContact) and c.friction > 0 for c in self.contacts):
             raise InputError("contacts", "sticking PointContacts (friction > 0)", repr(self.contacts)[:80])
         self.com = vector(self.com, "com")
-        try:
-            rotation = np.asarray(self.orientation, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError("orientation", "a rotation matrix (3, 3)", repr(self.orientation)[:80]) from None
-        if not (
-            rotation.shape == (3, 3)
-            and np.isfinite(rotation).all()
-            and np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-9)
-            and np.linalg.det(rotation) > 0
-        ):
-            raise InputError("orientation", "a rotation matrix (3, 3)", f"an array of shape {rotation.shape}, not a rotation")
+        self.orientation = _rotation(self.orientation)
         for name in ("kp", "kd", "posture_kp", "posture_kd"):
             setattr(self, name, scalar(getattr(self, name), name, "a finite gain >= 0"))
-        self.orientation = rotation
+        weights = vector(self.weights, "weights", 3, "[1]")
+        if (weights < 0).any():
+            raise InputError("weights", "3 finite weights >= 0", repr(self.weights)[:80])
+        self.weights = (float(weights[0]), float(weights[1]), float(weights[2]))
+        if self.margin is not None and not 0 < scalar(self.margin, "margin", "a fraction in (0, 1] or None") <= 1:
+            raise InputError("margin", "a fraction in (0, 1] or None", repr(self.margin))
         (self.posture,), batch = model.validate(q=self.posture)
         if batch:
             raise InputError("posture", f"one configuration ({model.nq} values)", f"shape {self.posture.shape}")
         self._actuated = np.array([dof.index for dof in model.dofs if dof.actuated])
         limits = model.model.effortLimit[self._actuated] if self.torque_limit is None else self.torque_limit
-        self.torque_limit = np.broadcast_to(np.asarray(limits, float), (len(self._actuated),)).copy()
+        try:
+            self.torque_limit = np.broadcast_to(np.asarray(limits, float), (len(self._actuated),)).copy()
+        except (TypeError, ValueError):
+            raise InputError(
+                "torque_limit", f"a limit or {len(self._actuated)} limits in [N m] or [N]", repr(limits)[:80]
+            ) from None
         if not (self.torque_limit > 0).all():
             raise InputError("torque_limit", "limits > 0 in [N m] or [N]", repr(self.torque_limit)[:80])
         self._tangent_rows = [_tangents(np.asarray(contact.normal)) for contact in self.contacts]
@@ -270,7 +286,7 @@ class Stand:
         """The QP's ``(v̇, τ, f)`` at a state: (nv,), (actuated,), (3 k,) in SI units, world axes for ``f``.
 
         Raises:
-            InputError: If the QP has no solution (targets the contacts cannot carry).
+            InputError: If the QP has no solution at this state (naming ``q``).
         """
         clarabel = require("clarabel", extra="ident", purpose="the whole-body controller's QP")
         from scipy import sparse
@@ -291,7 +307,9 @@ class Stand:
         solution = solver.solve()
         if str(solution.status) not in ("Solved", "AlmostSolved"):
             raise InputError(
-                "com", "targets the contacts can carry within their cones and torque limits", f"a QP {solution.status}"
+                "q",
+                "a state from which the contacts can carry the robot within their cones and torque limits",
+                f"a QP {solution.status} (a leg stretched, a push beyond friction)",
             )
         x = np.asarray(solution.x)
         return x[:nv], x[nv : nv + nt], x[nv + nt :]

@@ -110,7 +110,17 @@ def test_a_fixed_robot_or_a_contact_that_slides_is_refused():
 
 
 @pytest.mark.parametrize(
-    ("field", "value"), [("com", "north"), ("com", [0.0, np.nan, 0.0]), ("orientation", "up"), ("kp", -1.0), ("kd", "x")]
+    ("field", "value"),
+    [
+        ("com", "north"),
+        ("com", [0.0, np.nan, 0.0]),
+        ("orientation", "up"),
+        ("kp", -1.0),
+        ("kd", "x"),
+        ("weights", (1.0, -1.0, 0.0)),
+        ("margin", 2.0),
+        ("torque_limit", [1.0, 2.0]),
+    ],
 )
 def test_hostile_targets_and_gains_are_refused_in_one_sentence(field, value):
     robot, q, feet = standing()
