@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import robodyn
+from robodyn.common.text import counted
 from robodyn.exceptions import InputError
 
 
@@ -126,7 +127,7 @@ def state(robot: robodyn.Robot, values: list[float] | None, name: str, size: int
     if values is None:
         return default
     if len(values) != size:
-        raise InputError(f"--{name}", f"{size} values ({', '.join(robot.joint_names)})", f"{len(values)} values")
+        raise InputError(f"--{name}", f"{counted(size, 'value')} ({', '.join(robot.joint_names)})", counted(len(values), "value"))
     return np.array(values)
 
 

@@ -47,7 +47,7 @@ def run_experiment(
         out: Trajectory file (``.csv`` or ``.npz``).
         plot: PNG figure: positions, torques, task error, energy.
         record: Self-contained HTML animation (meshcat).
-        png: With ``record``: a still of the first frame (needs Chromium).
+        png: With ``record``: a poster, the final frame with the path drawn (needs Chromium).
         **settings: ``controller``, ``target``, ``frame``, ``q0``, ``duration``, ``dt``,
             ``integrator``, ``limits``, ``engine``, ``posture``, ``stiffness``,
             ``damping``, ``force_at``, ``observer_gain``, ``actuated``, ``control_period``.

@@ -6,7 +6,7 @@ import argparse
 import json
 
 from robodyn.cli.common import MODEL_HELP, add_file_arguments, package_arguments, xacro_arguments
-from robodyn.common.text import printable
+from robodyn.common.text import counted, printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -46,7 +46,7 @@ def run(arguments: argparse.Namespace) -> int:
         for problem in problems:
             print(f"{problem.severity}: {problem}")
         print(
-            f"{printable(arguments.model) if len(arguments.model) < 80 else '<URDF text>'}: {errors} errors, "
-            f"{len(problems) - errors} warnings"
+            f"{printable(arguments.model) if len(arguments.model) < 80 else '<URDF text>'}: {counted(errors, 'error')}, "
+            f"{counted(len(problems) - errors, 'warning')}"
         )
     return 1 if errors else 0
