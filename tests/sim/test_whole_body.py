@@ -178,3 +178,23 @@ def test_a_pushed_robot_recovers_with_its_feet_inside_their_cones_and_without_th
     assert np.abs(robot.center_of_mass(run.trajectory.q[-1]) - robot.center_of_mass(q)).max() < 1e-4
     _, _, _, loose = push_run(None)
     assert friction_cone_margin(feet, loose.multipliers).min() < -0.1
+
+
+@pytest.mark.slow
+def test_anymal_under_tilted_gravity_stands_and_its_feet_carry_minus_m_g():
+    """Another quadruped (30 kg), gravity (0.3, −0.2, −9.7): the feet's forces sum to
+    ``−m g`` at rest (a sideways part the friction carries), inside their cones."""
+    robot = robodyn.load("anymal", gravity=(0.3, -0.2, -9.7))
+    legs = np.array([0.0, 0.6, -1.0, 0.0, -0.6, 1.0, 0.0, 0.6, -1.0, 0.0, -0.6, 1.0])
+    names = ("LF_FOOT", "LH_FOOT", "RF_FOOT", "RH_FOOT")
+    q = robot.floating_configuration([0.0, 0.0, 0.6], [0.0, 0.0, 0.0], legs)
+    height = np.mean([robot.frame_position(q, foot)[2] for foot in names])
+    q = robot.floating_configuration([0.0, 0.0, 0.6 - height], [0.0, 0.0, 0.0], legs)
+    feet = [PointContact(foot, friction=0.8) for foot in names]
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    run = simulate_constrained(robot, q, kicked(robot), constraints=feet, duration=2.0, dt=2e-3, tau=control)
+    weight = robot.total_mass * np.linalg.norm(robot.gravity_vector)
+    total = run.multipliers[-1].reshape(4, 3).sum(axis=0)
+    assert np.abs(total + robot.total_mass * robot.gravity_vector).max() <= 1e-6 * weight
+    assert np.abs(run.trajectory.q[-1, :3] - q[:3]).max() < 1e-6
+    assert friction_cone_margin(feet, run.multipliers).min() > 0
