@@ -11,7 +11,7 @@ from tests.integration.test_notebook import run_notebook
 
 @pytest.mark.slow  # two 2 s whole-body simulations of solo12: about two minutes
 def test_the_third_lecture_notebook_runs_and_each_law_holds():
-    text, _ = run_notebook("third_lecture.ipynb")
+    text, data = run_notebook("third_lecture.ipynb")
 
     def number(pattern: str) -> float:
         return float(re.search(pattern, text).group(1))
@@ -36,3 +36,4 @@ def test_the_third_lecture_notebook_runs_and_each_law_holds():
     assert number(r"smallest margin inside the friction cones: (\S+) N") > 0
     assert number(r"centre of mass off its shifted target after 2 s: (\S+) m") < 1e-4
     assert number(r"smallest margin inside the friction cones while shifting: (\S+) N") > 0
+    assert sum("image/png" in d for d in data) == 2  # commanded vs measured force; the CoM over the support polygon
