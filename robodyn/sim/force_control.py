@@ -188,8 +188,8 @@ class HybridForceMotion:
         selection = self.motion_selection
         return selection @ (x_d - position), selection @ (dx_d - jacobian @ v)
 
-    def _task_inertia(self, inverse: np.ndarray) -> np.ndarray:
-        inertia = damped_task_inertia(inverse, self.damping)
+    def _task_inertia(self, inertia: np.ndarray) -> np.ndarray:
+        """``Λ``, or without decoupling the mean of its eigenvalues where the frame can move."""
         if self.decoupled:
             return inertia
         values = np.linalg.eigvalsh(inertia)
@@ -203,11 +203,11 @@ class HybridForceMotion:
         command = ddx_d + self.kd * (dx_d - jacobian @ v) + self.kp * (x_d - position)
         mass = model.mass_matrix(q)
         mass_inv_jt = np.linalg.solve(mass, jacobian.T)
-        inertia = self._task_inertia(jacobian @ mass_inv_jt)
-        null_space = np.eye(model.nv) - mass_inv_jt @ damped_task_inertia(jacobian @ mass_inv_jt, self.damping) @ jacobian
+        inertia = damped_task_inertia(jacobian @ mass_inv_jt, self.damping)
+        null_space = np.eye(model.nv) - mass_inv_jt @ inertia @ jacobian  # N = I − J̄ J
         posture_error = np.zeros(model.nv) if self.posture is None else pin.difference(model.model, q, self.posture)
         posture = mass @ (self.posture_kp * posture_error - self.posture_kd * v)
-        task = inertia @ (self.motion_selection @ command - bias) + self.force_command
+        task = self._task_inertia(inertia) @ (self.motion_selection @ command - bias) + self.force_command
         return jacobian.T @ task + model.nonlinear_effects(q, v) + null_space.T @ posture
 
 

@@ -165,6 +165,7 @@ class Stand:
         weights: Of the centre of mass, attitude and posture tasks.
         torque_limit: ``τ_max`` of each actuated joint (nv − 6,), default the model's effort limits.
         margin: ``μ_c / μ`` (:data:`CONE_MARGIN`); ``None`` drops the cone (a negative control).
+        last_forces: The QP's contact forces at the last call, (3 k,) in [N], world axes.
 
     Raises:
         InputError: A fixed-base or mimic robot, contacts that do not stick, bad targets.
@@ -289,8 +290,7 @@ class Stand:
             InputError: If the QP has no solution at this state (naming ``q``).
         """
         clarabel = require("clarabel", extra="ident", purpose="the whole-body controller's QP")
-        from scipy import sparse
-
+        sparse = require("scipy.sparse", extra="ident", purpose="the whole-body controller's QP")
         nv, nt, nf = self.model.nv, len(self._actuated), 3 * len(self.contacts)
         tasks, targets = self._tasks(q, v)
         hessian = np.zeros((nv + nt + nf,) * 2)
