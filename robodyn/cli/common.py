@@ -60,13 +60,19 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_file_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable)."""
+    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable), ``--xacro-env``."""
     parser.add_argument(
         "--xacro-arg",
         dest="xacro_arg",
         action="append",
         metavar="NAME:=VALUE",
         help="a xacro argument of a .xacro model (repeatable)",
+    )
+    parser.add_argument(
+        "--xacro-env",
+        dest="xacro_env",
+        action="store_true",
+        help="let a xacro model read environment variables ($(env NAME), $(optenv NAME)); refused otherwise",
     )
     parser.add_argument(
         "--package",
@@ -120,6 +126,7 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
         lock=lock_values(getattr(arguments, "lock", None)),
         xacro_args=xacro_arguments(getattr(arguments, "xacro_arg", None)) or None,
         packages=package_arguments(getattr(arguments, "package", None)) or None,
+        xacro_env=bool(getattr(arguments, "xacro_env", False)),
     )
 
 

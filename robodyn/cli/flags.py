@@ -14,6 +14,11 @@ from robodyn.exceptions import InputError, RobodynError
 
 #: Library parameter name -> the flag that sets it.
 FLAGS: dict[str, str] = {
+    "ground": "--ground",
+    "height": "--ground",
+    "friction": "--friction",
+    "contacts": "--contact",
+    "integrator": "--integrator",
     "target": "--target",
     "frame": "--frame",
     "q0": "--q0",
@@ -62,6 +67,7 @@ SWITCHES: dict[str, str] = {
     "check_inertia=False": "--no-check-inertia",
     "strict=True": "--strict",
     "joint_friction=False": "--no-joint-friction",
+    "xacro_env=True": "--xacro-env",
 }
 
 #: Boolean parameters whose switch turns them off: an error asking for ``False`` names the switch.

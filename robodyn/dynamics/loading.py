@@ -53,13 +53,14 @@ def pinocchio_xml(spec: URDFSpec) -> str:
 
 def data_memory_estimate(nv: int, njoints: int) -> int:
     """Bytes one Pinocchio ``Data`` needs for a model of ``nv`` velocities and ``njoints``
-    joints (universe included), an upper bound of ``60 njoints nv² + 1600 nv² + 2 MB``.
+    joints (universe included), an upper bound of ``60 njoints nv² + 1600 nv² + 3.5 MB``.
 
     Fitted on Pinocchio 4.1 (growth of the peak resident size in ``createData``): chains
-    and stars of 25, 50, 100 and 150 joints took 5.0, 13.5, 74.6 and 234 MB (chains and
-    stars alike); the fit gives 4.0 GB for a 400-joint star (measured: 4.1 GB).
+    and stars of 25, 40, 50, 100 and 150 joints took 5.0, 8.9, 13.5, 74.6 and 234 MB (chains
+    and stars alike; measured in a process that imports Pinocchio only); the fit gives 4.0 GB
+    for a 400-joint star (measured: 4.1 GB).
     """
-    return int(60 * njoints * nv * nv + 1600 * nv * nv + 2_000_000)
+    return int(60 * njoints * nv * nv + 1600 * nv * nv + 3_500_000)
 
 
 def load(
@@ -77,6 +78,7 @@ def load(
     packages: Mapping[str, str | os.PathLike] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
+    xacro_env: bool = False,
 ) -> Robot:
     """Load a robot.
 
@@ -112,6 +114,9 @@ def load(
             ``FrameAnchor``, ``PointContact`` or a list of them), after those the file
             declares (MJCF ``<equality>``); :attr:`Robot.constraints` lists them all. See
             docs/constraints.md.
+        xacro_env: Let a xacro source read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); without it they are refused. See docs/robot-files.md for
+            everything a xacro may do.
 
     Returns:
         The robot.
@@ -128,7 +133,13 @@ def load(
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
     resolved = resolve_source(
-        source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict, max_dof=max_dof
+        source,
+        max_bytes=max_bytes,
+        xacro_args=xacro_args,
+        packages=folders,
+        strict=strict,
+        max_dof=max_dof,
+        xacro_env=xacro_env,
     )
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     _report_equalities(resolved, strict)
@@ -147,6 +158,7 @@ def load(
         packages=folders,
         armature=armature,
         constraints=constraints,
+        xacro_env=xacro_env,
     )
     return build_robot(resolved, options)
 

@@ -52,6 +52,8 @@ class LoadOptions:
             [kg])`` pairs (on top of what the file says).
         constraints: Constraints added to the robot (:mod:`robodyn.constraints`), after
             those its file declares.
+        xacro_env: Whether a xacro source could read environment variables (the source
+            carries the expanded text).
     """
 
     floating_base: bool
@@ -66,6 +68,7 @@ class LoadOptions:
     packages: tuple[tuple[str, str], ...] = ()
     armature: tuple[tuple[str, float], ...] = ()
     constraints: tuple[Constraint, ...] = ()
+    xacro_env: bool = False
 
 
 def load_options(
@@ -82,6 +85,7 @@ def load_options(
     packages: Mapping[str, str] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
+    xacro_env: bool = False,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 
@@ -104,6 +108,7 @@ def load_options(
         packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
         armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
         constraints=as_constraints(constraints),
+        xacro_env=bool(xacro_env),
     )
 
 

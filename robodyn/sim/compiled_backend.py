@@ -60,6 +60,7 @@ def unsupported(plan: RunPlan) -> list[str]:
         (bool(plan.external), "external wrenches", "external"),
         (plan.observer is not None, "a momentum observer", "observer"),
         (plan.limits == "enforce", "limits enforced", "limits"),
+        (plan.ground is not None, "contact with a ground", "ground"),
     ]
     reasons += [Reason(f"{what} (the compiled engine models none)", name) for refused, what, name in refusals if refused]
     if plan.coulomb:

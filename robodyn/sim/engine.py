@@ -12,7 +12,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from time import perf_counter
-from typing import Literal
+from typing import Any, Literal
 
 from robodyn.exceptions import CompileError, InputError, JointLimitWarning, RobodynWarning
 from robodyn.sim import compiled_backend, pinocchio_loop
@@ -36,6 +36,8 @@ class EngineRun:
             torque held; ``None`` when it was evaluated at every integrator stage (or there
             is none).
         controller_in_c: Whether the controller ran in C (passive runs: ``False``).
+        contact: A run on the ground: its contact forces, gaps and summary
+            (:class:`robodyn.sim.contact_run.ContactSimulation`); ``None`` without a ground.
     """
 
     engine: Literal["pinocchio", "compiled"]
@@ -44,6 +46,7 @@ class EngineRun:
     compile_time: float = 0.0
     control_period: float | None = None
     controller_in_c: bool = False
+    contact: Any = None
 
 
 def choose(plan: RunPlan) -> tuple[Literal["pinocchio", "compiled"], str]:
@@ -108,4 +111,6 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
     violations = [] if plan.limits == "ignore" else JointLimits(robot).violations(trajectory)
     if violations:  # stack level 4: the caller of simulate / simulate_run
         warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=4)
-    return trajectory, EngineRun(engine, reason, outcome.loop_time, compile_time, plan.control_period, outcome.controller_in_c)
+    return trajectory, EngineRun(
+        engine, reason, outcome.loop_time, compile_time, plan.control_period, outcome.controller_in_c, outcome.contact
+    )

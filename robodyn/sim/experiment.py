@@ -30,9 +30,12 @@ from robodyn.common.text import counted
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
+from robodyn.sim.contact_checks import start_above
+from robodyn.sim.contact_run import ground_lines
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
 from robodyn.sim.gains import LQR_ACCELERATION as LQR_ACCELERATION
 from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_gains
+from robodyn.sim.ground import Ground
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
@@ -68,7 +71,7 @@ def run_simulation(
     q0: list[float] | None = None,
     duration: float = 3.0,
     dt: float = 1e-3,
-    integrator: Integrator = "rk4",
+    integrator: Integrator | None = None,
     limits: LimitMode = "warn",
     engine: Engine = "auto",
     posture: list[float] | None = None,
@@ -82,6 +85,8 @@ def run_simulation(
     joint_friction: bool = True,
     kp: float | list[float] | None = None,
     kd: float | list[float] | None = None,
+    ground: Ground | None = None,
+    contacts: str | Sequence[str] = "collision",
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
@@ -126,6 +131,8 @@ def run_simulation(
             [N m s/rad] (default: scaled to each joint's inertia,
             :func:`~robodyn.sim.gains.pd_gains`); computed-torque: in [1/s²] and [1/s]
             (default 400 and 40). Refused with the other controllers.
+        ground, contacts: As for :func:`robodyn.simulate`: the robot on a plane with
+            friction (docs/contact.md); the summary gives its contact lines.
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -141,6 +148,10 @@ def run_simulation(
     if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
         raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
+    lifted: tuple[str, ...] = ()
+    if q0 is None and ground is not None and robot.floating_base:  # dropped from 5 cm, not started in the floor
+        start, lift = start_above(robot, start, ground, contacts)
+        lifted = (f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point 5 cm above it)",)
     options: dict[str, Any] = {"posture": posture, "stiffness": stiffness, "damping": damping}
     if actuated is not None and controller not in ("pd", "computed-torque", "lqr"):
         raise InputError("actuated", "given only with the pd, computed-torque or lqr controller", f"{len(actuated)} joints")
@@ -161,11 +172,11 @@ def run_simulation(
         trajectory, run = simulate_run(
             robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits,
             engine=engine, external=external, observer=observer, control_period=control_period,
-            joint_friction=joint_friction,
+            joint_friction=joint_friction, ground=ground, contacts=contacts,
         )  # fmt: skip
     settings = {
         "controller": controller,
-        "integrator": integrator,
+        "integrator": integrator or ("semi-implicit-euler" if ground is not None else "rk4"),
         "limits": limits,
         "engine": run.engine,
         "duration": duration,
@@ -174,7 +185,7 @@ def run_simulation(
     summary = replace(
         _summary(robot, trajectory, settings, run.loop_time), pushes=pushes, engine_reason=run.reason,
         control_period=run.control_period, controller_in_c=run.controller_in_c, loop_time=run.loop_time,
-        compile_time=run.compile_time,
+        compile_time=run.compile_time, ground=lifted + ground_lines(robot, run.contact), contact=run.contact,
     )  # fmt: skip
     if observer is not None:
         summary = replace(summary, observer=_observer_outcome(robot, trajectory, observer, external))

@@ -1,8 +1,8 @@
 """The Pinocchio backend: a run plan integrated in Python over Pinocchio's ABA.
 
 It models everything a plan can ask (external wrenches, enforced limits, an observer,
-stick–slip joint friction, a controller evaluated at every stage or sampled):
-:func:`unsupported` names nothing.
+stick–slip joint friction, a controller evaluated at every stage or sampled, a ground:
+:mod:`robodyn.sim.contact_backend`): :func:`unsupported` names nothing.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import numpy as np
 from robodyn.compiled.simulation import SimulationArrays
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import SingularMassMatrixError
+from robodyn.sim import contact_backend
 from robodyn.sim.joint_friction import JointFriction
 from robodyn.sim.limits import JointLimits
 from robodyn.sim.plan import Controller, ExternalWrench, Outcome, RunPlan, external_torques
@@ -38,6 +39,8 @@ def run(plan: RunPlan) -> Outcome:
     robot = plan.robot
     if robot.massless_joints or singular(robot, plan.q0):
         raise SingularMassMatrixError(robot.name, robot.massless_joints)
+    if plan.ground is not None:
+        return contact_backend.run(plan)  # on the ground: robodyn.sim.contact's step
     joint_limits = JointLimits(robot)
     enforce = plan.limits == "enforce"
     controller = _saturated(plan.controller, joint_limits) if enforce else plan.controller

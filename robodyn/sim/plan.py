@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 
@@ -25,6 +25,8 @@ from robodyn.compiled.loop_rules import INTEGRATORS, Integrator, check_integrato
 from robodyn.compiled.simulation import SimulationArrays
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.contact_checks import check_contact_run
+from robodyn.sim.ground import ContactPoint, Contacts, Ground
 from robodyn.sim.joint_friction import has_joint_friction
 from robodyn.sim.limits import LimitMode, check_mode
 from robodyn.sim.observer import MomentumObserver
@@ -83,6 +85,9 @@ class RunPlan:
         external: Wrenches the environment applies.
         observer: A momentum observer fed every sample, or ``None``.
         engine: The engine asked for (``"auto"``, ``"pinocchio"`` or ``"compiled"``).
+        ground: The plane the robot touches (:mod:`robodyn.sim.ground`), or ``None``.
+        contacts: The robot's points that touch it (and what of its collision geometry
+            they leave out); ``None`` without a ground.
     """
 
     robot: Robot
@@ -98,6 +103,8 @@ class RunPlan:
     external: tuple[ExternalWrench, ...]
     observer: MomentumObserver | None
     engine: Engine
+    ground: Ground | None = None
+    contacts: Contacts | None = None
 
     @property
     def rk4(self) -> bool:
@@ -131,6 +138,7 @@ class Outcome(NamedTuple):
     arrays: SimulationArrays
     loop_time: float
     controller_in_c: bool = False
+    contact: Any = None  # a contact run's robodyn.sim.contact_run.ContactSimulation
 
 
 def plan(
@@ -141,7 +149,7 @@ def plan(
     dt: float,
     *,
     controller: Controller | None = None,
-    integrator: Integrator = "rk4",
+    integrator: Integrator | None = None,
     external: Sequence[ExternalWrench] = (),
     hold: bool = False,
     limits: LimitMode = "warn",
@@ -149,6 +157,8 @@ def plan(
     control_period: float | None = None,
     observer: MomentumObserver | None = None,
     joint_friction: bool = True,
+    ground: Ground | None = None,
+    contacts: str | Sequence[str | ContactPoint] = "collision",
 ) -> RunPlan:
     """Check a run's arguments, once, into its plan.
 
@@ -159,7 +169,8 @@ def plan(
         duration: Simulated time in [s], a whole number of steps (to 1e-9 relative).
         dt: Step in [s].
         controller: ``controller(t, q, v) -> tau``; ``None`` for zero torque (passive).
-        integrator: ``"rk4"`` or ``"semi-implicit-euler"``.
+        integrator: ``"rk4"`` or ``"semi-implicit-euler"``; default ``"rk4"``, or with a
+            ``ground`` ``"semi-implicit-euler"`` (the contact step's scheme, the only one).
         external: Wrenches the environment applies (constant or functions of time), each
             at a frame some joint moves.
         hold: Sample the controller once per step and hold its torque (zero-order hold)
@@ -180,12 +191,17 @@ def plan(
             (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`: ``−b v``, and
             stick–slip friction up to ``±f``, :mod:`robodyn.sim.joint_friction`); ``False``
             gives the rigid-body motion.
+        ground: A :class:`~robodyn.sim.ground.Ground` the robot stands on (contact with
+            friction, :mod:`robodyn.sim.contact`; the Pinocchio engine only); ``None``: none.
+        contacts: With a ground, the points that touch it: ``"collision"`` (the URDF's
+            collision spheres and boxes) or frame names / ``ContactPoint`` values.
 
     Raises:
         InputError: For a bad initial state, step, duration, integrator, limits mode,
             engine or control period (or one given without a controller).
         FrameError: An external wrench on a frame that is unknown or that no joint moves.
     """
+    integrator = integrator or ("semi-implicit-euler" if ground is not None else "rk4")
     check_integrator(integrator)
     check_mode(limits)
     if engine not in ENGINES:
@@ -199,7 +215,8 @@ def plan(
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     for item in external:
         robot.task_frame(item.frame, "an external wrench")
+    found = check_contact_run(robot, ground, contacts, q0=q, integrator=integrator, every=every, limits=limits, observer=observer)
     return RunPlan(
         robot, q, v, float(dt), steps, integrator, controller, every, limits, joint_friction and has_joint_friction(robot),
-        tuple(external), observer, engine,
+        tuple(external), observer, engine, ground, found,
     )  # fmt: skip

@@ -130,6 +130,7 @@ class _Reading:
     strict: bool
     interpret: bool = True
     max_dof: int | None = None
+    xacro_env: bool = False
 
 
 _ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
@@ -168,12 +169,14 @@ def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
     is_xacro = source.path is not None and source.path.suffix == ".xacro"
     if is_xacro or (tag == "robot" and is_xacro_text(source.text)):
         text = expand_xacro(
-            path=source.path if source.path is not None else None,
+            path=source.path,
             text=source.text,
             label=source.label,
             args=reading.xacro_args,
             lookup=reading.lookup,
             read_file=lambda path: read_text(path, reading.limit),
+            limit=reading.limit,
+            env=reading.xacro_env,
         )
         name = source.name.removesuffix(".urdf") if is_xacro else source.name
         return replace(source, text=text, name=name, file_format="xacro")
@@ -189,6 +192,7 @@ def resolve_source(
     strict: bool = False,
     interpret: bool = True,
     max_dof: int | None = None,
+    xacro_env: bool = False,
 ) -> URDFSource:
     """Find the URDF a source names.
 
@@ -205,6 +209,8 @@ def resolve_source(
             as read, for telling reading errors from the document's own problems).
         max_dof: Most degrees of freedom of an MJCF file, counted while it is read
             (default 300, :data:`robodyn.dynamics.options.MAX_DOF`).
+        xacro_env: Let a xacro read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); refused otherwise.
 
     Raises:
         URDFError: If a file cannot be read, is not a regular file or is too large, a
@@ -212,7 +218,7 @@ def resolve_source(
         UnknownRobotError: If a name is neither a robot nor an existing file.
     """
     limit = max_urdf_bytes(max_bytes)
-    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret, max_dof=max_dof)
+    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret, max_dof=max_dof, xacro_env=bool(xacro_env))
     if isinstance(source, os.PathLike):
         return _read_file(Path(source), limit, reading)
     if not isinstance(source, str):
@@ -294,6 +300,7 @@ def lint_source(
     floating_base: bool | None = None,
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
+    xacro_env: bool = False,
 ) -> list[Problem]:
     """Every problem of a robot file (a path, text or robot name), errors and warnings.
 
@@ -309,7 +316,7 @@ def lint_source(
     try:
         with warnings.catch_warnings(record=True) as caught:  # what the import reports is reported here
             warnings.simplefilter("always", RobodynWarning)
-            resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
+            resolved = resolve_source(source, xacro_args=xacro_args, packages=packages, xacro_env=xacro_env)
     except URDFError as error:
         return [Problem(error.element, error.rule)]
     reported = [_import_problem(str(item.message)) for item in caught if issubclass(item.category, RobodynWarning)]

@@ -244,7 +244,7 @@ def _reference_terms(model, states: tuple[np.ndarray, ...], progress: Progress |
     count = len(states[0])
     size = max(1, -(-count // PROGRESS_STEPS))
     slices = []
-    for start in range(0, count, size):
+    for start in range(0, max(count, 1), size):  # one empty slice for no samples
         slices.append(model.terms(*(x[start : start + size] for x in states)))
         if progress:
             progress("reference", min(start + size, count), count)

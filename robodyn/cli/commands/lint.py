@@ -29,6 +29,7 @@ def run(arguments: argparse.Namespace) -> int:
         floating_base=arguments.floating_base,
         xacro_args=xacro_arguments(arguments.xacro_arg) or None,
         packages=package_arguments(arguments.package) or None,
+        xacro_env=arguments.xacro_env,
     )
     errors = sum(problem.severity == "error" for problem in problems)
     if arguments.json:
@@ -46,7 +47,7 @@ def run(arguments: argparse.Namespace) -> int:
         for problem in problems:
             print(f"{problem.severity}: {problem}")
         print(
-            f"{printable(arguments.model) if len(arguments.model) < 80 else '<URDF text>'}: {counted(errors, 'error')}, "
-            f"{counted(len(problems) - errors, 'warning')}"
+            f"{'<URDF text>' if arguments.model.lstrip().startswith('<') else printable(arguments.model)}: "
+            f"{counted(errors, 'error')}, {counted(len(problems) - errors, 'warning')}"
         )
     return 1 if errors else 0

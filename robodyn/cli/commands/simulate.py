@@ -33,7 +33,13 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
     parser.add_argument("--dt", type=float, default=1e-3, help=f"step, {RANGES['dt'].text()}, at most --duration (default 0.001)")
-    parser.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], default="rk4")
+    parser.add_argument(
+        "--integrator",
+        choices=["rk4", "semi-implicit-euler"],
+        default=None,
+        help="default rk4; with --ground semi-implicit-euler (the contact step's scheme, the only one there)",
+    )
+    _add_ground_arguments(parser)
     parser.add_argument(
         "--limits",
         choices=["warn", "enforce", "ignore"],
@@ -106,6 +112,7 @@ def run(arguments: argparse.Namespace) -> int:
         record=arguments.record,
         png=arguments.png,
         **_reference(arguments),
+        **_ground(arguments),
     )
     # the library's summary names its parameters (engine='compiled'); the command line, its flags
     summary = replace(summary.with_startup(startup), engine_reason=command_line_text(summary.engine_reason))
@@ -162,6 +169,37 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         help="pd, computed-torque, lqr: the actuated joints, comma-separated (default: the file's actuated joints, else "
         "all); the others get no torque",
     )
+
+
+def _add_ground_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--ground``, ``--friction`` and ``--contact`` (docs/contact.md)."""
+    parser.add_argument(
+        "--ground",
+        type=float,
+        nargs="?",
+        const=0.0,
+        metavar="HEIGHT",
+        help="stand the robot on a flat ground at this height in [m] (default 0 when given without a value): "
+        "point contacts with Coulomb friction; the summary gives peak normal force, slip and penetration",
+    )
+    parser.add_argument("--friction", type=float, default=1.0, help="with --ground: the friction coefficient mu (default 1)")
+    parser.add_argument(
+        "--contact",
+        metavar="FRAME[,...]",
+        help="with --ground: the frames that touch it, comma-separated (default: the URDF's collision spheres and boxes)",
+    )
+
+
+def _ground(arguments: argparse.Namespace) -> dict:
+    """``ground=`` and ``contacts=`` of ``--ground``, ``--friction`` and ``--contact``."""
+    if arguments.ground is None:
+        if arguments.contact is not None:
+            raise InputError("--contact", "given only with --ground", repr(arguments.contact))
+        return {}
+    from robodyn.sim.ground import Ground
+
+    contacts = "collision" if arguments.contact is None else [name.strip() for name in arguments.contact.split(",")]
+    return {"ground": Ground(height=arguments.ground, friction=arguments.friction), "contacts": contacts}
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
