@@ -198,3 +198,33 @@ def test_anymal_under_tilted_gravity_stands_and_its_feet_carry_minus_m_g():
     assert np.abs(total + robot.total_mass * robot.gravity_vector).max() <= 1e-6 * weight
     assert np.abs(run.trajectory.q[-1, :3] - q[:3]).max() < 1e-6
     assert friction_cone_margin(feet, run.multipliers).min() > 0
+
+
+def push_on_the_ground(margin: float | None):
+    """solo12 on the ground (unilateral contacts, Coulomb μ = 0.7: robodyn.sim.contact_run),
+    pushed sideways at the base with 8 N from 0.1 s to 0.3 s (the controller does not know)."""
+    from robodyn.sim.contact_run import simulate_contact
+    from robodyn.sim.ground import Ground
+
+    robot, q, feet = standing()
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q, margin=margin)
+    push = np.array([0.0, 8.0, 0.0, 0.0, 0.0, 0.0])
+
+    def pushed(t: float, qi: np.ndarray, vi: np.ndarray) -> np.ndarray:
+        tau = control(t, qi, vi)
+        return tau + robot.wrench_torques(qi, "base_link", push) if 0.1 <= t < 0.3 else tau
+
+    run = simulate_contact(robot, ground=Ground(friction=0.7), contacts=list(FEET), controller=pushed, duration=1.2, q0=q)
+    soles = np.array([[robot.frame_position(qi, foot)[:2] for foot in FEET] for qi in run.trajectory.q[::10]])
+    return robot, q, run, float(np.abs(soles - soles[0]).max())
+
+
+@pytest.mark.slow  # two 1.2 s contact runs, about 15 s
+def test_on_real_ground_a_pushed_robot_recovers_without_a_foot_slipping_and_without_the_cone_a_foot_slips():
+    robot, q, run, travelled = push_on_the_ground(0.9)
+    assert run.active.all() and run.converged.all()
+    assert np.where(run.active, run.slip, 0.0).max() < 1e-9  # [m/s]
+    assert travelled < 1e-5  # [m]
+    assert np.abs(robot.center_of_mass(run.trajectory.q[-1]) - robot.center_of_mass(q)).max() < 1e-4
+    _, _, loose, slid = push_on_the_ground(None)
+    assert np.where(loose.active, loose.slip, 0.0).max() > 0.1 and slid > 5e-3
