@@ -201,22 +201,28 @@ def test_anymal_under_tilted_gravity_stands_and_its_feet_carry_minus_m_g():
 
 
 def push_on_the_ground(margin: float | None):
-    """solo12 on the ground (unilateral contacts, Coulomb μ = 0.7: robodyn.sim.contact_run),
-    pushed sideways at the base with 8 N from 0.1 s to 0.3 s (the controller does not know)."""
-    from robodyn.sim.contact_run import simulate_contact
+    """solo12 on the ground (unilateral contacts, Coulomb μ = 0.7: docs/contact.md), pushed
+    sideways at the base with 8 N from 0.1 s to 0.3 s by ``robodyn.simulate``'s external
+    wrench (the sequel's push: the controller does not know)."""
     from robodyn.sim.ground import Ground
+    from robodyn.sim.simulation import simulate_run
 
     robot, q, feet = standing()
     control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q, margin=margin)
-    push = np.array([0.0, 8.0, 0.0, 0.0, 0.0, 0.0])
-
-    def pushed(t: float, qi: np.ndarray, vi: np.ndarray) -> np.ndarray:
-        tau = control(t, qi, vi)
-        return tau + robot.wrench_torques(qi, "base_link", push) if 0.1 <= t < 0.3 else tau
-
-    run = simulate_contact(robot, ground=Ground(friction=0.7), contacts=list(FEET), controller=pushed, duration=1.2, q0=q)
-    soles = np.array([[robot.frame_position(qi, foot)[:2] for foot in FEET] for qi in run.trajectory.q[::10]])
-    return robot, q, run, float(np.abs(soles - soles[0]).max())
+    push = robodyn.ExternalWrench("base_link", lambda t: np.array([0.0, 8.0, 0.0]) if 0.1 <= t < 0.3 else np.zeros(3))
+    trajectory, run = simulate_run(
+        robot,
+        q,
+        np.zeros(robot.nv),
+        1.2,
+        1e-3,
+        controller=control,
+        ground=Ground(friction=0.7),
+        contacts=list(FEET),
+        external=[push],
+    )
+    soles = np.array([[robot.frame_position(qi, foot)[:2] for foot in FEET] for qi in trajectory.q[::10]])
+    return robot, q, run.contact, float(np.abs(soles - soles[0]).max())
 
 
 @pytest.mark.slow  # two 1.2 s contact runs, about 15 s
