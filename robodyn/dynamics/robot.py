@@ -31,7 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.constraints import Constraint, from_equalities
-from robodyn.dynamics import configurations, constrained, derivatives, energies, frames, kinematics, mujoco_state
+from robodyn.dynamics import centroidal, configurations, constrained, derivatives, energies, frames, kinematics, mujoco_state
 from robodyn.dynamics import regressor as identification
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
@@ -568,6 +568,25 @@ class Robot:
     def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
         """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`)."""
         return mujoco_state.from_mujoco(self, qpos, qvel, joint_names=joint_names)
+
+    # ----------------------------------------------------------------------------------
+    # Centroidal quantities (robodyn.dynamics.centroidal)
+    # ----------------------------------------------------------------------------------
+    def center_of_mass(self, q: np.ndarray) -> np.ndarray:
+        """The moving bodies' centre of mass (a floating robot's: all of it) in [m], world
+        axes, shape (3,) or (N, 3)
+        (:func:`robodyn.dynamics.centroidal.center_of_mass`)."""
+        return centroidal.center_of_mass(self.handle, q)
+
+    def centroidal_momentum(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Linear [kg m/s] then angular momentum about the centre of mass [kg m²/s], world
+        axes, shape (6,) or (N, 6) (:func:`robodyn.dynamics.centroidal.centroidal_momentum`)."""
+        return centroidal.centroidal_momentum(self.handle, q, v)
+
+    def centroidal_momentum_matrix(self, q: np.ndarray) -> np.ndarray:
+        """``A_G(q)`` with ``h = A_G v``, shape (6, nv) or (N, 6, nv)
+        (:func:`robodyn.dynamics.centroidal.centroidal_momentum_matrix`)."""
+        return centroidal.centroidal_momentum_matrix(self.handle, q)
 
 
 def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:

@@ -30,6 +30,7 @@ import numpy as np
 
 from robodyn.common.inputs import as_states
 from robodyn.common.rotations import skew
+from robodyn.reference import centroidal
 from robodyn.reference.tree import KinematicTree
 from robodyn.urdf.validation import URDFSpec
 
@@ -332,3 +333,41 @@ class ReferenceRobot:
         """``U = −Σ m_b gᵀ p_b`` in [J]: a float or shape (N,)."""
         energy = self._call("U", q=q)
         return energy if np.ndim(energy) else float(energy)
+
+    # ----------------------------------------------------------------------------------
+    # Centroidal quantities (robodyn.reference.centroidal), body by body
+    # ----------------------------------------------------------------------------------
+    def body_motion(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The robot's bodies (armature rotors left out) at stacked states: masses (B,),
+        centres of mass (N, B, 3) [m], their velocities (N, B, 3) [m/s], inertias about
+        them in world axes (N, B, 3, 3) [kg m²], angular velocities (N, B, 3) [rad/s]."""
+        base = None
+        if self.floating_base:  # the virtual joints sit at zero, hanging from the base pose
+            base = (_quaternion_matrix(q[:, 3:7]), q[:, :3])
+            q = np.hstack([np.zeros((len(q), 6)), q[:, 7:]])
+        theta = q @ self._selection.T + self._offset
+        rotations, positions, axes, joint_origins = self._kinematics(theta, base)
+        coms = positions + np.einsum("nbij,bj->nbi", rotations, self._coms)
+        linear, angular = self._jacobians(coms, axes, joint_origins, self.tree.ancestors)
+        rate = v @ self._selection.T  # θ̇: a floating base's virtual rates are its body-frame twist
+        inertias = rotations @ self._inertias[None] @ np.swapaxes(rotations, -1, -2)
+        keep = np.array([not body.rotor for body in self.tree.bodies])
+        velocities = np.einsum("nbia,ni->nba", linear, rate)
+        omegas = np.einsum("nbia,ni->nba", angular, rate)
+        return self._masses[keep], coms[:, keep], velocities[:, keep], inertias[:, keep], omegas[:, keep]
+
+    def center_of_mass(self, q: np.ndarray) -> np.ndarray:
+        """``Σ mᵢ pᵢ / m`` in [m], world axes, shape (3,) or (N, 3)."""
+        (q,), batch = as_states({"q": (q, self.nq)})
+        stacked = q if batch else q[None]
+        masses, coms, *_ = self.body_motion(stacked, np.zeros((len(stacked), self.nv)))
+        result = centroidal.center_of_mass(masses, coms)
+        return result if batch else result[0]
+
+    def centroidal_momentum(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``(Σ mᵢ vᵢ, Σ (pᵢ − c) × mᵢ vᵢ + Iᵢ ωᵢ)``: linear [kg m/s] then angular
+        [kg m²/s] momentum about the centre of mass, world axes, shape (6,) or (N, 6)."""
+        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        stacked = [q, v] if batch else [q[None], v[None]]
+        result = centroidal.centroidal_momentum(*self.body_motion(*stacked))
+        return result if batch else result[0]
