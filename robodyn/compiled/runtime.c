@@ -674,6 +674,18 @@ static void rdc_lqr(const double *p, const double *q, const double *v, double *t
     }
 }
 
+/* The quintic rest-to-rest profile at time t of a motion lasting duration (the one C copy of
+ * robodyn.sim.control.QuinticReference, same operations in the same order): the share of the
+ * way covered, its rate [1/s] and its second derivative [1/s²]; at rest outside (0, duration). */
+static void rd_quintic(double t, double duration, double *position, double *speed, double *acceleration) {
+    double s = t / duration;
+    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    const int moving = 0 < t && t < duration;
+    *position = 10 * pow(s, 3) - 15 * pow(s, 4) + 6 * pow(s, 5);
+    *speed = moving ? (30 * pow(s, 2) - 60 * pow(s, 3) + 30 * pow(s, 4)) / duration : 0.0;
+    *acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
+}
+
 #if RD_NQ != RD_NV
 /* Joint torques giving the joints the accelerations a[6:] with no torque on the free base
  * (robodyn.sim.control.free_base_torques): a[0:6] = -M_bb⁻¹ (M_bj a_j + h_b), tau = ID(q, v, a), tau[0:6] = 0. */
@@ -708,13 +720,8 @@ static void rd_control_free_base(const rd_controller *c, double t, const double 
             tau[6 + i] = p[RD_PD_KP(m) + i] * (p[RD_PD_TARGET(m) + i] - q[7 + i]) - p[RD_PD_KD(m) + i] * v[6 + i] + holding[6 + i];
         return;
     }
-    const double duration = p[RD_CT_DURATION(m)];
-    double s = t / duration;
-    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
-    const int moving = 0 < t && t < duration;
-    const double position = 10 * pow(s, 3) - 15 * pow(s, 4) + 6 * pow(s, 5);
-    const double speed = moving ? (30 * pow(s, 2) - 60 * pow(s, 3) + 30 * pow(s, 4)) / duration : 0.0;
-    const double acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
+    double position, speed, acceleration;
+    rd_quintic(t, p[RD_CT_DURATION(m)], &position, &speed, &acceleration);
     for (int i = 0; i < m; ++i) {
         const double delta = p[RD_CT_Q_END(m) + i] - p[RD_CT_Q_START(m) + i];
         const double q_d = p[RD_CT_Q_START(m) + i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
@@ -744,13 +751,8 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
     } else if (c->kind != RD_KIND_CT) { /* task space, operational space, impedance */
         rd_control_frame(c, q, v, tau);
     } else { /* computed torque along a quintic */
-        const double duration = p[RD_CT_DURATION(n)];
-        double s = t / duration;
-        s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
-        const int moving = 0 < t && t < duration;
-        const double position = 10 * pow(s, 3) - 15 * pow(s, 4) + 6 * pow(s, 5);
-        const double speed = moving ? (30 * pow(s, 2) - 60 * pow(s, 3) + 30 * pow(s, 4)) / duration : 0.0;
-        const double acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
+        double position, speed, acceleration;
+        rd_quintic(t, p[RD_CT_DURATION(n)], &position, &speed, &acceleration);
         double command[RD_NV];
         for (int i = 0; i < n; ++i) {
             const double delta = p[RD_CT_Q_END(n) + i] - p[RD_CT_Q_START(n) + i];
