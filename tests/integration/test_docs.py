@@ -176,3 +176,23 @@ def test_make_docs_builds_the_api_reference_with_warnings_as_errors(tmp_path):
     assert 'id="robodyn.urdf.validation.parse_urdf"' in validation
     exceptions = (pages / "robodyn.exceptions.html").read_text(encoding="utf-8")
     assert 'id="robodyn.exceptions.URDFError"' in exceptions and "The rule that was broken." in exceptions
+
+
+@pytest.mark.slow
+def test_the_strict_build_fails_on_a_broken_docstring(tmp_path):  # negative control of the build
+    package = tmp_path / "brokendoc"
+    package.mkdir()
+    (package / "__init__.py").write_text('"""Broken."""\n\ndef peak(tau):\n    """Largest |tau| of each joint."""\n')
+    source = tmp_path / "api"
+    source.mkdir()
+    shutil.copy(ROOT / "docs" / "api" / "conf.py", source / "conf.py")
+    shutil.copytree(ROOT / "docs" / "api" / "_templates", source / "_templates")
+    (source / "index.rst").write_text("Broken\n======\n\n.. autosummary::\n   :toctree: generated\n\n   brokendoc\n")
+    build = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q", str(source), str(tmp_path / "html")],
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert build.returncode != 0 and "Undefined substitution" in build.stderr
