@@ -111,7 +111,12 @@ def _errata_tex(steps: DerivationSteps, step: int) -> list[str]:
 
 
 def latex_math(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> str:
-    """Every step as ``align*`` environments, titles and errata as text rows (for notebooks)."""
+    """Every step as ``align*`` environments, titles and errata as text rows (for notebooks).
+
+    Args:
+        steps: The derivation (:func:`robodyn.equations.derivation.derive_steps`).
+        precision: Significant digits of the printed floats.
+    """
     printer = EquationPrinter(precision, _names(steps))
     out = []
     for number, (title, rows) in enumerate(zip(STEP_TITLES, _latex_blocks(steps, printer), strict=True), 1):
@@ -121,7 +126,12 @@ def latex_math(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) ->
 
 
 def to_latex(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> str:
-    """A complete LaTeX document (amsmath): legends, then the six steps with their errata."""
+    """A complete LaTeX document (amsmath): legends, then the six steps with their errata.
+
+    Args:
+        steps: The derivation (:func:`robodyn.equations.derivation.derive_steps`).
+        precision: Significant digits of the printed floats.
+    """
     printer = EquationPrinter(precision, _names(steps))
     names = _names(steps)
     body = [
@@ -163,7 +173,12 @@ def to_latex(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> s
 
 
 def to_pdf(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> bytes:
-    """The document of :func:`to_latex`, compiled with pdflatex."""
+    """The document of :func:`to_latex`, compiled with pdflatex.
+
+    Args:
+        steps: The derivation (:func:`robodyn.equations.derivation.derive_steps`).
+        precision: Significant digits of the printed floats.
+    """
     with tempfile.TemporaryDirectory(prefix="robodyn-tex-") as folder:
         pdf, _ = compile_latex(to_latex(steps, precision=precision), Path(folder))
         return pdf.read_bytes()

@@ -52,14 +52,23 @@ LECTURE_NOTE = (
 
 
 def errata_at(steps: DerivationSteps, step: int) -> list[tuple[int, str, tuple[str, ...]]]:
-    """The lecture's errata entering at ``step`` (1..6): number, text and the terms touched."""
+    """The lecture's errata entering at ``step`` (1..6): number, text and the terms touched.
+
+    Args:
+        steps: The derivation (:func:`robodyn.equations.derivation.derive_steps`).
+        step: The step, 1..6.
+    """
     if not steps.lecture:
         return []
     return [(n, *lecture.ERRATA[n]) for n, key in LECTURE_ERRATA_STEPS.items() if STEP_OF[key] == step]
 
 
 def printed_tau(steps: DerivationSteps) -> sp.Matrix:
-    """The lecture's result as printed on slide 34, in the derivation's joint symbols."""
+    """The lecture's result as printed on slide 34, in the derivation's joint symbols.
+
+    Args:
+        steps: The lecture arm's derivation.
+    """
     joint = {lecture.q1: steps.q[0], lecture.q2: steps.q[1], lecture.qd1: steps.qd[0], lecture.qd2: steps.qd[1]}
     joint.update({lecture.qdd1: steps.qdd[0], lecture.qdd2: steps.qdd[1]})
     return lecture.printed().xreplace(joint)
@@ -76,6 +85,9 @@ def to_dict(steps: DerivationSteps) -> dict[str, Any]:
     ``omega``, ``T``, ``U``; ``L``; per joint ``dL_dqd``, ``ddt_dL_dqd``, ``dL_dq``, ``tau``;
     ``M``, ``C``, ``Cv``, ``G``; ``trace``; for the lecture's arm ``lecture`` (the printed
     result and the errata with their steps).
+
+    Args:
+        steps: The derivation (:func:`robodyn.equations.derivation.derive_steps`).
     """
 
     def text(expr: sp.Expr) -> str:
@@ -188,7 +200,12 @@ def _text_steps(steps: DerivationSteps, precision: int) -> list[list[str]]:
 
 
 def to_text(steps: DerivationSteps, *, precision: int = DEFAULT_PRECISION) -> str:
-    """The derivation as readable text, with the lecture's errata marked where they enter."""
+    """The derivation as readable text, with the lecture's errata marked where they enter.
+
+    Args:
+        steps: The derivation (:func:`robodyn.equations.derivation.derive_steps`).
+        precision: Significant digits of the printed floats.
+    """
     lines = [*_text_header(steps, precision)]
     for number, (title, body) in enumerate(zip(STEP_TITLES, _text_steps(steps, precision), strict=True), 1):
         lines += ["", f"Step {title}", *body]

@@ -29,6 +29,9 @@ def floating_tree(tree: KinematicTree) -> KinematicTree:
     The programs take body 0's motion as inputs (``free_base=True`` of
     :func:`derive_newton_euler` and :func:`robodyn.equations.compact.derive_compact`).
 
+    Args:
+        tree: A floating-base tree.
+
     Raises:
         InputError: For a fixed-base tree.
     """
@@ -50,7 +53,11 @@ def floating_tree(tree: KinematicTree) -> KinematicTree:
 
 
 def floating_reference(robot: ReferenceRobot) -> ReferenceRobot:
-    """A floating reference robot with its tree as :func:`floating_tree` (for ``free_base=True``)."""
+    """A floating reference robot with its tree as :func:`floating_tree` (for ``free_base=True``).
+
+    Args:
+        robot: A floating-base reference robot.
+    """
     tree = floating_tree(robot.tree)
     return ReferenceRobot(tree, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
 
@@ -80,7 +87,11 @@ class BaseSymbols:
         return cls(dummies("qx qy qz qw"), dummies("vx vy vz wx wy wz"), dummies("ax ay az bx by bz"))
 
     def gravity(self, gravity: sp.Matrix) -> sp.Matrix:
-        """``Rᵀ g``: world gravity in the base frame, ``R`` of the quaternion (Eigen's formula)."""
+        """``Rᵀ g``: world gravity in the base frame, ``R`` of the quaternion (Eigen's formula).
+
+        Args:
+            gravity: World gravity, 3×1, in [m/s²].
+        """
         x, y, z, w = self.quaternion
         R = sp.Matrix(
             [

@@ -87,7 +87,14 @@ class Motion:
 
 
 def check_fixed_base(robot: ReferenceRobot) -> None:
-    """Refuse a floating base (its six virtual joints are not Pinocchio's coordinates)."""
+    """Refuse a floating base (its six virtual joints are not Pinocchio's coordinates).
+
+    Args:
+        robot: The reference robot.
+
+    Raises:
+        InputError: For a floating-base robot.
+    """
     if robot.floating_base:
         raise InputError(
             "robot",
@@ -200,7 +207,14 @@ def backward_pass(
     bodies: Sequence[SymbolicBody], builder: ProgramBuilder, motion: Motion, *, tag: str = ""
 ) -> tuple[list[sp.Matrix], list[sp.Matrix]]:
     """Each subtree's force and moment (about the body's origin) in the body's frame,
-    children first: ``(forces, moments)``, 3×1 each."""
+    children first: ``(forces, moments)``, 3×1 each.
+
+    Args:
+        bodies: The tree's bodies (:func:`symbolic_bodies`).
+        builder: The program the variables are added to.
+        motion: The forward pass's result (:func:`forward_pass`).
+        tag: Appended to the variables' names (keeps two passes of one program apart).
+    """
     count = len(bodies)
     force, moment = [_ZERO] * count, [_ZERO] * count
     for b in reversed(range(count)):
@@ -222,7 +236,13 @@ def backward_pass(
 
 def project(body: SymbolicBody, moment: sp.Matrix, force: sp.Matrix) -> sp.Expr:
     """The joint's share of a moment and force in the body's frame: the moment about a
-    revolute axis, the force along a prismatic one."""
+    revolute axis, the force along a prismatic one.
+
+    Args:
+        body: The body its joint moves.
+        moment: About the body's origin, body frame, 3×1.
+        force: Body frame, 3×1.
+    """
     return (body.axis.T * (moment if body.revolute else force))[0]
 
 

@@ -63,6 +63,12 @@ def derivation_document(
 ) -> str | bytes:
     """The derivation of a robot in one of :data:`DERIVATION_FORMATS` (``"pdf"`` gives bytes).
 
+    Args:
+        source, keep_params, gravity, lock: As for
+            :func:`robodyn.equations.derivation.derive_steps`.
+        format: One of :data:`DERIVATION_FORMATS`.
+        precision: Significant digits of the printed floats.
+
     Raises:
         InputError: For an unknown format or precision, or a robot too large.
         MissingToolError: For ``"pdf"`` without pdflatex.
@@ -80,7 +86,13 @@ def _check(format: str, precision: int) -> None:
 def render_derivation(
     steps: DerivationSteps, format: DerivationFormat = "text", *, precision: int = DEFAULT_PRECISION
 ) -> str | bytes:
-    """``steps`` as text, a LaTeX document, a PDF (bytes) or JSON."""
+    """``steps`` as text, a LaTeX document, a PDF (bytes) or JSON.
+
+    Args:
+        steps: The derivation (:func:`derivation`).
+        format: One of :data:`DERIVATION_FORMATS`.
+        precision: Significant digits of the printed floats.
+    """
     _check(format, precision)
     if format == "text":
         return to_text(steps, precision=precision)

@@ -162,6 +162,13 @@ class MomentumObserver:
     def update(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Take one sample and return the estimate ``r`` (nv,) in [N m] / [N].
 
+        Args:
+            t: The sample's time in [s], after the previous one's.
+            q: Configuration, shape (nq,).
+            v: Velocity, shape (nv,).
+            tau: The motor torque given with this sample (read as :attr:`torque` says),
+                shape (nv,), in [N m] / [N].
+
         Raises:
             InputError: A time not after the previous sample's (e.g. the intermediate
                 calls of a Runge–Kutta step: simulate with ``hold=True``).
@@ -187,7 +194,11 @@ class MomentumObserver:
         return residual
 
     def wrap(self, controller: Callable[[float, np.ndarray, np.ndarray], np.ndarray]) -> Callable:
-        """A controller that also feeds this observer each sample and the torque it applies."""
+        """A controller that also feeds this observer each sample and the torque it applies.
+
+        Args:
+            controller: Called as ``controller(t, q, v)``, returning the torque (nv,).
+        """
 
         def observed(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
             tau = np.asarray(controller(t, q, v), dtype=float)

@@ -28,7 +28,11 @@ def _visible_ticks(axis) -> list:
 
 
 def text_boxes(figure: Figure) -> list[tuple[str, Bbox]]:
-    """Every visible text and legend of a figure with its box in display pixels (draws it)."""
+    """Every visible text and legend of a figure with its box in display pixels (draws it).
+
+    Args:
+        figure: The figure.
+    """
     canvas = figure.canvas if isinstance(figure.canvas, FigureCanvasAgg) else FigureCanvasAgg(figure)
     canvas.draw()
     renderer = canvas.get_renderer()

@@ -40,19 +40,33 @@ _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 
 
 def text_label(name: str) -> str:
-    """A name as matplotlib draws it literally: ``$`` escaped (no mathtext), control characters as ``?``."""
+    """A name as matplotlib draws it literally: ``$`` escaped (no mathtext), control characters as ``?``.
+
+    Args:
+        name: A joint's or frame's name (from the robot's file).
+    """
     return _CONTROL.sub("?", str(name)).replace("$", r"\$")
 
 
 def new_figure(width: float, height: float) -> Figure:
-    """A figure with constrained layout on its own Agg canvas (sizes in [inch])."""
+    """A figure with constrained layout on its own Agg canvas.
+
+    Args:
+        width: In [inch].
+        height: In [inch].
+    """
     figure = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
     FigureCanvasAgg(figure)
     return figure
 
 
 def save_png(figure: Figure, path: str | Path) -> Path | None:
-    """Write a figure as PNG, atomically; the file written, ``None`` for standard output (``-``)."""
+    """Write a figure as PNG, atomically; the file written, ``None`` for standard output (``-``).
+
+    Args:
+        figure: The figure.
+        path: The PNG file, or ``-`` for standard output.
+    """
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     return atomic_write_bytes(path, buffer.getvalue())
@@ -190,7 +204,12 @@ def _energy_panel(axis: Axes, robot: Robot, trajectory: Trajectory) -> None:
 def plot_simulation(
     robot: Robot, trajectory: Trajectory, path: str | Path, *, frame: str | None = None, target: np.ndarray | None = None
 ) -> Path | None:
-    """Write :func:`simulation_figure` as a PNG (atomically) and return its path (``None`` for ``-``)."""
+    """Write :func:`simulation_figure` as a PNG (atomically) and return its path (``None`` for ``-``).
+
+    Args:
+        path: The PNG file, or ``-`` for standard output; the other arguments are
+            :func:`simulation_figure`'s.
+    """
     return save_png(simulation_figure(robot, trajectory, frame=frame, target=target), path)
 
 
@@ -266,7 +285,12 @@ def _whatif_limit(axis: Axes, top: float, limit: float, unit: str) -> None:
 
 
 def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path, **options) -> Path | None:
-    """Write :func:`whatif_figure` as a PNG (atomically) and return its path (``None`` for ``-``)."""
+    """Write :func:`whatif_figure` as a PNG (atomically) and return its path (``None`` for ``-``).
+
+    Args:
+        path: The PNG file, or ``-`` for standard output; the other arguments are
+            :func:`whatif_figure`'s.
+    """
     return save_png(whatif_figure(rows, joint_names, units, **options), path)
 
 
@@ -325,5 +349,10 @@ def plot_external_torques(
     *,
     gain: float | None = None,
 ) -> Path | None:
-    """Write :func:`external_torques_figure` as a PNG (atomically); ``None`` for ``-``."""
+    """Write :func:`external_torques_figure` as a PNG (atomically); ``None`` for ``-``.
+
+    Args:
+        path: The PNG file, or ``-`` for standard output; the other arguments are
+            :func:`external_torques_figure`'s.
+    """
     return save_png(external_torques_figure(t, estimate, applied, dof_names, units, gain=gain), path)

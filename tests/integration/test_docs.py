@@ -29,6 +29,10 @@ import pytest
 from tests.conftest import ROOT
 
 KNOWN_GAPS = ROOT / "docs" / "api" / "known_gaps.txt"
+#: Every other public function or method whose Args miss parameters, as measured when the
+#: check came in (issue 37): new code may not add to it (``python -m tests.integration.test_docs``
+#: rewrites it after docstrings are completed).
+UNDOCUMENTED = ROOT / "docs" / "api" / "undocumented_parameters.txt"
 _SECTION = re.compile(
     r"^[ \t]*(?:Args|Arguments|Parameters):[ \t]*\n(.*?)(?=^[ \t]*[A-Z][A-Za-z ]*:[ \t]*$|\Z)", re.MULTILINE | re.DOTALL
 )
@@ -114,8 +118,25 @@ def api_gaps(package: ModuleType) -> list[str]:
     return gaps
 
 
-def known_gaps() -> list[str]:
-    lines = KNOWN_GAPS.read_text(encoding="utf-8").splitlines()
+def package_gaps(package: ModuleType) -> list[str]:
+    """``name: parameters`` for every public function and public method of a public class,
+    in every public module, with undocumented parameters."""
+    gaps = []
+    for module in public_modules(package):
+        for name, value in vars(module).items():
+            if name.startswith("_") or getattr(value, "__module__", None) != module.__name__:
+                continue
+            functions = [(name, value)] if inspect.isfunction(value) else []
+            if inspect.isclass(value):
+                functions = [(f"{name}.{key}", f) for key, f in vars(value).items() if inspect.isfunction(f) and key[0] != "_"]
+            for qualified, function in functions:
+                if missing := undocumented_parameters(function, module):
+                    gaps.append(f"{module.__name__}.{qualified}: {', '.join(missing)}")
+    return sorted(gaps)
+
+
+def known_gaps(path=KNOWN_GAPS) -> list[str]:
+    lines = path.read_text(encoding="utf-8").splitlines()
     return sorted(line for line in lines if line.strip() and not line.startswith("#"))
 
 
@@ -137,6 +158,7 @@ def test_the_checks_see_an_undocumented_function_and_parameter(tmp_path, monkeyp
     fake = importlib.import_module("fakepkg")
     assert missing_docstrings(fake) == ["fakepkg.tools.silent"]
     assert api_gaps(fake) == ["fakepkg.half: b", "fakepkg.silent: a"]
+    assert package_gaps(fake) == ["fakepkg.tools.half: b", "fakepkg.tools.silent: a"]
 
 
 def test_every_public_module_function_and_class_has_a_docstring():
@@ -151,6 +173,13 @@ def test_the_public_api_documents_every_parameter():
     gaps = api_gaps(robodyn)
     assert len(gaps) <= len(known_gaps())
     assert sorted(gaps) == known_gaps()
+
+
+def test_no_public_function_or_method_adds_an_undocumented_parameter():
+    import robodyn
+
+    added = sorted(set(package_gaps(robodyn)) - set(known_gaps(UNDOCUMENTED)))
+    assert added == [], "document these parameters in the docstring's Args"
 
 
 @pytest.mark.slow
@@ -196,3 +225,10 @@ def test_the_strict_build_fails_on_a_broken_docstring(tmp_path):  # negative con
         timeout=600,
     )
     assert build.returncode != 0 and "Undefined substitution" in build.stderr
+
+
+if __name__ == "__main__":  # rewrite the measured list (after completing docstrings)
+    import robodyn
+
+    header = [line for line in UNDOCUMENTED.read_text(encoding="utf-8").splitlines() if line.startswith("#")]
+    UNDOCUMENTED.write_text("\n".join([*header, *package_gaps(robodyn)]) + "\n", encoding="utf-8")
