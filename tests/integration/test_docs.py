@@ -205,6 +205,8 @@ def test_make_docs_builds_the_api_reference_with_warnings_as_errors(tmp_path):
     assert 'id="robodyn.urdf.validation.parse_urdf"' in validation
     exceptions = (pages / "robodyn.exceptions.html").read_text(encoding="utf-8")
     assert 'id="robodyn.exceptions.URDFError"' in exceptions and "The rule that was broken." in exceptions
+    index = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
+    assert 'href="generated/robodyn.dynamics.loading.html#robodyn.dynamics.loading.load"' in index  # links resolve
 
 
 @pytest.mark.slow
