@@ -41,12 +41,36 @@ class Reader:
         self.problems: list[Problem] = []
 
     def error(self, element: str | None, rule: str) -> None:
+        """Record an error.
+
+        Args:
+            element: The offending element, e.g. ``'joint "j1"'``, or ``None`` for the robot.
+            rule: The rule it breaks, one sentence.
+        """
         self.problems.append(Problem(element, rule))
 
     def warn(self, element: str | None, rule: str, *, loud: bool = False) -> None:
+        """Record a warning.
+
+        Args:
+            element: The element it is about, or ``None`` for the robot.
+            rule: What is suspicious, one sentence.
+            loud: Shown when loading (and an error with ``strict=True``), not only by lint.
+        """
         self.problems.append(Problem(element, rule, "warning", loud))
 
     def floats(self, where: str, node: ET.Element | None, attribute: str, default: str) -> np.ndarray:
+        """An attribute's list of numbers, finite and within ``MAX_MAGNITUDE``.
+
+        Args:
+            where: The element named in messages.
+            node: The element, or ``None`` when absent (then ``default``).
+            attribute: The attribute's name.
+            default: The numbers when the attribute is absent, as text; also their count.
+
+        Returns:
+            The numbers; ``default``'s, with an error recorded, when they are not valid.
+        """
         text = default if node is None else node.get(attribute, default)
         fallback = _DEFAULTS.setdefault(default, tuple(float(token) for token in default.split()))
         parsed = [parse_number(token) for token in split_numbers(text)]
@@ -74,6 +98,18 @@ class Reader:
     def number(
         self, where: str, node: ET.Element | None, attribute: str, default: float | None, *, bounded: bool = True
     ) -> float | None:
+        """An attribute's number (infinities allowed, NaN refused).
+
+        Args:
+            where: The element named in messages.
+            node: The element, or ``None`` when absent (then ``default``).
+            attribute: The attribute's name.
+            default: The value when the attribute is absent or invalid.
+            bounded: Refuse finite values beyond ``MAX_MAGNITUDE``.
+
+        Returns:
+            The number; ``default``, with an error recorded, when it is not valid.
+        """
         text = None if node is None else node.get(attribute)
         if text is None:
             return default
