@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint bench mutants clean chromium tex
+.PHONY: demo test test-fast lint docs bench mutants clean chromium tex
 
 $(STAMP): pyproject.toml requirements.lock
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -54,6 +54,12 @@ test: $(STAMP) chromium tex
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -m "not slow" -n $(TEST_WORKERS) -x -q
 
+# The API reference of every public module, from the docstrings (Sphinx autodoc + napoleon;
+# sources in docs/api/), warnings as errors. Open build/docs/index.html.
+docs: $(STAMP)
+	$(BIN)/python -m sphinx -b html -W --keep-going -q docs/api build/docs
+	@echo "API reference: build/docs/index.html"
+
 lint: $(STAMP)
 	$(BIN)/ruff check robodyn tests scripts
 	$(BIN)/ruff format --check robodyn tests scripts
@@ -76,4 +82,4 @@ mutants: $(STAMP)
 	$(BIN)/mutmut results
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache mutants
+	rm -rf $(VENV) .pytest_cache .ruff_cache mutants build/docs docs/api/generated

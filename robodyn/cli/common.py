@@ -32,6 +32,7 @@ MODEL_HELP = "a URDF, .xacro or MJCF file path, a robot name (see 'robodyn list'
 
 
 def add_model_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the robot-file arguments every command shares (the model and how to read it) to ``parser``."""
     parser.add_argument("model", help=MODEL_HELP)
     base = parser.add_mutually_exclusive_group()
     base.add_argument(
@@ -131,6 +132,11 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
 
 
 def state(robot: robodyn.Robot, values: list[float] | None, name: str, size: int, default: np.ndarray) -> np.ndarray:
+    """The values of flag ``--name`` as an array of ``size`` (``default`` when not given).
+
+    Raises:
+        InputError: Naming the flag and the joints, when the count is not ``size``.
+    """
     if values is None:
         return default
     if len(values) != size:

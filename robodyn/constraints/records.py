@@ -50,14 +50,22 @@ def from_equality(record: EqualityRecord) -> Constraint | None:
 
 
 def from_equalities(records: Sequence[EqualityRecord]) -> tuple[Constraint, ...]:
-    """The constraints of a file's equality records (inactive ones left out: :func:`equality_notes`)."""
+    """The constraints of a file's equality records (inactive ones left out: :func:`equality_notes`).
+
+    Args:
+        records: A file's equality records.
+    """
     converted = (from_equality(record) for record in records)
     return tuple(constraint for constraint in converted if constraint is not None)
 
 
 def equality_notes(records: Sequence[EqualityRecord]) -> list[str]:
     """One line for each part of the records robodyn does not model (inactive elements,
-    a weld's ``torquescale`` other than 1)."""
+    a weld's ``torquescale`` other than 1).
+
+    Args:
+        records: A file's equality records.
+    """
     notes = []
     for record in records:
         label = f"<equality {record.kind}{' ' + quoted(record.name) if record.name else ''}>"

@@ -227,6 +227,11 @@ _KINDS = (PointAnchor, FrameAnchor, PointContact)
 def as_constraints(value: object, argument: str = "constraints") -> tuple[Constraint, ...]:
     """``None``, one constraint or an iterable of them, as a tuple.
 
+    Args:
+        value: ``None``, a :class:`PointAnchor`, :class:`FrameAnchor`, :class:`PointContact`
+            or an iterable of them.
+        argument: The parameter's name, for the error.
+
     Raises:
         InputError: For anything that is not a constraint (naming its index).
     """
@@ -246,6 +251,11 @@ def as_constraints(value: object, argument: str = "constraints") -> tuple[Constr
 def check_frames(constraints: Sequence[Constraint], links: Sequence[str], robot: str) -> None:
     """Refuse a constraint naming a link the robot does not have, in one line listing the valid ones.
 
+    Args:
+        constraints: The constraints.
+        links: The robot's link names.
+        robot: The robot's name, for the error.
+
     Raises:
         InputError: Naming the constraint's index and field, the robot and its links.
     """
@@ -261,7 +271,11 @@ def check_frames(constraints: Sequence[Constraint], links: Sequence[str], robot:
 
 
 def total_rows(constraints: Sequence[Constraint]) -> int:
-    """Rows of a set of constraints (the length of ``λ`` and of ``Φ``)."""
+    """Rows of a set of constraints (the length of ``λ`` and of ``Φ``).
+
+    Args:
+        constraints: The constraints.
+    """
     return sum(constraint.rows for constraint in constraints)
 
 

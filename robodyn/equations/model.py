@@ -64,7 +64,11 @@ def numeric(expr: sp.Expr, digits: int = 17) -> sp.Expr:
 def operation_count(equations: EquationsData) -> int:
     """The size of the equations as printed: ``sympy.count_ops`` over every assignment and
     every entry of ``M``, ``C q̇`` and ``G``, numbers as floats (``0.41 q`` is one
-    multiplication, not a multiplication and a division)."""
+    multiplication, not a multiplication and a division).
+
+    Args:
+        equations: The equations, as derived.
+    """
     expressions = [e for _, e in equations.assignments] + [*equations.M, *equations.Cv, *equations.G]
     return int(sum(sp.count_ops(numeric(e)) for e in expressions))
 

@@ -18,6 +18,7 @@ The pieces are public so that the users share them: :func:`symbolic_bodies` (the
 ``q``-dependent frames, built once), :func:`newton_euler` (one pass pair, with or without
 speeds, accelerations and gravity: the compact equations run it for ``C q̇`` and for ``G``)
 and :func:`derive_newton_euler` (the whole program of ``tau``: the compiled ``tau`` kernel).
+The free base's tree and symbols are in :mod:`robodyn.equations.free_base` (re-exported here).
 
 No Pinocchio here.
 """
@@ -25,16 +26,17 @@ No Pinocchio here.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
-import numpy as np
 import sympy as sp
 
+from robodyn.equations.free_base import BaseSymbols
+from robodyn.equations.free_base import floating_reference as floating_reference  # re-exported
+from robodyn.equations.free_base import floating_tree as floating_tree  # re-exported
 from robodyn.equations.program import Program, ProgramBuilder
 from robodyn.exceptions import InputError
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, axis_rotation, body_coordinates, exact_matrix, joint_symbols
-from robodyn.reference.tree import KinematicTree
 
 #: Default tolerance for exact rotation and axis entries of the program: float rounding only
 #: (cos(π/2) = 6e-17), so the program is the URDF's robot. The printed equations snap more
@@ -85,85 +87,20 @@ class Motion:
 
 
 def check_fixed_base(robot: ReferenceRobot) -> None:
-    """Refuse a floating base (its six virtual joints are not Pinocchio's coordinates)."""
+    """Refuse a floating base (its six virtual joints are not Pinocchio's coordinates).
+
+    Args:
+        robot: The reference robot.
+
+    Raises:
+        InputError: For a floating-base robot.
+    """
     if robot.floating_base:
         raise InputError(
             "robot",
             "a fixed-base robot (floating_base=False): the Newton–Euler program models fixed bases",
             f"a floating {robot.name}",
         )
-
-
-def floating_tree(tree: KinematicTree) -> KinematicTree:
-    """A floating tree (six virtual joints) as a tree whose body 0 is the free base.
-
-    Body 0 is the root link (no joint: zero axis, identity origin, parent -1), the moving
-    joints' bodies follow with their parents renumbered, armature rotors stay roots; the
-    selection and offset keep the independent joints' columns (body 0's row is zero).
-    The programs take body 0's motion as inputs (``free_base=True`` of
-    :func:`derive_newton_euler` and :func:`robodyn.equations.compact.derive_compact`).
-
-    Raises:
-        InputError: For a fixed-base tree.
-    """
-    if not tree.floating_base:
-        raise InputError("tree", "a floating-base tree (floating_base=True)", f"the fixed-base {tree.name}")
-    root = tree.bodies[5]
-    base = replace(root, parent=-1, axis=np.zeros(3), revolute=False, origin=np.eye(4))
-    moved = [replace(body, parent=body.parent - 5 if body.parent >= 5 else -1) for body in tree.bodies[6:]]
-    keep = [5, *range(6, len(tree.bodies))]
-    return KinematicTree(
-        tree.name,
-        [base, *moved],
-        list(tree.joint_names[6:]),
-        tree.selection[keep][:, 6:],
-        tree.offset[keep],
-        tree.ancestors[np.ix_(keep, keep)],
-        floating_base=False,
-    )
-
-
-def floating_reference(robot: ReferenceRobot) -> ReferenceRobot:
-    """A floating reference robot with its tree as :func:`floating_tree` (for ``free_base=True``)."""
-    tree = floating_tree(robot.tree)
-    return ReferenceRobot(tree, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
-
-
-@dataclass(frozen=True)
-class BaseSymbols:
-    """The free base's inputs of a program (Pinocchio's free flyer).
-
-    Attributes:
-        quaternion: ``x, y, z, w`` of the base's orientation (``q[3:7]``).
-        velocity: Linear then angular velocity of the base in its own frame (``v[0:6]``).
-        acceleration: Pinocchio's ``v̇[0:6]``: the spatial acceleration in the base frame
-            (the base origin's classical acceleration is ``a_lin + ω × v_lin``).
-    """
-
-    quaternion: tuple[sp.Symbol, ...]
-    velocity: tuple[sp.Symbol, ...]
-    acceleration: tuple[sp.Symbol, ...]
-
-    @classmethod
-    def make(cls) -> BaseSymbols:
-        """Fresh symbols (``Dummy``: never equal to a joint's symbol, whatever its name)."""
-
-        def dummies(names: str) -> tuple[sp.Symbol, ...]:
-            return tuple(sp.Dummy(name, real=True) for name in names.split())
-
-        return cls(dummies("qx qy qz qw"), dummies("vx vy vz wx wy wz"), dummies("ax ay az bx by bz"))
-
-    def gravity(self, gravity: sp.Matrix) -> sp.Matrix:
-        """``Rᵀ g``: world gravity in the base frame, ``R`` of the quaternion (Eigen's formula)."""
-        x, y, z, w = self.quaternion
-        R = sp.Matrix(
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-            ]
-        )
-        return R.T * gravity
 
 
 def symbolic_bodies(
@@ -270,7 +207,14 @@ def backward_pass(
     bodies: Sequence[SymbolicBody], builder: ProgramBuilder, motion: Motion, *, tag: str = ""
 ) -> tuple[list[sp.Matrix], list[sp.Matrix]]:
     """Each subtree's force and moment (about the body's origin) in the body's frame,
-    children first: ``(forces, moments)``, 3×1 each."""
+    children first: ``(forces, moments)``, 3×1 each.
+
+    Args:
+        bodies: The tree's bodies (:func:`symbolic_bodies`).
+        builder: The program the variables are added to.
+        motion: The forward pass's result (:func:`forward_pass`).
+        tag: Appended to the variables' names (keeps two passes of one program apart).
+    """
     count = len(bodies)
     force, moment = [_ZERO] * count, [_ZERO] * count
     for b in reversed(range(count)):
@@ -292,7 +236,13 @@ def backward_pass(
 
 def project(body: SymbolicBody, moment: sp.Matrix, force: sp.Matrix) -> sp.Expr:
     """The joint's share of a moment and force in the body's frame: the moment about a
-    revolute axis, the force along a prismatic one."""
+    revolute axis, the force along a prismatic one.
+
+    Args:
+        body: The body its joint moves.
+        moment: About the body's origin, body frame, 3×1.
+        force: Body frame, 3×1.
+    """
     return (body.axis.T * (moment if body.revolute else force))[0]
 
 

@@ -55,7 +55,12 @@ class Program:
         return [expr for exprs in self.outputs.values() for expr in exprs]
 
     def with_outputs(self, flat: Sequence[sp.Expr], assignments: Iterable[Assignment]) -> Program:
-        """The program with new assignments and its outputs replaced, in order, by ``flat``."""
+        """The program with new assignments and its outputs replaced, in order, by ``flat``.
+
+        Args:
+            flat: Every output entry, in the order of :attr:`outputs` (names, then entries).
+            assignments: The new assignments, each after the symbols it uses.
+        """
         outputs, start = {}, 0
         for name, exprs in self.outputs.items():
             outputs[name] = tuple(flat[start : start + len(exprs)])
@@ -64,7 +69,11 @@ class Program:
 
 
 def trivial(expr: sp.Expr) -> bool:
-    """Whether an expression is not worth a variable: a number, a symbol, or number × symbol."""
+    """Whether an expression is not worth a variable: a number, a symbol, or number × symbol.
+
+    Args:
+        expr: A sympy expression.
+    """
     return bool(
         expr.is_Number
         or expr.is_Symbol
@@ -92,12 +101,21 @@ class ProgramBuilder:
         self._counter = 0
 
     def pair(self, c: sp.Expr, s: sp.Expr) -> None:
-        """Register ``c = cos x``, ``s = sin x`` (used with ``pythagoras`` only)."""
+        """Register ``c = cos x``, ``s = sin x`` (used with ``pythagoras`` only).
+
+        Args:
+            c: The symbol of a cosine.
+            s: The symbol of the sine of the same angle.
+        """
         if self.pythagoras and c.is_Symbol and s.is_Symbol:
             self.pairs.append((c, s))
 
     def rewrite(self, expr: sp.Expr) -> sp.Expr:
-        """``expr`` expanded, with ``c² + s² = 1`` used where shorter (see the class)."""
+        """``expr`` expanded, with ``c² + s² = 1`` used where shorter (see the class).
+
+        Args:
+            expr: A sympy expression.
+        """
         expr = sp.expand(expr)
         present, powered = _symbols_and_powers(expr) if self.pairs else (set(), set())
         for c, s in self.pairs:
@@ -110,7 +128,12 @@ class ProgramBuilder:
         return expr
 
     def let(self, expr: sp.Expr, prefix: str = "x") -> sp.Expr:
-        """A new symbol for ``expr`` (rewritten), or ``expr`` itself where trivial."""
+        """A new symbol for ``expr`` (rewritten), or ``expr`` itself where trivial.
+
+        Args:
+            expr: A sympy expression.
+            prefix: The new symbol's name before its number.
+        """
         expr = self.rewrite(expr)
         if trivial(expr):
             return expr
@@ -120,21 +143,41 @@ class ProgramBuilder:
         return symbol
 
     def vector(self, values: Iterable[sp.Expr], prefix: str) -> sp.Matrix:
-        """:meth:`let` of every entry, as a column."""
+        """:meth:`let` of every entry, as a column.
+
+        Args:
+            values: The entries.
+            prefix: The new symbols' name before their number.
+        """
         return sp.Matrix([self.let(v, prefix) for v in values])
 
     def matrix(self, matrix: sp.Matrix, prefix: str) -> sp.Matrix:
-        """:meth:`let` of every entry."""
+        """:meth:`let` of every entry.
+
+        Args:
+            matrix: A sympy matrix.
+            prefix: The new symbols' name before their number.
+        """
         return sp.Matrix(matrix.rows, matrix.cols, lambda i, j: self.let(matrix[i, j], prefix))
 
     def program(self, inputs: dict[str, tuple[sp.Symbol, ...]], outputs: dict[str, Sequence[sp.Expr]]) -> Program:
-        """The program so far, with ``outputs`` rewritten like the assignments."""
+        """The program so far, with ``outputs`` rewritten like the assignments.
+
+        Args:
+            inputs: The input symbols by name.
+            outputs: The output expressions by name.
+        """
         rewritten = {name: tuple(self.rewrite(e) for e in exprs) for name, exprs in outputs.items()}
         return Program(inputs, tuple(self.assignments), rewritten)
 
 
 def needed(assignments: Sequence[Assignment], outputs: Iterable[sp.Expr]) -> list[Assignment]:
-    """The assignments the outputs depend on, in their original order."""
+    """The assignments the outputs depend on, in their original order.
+
+    Args:
+        assignments: ``(symbol, expression)`` pairs, each after the symbols it uses.
+        outputs: The expressions wanted.
+    """
     wanted: set[sp.Basic] = set().union(*(sp.sympify(expr).free_symbols for expr in outputs))
     kept = []
     for symbol, expr in reversed(assignments):
@@ -145,7 +188,12 @@ def needed(assignments: Sequence[Assignment], outputs: Iterable[sp.Expr]) -> lis
 
 
 def in_order(definitions: Mapping[sp.Symbol, sp.Expr], outputs: Iterable[sp.Expr]) -> list[Assignment]:
-    """The definitions the outputs depend on, each after everything it uses."""
+    """The definitions the outputs depend on, each after everything it uses.
+
+    Args:
+        definitions: Expression of each defined symbol (in any order).
+        outputs: The expressions wanted.
+    """
     ordered: list[Assignment] = []
     state: dict[sp.Symbol, int] = {}  # 1: in progress, 2: done
     roots = sorted({s for e in outputs for s in e.free_symbols if s in definitions}, key=str)
@@ -168,7 +216,11 @@ def in_order(definitions: Mapping[sp.Symbol, sp.Expr], outputs: Iterable[sp.Expr
 
 
 def operation_count(program: Program) -> int:
-    """``sympy.count_ops`` over every assignment and output (numbers as they are)."""
+    """``sympy.count_ops`` over every assignment and output (numbers as they are).
+
+    Args:
+        program: The program.
+    """
     expressions = [e for _, e in program.assignments] + program.output_expressions()
     return int(sum(sp.count_ops(e) for e in expressions))
 

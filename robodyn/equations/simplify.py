@@ -29,7 +29,11 @@ RELATIVE_ROUND_OFF = 1e-12
 
 def size(expr: sp.Expr) -> int:
     """Operations of ``expr`` as printed (fractions as one float each; a fast stand-in for
-    :func:`robodyn.equations.model.operation_count`'s measure)."""
+    :func:`robodyn.equations.model.operation_count`'s measure).
+
+    Args:
+        expr: A sympy expression.
+    """
     fractions = {a: sp.Float(a) for a in expr.atoms(sp.Rational) if not a.is_Integer}
     return int(sp.count_ops(expr.xreplace(fractions) if fractions else expr))
 
@@ -40,13 +44,22 @@ def _weights(expr: sp.Expr) -> list[float]:
 
 
 def largest_coefficient(exprs: Iterable[sp.Expr]) -> float:
-    """The largest magnitude of a numeric coefficient of the expanded ``exprs`` (0 if none)."""
+    """The largest magnitude of a numeric coefficient of the expanded ``exprs`` (0 if none).
+
+    Args:
+        exprs: Sympy expressions.
+    """
     return max((w for e in exprs for w in _weights(sp.expand(e))), default=0.0)
 
 
 def chop(expr: sp.Expr, floor: float | None = None) -> sp.Expr:
     """``expr`` (expanded) without terms whose numeric coefficient is below ``floor``
-    (default: :data:`RELATIVE_ROUND_OFF` of its own largest)."""
+    (default: :data:`RELATIVE_ROUND_OFF` of its own largest).
+
+    Args:
+        expr: A sympy expression.
+        floor: Terms whose numeric coefficient is below it are dropped; ``None``: relative.
+    """
     expr = sp.expand(expr)
     if not expr.is_Add:
         return expr if floor is None or expr == 0 or _weights(expr)[0] >= floor else sp.Integer(0)
@@ -56,7 +69,12 @@ def chop(expr: sp.Expr, floor: float | None = None) -> sp.Expr:
 
 
 def clean(expr: sp.Expr, floor: float) -> bool:
-    """No term of ``expr`` (expanded) has a numeric coefficient below ``floor``."""
+    """No term of ``expr`` (expanded) has a numeric coefficient below ``floor``.
+
+    Args:
+        expr: A sympy expression.
+        floor: The smallest coefficient accepted.
+    """
     return all(w >= floor for w in _weights(sp.expand(expr)))
 
 
@@ -81,7 +99,11 @@ def _collected(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
 
 def absorb(expr: sp.Expr) -> sp.Expr:
     """A numeric factor in front of a product moved into one of its sums:
-    ``(2*q + 1.4)*x`` rather than ``2*(q + 0.7)*x`` or ``3.3e-16*(1e13*s + ...)``."""
+    ``(2*q + 1.4)*x`` rather than ``2*(q + 0.7)*x`` or ``3.3e-16*(1e13*s + ...)``.
+
+    Args:
+        expr: A sympy expression.
+    """
     if expr.is_Add:
         return sp.Add(*(absorb(term) for term in expr.args))
     if not expr.is_Mul:
@@ -111,7 +133,12 @@ def _best(candidates: list[sp.Expr], floor: float) -> sp.Expr:
 def pythagoras(expr: sp.Expr, floor: float = 0.0) -> sp.Expr:
     """``expr`` expanded, reduced with ``sin² + cos² = 1`` of each angle (towards
     whichever of ``sin²`` or ``cos²`` gives the shorter result), terms below ``floor``
-    dropped."""
+    dropped.
+
+    Args:
+        expr: A sympy expression.
+        floor: Terms whose numeric coefficient is below it are dropped.
+    """
     expr = chop(expr, floor)
     angles = {f.args[0] for f in expr.atoms(sp.sin)} & {f.args[0] for f in expr.atoms(sp.cos)}
     for angle in sorted(angles, key=sp.default_sort_key):
@@ -131,7 +158,12 @@ def pythagoras(expr: sp.Expr, floor: float = 0.0) -> sp.Expr:
 
 def completed_square(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
     """``a q² + b q + c`` as ``a (q + b/2a)² + c − b²/4a`` for the first coordinate it is
-    quadratic in (a prismatic joint's ``r = q + offset``), else ``expr``."""
+    quadratic in (a prismatic joint's ``r = q + offset``), else ``expr``.
+
+    Args:
+        expr: A sympy expression.
+        q: The joint position symbols.
+    """
     for variable in q:
         if not expr.has(variable):
             continue
@@ -150,7 +182,13 @@ def completed_square(expr: sp.Expr, q: list[sp.Symbol]) -> sp.Expr:
 
 def coefficient(expr: sp.Expr, q: list[sp.Symbol], floor: float = 0.0) -> sp.Expr:
     """The shortest of several equivalent forms of a function of ``q`` (terms below
-    ``floor`` dropped)."""
+    ``floor`` dropped).
+
+    Args:
+        expr: A sympy expression.
+        q: The joint position symbols.
+        floor: Terms whose numeric coefficient is below it are dropped.
+    """
     reduced = pythagoras(expr, floor)
     if reduced.is_number:
         return reduced
@@ -166,8 +204,13 @@ def coefficient(expr: sp.Expr, q: list[sp.Symbol], floor: float = 0.0) -> sp.Exp
 def entry(expr: sp.Expr, q: list[sp.Symbol], qd: list[sp.Symbol], *, floor: float | None = None) -> sp.Expr:
     """One entry of ``M``, ``C q̇`` or ``G``, chopped and simplified (see the module).
 
-    ``floor``: terms whose numeric coefficient is below it are dropped (default
-    :data:`RELATIVE_ROUND_OFF` of the entry's largest)."""
+    Args:
+        expr: The exact entry.
+        q: The joint position symbols.
+        qd: The joint velocity symbols.
+        floor: Terms whose numeric coefficient is below it are dropped (default
+            :data:`RELATIVE_ROUND_OFF` of the entry's largest).
+    """
     expr = chop(expr, floor)
     floor = RELATIVE_ROUND_OFF * largest_coefficient([expr]) if floor is None else floor
     speeds = [v for v in qd if expr.has(v)]

@@ -4,8 +4,8 @@ Gautier's numerical method. The regressor ``Y`` (:mod:`robodyn.dynamics.regresso
 stacked at ``samples`` random states (``q`` uniform within the joint limits, ``v`` and ``a``
 standard normal) into ``W`` (samples·nv rows), each column scaled to unit length (columns
 of norm ≤ ``tolerance`` times the largest are zero: those parameters do not act on τ).
+Joints whose URDF limits are equal are sampled in [−π, π] (:func:`joint_ranges`).
 
-  Joints whose URDF limits are equal are sampled in [−π, π] (:func:`joint_ranges`).
 - The rank ``r`` comes from a QR decomposition **with column pivoting** of ``W``: the
   number of ``|R_ii|`` above ``tolerance · |R_00|``.
 - The ``r`` independent columns are chosen in the standard order (first body first,

@@ -113,6 +113,9 @@ def exact_number(value: float) -> sp.Rational:
     The float's shortest decimal of up to 15 significant digits (within 1e-15 of it,
     relative) is taken, so ``0.30000000000000004`` is ``3/10``; magnitudes below
     :data:`ROUND_OFF` are 0.
+
+    Args:
+        value: A finite float.
     """
     if not np.isfinite(value):
         raise ValueError(f"not a finite number: {value!r}")
@@ -123,7 +126,11 @@ def exact_number(value: float) -> sp.Rational:
 
 def exact_angle(value: float) -> sp.Expr:
     """An angle in [rad], recognised as a fraction of π (``1.5707963267948966`` is ``π/2``)
-    when within 1e-12 of one with a denominator up to 12, else :func:`exact_number`."""
+    when within 1e-12 of one with a denominator up to 12, else :func:`exact_number`.
+
+    Args:
+        value: The angle in [rad].
+    """
     for denominator in range(1, 13):
         numerator = round(value * denominator / np.pi)
         if numerator and abs(value - numerator * np.pi / denominator) <= 1e-12:
@@ -140,7 +147,13 @@ def _exact(value: float, snap: float) -> sp.Expr:
 
 
 def exact_matrix(values: np.ndarray, snap: float) -> sp.Matrix:
-    """A sympy matrix of numbers, each snapped to an exact value within ``snap``."""
+    """A sympy matrix of numbers, each snapped to an exact value within ``snap``.
+
+    Args:
+        values: The numbers, 1-D (one row) or 2-D.
+        snap: Entries within it of 0, ±½, ±√2/2, ±√3/2 or ±1 become that value (else the
+            rational they were written as).
+    """
     values = np.atleast_2d(values)
     return sp.Matrix(values.shape[0], values.shape[1], lambda i, j: _exact(float(values[i, j]), snap))
 
@@ -149,6 +162,9 @@ def joint_symbols(names: list[str]) -> tuple[list[sp.Symbol], list[sp.Symbol], l
     """Position, velocity and acceleration symbols named after the joints.
 
     A joint ``joint1`` gives ``q_joint1``, ``qd_joint1`` and ``qdd_joint1``.
+
+    Args:
+        names: The joints' names (spaces, ``-`` and ``.`` become ``_``).
     """
     clean = [name.replace(" ", "_").replace("-", "_").replace(".", "_") for name in names]
     return (
@@ -172,7 +188,14 @@ class Parameters:
         self.labels: dict[sp.Symbol, tuple[str, str, str]] = {}
 
     def symbol(self, value: float, kind: str, owner: str = "", component: str = "") -> sp.Expr:
-        """One constant (exact), or its symbol."""
+        """One constant (exact), or its symbol.
+
+        Args:
+            value: The constant.
+            kind: What it is, the symbol's first part (e.g. ``"m"``, ``"I"``, ``"g"``).
+            owner: The link or joint it belongs to.
+            component: Its component (e.g. ``"x"``, ``"xy"``).
+        """
         if not self.keep or value == 0:
             return exact_number(float(value))
         name = "_".join(part for part in (kind, owner, component) if part)
@@ -182,11 +205,22 @@ class Parameters:
         return symbol
 
     def vector(self, values: np.ndarray, kind: str, owner: str) -> sp.Matrix:
-        """A 3-vector (components ``x``, ``y``, ``z``)."""
+        """A 3-vector (components ``x``, ``y``, ``z``).
+
+        Args:
+            values: Its three numbers.
+            kind: What it is (see :meth:`symbol`).
+            owner: The link or joint it belongs to.
+        """
         return sp.Matrix([self.symbol(v, kind, owner, a) for v, a in zip(np.ravel(values), "xyz", strict=True)])
 
     def inertia(self, values: np.ndarray, owner: str) -> sp.Matrix:
-        """A symmetric 3×3 inertia (components ``xx``, ``xy``, ...: one symbol a pair)."""
+        """A symmetric 3×3 inertia (components ``xx``, ``xy``, ...: one symbol a pair).
+
+        Args:
+            values: The 3×3 inertia in [kg m²].
+            owner: The link it belongs to.
+        """
         entries = {}
         for i in range(3):
             for j in range(i, 3):
@@ -195,7 +229,11 @@ class Parameters:
 
     def gravity(self, vector: np.ndarray) -> sp.Matrix:
         """The gravity vector: with ``keep``, ``g`` times an axis when along one, else
-        one symbol ``g_x``, ``g_y``, ``g_z`` a non-zero component."""
+        one symbol ``g_x``, ``g_y``, ``g_z`` a non-zero component.
+
+        Args:
+            vector: World gravity in [m/s²], shape (3,).
+        """
         nonzero = np.flatnonzero(vector)
         if self.keep and len(nonzero) == 1:
             axis = sp.zeros(3, 1)
@@ -261,7 +299,14 @@ def body_poses(
     robot: ReferenceRobot, theta: sp.Matrix, params: Parameters | None = None, *, snap: float = 1e-8
 ) -> tuple[list[sp.Matrix], list[sp.Matrix], list[sp.Matrix]]:
     """World rotation, origin and joint axis of every body frame as functions of the bodies'
-    coordinates ``theta`` (forward kinematics in closed form, exact constants)."""
+    coordinates ``theta`` (forward kinematics in closed form, exact constants).
+
+    Args:
+        robot: The reference robot.
+        theta: Every body's joint coordinate (:func:`body_coordinates`).
+        params: Which constants stay symbols (default: none).
+        snap: Rotation and axis entries within it of 0, ±½, ±√2/2, ±√3/2 or ±1 become that value.
+    """
     params = params or Parameters(False)
     rotations: list[sp.Matrix] = []
     positions: list[sp.Matrix] = []
@@ -284,7 +329,13 @@ def body_poses(
 
 
 def axis_rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
-    """Rodrigues' rotation about a unit ``axis`` by the angle whose cosine is ``c`` and sine ``s``."""
+    """Rodrigues' rotation about a unit ``axis`` by the angle whose cosine is ``c`` and sine ``s``.
+
+    Args:
+        axis: Unit axis, 3×1.
+        c: Cosine of the angle.
+        s: Sine of the angle.
+    """
     x, y, z = axis
     skew = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
     return sp.eye(3) + s * skew + (1 - c) * skew * skew
@@ -292,7 +343,13 @@ def axis_rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
 
 def body_coordinates(robot: ReferenceRobot, q: list[sp.Symbol], qd: list[sp.Symbol]) -> tuple[sp.Matrix, sp.Matrix]:
     """Every body's joint coordinate and speed: ``theta = S q + offset``, ``theta_dot = S q̇``
-    (mimic joints through their exact multiplier and offset)."""
+    (mimic joints through their exact multiplier and offset).
+
+    Args:
+        robot: The reference robot.
+        q: Joint position symbols.
+        qd: Joint velocity symbols.
+    """
     tree = robot.tree
     selection = exact_matrix(tree.selection, 0.0)
     offset = [

@@ -68,21 +68,38 @@ def inverse_dynamics(robot: Robot, q, v, a):
 
 
 def forward_dynamics(robot: Robot, q, v, tau):
-    """Accelerations ``M(q)⁻¹ (tau − C(q, v) v − G(q))``, shape (N, nv)."""
+    """Accelerations ``M(q)⁻¹ (tau − C(q, v) v − G(q))``, shape (N, nv).
+
+    Args:
+        robot: The robot.
+        q: Configurations, shape (N, nq) (numpy or Dask).
+        v: Velocities, shape (N, nv).
+        tau: Joint torques and forces, shape (N, nv), in [N m] / [N].
+    """
     if not _is_dask(q, v, tau):
         return robot.forward_dynamics(q, v, tau)
     return _map(robot, "forward_dynamics", {"q": q, "v": v, "tau": tau}, (robot.nv,))
 
 
 def gravity(robot: Robot, q):
-    """Generalised gravity ``G(q)``, shape (N, nv), in [N m] / [N]."""
+    """Generalised gravity ``G(q)``, shape (N, nv), in [N m] / [N].
+
+    Args:
+        robot: The robot.
+        q: Configurations, shape (N, nq) (numpy or Dask).
+    """
     if not _is_dask(q):
         return robot.gravity(q)
     return _map(robot, "gravity", {"q": q}, (robot.nv,))
 
 
 def mass_matrix(robot: Robot, q):
-    """Mass matrices ``M(q)``, shape (N, nv, nv), in [kg m²] / [kg]."""
+    """Mass matrices ``M(q)``, shape (N, nv, nv), in [kg m²] / [kg].
+
+    Args:
+        robot: The robot.
+        q: Configurations, shape (N, nq) (numpy or Dask).
+    """
     if not _is_dask(q):
         return robot.mass_matrix(q)
     return _map(robot, "mass_matrix", {"q": q}, (robot.nv, robot.nv))

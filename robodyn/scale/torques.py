@@ -37,7 +37,7 @@ class TorquesRun:
         samples: Rows computed; ``chunks``: in how many chunks.
         names: One name a velocity coordinate (``robot.dofs``: ``base.x`` … for a base).
         units: Unit of each one's effort (``"N m"`` or ``"N"``).
-        peak: Largest |tau| of each, in ``units``; ``rms``: root mean square of tau.
+        peak: Largest ``|tau|`` of each, in ``units``; ``rms``: root mean square of tau.
         out: The file written, if any.
     """
 

@@ -17,9 +17,8 @@ continuously (``simulate`` without ``hold``). The wrong one leaves an error of a
 ``Δτ / 2`` per step in the estimate of a fast-changing torque.
 
 From the residual: the wrench at a frame (:func:`external_wrench`, ``F = (Jᵀ)⁺ r``) and
-collision detection (:func:`detect_collision`: when the first ``|r_i|`` crosses its
-threshold, and the last joint whose residual is significant — a force on a link moves
-only the joints before it, so that joint's child link is the one that was hit).
+collision detection (:func:`detect_collision`), both in :mod:`robodyn.sim.collision`
+(re-exported here).
 :func:`observe_file` does all of it for a trajectory file (``robodyn observe``) and returns
 an :class:`ObservationRun`.
 """
@@ -37,6 +36,7 @@ from robodyn.common.files import atomic_write_text
 from robodyn.common.text import counted, printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.collision import Collision, detect_collision, external_wrench
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.io import csv_preamble, format_rows, read_extra
 
@@ -162,6 +162,13 @@ class MomentumObserver:
     def update(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Take one sample and return the estimate ``r`` (nv,) in [N m] / [N].
 
+        Args:
+            t: The sample's time in [s], after the previous one's.
+            q: Configuration, shape (nq,).
+            v: Velocity, shape (nv,).
+            tau: The motor torque given with this sample (read as :attr:`torque` says),
+                shape (nv,), in [N m] / [N].
+
         Raises:
             InputError: A time not after the previous sample's (e.g. the intermediate
                 calls of a Runge–Kutta step: simulate with ``hold=True``).
@@ -187,7 +194,11 @@ class MomentumObserver:
         return residual
 
     def wrap(self, controller: Callable[[float, np.ndarray, np.ndarray], np.ndarray]) -> Callable:
-        """A controller that also feeds this observer each sample and the torque it applies."""
+        """A controller that also feeds this observer each sample and the torque it applies.
+
+        Args:
+            controller: Called as ``controller(t, q, v)``, returning the torque (nv,).
+        """
 
         def observed(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
             tau = np.asarray(controller(t, q, v), dtype=float)
@@ -195,76 +206,6 @@ class MomentumObserver:
             return tau
 
         return observed
-
-
-def external_wrench(robot: Robot, q: np.ndarray, residual: np.ndarray, frame: str) -> np.ndarray:
-    """The wrench at a frame's origin that explains external joint torques: ``(Jᵀ)⁺ r``.
-
-    Exact when the torques come from a wrench at that frame and ``Jᵀ`` has full column
-    rank (six joints or more before the frame, away from singularities); otherwise the
-    least-squares wrench of least norm.
-
-    Args:
-        robot: The robot.
-        q: Configuration(s), shape (nq,) or (N, nq).
-        residual: External torques, shape (nv,) or (N, nv).
-        frame: The frame whose wrench is wanted.
-
-    Returns:
-        Force in [N] then torque in [N m], world axes: shape (6,) or (N, 6).
-    """
-    jacobian = robot.frame_jacobian(q, robot.task_frame(frame, "an external wrench"))
-    residual = np.asarray(residual, dtype=float)
-    return np.einsum("...ij,...j->...i", np.linalg.pinv(np.swapaxes(jacobian, -1, -2), rcond=1e-10), residual)
-
-
-@dataclass(frozen=True)
-class Collision:
-    """A detected contact.
-
-    Attributes:
-        time: First time a residual crossed its threshold, in [s].
-        index: Index in ``v`` of the last joint whose residual was significant.
-        dof: That degree of freedom's name (``robot.dofs``).
-        peak: Largest ``|r_i|`` of each joint over the contact, shape (nv,).
-    """
-
-    time: float
-    index: int
-    dof: str
-    peak: np.ndarray
-
-
-def detect_collision(robot: Robot, t: np.ndarray, residual: np.ndarray, threshold: float | np.ndarray) -> Collision | None:
-    """The first contact in an observer's residual, and which joint's link it hit.
-
-    The contact starts when some ``|r_i|`` first exceeds its threshold and lasts while any
-    does; the joint reported is the last one whose ``|r_i|`` exceeded its threshold during
-    it (a wrench on a link produces torques at the joints before it only).
-
-    Args:
-        robot: The robot (for the joints' names).
-        t: Times in [s], shape (N,).
-        residual: The observer's estimate, shape (N, nv).
-        threshold: In [N m] / [N], scalar or (nv,), positive.
-
-    Returns:
-        The contact, or ``None`` when no residual crosses its threshold.
-    """
-    residual = np.abs(np.asarray(residual, dtype=float))
-    limits = np.broadcast_to(np.asarray(threshold, dtype=float), (robot.nv,))
-    if not (np.isfinite(limits).all() and (limits > 0).all()):
-        raise InputError("threshold", f"a positive scalar or {robot.nv} positive values in [N m] / [N]", repr(threshold))
-    above = residual > limits
-    hits = np.flatnonzero(above.any(axis=1))
-    if hits.size == 0:
-        return None
-    start = int(hits[0])
-    quiet = np.flatnonzero(~above[start:].any(axis=1))
-    end = start + int(quiet[0]) if quiet.size else len(residual)
-    peak = residual[start:end].max(axis=0)
-    index = int(np.flatnonzero(peak > limits)[-1])
-    return Collision(float(t[start]), index, robot.dofs[index].name, peak)
 
 
 #: Column names of the wrench at a frame in ``robodyn observe``'s output: [N], then [N m].

@@ -151,10 +151,10 @@ class SimulationSummary:
         joint_names: The robot's joints; ``dof_names``: one name a velocity coordinate
             (``robot.dofs``: ``base.x`` … ``base.rz`` for a floating base).
         final_q: The last configuration, shape (nq,).
-        peak_abs_torque: Largest |tau| of each coordinate, in ``torque_units`` (N m or N).
+        peak_abs_torque: Largest ``|tau|`` of each coordinate, in ``torque_units`` (N m or N).
         energy_change: Total energy at the end minus at the start, in [J].
         task: Where a task-space run left its frame (``None`` for other controllers).
-        final_joint_error: Largest |q − target| at the end (pd, computed torque), rad or m.
+        final_joint_error: Largest ``|q − target|`` at the end (pd, computed torque), rad or m.
         pushes: The pushes applied during the run.
         observer: What a momentum observer run along estimated (``None`` without one).
         violations: Every limit the run broke (none with ``limits="ignore"``).

@@ -55,7 +55,12 @@ def coordinate_names(joint_names: list[str], floating_base: bool) -> tuple[list[
 
 
 def coordinate_names_to_joints(v_names: list[str], floating_base: bool) -> list[str]:
-    """``Robot.joint_names`` from velocity coordinate names (inverse of :func:`coordinate_names`)."""
+    """``Robot.joint_names`` from velocity coordinate names (inverse of :func:`coordinate_names`).
+
+    Args:
+        v_names: The velocity coordinates' names (a floating base's six first).
+        floating_base: Whether the first joint is a free-flyer.
+    """
     return [ROOT_JOINT, *v_names[len(BASE_V_NAMES) :]] if floating_base else list(v_names)
 
 
@@ -82,7 +87,12 @@ def contact_columns(header: list[str], table: np.ndarray, contacts: list[str]) -
 
 
 def short_list(names: list[str], limit: int = 4) -> str:
-    """The first ``limit`` names (escaped), and how many more."""
+    """The first ``limit`` names (escaped), and how many more.
+
+    Args:
+        names: The names.
+        limit: How many to show.
+    """
     shown = ", ".join(printable(name) for name in names[:limit])
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
 

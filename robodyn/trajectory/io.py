@@ -29,7 +29,12 @@ _NPZ_NAMES = ("t", "q_names", "v_names", "joint_names", "robot")
 
 
 def csv_preamble(robot: str, header: list[str]) -> str:
-    """The comment line and the header line of a CSV trajectory."""
+    """The comment line and the header line of a CSV trajectory.
+
+    Args:
+        robot: The robot's name (line breaks and ``;`` become spaces in the comment line).
+        header: The column names.
+    """
     name = robot.replace("\n", " ").replace("\r", " ").replace(";", " ")
     line = io.StringIO()
     csv.writer(line, lineterminator="\n").writerow(header)  # names with commas or quotes are quoted
@@ -37,7 +42,11 @@ def csv_preamble(robot: str, header: list[str]) -> str:
 
 
 def format_rows(table: np.ndarray) -> str:
-    """CSV rows, each number written so that it reads back exactly (``repr``)."""
+    """CSV rows, each number written so that it reads back exactly (``repr``).
+
+    Args:
+        table: The samples, shape (N, columns).
+    """
     return "".join(",".join(map(repr, row)) + "\n" for row in table.tolist())
 
 
@@ -82,6 +91,9 @@ def write_npz(
 def read_table(path: Path) -> tuple[np.ndarray, Layout, str]:
     """Read a trajectory file (``.csv``, ``.npz``; ``.parquet`` with pyarrow installed).
 
+    Args:
+        path: The file.
+
     Returns:
         ``(table, layout, robot)``: the samples (N, layout.width), their columns, the robot's
         name ("" when the file does not say).
@@ -109,6 +121,10 @@ def read_table(path: Path) -> tuple[np.ndarray, Layout, str]:
 
 def read_csv_header(stream: TextIO, source: str) -> tuple[list[str], str, int]:
     """Read the comment and header lines of an open CSV file.
+
+    Args:
+        stream: The file, at its start.
+        source: Its name, for errors.
 
     Returns:
         The column names, the robot name ("" if no comment line) and the number of lines read.

@@ -11,8 +11,9 @@ Conventions:
     - a joint has one colour in every panel; the legend sits outside the data;
     - position and effort limits are drawn as a light band in the joint's colour (with
       dashed edges), and the axis is widened to show a limit close to the motion;
-    - :func:`text_overlaps` finds text that collides or leaves the figure (the tests run it
-      on every figure; :func:`whatif_figure` uses it to tilt crowded tick labels).
+    - :func:`text_overlaps` (:mod:`robodyn.viz.layout`, re-exported here) finds text that
+      collides or leaves the figure (the tests run it on every figure;
+      :func:`whatif_figure` uses it to tilt crowded tick labels).
 """
 
 from __future__ import annotations
@@ -22,37 +23,50 @@ import re
 from pathlib import Path
 
 import numpy as np
-from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.text import Text
-from matplotlib.transforms import Bbox
 
 from robodyn.common.files import atomic_write_bytes
 from robodyn.dynamics.dofs import Dof
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import ViewerError
 from robodyn.trajectory import Trajectory
+from robodyn.viz.layout import text_boxes as text_boxes  # re-exported
+from robodyn.viz.layout import text_overlaps
 
 DPI = 110
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 
 
 def text_label(name: str) -> str:
-    """A name as matplotlib draws it literally: ``$`` escaped (no mathtext), control characters as ``?``."""
+    """A name as matplotlib draws it literally: ``$`` escaped (no mathtext), control characters as ``?``.
+
+    Args:
+        name: A joint's or frame's name (from the robot's file).
+    """
     return _CONTROL.sub("?", str(name)).replace("$", r"\$")
 
 
 def new_figure(width: float, height: float) -> Figure:
-    """A figure with constrained layout on its own Agg canvas (sizes in [inch])."""
+    """A figure with constrained layout on its own Agg canvas.
+
+    Args:
+        width: In [inch].
+        height: In [inch].
+    """
     figure = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
     FigureCanvasAgg(figure)
     return figure
 
 
 def save_png(figure: Figure, path: str | Path) -> Path | None:
-    """Write a figure as PNG, atomically; the file written, ``None`` for standard output (``-``)."""
+    """Write a figure as PNG, atomically; the file written, ``None`` for standard output (``-``).
+
+    Args:
+        figure: The figure.
+        path: The PNG file, or ``-`` for standard output.
+    """
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=DPI)
     return atomic_write_bytes(path, buffer.getvalue())
@@ -190,7 +204,12 @@ def _energy_panel(axis: Axes, robot: Robot, trajectory: Trajectory) -> None:
 def plot_simulation(
     robot: Robot, trajectory: Trajectory, path: str | Path, *, frame: str | None = None, target: np.ndarray | None = None
 ) -> Path | None:
-    """Write :func:`simulation_figure` as a PNG (atomically) and return its path (``None`` for ``-``)."""
+    """Write :func:`simulation_figure` as a PNG (atomically) and return its path (``None`` for ``-``).
+
+    Args:
+        path: The PNG file, or ``-`` for standard output; the other arguments are
+            :func:`simulation_figure`'s.
+    """
     return save_png(simulation_figure(robot, trajectory, frame=frame, target=target), path)
 
 
@@ -266,85 +285,13 @@ def _whatif_limit(axis: Axes, top: float, limit: float, unit: str) -> None:
 
 
 def plot_whatif(rows, joint_names: list[str], units: list[str], path: str | Path, **options) -> Path | None:
-    """Write :func:`whatif_figure` as a PNG (atomically) and return its path (``None`` for ``-``)."""
-    return save_png(whatif_figure(rows, joint_names, units, **options), path)
-
-
-# --------------------------------------------------------------------------------------
-# Layout check: text that collides or leaves the figure
-# --------------------------------------------------------------------------------------
-def _visible_ticks(axis) -> list:
-    low, high = sorted(axis.get_view_interval())
-    tolerance = 1e-9 * (high - low)
-    locations = axis.get_majorticklocs()
-    labels = []
-    for tick, location in zip(axis.get_major_ticks(len(locations)), locations, strict=True):
-        if low - tolerance <= location <= high + tolerance:
-            labels += [label for label in (tick.label1, tick.label2) if label.get_visible() and label.get_text()]
-    return labels
-
-
-def text_boxes(figure: Figure) -> list[tuple[str, Bbox]]:
-    """Every visible text and legend of a figure with its box in display pixels (draws it)."""
-    canvas = figure.canvas if isinstance(figure.canvas, FigureCanvasAgg) else FigureCanvasAgg(figure)
-    canvas.draw()
-    renderer = canvas.get_renderer()
-    boxes: list[tuple[str, Artist]] = []
-    for number, axis in enumerate(figure.axes):
-        if not axis.get_visible():
-            continue
-        texts = [
-            ("title", axis.title),
-            ("xlabel", axis.xaxis.label),
-            ("ylabel", axis.yaxis.label),
-            ("x offset", axis.xaxis.get_offset_text()),
-            ("y offset", axis.yaxis.get_offset_text()),
-            *(("text", text) for text in axis.texts),
-        ]
-        texts += [("x tick", label) for label in _visible_ticks(axis.xaxis)]
-        texts += [("y tick", label) for label in _visible_ticks(axis.yaxis)]
-        boxes += [(f"axes {number} {kind} {artist.get_text()!r}", artist) for kind, artist in texts]
-        legend = axis.get_legend()
-        if legend is not None:
-            boxes.append((f"axes {number} legend", legend))
-    boxes += [(f"figure legend {i}", legend) for i, legend in enumerate(figure.legends)]
-    # Figure._suptitle (private, not in the stubs) is the Text that suptitle() made
-    suptitle: Text | None = getattr(figure, "_suptitle", None)
-    boxes += [(f"figure text {text.get_text()!r}", text) for text in figure.texts if text is not suptitle]
-    if suptitle is not None:
-        boxes.append((f"suptitle {suptitle.get_text()!r}", suptitle))
-    found = []
-    for name, artist in boxes:
-        if artist.get_visible() and (not hasattr(artist, "get_text") or artist.get_text()):
-            found.append((name, artist.get_window_extent(renderer)))
-    return found
-
-
-def text_overlaps(figure: Figure, *, tolerance: float = 0.5) -> list[tuple[str, str]]:
-    """Pairs of texts/legends whose boxes intersect, legends over a plot, text cut off.
+    """Write :func:`whatif_figure` as a PNG (atomically) and return its path (``None`` for ``-``).
 
     Args:
-        figure: The figure (it is drawn to measure).
-        tolerance: Overlap in [pixel] forgiven on each side.
-
-    Returns:
-        ``(a, b)`` descriptions of each problem; empty for a clean layout.
+        path: The PNG file, or ``-`` for standard output; the other arguments are
+            :func:`whatif_figure`'s.
     """
-    boxes = text_boxes(figure)
-    problems = []
-    for i, (name_a, a) in enumerate(boxes):
-        shrunk = Bbox.from_extents(a.x0 + tolerance, a.y0 + tolerance, a.x1 - tolerance, a.y1 - tolerance)
-        for name_b, b in boxes[i + 1 :]:
-            if shrunk.overlaps(b):
-                problems.append((name_a, name_b))
-        if a.x0 < -tolerance or a.y0 < -tolerance or a.x1 > figure.bbox.x1 + tolerance or a.y1 > figure.bbox.y1 + tolerance:
-            problems.append((name_a, "the figure's edge"))
-    for name, box in boxes:
-        if "legend" in name:
-            for number, axis in enumerate(figure.axes):
-                if box.overlaps(axis.get_window_extent()):
-                    problems.append((name, f"axes {number} data"))
-    return problems
+    return save_png(whatif_figure(rows, joint_names, units, **options), path)
 
 
 def external_torques_figure(
@@ -402,5 +349,10 @@ def plot_external_torques(
     *,
     gain: float | None = None,
 ) -> Path | None:
-    """Write :func:`external_torques_figure` as a PNG (atomically); ``None`` for ``-``."""
+    """Write :func:`external_torques_figure` as a PNG (atomically); ``None`` for ``-``.
+
+    Args:
+        path: The PNG file, or ``-`` for standard output; the other arguments are
+            :func:`external_torques_figure`'s.
+    """
     return save_png(external_torques_figure(t, estimate, applied, dof_names, units, gain=gain), path)

@@ -35,6 +35,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn check`` with the parsed ``arguments``; return the exit status."""
     from robodyn.common.text import printable, printable_lines
     from robodyn.verify.check import check_robot
 

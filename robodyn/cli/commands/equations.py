@@ -147,6 +147,7 @@ def _export(arguments: argparse.Namespace) -> int:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn equations`` with the parsed ``arguments``; return the exit status."""
     if arguments.base_parameters:
         return _base_parameters(arguments)
     if arguments.format in ("casadi", "jax"):

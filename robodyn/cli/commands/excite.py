@@ -30,6 +30,7 @@ def _limit(values: list[float] | None):
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn excite`` with the parsed ``arguments``; return the exit status."""
     from robodyn.ident.run import excite_run
 
     run = excite_run(

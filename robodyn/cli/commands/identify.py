@@ -40,6 +40,7 @@ def _links(text: str) -> list[str]:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn identify`` with the parsed ``arguments``; return the exit status."""
     from robodyn.ident import base_parameters
     from robodyn.ident.render import render_base_parameters
     from robodyn.ident.run import identify_run

@@ -18,6 +18,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn info`` with the parsed ``arguments``; return the exit status."""
     robot = load_robot(arguments)
     if arguments.json:
         print(json_text(report.info_dict(robot)))

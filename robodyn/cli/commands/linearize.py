@@ -32,6 +32,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn linearize`` with the parsed ``arguments``; return the exit status."""
     from robodyn.sim.linearize import actuation_matrix, linearization
 
     robot = load_robot(arguments)

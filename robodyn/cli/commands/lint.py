@@ -22,6 +22,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn lint`` with the parsed ``arguments``; return the exit status."""
     from robodyn.urdf.sources import lint_source
 
     problems = lint_source(

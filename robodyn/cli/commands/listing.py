@@ -16,6 +16,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn list`` with the parsed ``arguments``; return the exit status."""
     from robodyn.urdf.models import GENERATED
     from robodyn.urdf.zoo import ZOO
 

@@ -32,6 +32,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn observe`` with the parsed ``arguments``; return the exit status."""
     from robodyn.viz.experiment import run_observation
 
     observed = run_observation(

@@ -35,6 +35,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn optimize`` with the parsed ``arguments``; return the exit status."""
     from robodyn.common.text import printable
     from robodyn.optimize import point_to_point
 

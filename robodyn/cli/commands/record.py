@@ -37,6 +37,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn record`` with the parsed ``arguments``; return the exit status."""
     from robodyn.exceptions import MeshWarning
     from robodyn.trajectory import Trajectory
     from robodyn.viz.experiment import record_files

@@ -81,6 +81,7 @@ def _reference(arguments: argparse.Namespace) -> dict:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn simulate`` with the parsed ``arguments``; return the exit status."""
     from robodyn.sim.report import seconds_since_process_start
     from robodyn.viz.experiment import run_experiment
 

@@ -45,6 +45,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn torques`` with the parsed ``arguments``; return the exit status."""
     from robodyn.scale.torques import torques_run
 
     robot = load_robot(arguments)

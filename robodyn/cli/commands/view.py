@@ -19,6 +19,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn view`` with the parsed ``arguments``; return the exit status."""
     from robodyn.trajectory import Trajectory
     from robodyn.viz.live import LiveViewer, wait
 

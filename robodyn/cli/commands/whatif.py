@@ -31,6 +31,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """Run ``robodyn whatif`` with the parsed ``arguments``; return the exit status."""
     from robodyn.viz.experiment import run_whatif
 
     if arguments.force and len(arguments.force) != 3:
