@@ -35,8 +35,4 @@ napoleon_use_ivar = True
 templates_path = ["_templates"]
 exclude_patterns = ["_build", "generated/*.rst.tmp"]
 html_theme = "alabaster"
-# Known and accepted: a type hint ``Robot`` has two targets, robodyn.dynamics.robot.Robot and
-# the Protocol of robodyn.dynamics.mujoco_state (named Robot too); Sphinx links one and warns.
-# Renaming that Protocol (e.g. RobotLike) lets this line go.
-suppress_warnings = ["ref.python"]
 html_title = "robodyn API reference"

@@ -32,7 +32,7 @@ from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
 
 
-class Robot(Protocol):
+class RobotLike(Protocol):
     """What of a :class:`robodyn.Robot` the conversion reads (the robot module calls this one)."""
 
     nq: int
@@ -45,7 +45,7 @@ class Robot(Protocol):
     options: LoadOptions
 
 
-def mujoco_joint_order(robot: Robot, joint_names: Sequence[str] | None = None) -> list[str]:
+def mujoco_joint_order(robot: RobotLike, joint_names: Sequence[str] | None = None) -> list[str]:
     """MuJoCo's order of the robot's moving joints (the free joint not included).
 
     Args:
@@ -74,7 +74,7 @@ def mujoco_joint_order(robot: Robot, joint_names: Sequence[str] | None = None) -
     return names
 
 
-def _layout(robot: Robot, joint_names: Sequence[str] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+def _layout(robot: RobotLike, joint_names: Sequence[str] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """Indices into robodyn's q and v of MuJoCo's joint entries, their ``ref`` offsets, and
     the free joint's size in qpos (0 or 7)."""
     order = mujoco_joint_order(robot, joint_names)
@@ -85,7 +85,7 @@ def _layout(robot: Robot, joint_names: Sequence[str] | None) -> tuple[np.ndarray
 
 
 def to_mujoco(
-    robot: Robot, q: np.ndarray, v: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None
+    robot: RobotLike, q: np.ndarray, v: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """MuJoCo's ``qpos`` and ``qvel`` of robodyn's ``q`` and ``v`` (see the module).
 
@@ -119,7 +119,7 @@ def to_mujoco(
 
 
 def from_mujoco(
-    robot: Robot, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None
+    robot: RobotLike, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """robodyn's ``q`` and ``v`` of MuJoCo's ``qpos`` and ``qvel`` (see the module).
 

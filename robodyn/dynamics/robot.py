@@ -23,16 +23,13 @@ the functions of the handle in :mod:`~robodyn.dynamics.kinematics`,
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from robodyn.constraints import Constraint, from_equalities
-from robodyn.dynamics import centroidal, configurations, constrained, derivatives, energies, frames, kinematics, mujoco_state
-from robodyn.dynamics import regressor as identification
+from robodyn.dynamics import frames
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
 from robodyn.dynamics.dofs import Dof, configuration_names, robot_dofs
@@ -42,12 +39,16 @@ from robodyn.dynamics.joints import JointInfo
 from robodyn.dynamics.kernels import massless_joints
 from robodyn.dynamics.mimic import MimicExpansion
 from robodyn.dynamics.options import LoadOptions
+from robodyn.dynamics.robot_constraints import RobotConstraints
+from robodyn.dynamics.robot_derivatives import RobotDerivatives
+from robodyn.dynamics.robot_exchange import RobotExchange
+from robodyn.dynamics.robot_kinematics import RobotKinematics
 from robodyn.exceptions import NonFiniteResultError, SingularMassMatrixError
 from robodyn.urdf.sources import URDFSource
 from robodyn.urdf.validation import URDFSpec
 
 
-class Robot:
+class Robot(RobotDerivatives, RobotKinematics, RobotConstraints, RobotExchange):
     """A rigid-body robot and its dynamics (RNEA, CRBA, ABA through Pinocchio).
 
     Build one with :func:`robodyn.load`. The Pinocchio model is available as
@@ -340,253 +341,6 @@ class Robot:
             Shape (nv,) or (N, nv), in [N m] / [N].
         """
         return self.handle.calls.nle(q, v)
-
-    # ----------------------------------------------------------------------------------
-    # Derivatives (robodyn.dynamics.derivatives): q columns in the tangent space
-    # ----------------------------------------------------------------------------------
-    def inverse_dynamics_derivatives(
-        self, q: np.ndarray, v: np.ndarray, a: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M)`` of inverse dynamics (Pinocchio's analytical RNEA
-        derivatives; :func:`robodyn.dynamics.derivatives.inverse_dynamics_derivatives`).
-
-        Derivatives in ``q`` are along :meth:`integrate` (Pinocchio's convention: the
-        floating base's six columns are its displacements in the base frame).
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq).
-            v: Velocity, shape (nv,) or (N, nv).
-            a: Acceleration, shape (nv,) or (N, nv).
-
-        Returns:
-            Three arrays of shape (nv, nv) or (N, nv, nv), in SI units (torque per unit of
-            the coordinate).
-        """
-        return derivatives.inverse_dynamics_derivatives(self.handle, q, v, a)
-
-    def forward_dynamics_derivatives(
-        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹)`` of forward dynamics (Pinocchio's analytical ABA
-        derivatives; :func:`robodyn.dynamics.derivatives.forward_dynamics_derivatives`).
-
-        Derivatives in ``q`` are along :meth:`integrate`, as for
-        :meth:`inverse_dynamics_derivatives`.
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq).
-            v: Velocity, shape (nv,) or (N, nv).
-            tau: Torques in [N m] / [N], shape (nv,) or (N, nv).
-
-        Returns:
-            Three arrays of shape (nv, nv) or (N, nv, nv), in SI units.
-
-        Raises:
-            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
-        """
-        return derivatives.forward_dynamics_derivatives(self.handle, q, v, tau)
-
-    # ----------------------------------------------------------------------------------
-    # Energies (robodyn.dynamics.energies)
-    # ----------------------------------------------------------------------------------
-    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
-        """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch."""
-        return energies.kinetic_energy(self.handle, q, v)
-
-    def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
-        """Gravitational potential energy ``−Σ m_i gᵀ p_i`` in [J]: a float, or shape (N,).
-
-        Zero when every centre of mass is at height zero (for the default gravity).
-        """
-        return energies.potential_energy(self.handle, q)
-
-    # ----------------------------------------------------------------------------------
-    # Kinematics (robodyn.dynamics.kinematics)
-    # ----------------------------------------------------------------------------------
-    @property
-    def frame_names(self) -> list[str]:
-        """Names of every frame: links, joints and fixed frames of the URDF."""
-        return list(self.handle.frames)
-
-    @property
-    def frame_ids(self) -> dict[str, int]:
-        """Pinocchio index of every frame, by name (a copy)."""
-        return dict(self.handle.frames)
-
-    def frame_id(self, frame: str) -> int:
-        """Pinocchio index of a frame (link, joint or fixed frame) by name.
-
-        Raises:
-            FrameError: If the robot has no such frame (with the closest names).
-        """
-        return kinematics.frame_id(self.handle, frame)
-
-    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Position of a frame's origin in the world frame, shape (3,) or (N, 3), in [m]
-        (:func:`robodyn.dynamics.kinematics.frame_position`)."""
-        return kinematics.frame_position(self.handle, q, frame)
-
-    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Jacobian of a frame, shape (6, nv) or (N, 6, nv): linear rows then angular, in
-        world-aligned axes at the frame's origin (:func:`robodyn.dynamics.kinematics.frame_jacobian`)."""
-        return kinematics.frame_jacobian(self.handle, q, frame)
-
-    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str) -> np.ndarray:
-        """``J̇(q, v) v`` of a frame's origin, world axes, shape (3,), in [m/s²]
-        (:func:`robodyn.dynamics.kinematics.frame_bias_acceleration`)."""
-        return kinematics.frame_bias_acceleration(self.handle, q, v, frame)
-
-    def wrench_torques(self, q: np.ndarray, frame: str, wrench: np.ndarray) -> np.ndarray:
-        """Joint torques ``J(q)ᵀ w`` of a wrench (force [N], torque [N m], world axes) on a
-        frame's origin, shape (nv,) (:func:`robodyn.dynamics.kinematics.wrench_torques`)."""
-        return kinematics.wrench_torques(self.handle, q, frame, wrench)
-
-    def integrate(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
-        """The configuration reached from ``q`` along the velocity ``dq`` in unit time
-        (:func:`robodyn.dynamics.kinematics.integrate`: SE(3) for a floating base)."""
-        return kinematics.integrate(self.handle, q, dq)
-
-    # ----------------------------------------------------------------------------------
-    # Limits and configurations (robodyn.dynamics.configurations)
-    # ----------------------------------------------------------------------------------
-    @property
-    def lower_limits(self) -> np.ndarray:
-        """Lower position limits per degree of freedom, shape (nv,), in [rad] or [m].
-
-        The six base coordinates of a floating base are unlimited (-inf).
-        """
-        return configurations.lower_limits(self.dofs)
-
-    @property
-    def upper_limits(self) -> np.ndarray:
-        """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m]."""
-        return configurations.upper_limits(self.dofs)
-
-    def neutral_configuration(self) -> np.ndarray:
-        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
-        return configurations.neutral_configuration(self.handle)
-
-    def default_configuration(self) -> np.ndarray:
-        """The neutral configuration clipped into the joint position limits, shape (nq,)
-        (:func:`robodyn.dynamics.configurations.default_configuration`)."""
-        return configurations.default_configuration(self.handle, self.dofs)
-
-    def physical_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        """Position limits of the joints (floating base excluded), placeholders and empty
-        ranges as ±inf: ``(lower, upper)``, each of shape (nv,) or (nv − 6,)
-        (:func:`robodyn.dynamics.configurations.physical_limits`)."""
-        return configurations.physical_limits(self.dofs)
-
-    def floating_configuration(self, position, rpy, joints=None) -> np.ndarray:
-        """A floating-base ``q`` (nq,) from the base position in [m], its roll, pitch, yaw
-        in [rad] and the joint positions (default zeros)
-        (:func:`robodyn.dynamics.configurations.floating_configuration`).
-
-        Raises:
-            InputError: For a fixed-base robot or wrong sizes.
-        """
-        return configurations.floating_configuration(self.handle, position, rpy, joints)
-
-    def random_configuration(self, rng: np.random.Generator, count: int | None = None) -> np.ndarray:
-        """Configurations drawn uniformly within the joint limits, in a physical range,
-        shape (nq,) or (count, nq) (:func:`robodyn.dynamics.configurations.random_configuration`).
-
-        Raises:
-            InputError: If ``count`` is not a non-negative integer.
-        """
-        return configurations.random_configuration(self.handle, self.dofs, rng, count)
-
-    # ----------------------------------------------------------------------------------
-    # Identification (robodyn.dynamics.regressor)
-    # ----------------------------------------------------------------------------------
-    def regressor(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, friction: bool = False) -> np.ndarray:
-        """The inertial-parameter regressor ``Y`` with ``Y @ inertial_parameters() == tau``.
-
-        Per body (the links that move): m, m·c (3), inertia about the body origin in the
-        body frame (Ixx, Ixy, Iyy, Ixz, Iyz, Izz); optional viscous and Coulomb friction
-        columns per degree of freedom. See :func:`robodyn.dynamics.regressor.regressor`.
-
-        Returns:
-            Shape (nv, 10·n_bodies [+ 2·nv]) or (N, nv, …) for a batch.
-        """
-        return identification.regressor(self.handle, q, v, a, friction=friction)
-
-    def inertial_parameters(self, *, friction: bool = False) -> np.ndarray:
-        """The URDF's standard inertial parameters π, in :meth:`regressor`'s order."""
-        return identification.inertial_parameters(self.handle, friction=friction)
-
-    # ----------------------------------------------------------------------------------
-    # Constraints (robodyn.dynamics.constrained; the rows: robodyn.constraints.algebra).
-    # ``constraints=None``: the robot's own (:attr:`constraints`).
-    # ----------------------------------------------------------------------------------
-    @property
-    def constraints(self) -> tuple[Constraint, ...]:
-        """The robot's constraints: its file's (MJCF ``<equality>``), then ``load(constraints=)``'s."""
-        return (*from_equalities(self.source.equalities), *self.options.constraints)
-
-    def constrained_forward_dynamics(
-        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, constraints: object = None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """``(a, λ)`` of ``M a + C v + G = tau + Jᵀ λ``, ``J a + J̇ v = 0`` (contacts bilateral;
-        ``λ`` least-norm for a redundant set), shapes (nv,), (m,) or (N, nv), (N, m)
-        (:func:`robodyn.dynamics.constrained.forward_dynamics`)."""
-        return constrained.forward_dynamics(self, q, v, tau, constraints)
-
-    def contact_inverse_dynamics(
-        self, q: np.ndarray, v: np.ndarray, a: np.ndarray, constraints: object = None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """``(tau, λ)``: the least-norm ``λ`` that carries the unactuated coordinates, ``tau``
-        the rest (:func:`robodyn.dynamics.constrained.contact_inverse_dynamics`)."""
-        return constrained.contact_inverse_dynamics(self, q, v, a, constraints)
-
-    def constraint_jacobian(self, q: np.ndarray, constraints: object = None) -> np.ndarray:
-        """``J(q)``, shape (m, nv) or (N, m, nv) (:func:`robodyn.dynamics.constrained.constraint_jacobian`)."""
-        return constrained.constraint_jacobian(self, q, constraints)
-
-    def constraint_drift(self, q: np.ndarray, v: np.ndarray, constraints: object = None) -> np.ndarray:
-        """``J̇(q, v) v``, shape (m,) or (N, m) (:func:`robodyn.dynamics.constrained.constraint_drift`)."""
-        return constrained.constraint_drift(self, q, v, constraints)
-
-    def constraint_residual(self, q: np.ndarray, constraints: object = None) -> np.ndarray:
-        """``Φ(q)`` in [m] / [rad], shape (m,) or (N, m) (:func:`robodyn.dynamics.constrained.constraint_residual`)."""
-        return constrained.constraint_residual(self, q, constraints)
-
-    def constraint_rank(self, q: np.ndarray, constraints: object = None) -> int:
-        """Independent rows of the constraints at ``q`` (nq,) (:func:`robodyn.dynamics.constrained.constraint_rank`)."""
-        return constrained.constraint_rank(self, q, constraints)
-
-    # ----------------------------------------------------------------------------------
-    # MuJoCo's state (robodyn.dynamics.mujoco_state)
-    # ----------------------------------------------------------------------------------
-    def to_mujoco(self, q: np.ndarray, v: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
-        """MuJoCo's ``(qpos, qvel)`` of ``(q, v)``: joints by name in MuJoCo's order, ``ref``
-        offsets, the free joint's w-first quaternion and world linear velocity. See
-        :mod:`robodyn.dynamics.mujoco_state` (``joint_names``: MuJoCo's order, needed
-        unless the robot was read from MJCF)."""
-        return mujoco_state.to_mujoco(self, q, v, joint_names=joint_names)
-
-    def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
-        """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`)."""
-        return mujoco_state.from_mujoco(self, qpos, qvel, joint_names=joint_names)
-
-    # ----------------------------------------------------------------------------------
-    # Centroidal quantities (robodyn.dynamics.centroidal)
-    # ----------------------------------------------------------------------------------
-    def center_of_mass(self, q: np.ndarray) -> np.ndarray:
-        """The moving bodies' centre of mass (a floating robot's: all of it) in [m], world
-        axes, shape (3,) or (N, 3)
-        (:func:`robodyn.dynamics.centroidal.center_of_mass`)."""
-        return centroidal.center_of_mass(self.handle, q)
-
-    def centroidal_momentum(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Linear [kg m/s] then angular momentum about the centre of mass [kg m²/s], world
-        axes, shape (6,) or (N, 6) (:func:`robodyn.dynamics.centroidal.centroidal_momentum`)."""
-        return centroidal.centroidal_momentum(self.handle, q, v)
-
-    def centroidal_momentum_matrix(self, q: np.ndarray) -> np.ndarray:
-        """``A_G(q)`` with ``h = A_G v``, shape (6, nv) or (N, 6, nv)
-        (:func:`robodyn.dynamics.centroidal.centroidal_momentum_matrix`)."""
-        return centroidal.centroidal_momentum_matrix(self.handle, q)
 
 
 def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:
