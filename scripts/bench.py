@@ -1232,6 +1232,68 @@ def bench_compiled_floating(quick: bool) -> list[dict]:
     return rows
 
 
+def _cpu_three(functions: list[Callable[[], object]], repeats: int) -> list[list[float]]:
+    """Per-repeat CPU times (this thread's) of functions measured alternately, one list a function."""
+    number = 2000
+    times: list[list[float]] = [[] for _ in functions]
+    for _ in range(repeats):
+        for index, function in enumerate(functions):
+            times[index].append(timeit.timeit(function, number=number, timer=time.thread_time) / number)
+    return times
+
+
+def bench_robot_engine(quick: bool) -> list[dict]:
+    """``Robot``'s single calls through its compiled kernels (``engine="auto"``, kernels built)
+    and through Pinocchio (``engine="pinocchio"``, the figure before) against the raw
+    Pinocchio call, the three alternated in the same run (CPU-time medians; ratio: median of
+    the per-repeat ratios). The mimic panda's raw forward dynamics: CRBA + solve (ABA refuses
+    mimic joints). Issue 43's target: each compiled ratio < 1 (a Robot faster than raw Pinocchio)."""
+    rows = []
+    for label, name, options in (("ur5", "ur5", {}), ("panda arm", "panda", PANDA_ARM), ("panda (mimic finger)", "panda", {})):
+        robodyn.compile(robodyn.load(name, **options))
+        fast, slow = robodyn.load(name, **options), robodyn.load(name, engine="pinocchio", **options)
+        assert fast.handle.engine == "compiled" and slow.handle.engine == "pinocchio"
+        model, data = slow.model, slow.model.createData()
+        rng = np.random.default_rng(0)
+        q = slow.random_configuration(rng).copy()
+        v, a = rng.normal(size=slow.nv), rng.normal(size=slow.nv)
+        tau = slow.inverse_dynamics(q, v, a)
+        raw_fd = (
+            (lambda: pin.aba(model, data, q, v, tau))
+            if slow.mimic is None
+            else (lambda: np.linalg.solve(pin.crba(model, data, q), tau - pin.nonLinearEffects(model, data, q, v)))
+        )
+        cases = {
+            "tau vs pin.rnea": (lambda r: r.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a)),
+            "M vs pin.crba": (lambda r: r.mass_matrix(q), lambda: pin.crba(model, data, q)),
+            "G vs pin.computeGeneralizedGravity": (lambda r: r.gravity(q), lambda: pin.computeGeneralizedGravity(model, data, q)),
+            "C v + G vs pin.nonLinearEffects": (
+                lambda r: r.nonlinear_effects(q, v),
+                lambda: pin.nonLinearEffects(model, data, q, v),
+            ),
+            "forward dynamics vs " + ("pin.aba" if slow.mimic is None else "CRBA + solve"): (
+                lambda r: r.forward_dynamics(q, v, tau),
+                raw_fd,
+            ),
+        }
+        for method, (call, raw) in cases.items():
+            compiled_t, pinocchio_t, raw_t = _cpu_three(
+                [lambda c=call: c(fast), lambda c=call: c(slow), raw], repeats=7 if quick else 21
+            )
+            rows.append(
+                {
+                    "robot": label, "call": method,
+                    "compiled_us": statistics.median(compiled_t) * 1e6,
+                    "pinocchio_engine_us": statistics.median(pinocchio_t) * 1e6,
+                    "raw_us": statistics.median(raw_t) * 1e6,
+                    "ratio_after": statistics.median([c / r for c, r in zip(compiled_t, raw_t, strict=True)]),
+                    "ratio_before": statistics.median([p / r for p, r in zip(pinocchio_t, raw_t, strict=True)]),
+                    "load_average": os.getloadavg()[0],
+                }
+            )  # fmt: skip
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -1256,6 +1318,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compile-scaling": bench_compile_scaling,
     "engines": bench_engines,
     "compiled-floating": bench_compiled_floating,
+    "robot-engine": bench_robot_engine,
 }
 
 

@@ -16,6 +16,7 @@ from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.common.text import quoted
 from robodyn.constraints import Constraint, as_constraints
+from robodyn.dynamics.engines import check_engine
 from robodyn.exceptions import InputError
 from robodyn.urdf.sources import max_urdf_bytes
 
@@ -51,6 +52,9 @@ class LoadOptions:
             [kg])`` pairs (on top of what the file says).
         constraints: Constraints added to the robot (:mod:`robodyn.constraints`), after
             those its file declares.
+        engine: Who answers the single calls (:mod:`robodyn.dynamics.engines`): ``"auto"``
+            the robot's compiled kernels when they are built already (never building them),
+            else Pinocchio; ``"pinocchio"`` always Pinocchio.
     """
 
     floating_base: bool
@@ -65,6 +69,7 @@ class LoadOptions:
     packages: tuple[tuple[str, str], ...] = ()
     armature: tuple[tuple[str, float], ...] = ()
     constraints: tuple[Constraint, ...] = ()
+    engine: str = "auto"
 
 
 def load_options(
@@ -81,13 +86,15 @@ def load_options(
     packages: Mapping[str, str] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
+    engine: str = "auto",
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 
     Arguments as for :func:`robodyn.load` (``floating_base`` already decided).
 
     Raises:
-        InputError: If ``gravity`` is not 3 finite numbers, or ``constraints`` not constraints.
+        InputError: If ``gravity`` is not 3 finite numbers, ``constraints`` not constraints,
+            or ``engine`` not one of :data:`robodyn.dynamics.engines.ENGINES`.
     """
     vector = STANDARD_GRAVITY if gravity is None else tuple(float(g) for g in as_state(gravity, "gravity", 3))
     return LoadOptions(
@@ -103,6 +110,7 @@ def load_options(
         packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
         armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
         constraints=as_constraints(constraints),
+        engine=check_engine(engine),
     )
 
 
