@@ -4,6 +4,7 @@
  * Python entry points (METH_FASTCALL; one state 1-D, a batch 2-D with one state a row):
  *   tau_derivatives(q, v, a, threads) -> (dtau_dq, dtau_dv, M)
  *   fd_derivatives(q, v, tau, threads) -> (dqdd_dq, dqdd_dv, Minv)
+ *   info() -> {"nv", "instruction_set" (of batches: "scalar", "sse2", "avx2", "avx512"), "lanes"}
  * Each returns a tuple of three new float64 arrays (nv, nv) or (rows, nv, nv), or None when
  * an argument is not a C-contiguous native float64 array of the right shape (the caller then
  * checks and converts it), or an int status as the runtime's: 1 a non-finite input, 2 a
@@ -84,9 +85,85 @@ static int rdd_pair_fd(const double *const *in0, const double *const *in1, doubl
 }
 #endif
 
+/* L rows at once (a batch): derivatives.py's rdd<L>_tau_derivatives, one per instruction set
+ * built (RDD_BLOCKS(X) lists them as X(type, L, name, GCC target, target attribute)), the rest
+ * of each row (its checks, M, the forward dynamics' factorisation and solves) as the single
+ * call does it. A block's status is the worst of its rows'; a failing block's rows are done
+ * again one by one (their exact statuses). */
+typedef int (*rdd_block)(const double *const *in, double *const *out);
+typedef struct {
+    const char *name;
+    int lanes;
+    rdd_block tau, fd;
+} rdd_variant;
+
+#define RDD_BLOCK_DEFINE(T, L, NAME, TARGET, ATTR)                                                        \
+    static ATTR int T##_block_tau(const double *const *in, double *const *out) {                         \
+        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
+        const double *q[L], *v[L], *a[L];                                                                \
+        double *dq[L], *dv[L];                                                                           \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            q[l] = in[0] + l * n, v[l] = in[1] + l * n, a[l] = in[2] + l * n;                            \
+            if (!rd_finite(q[l], RD_NV) || !rd_finite(v[l], RD_NV) || !rd_finite(a[l], RD_NV)) return 1; \
+            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
+        }                                                                                                \
+        T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            rd_mass(q[l], out[2] + l * size);                                                            \
+            for (int k = 0; k < 3; ++k)                                                                  \
+                if (!rd_finite(out[k] + l * size, RD_NV * RD_NV)) return 2;                              \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    static ATTR int T##_block_fd(const double *const *in, double *const *out) {                          \
+        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
+        double M[L][RD_NV * RD_NV], acc[L][RD_NV];                                                       \
+        const double *q[L], *v[L], *a[L];                                                                \
+        double *dq[L], *dv[L];                                                                           \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            const double *row[3] = {in[0] + l * n, in[1] + l * n, in[2] + l * n};                        \
+            const int status = rdd_fd_start(row, M[l], acc[l]);                                          \
+            if (status) return status;                                                                   \
+            q[l] = row[0], v[l] = row[1], a[l] = acc[l];                                                 \
+            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
+        }                                                                                                \
+        T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        int worst = 0;                                                                                   \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            double *const row[3] = {out[0] + l * size, out[1] + l * size, out[2] + l * size};            \
+            const int status = rdd_fd_finish(M[l], row);                                                 \
+            if (status > worst) worst = status;                                                          \
+        }                                                                                                \
+        return worst;                                                                                    \
+    }                                                                                                    \
+    static const rdd_variant T##_variant = {NAME, L, T##_block_tau, T##_block_fd};
+
+#define RDD_CHOOSE(T, L, NAME, TARGET, ATTR) \
+    if (!chosen && __builtin_cpu_supports(TARGET)) chosen = &T##_variant;
+
+RDD_BLOCKS(RDD_BLOCK_DEFINE)
+
+/* The widest variant built that this CPU runs (chosen once), or NULL: rows and pairs. */
+static const rdd_variant *rdd_current(void) {
+    static int chosen_yet = 0;
+    static const rdd_variant *current = NULL;
+    if (!chosen_yet) {
+        const rdd_variant *chosen = NULL;
+#if defined(__x86_64__) && defined(__GNUC__)
+        __builtin_cpu_init();
+        RDD_BLOCKS(RDD_CHOOSE)
+#endif
+        current = chosen;
+        chosen_yet = 1;
+    }
+    return current;
+}
+
 typedef struct {
     rdd_row row;
     rdd_pair pair; /* NULL: one row at a time */
+    rdd_block block; /* NULL: no blocks of lanes rows */
+    int lanes;
     const double *in[3];
     double *out[3];
 } rdd_job;
@@ -100,7 +177,19 @@ static int rdd_rows(const void *work, Py_ssize_t begin, Py_ssize_t end) {
         const double *in[3] = {job->in[0] + r * RD_NV, job->in[1] + r * RD_NV, job->in[2] + r * RD_NV};
         double *out[3] = {job->out[0] + r * size, job->out[1] + r * size, job->out[2] + r * size};
         int status;
-        if (job->pair && r + 1 < end) {
+        if (job->block && r + job->lanes <= end) {
+            status = job->block(in, out);
+            if (status) { /* its rows again one by one: their exact statuses */
+                status = 0;
+                for (int l = 0; l < job->lanes; ++l) {
+                    const double *row_in[3] = {in[0] + l * RD_NV, in[1] + l * RD_NV, in[2] + l * RD_NV};
+                    double *row_out[3] = {out[0] + l * size, out[1] + l * size, out[2] + l * size};
+                    const int row_status = job->row(row_in, row_out);
+                    if (row_status > status) status = row_status;
+                }
+            }
+            r += job->lanes;
+        } else if (job->pair && r + 1 < end) {
             const double *in1[3] = {in[0] + RD_NV, in[1] + RD_NV, in[2] + RD_NV};
             double *out1[3] = {out[0] + size, out[1] + size, out[2] + size};
             status = job->pair(in, in1, out, out1);
@@ -128,7 +217,12 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
     npy_intp dims[3] = {rows, RD_NV, RD_NV};
     PyObject *result = PyTuple_New(3);
     if (!result) return NULL;
-    rdd_job job = {row, pair, {0, 0, 0}, {0, 0, 0}};
+    const rdd_variant *variant = ndim == 2 ? rdd_current() : NULL;
+    rdd_job job = {row, pair, NULL, 1, {0, 0, 0}, {0, 0, 0}};
+    if (variant) {
+        job.block = row == rdd_row_tau ? variant->tau : variant->fd;
+        job.lanes = variant->lanes;
+    }
     for (int k = 0; k < 3; ++k) {
         PyObject *out = PyArray_SimpleNew(ndim + 1, ndim == 2 ? dims : dims + 1, NPY_DOUBLE);
         if (!out) {
@@ -144,7 +238,7 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         status = row(job.in, job.out);
     } else {
         Py_BEGIN_ALLOW_THREADS
-        status = rd_parallel(rdd_rows, &job, rows, 1, threads);
+        status = rd_parallel(rdd_rows, &job, rows, job.lanes, threads);
         Py_END_ALLOW_THREADS
     }
     if (status) {
@@ -164,7 +258,11 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
 static PyObject *py_tau_derivatives(PyObject *m, PyObject *const *a, Py_ssize_t n) { return rdd_entry(a, n, rdd_row_tau, RDD_PAIR_TAU); }
 static PyObject *py_fd_derivatives(PyObject *m, PyObject *const *a, Py_ssize_t n) { return rdd_entry(a, n, rdd_row_fd, RDD_PAIR_FD); }
 
-static PyObject *py_derivative_info(PyObject *m, PyObject *unused) { return Py_BuildValue("{s:i}", "nv", RD_NV); }
+static PyObject *py_derivative_info(PyObject *m, PyObject *unused) {
+    const rdd_variant *variant = rdd_current();
+    return Py_BuildValue("{s:i,s:s,s:i}", "nv", RD_NV, "instruction_set", variant ? variant->name : "scalar", "lanes",
+                         variant ? variant->lanes : (RDD_PAIRS ? 2 : 1));
+}
 
 static PyMethodDef rdd_methods[] = {
     {"tau_derivatives", (PyCFunction)(void (*)(void))py_tau_derivatives, METH_FASTCALL, "tau_derivatives(q, v, a, threads)"},

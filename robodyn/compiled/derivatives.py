@@ -26,9 +26,16 @@ generated functions::
                                     double *dq, double *dv);   /* (nv, nv) row-major each */
     static void rdd_tau_derivatives2(...);  /* two states at once, one a SIMD lane */
 
-A batch goes two rows at a time through ``rdd_tau_derivatives2`` (GCC/Clang vector
-extension, two doubles a lane pair: the same IEEE operations in the same order, so each row is
-bit-identical to a single call); ``cos``/``sin`` are called lane by lane.
+    static void rdd8_tau_derivatives(const double *const *q, ...);  /* 8 states, AVX-512 */
+
+A batch goes ``L`` rows at a time through the variant of the instruction set the build chose
+(:func:`robodyn.compiled.simd.build_variants`, as the dynamics' SIMD blocks: the widest the
+CPU runs, or ``$ROBODYN_SIMD``; 2, 4 or 8 lanes, compiled with that ``target`` attribute and
+chosen at run time with ``__builtin_cpu_supports``), else two at a time
+(``rdd_tau_derivatives2``, plain SSE2), on the runtime's thread pool. Each is a GCC/Clang
+vector extension of the same statements: the same IEEE operations in the same order (no
+FMA: contraction is off), so each row is bit-identical to a single call; ``cos``/``sin``
+are libm's, lane by lane (14 calls against ~10 000 arithmetic operations a panda-arm state).
 
 Why forward mode through the program and not the analytical recursions (Carpentier and
 Mansard 2018) in C: the program is already exact for every robot the compiled engine takes
@@ -48,7 +55,7 @@ from typing import cast
 import numpy as np
 import sympy as sp
 
-from robodyn.compiled import build
+from robodyn.compiled import build, simd
 from robodyn.compiled.cache import robot_key
 from robodyn.compiled.programs import dynamics_programs, robot_bodies
 from robodyn.dynamics.robot import Robot
@@ -101,8 +108,11 @@ class TangentWriter:
         offset: Shape (n_bodies,).
     """
 
-    def __init__(self, program: Program, selection: np.ndarray, offset: np.ndarray):
+    def __init__(
+        self, program: Program, selection: np.ndarray, offset: np.ndarray, variants: Sequence[tuple[str, int, str]] = ()
+    ):
         self.program = program
+        self.variants = tuple(variants)
         self.selection = np.asarray(selection, float)
         self.offset = np.asarray(offset, float)
         self.bodies, self.nv = self.selection.shape
@@ -220,7 +230,7 @@ class TangentWriter:
             "}",
             "",
         ]
-        return "\n".join(scalar + self._pairs(used, results))
+        return "\n".join(scalar + self._pairs(used, results) + self._blocks(used, results))
 
     def _pairs(self, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
         """``rdd_tau_derivatives2``: the same statements on two states, one a SIMD lane
@@ -253,6 +263,59 @@ class TangentWriter:
             "}",
             "",
         ]
+
+    def _blocks(self, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
+        """``rdd<L>_tau_derivatives``: the same statements on ``L`` states at once, one a lane
+        of a vector of the instruction set of each of :attr:`variants` (``(name, L, GCC
+        target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
+        with its ``target`` attribute; ``cos``/``sin`` lane by lane (libm's, as the single
+        call). ``RDD_BLOCKS`` names the variants for ``derivatives.c``'s blocks and dispatch."""
+        pattern = re.compile(r"= (cos|sin)\((\w+)\);$")
+        out: list[str] = []
+        names: list[str] = []
+        for name, lanes, target in self.variants:
+            vector, attribute = f"rdd{lanes}", f'__attribute__((target("{target}")))'
+            body = [pattern.sub(rf"= {vector}_\1(\2);", line).replace("const double ", f"const {vector} ") for line in self.lines]
+            if any(re.search(r"(?<!_)\b(cos|sin|pow)\(", line) for line in body):
+                return ["#define RDD_BLOCKS(X)", ""]
+            lane_values = [self._coordinates(used, str(lane)) for lane in range(lanes)]
+            head = []
+            for i, first in enumerate(lane_values[0]):
+                values = ", ".join(lane_values[lane][i].split(" = ", 1)[1][:-1] for lane in range(lanes))
+                head.append(f"    const {vector} {first.split(' = ')[0].split()[-1]} = {{{values}}};")
+            tail = []
+            for array, index, value in results:
+                try:  # a constant: the same in every lane
+                    constant = c_number(float(value))
+                    tail.append("    " + " = ".join(f"{array}{lane}[{index}]" for lane in range(lanes)) + f" = {constant};")
+                except ValueError:
+                    stores = " ".join(f"{array}{lane}[{index}] = o[{lane}];" for lane in range(lanes))
+                    tail.append(f"    {{ const {vector} o = {value}; {stores} }}")
+            pointers = [
+                f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];"
+                f" double *dq{lane} = dq[{lane}], *dv{lane} = dv[{lane}];"
+                for lane in range(lanes)
+            ]
+            inline = f"static inline __attribute__((always_inline)) {attribute}"
+            lane_loop = f"{vector} r; for (int l = 0; l < {lanes}; ++l) r[l] ="
+            out += [
+                f"typedef double {vector} __attribute__((vector_size({8 * lanes})));",
+                f"{inline} {vector} {vector}_cos({vector} x) {{ {lane_loop} cos(x[l]); return r; }}",
+                f"{inline} {vector} {vector}_sin({vector} x) {{ {lane_loop} sin(x[l]); return r; }}",
+                f"static {attribute} void {vector}_tau_derivatives(const double *const *q, const double *const *v,",
+                "        const double *const *a, double *const *dq, double *const *dv) {",
+                *pointers,
+                *head,
+                *body,
+                *tail,
+                "}",
+                "",
+            ]
+            names.append(f'X({vector}, {lanes}, "{name}", "{target}", {attribute})')
+        if not out:
+            return ["#define RDD_BLOCKS(X)", ""]
+        guard = "#if defined(__x86_64__) && defined(__GNUC__)"
+        return [guard, *out, f"#define RDD_BLOCKS(X) {' '.join(names)}", "#else", "#define RDD_BLOCKS(X)", "#endif", ""]
 
     def _outputs(self, outputs: Sequence[sp.Symbol]) -> list[tuple[str, int, str]]:
         """``(array, index, C value)`` of every entry of ``dq`` and ``dv``: ``Sᵀ`` times the
@@ -289,13 +352,14 @@ def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType
     Raises:
         CompileError: If the build fails or the module does not match the robot.
     """
-    own = "derivatives-" + robot_key(robot)
+    variants = simd.build_variants()
+    own = "derivatives-" + robot_key(robot) + "-simd=" + " ".join(name for name, _, _ in variants)
 
     def source() -> str:
         derivative = build.cached_kernels(own)
         if derivative is None:
             bodies = robot_bodies(robot)
-            derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset).source()
+            derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset, variants).source()
             build.store_kernels(own, derivative)
         runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
         return kernels() + "\n" + derivative + "\n" + runtime

@@ -5,8 +5,8 @@ Importing this module registers :func:`built_module` with :mod:`robodyn.dynamics
 answers ``tau``, ``M``, ``G``, ``C v + G`` and the forward dynamics with its compiled
 kernels when they are built already: in this process (a dictionary look-up) or in the cache
 folder (the key and one ``stat``, no sympy, no code generator: :func:`build.lookup`). It never
-builds anything: ``robodyn.compile(robot)`` does, and attaches the kernels to the robot it
-compiled (:func:`robodyn.compiled.robot.compile`).
+builds anything: ``robodyn.compile(robot)`` does (and leaves ``robot`` as it was: robots
+loaded afterwards get the kernels).
 """
 
 from __future__ import annotations

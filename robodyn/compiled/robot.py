@@ -92,8 +92,9 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     source), without generating any source: from this process's memory (about 10 µs), else
     the cache folder (milliseconds, no sympy imported); only a robot never compiled is
     derived (seconds) and built. ``robot.model`` is read-only to the compiled robot (see
-    :class:`CompiledRobot`). A robot loaded with ``engine="auto"`` (the default) then
-    answers its own single calls with these kernels too (:mod:`robodyn.compiled.engine`).
+    :class:`CompiledRobot`). ``robot`` itself is left as it is (it may be the Pinocchio
+    reference a caller compares with); robots loaded afterwards with ``engine="auto"`` (the
+    default) answer their single calls with these kernels (:mod:`robodyn.compiled.engine`).
 
     Args:
         robot: From :func:`robodyn.load` (mimic joints and a floating base are fine).
@@ -113,8 +114,6 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     module = build.robot_module(robot_key(robot), lambda: robot_kernels(robot), label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached kernels do not match the robot; clear the cache folder")
-    if robot.options.engine == "auto" and robot.handle.engine != "compiled":
-        robot.handle.accelerate(module)  # the robot's own single calls use them from now on
     return CompiledRobot(robot, module, threads=threads)
 
 

@@ -5,8 +5,8 @@ registers a *finder* here instead (:func:`register`, done by :mod:`robodyn.compi
 when it is imported: ``robodyn.load`` imports it): a function of a robot that returns the
 robot's compiled kernels' module when it is already built (in this process or in the cache
 folder), else ``None``, and never builds anything. :func:`attach` asks the finders for a
-robot loaded with ``engine="auto"`` (the default of :func:`robodyn.load`);
-``engine="pinocchio"`` never asks.
+robot loaded with ``engine="auto"`` (the default of :func:`robodyn.load`, unless
+``$ROBODYN_ENGINE`` says ``pinocchio``); ``engine="pinocchio"`` never asks.
 
 An attached module answers ``tau``, ``M``, ``G``, ``C v + G`` and the forward dynamics
 (:func:`compiled_calls`): a call whose arguments are float64 C-contiguous arrays of the
@@ -20,6 +20,7 @@ replaced, which checks, names the argument and raises the same errors as before.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -39,12 +40,21 @@ Finder = Callable[["Robot"], ModuleType | None]
 _finders: list[Finder] = []
 
 
+#: The environment variable that sets the default of ``engine=`` (``"auto"`` when unset).
+ENVIRONMENT = "ROBODYN_ENGINE"
+
+
 def check_engine(engine: object) -> str:
-    """The ``engine=`` option of :func:`robodyn.load`, checked.
+    """The ``engine=`` option of :func:`robodyn.load`, checked; ``None``: ``$ROBODYN_ENGINE``,
+    else ``"auto"``.
 
     Raises:
-        InputError: If it is not one of :data:`ENGINES`.
+        InputError: If it is not one of :data:`ENGINES` (naming ``$ROBODYN_ENGINE`` if it came from there).
     """
+    if engine is None:
+        engine = os.environ.get(ENVIRONMENT, "").strip() or "auto"
+        if engine not in ENGINES:
+            raise InputError(ENVIRONMENT, " or ".join(repr(name) for name in ENGINES), repr(engine))
     if engine not in ENGINES:
         raise InputError("engine", " or ".join(repr(name) for name in ENGINES), repr(engine))
     return str(engine)
@@ -161,4 +171,4 @@ def _three(compiled: Callable[..., Any], slow: Callable[..., np.ndarray], thread
 _WRAPPERS = {1: _one, 2: _two, 3: _three}
 
 
-__all__ = ["ENGINES", "Calls", "attach", "check_engine", "compiled_calls", "find", "register"]
+__all__ = ["ENGINES", "ENVIRONMENT", "Calls", "attach", "check_engine", "compiled_calls", "find", "register"]

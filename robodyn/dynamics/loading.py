@@ -77,7 +77,7 @@ def load(
     packages: Mapping[str, str | os.PathLike] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
-    engine: str = "auto",
+    engine: str | None = None,
 ) -> Robot:
     """Load a robot.
 
@@ -112,12 +112,12 @@ def load(
             ``FrameAnchor``, ``PointContact`` or a list of them), after those the file
             declares (MJCF ``<equality>``); :attr:`Robot.constraints` lists them all. See
             docs/constraints.md.
-        engine: ``"auto"`` (default): the single calls (``tau``, ``M``, ``G``, ``C v + G``,
+        engine: ``"auto"`` (default; ``$ROBODYN_ENGINE`` may set another): the single calls (``tau``, ``M``, ``G``, ``C v + G``,
             forward dynamics) go through the robot's compiled kernels when they are built
             already (``robodyn.compile`` once, in any process: the cache), never building
             them, else through Pinocchio; the same checks, errors and numbers (to 1e-13),
-            and ``robot.model`` is then read-only. ``"pinocchio"``: always Pinocchio.
-            See docs/compiled.md.
+            and ``robot.model`` is then read-only. ``"pinocchio"``: always Pinocchio (what
+            a reference to compare compiled code with needs). See docs/compiled.md.
 
     Returns:
         The robot.

@@ -86,7 +86,7 @@ def load_options(
     packages: Mapping[str, str] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
-    engine: str = "auto",
+    engine: str | None = None,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 

@@ -12,13 +12,22 @@ import pytest
 import robodyn
 from robodyn.compiled import build
 from robodyn.exceptions import InputError, RobodynError
+from tests.compiled_helpers import shared_cache
 from tests.conftest import NONDEGENERATE_CASES, random_states
 
 CASES = ["ur5", "panda_mimic", "solo12", "oblique"]
 QUANTITIES = ("inverse_dynamics", "forward_dynamics", "mass_matrix", "gravity", "nonlinear_effects")
 
 
+@pytest.fixture(scope="module", autouse=True)
+def cache():
+    """The session's compile cache (never the user's)."""
+    with shared_cache() as folder:
+        yield folder
+
+
 def _load(name: str, **options) -> robodyn.Robot:
+    options.setdefault("engine", "auto")  # tests/compiled/conftest.py makes Pinocchio the default here
     if name in NONDEGENERATE_CASES:
         path, extra = NONDEGENERATE_CASES[name]
         return robodyn.load(str(path), **extra, **options)
@@ -30,7 +39,7 @@ def pairs() -> dict[str, tuple[robodyn.Robot, robodyn.Robot]]:
     """Each case as (engine="auto", its kernels built) and (engine="pinocchio")."""
     out = {}
     for name in CASES:
-        robodyn.compile(_load(name))  # builds once (cached afterwards)
+        robodyn.compile(_load(name, engine="pinocchio"))  # builds once (cached afterwards)
         out[name] = (_load(name), _load(name, engine="pinocchio"))
     return out
 
@@ -69,7 +78,7 @@ def test_the_mimic_robots_mass_matrix_is_the_reduced_one_of_its_coordinates(pair
     np.testing.assert_array_equal(mass, mass.T)
     # against the expanded model's M projected independently: Sᵀ M_full S
     selection = fast.mimic.selection
-    full = robodyn.load("panda", engine="pinocchio").mimic
+    full = slow.mimic
     expanded = np.triu(_crba(full.model, full.q(q)))
     expanded = expanded + np.triu(expanded, 1).T
     np.testing.assert_allclose(mass, selection.T @ expanded @ selection, rtol=0, atol=1e-13 * np.abs(mass).max())
@@ -138,23 +147,31 @@ def test_lists_other_dtypes_and_strided_arrays_give_the_same_numbers_as_float64_
     np.testing.assert_allclose(fast.mass_matrix(q.astype(np.float32)), fast.mass_matrix(q.astype(np.float32).astype(float)))
 
 
-def test_a_robot_whose_kernels_are_not_built_uses_pinocchio(monkeypatch, tmp_path):
+def test_a_robot_whose_kernels_are_not_built_uses_pinocchio(monkeypatch, tmp_path, cache):
     monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))  # an empty cache: nothing is built
     robot = _load("oblique")
     assert robot.handle.engine == "pinocchio" and build.lookup(robot) is None
     assert list(tmp_path.iterdir()) == []  # looking never builds
-    monkeypatch.undo()
-    robodyn.compile(robot)  # compile() attaches the kernels it built to the robot
-    assert robot.handle.engine == "compiled"
+    monkeypatch.setenv("ROBODYN_CACHE", cache)
+    fast = robodyn.compile(robot)
+    assert robot.handle.engine == "pinocchio"  # compile() leaves the robot it was given as it was
+    assert _load("oblique").handle.engine == "compiled"  # ... robots loaded afterwards get the kernels
+    assert fast.robot is robot
 
 
-def test_engine_pinocchio_never_uses_the_kernels_and_travels_with_the_robot(pairs):
-    _, slow = pairs["ur5"]
-    robodyn.compile(slow)
-    assert slow.handle.engine == "pinocchio"
+def test_engine_pinocchio_never_uses_the_kernels_and_travels_with_the_robot(pairs, monkeypatch):
+    fast, slow = pairs["ur5"]
+    assert slow.handle.engine == "pinocchio" and build.lookup(slow) is not None
     again = pickle.loads(pickle.dumps(slow))
     assert again.options.engine == "pinocchio" and again.handle.engine == "pinocchio"
-    fast = pickle.loads(pickle.dumps(pairs["ur5"][0]))
-    assert fast.options.engine == "auto" and fast.handle.engine == "compiled"
+    fast_again = pickle.loads(pickle.dumps(fast))
+    assert fast_again.options.engine == "auto" and fast_again.handle.engine == "compiled"
     with pytest.raises(InputError, match="engine"):
         robodyn.load("ur5", engine="compiled")
+    monkeypatch.delenv("ROBODYN_ENGINE")
+    assert robodyn.load("ur5").handle.engine == "compiled"  # the default: "auto"
+    monkeypatch.setenv("ROBODYN_ENGINE", "pinocchio")
+    assert robodyn.load("ur5").options.engine == "pinocchio"
+    monkeypatch.setenv("ROBODYN_ENGINE", "fast")
+    with pytest.raises(InputError, match="ROBODYN_ENGINE"):
+        robodyn.load("ur5")
