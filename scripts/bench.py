@@ -758,7 +758,8 @@ def _generated_c(function, folder: Path):
 
 def bench_export(quick: bool) -> list[dict]:
     """CasADi graph sizes (M + C v + G) against adam's, and forward dynamics through CasADi's
-    generated C against pin.aba (10 000 states in one mapped call, per state)."""
+    generated C against pin.aba (10 000 states in one mapped call, per state; this thread's
+    CPU time, the two alternated: wall time on a loaded machine swung the ratio 0.8-2x)."""
     import tempfile
 
     from robodyn.export import casadi_functions
@@ -773,14 +774,20 @@ def bench_export(quick: bool) -> list[dict]:
         count = 1000 if quick else 10_000
         Q = robot.random_configuration(rng, count)
         V, TAU = rng.normal(size=(2, count, robot.nv))
+        model, data = robot.model, robot.model.createData()
+        q, v, tau = Q[0], V[0], TAU[0]
         with tempfile.TemporaryDirectory() as folder:
             mapped = _generated_c(functions["forward_dynamics"], Path(folder)).map(count, "serial")
             arguments = (Q.T.copy(), V.T.copy(), TAU.T.copy())
-            casadi_s = median_once(lambda: mapped(*arguments), repeats=3 if quick else 7) / count
             error = float(np.max(np.abs(np.array(mapped(*arguments)).T - robot.forward_dynamics(Q, V, TAU))))
-        model, data = robot.model, robot.model.createData()
-        q, v, tau = Q[0], V[0], TAU[0]
-        aba_s = min(timeit.repeat(lambda: pin.aba(model, data, q, v, tau), number=2000, repeat=5)) / 2000
+            # CPU time of this thread (CasADi's serial map runs here), alternated with pin.aba
+            casadi_times, aba_times = [], []
+            for _ in range(5 if quick else 11):
+                casadi_times.append(timeit.timeit(lambda: mapped(*arguments), number=1, timer=time.thread_time) / count)
+                aba_times.append(
+                    timeit.timeit(lambda: pin.aba(model, data, q, v, tau), number=count, timer=time.thread_time) / count
+                )
+        casadi_s, aba_s = statistics.median(casadi_times), statistics.median(aba_times)
         rows.append(
             {
                 "robot": label,
@@ -789,6 +796,10 @@ def bench_export(quick: bool) -> list[dict]:
                 "ratio": None if adam is None else sum(ours) / sum(adam),
                 "fd casadi C us/state": casadi_s * 1e6,
                 "pin.aba us/call": aba_s * 1e6,
+                "fd casadi / pin.aba (CPU, alternated)": statistics.median(
+                    [c / a for c, a in zip(casadi_times, aba_times, strict=True)]
+                ),
+                "load_average": os.getloadavg()[0],
                 "fd max error vs pin": error,
             }
         )

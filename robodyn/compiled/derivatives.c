@@ -89,7 +89,8 @@ static int rdd_pair_fd(const double *const *in0, const double *const *in1, doubl
  * built (RDD_BLOCKS(X) lists them as X(type, L, name, GCC target, target attribute)), the rest
  * of each row (its checks, M, the forward dynamics' factorisation and solves) as the single
  * call does it. A block's status is the worst of its rows'; a failing block's rows are done
- * again one by one (their exact statuses). */
+ * again one by one (their exact statuses). RDD_BLOCKS's entries: X(type, L, name, GCC target,
+ * target attribute, the SIMD dynamics' vector prefix, the exit's vzeroupper). */
 typedef int (*rdd_block)(const double *const *in, double *const *out);
 typedef struct {
     const char *name;
@@ -97,25 +98,46 @@ typedef struct {
     rdd_block tau, fd;
 } rdd_variant;
 
-#define RDD_BLOCK_DEFINE(T, L, NAME, TARGET, ATTR)                                                        \
-    static ATTR int T##_block_tau(const double *const *in, double *const *out) {                         \
+/* The forward dynamics' part of a block around the derivatives: with the robot's SIMD
+ * dynamics in the module (RD_SIMD: simd.py's rds<L>_mass_nle and tree LDLᵀ on vectors, the
+ * same operations as the scalar ones in the same order), on L lanes at once; else row by row. */
+#ifdef RD_SIMD
+#define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
+    static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
-        const double *q[L], *v[L], *a[L];                                                                \
+        S q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], h[RD_NV], X[RD_NV * RD_NV];                   \
+        double acc[L * RD_NV];                                                                           \
+        S##_load(in[0], RD_NV, q);                                                                       \
+        S##_load(in[1], RD_NV, v);                                                                       \
+        S##_load(in[2], RD_NV, tau);                                                                     \
+        if (S##_bad(q, RD_NV) || S##_bad(v, RD_NV) || S##_bad(tau, RD_NV)) return 1;                    \
+        S##_mass_nle(q, v, M, h);                                                                        \
+        for (int i = 0; i < RD_NV; ++i) h[i] = tau[i] - h[i];                                            \
+        if (S##_ldl_factor(M)) return 3;                                                                 \
+        S##_ldl_apply(M, h);                                                                             \
+        S##_store(h, RD_NV, acc);                                                                        \
+        const double *qs[L], *vs[L], *as[L];                                                             \
         double *dq[L], *dv[L];                                                                           \
         for (int l = 0; l < L; ++l) {                                                                    \
-            q[l] = in[0] + l * n, v[l] = in[1] + l * n, a[l] = in[2] + l * n;                            \
-            if (!rd_finite(q[l], RD_NV) || !rd_finite(v[l], RD_NV) || !rd_finite(a[l], RD_NV)) return 1; \
+            qs[l] = in[0] + l * n, vs[l] = in[1] + l * n, as[l] = acc + l * n;                           \
             dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
         }                                                                                                \
-        T##_tau_derivatives(q, v, a, dq, dv);                                                            \
-        for (int l = 0; l < L; ++l) {                                                                    \
-            rd_mass(q[l], out[2] + l * size);                                                            \
-            for (int k = 0; k < 3; ++k)                                                                  \
-                if (!rd_finite(out[k] + l * size, RD_NV * RD_NV)) return 2;                              \
+        T##_tau_derivatives(qs, vs, as, dq, dv);                                                         \
+        for (int k = 0; k < 3; ++k) {                                                                    \
+            if (k < 2) S##_load(out[k], RD_NV * RD_NV, X);                                               \
+            else                                                                                         \
+                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = S##_splat((i % (RD_NV + 1)) == 0 ? 1.0 : 0.0); \
+            S##_ldl_apply_columns(M, X, RD_NV);                                                          \
+            if (k < 2)                                                                                   \
+                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = -X[i];                                    \
+            if (S##_bad(X, RD_NV * RD_NV)) return 3;                                                     \
+            S##_store(X, RD_NV * RD_NV, out[k]);                                                         \
         }                                                                                                \
         return 0;                                                                                        \
-    }                                                                                                    \
-    static ATTR int T##_block_fd(const double *const *in, double *const *out) {                          \
+    }
+#else
+#define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
+    static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
         double M[L][RD_NV * RD_NV], acc[L][RD_NV];                                                       \
         const double *q[L], *v[L], *a[L];                                                                \
@@ -135,10 +157,42 @@ typedef struct {
             if (status > worst) worst = status;                                                          \
         }                                                                                                \
         return worst;                                                                                    \
+    }
+#endif
+
+#define RDD_BLOCK_DEFINE(T, L, NAME, TARGET, ATTR, S, VZEROUPPER)                                         \
+    static ATTR int T##_tau_inner(const double *const *in, double *const *out) {                         \
+        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
+        const double *q[L], *v[L], *a[L];                                                                \
+        double *dq[L], *dv[L];                                                                           \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            q[l] = in[0] + l * n, v[l] = in[1] + l * n, a[l] = in[2] + l * n;                            \
+            if (!rd_finite(q[l], RD_NV) || !rd_finite(v[l], RD_NV) || !rd_finite(a[l], RD_NV)) return 1; \
+            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
+        }                                                                                                \
+        T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            rd_mass(q[l], out[2] + l * size);                                                            \
+            for (int k = 0; k < 3; ++k)                                                                  \
+                if (!rd_finite(out[k] + l * size, RD_NV * RD_NV)) return 2;                              \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    RDD_FD_BLOCK(T, L, S, ATTR)                                                                          \
+    /* each clears the vector registers' upper halves on its way out (see simd.c) */                     \
+    static ATTR int T##_block_tau(const double *const *in, double *const *out) {                         \
+        const int status = T##_tau_inner(in, out);                                                       \
+        VZEROUPPER                                                                                       \
+        return status;                                                                                   \
+    }                                                                                                    \
+    static ATTR int T##_block_fd(const double *const *in, double *const *out) {                          \
+        const int status = T##_fd_inner(in, out);                                                        \
+        VZEROUPPER                                                                                       \
+        return status;                                                                                   \
     }                                                                                                    \
     static const rdd_variant T##_variant = {NAME, L, T##_block_tau, T##_block_fd};
 
-#define RDD_CHOOSE(T, L, NAME, TARGET, ATTR) \
+#define RDD_CHOOSE(T, L, NAME, TARGET, ATTR, S, VZEROUPPER) \
     if (!chosen && __builtin_cpu_supports(TARGET)) chosen = &T##_variant;
 
 RDD_BLOCKS(RDD_BLOCK_DEFINE)

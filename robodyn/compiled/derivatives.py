@@ -311,7 +311,8 @@ class TangentWriter:
                 "}",
                 "",
             ]
-            names.append(f'X({vector}, {lanes}, "{name}", "{target}", {attribute})')
+            vzeroupper = "__builtin_ia32_vzeroupper();" if lanes > 2 else ""
+            names.append(f'X({vector}, {lanes}, "{name}", "{target}", {attribute}, rds{lanes}, {vzeroupper})')
         if not out:
             return ["#define RDD_BLOCKS(X)", ""]
         guard = "#if defined(__x86_64__) && defined(__GNUC__)"
@@ -362,7 +363,8 @@ def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType
             derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset, variants).source()
             build.store_kernels(own, derivative)
         runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
-        return kernels() + "\n" + derivative + "\n" + runtime
+        robot_kernels = kernels()  # and their SIMD variants: the forward dynamics' part of a block
+        return robot_kernels + "\n" + simd.vector_source(robot_kernels, variants) + derivative + "\n" + runtime
 
     module = build.keyed_extension(own, source, init="rdd_module", label=robot.name)
     if module.info()["nv"] != robot.nv:
