@@ -102,6 +102,14 @@ typedef struct {
  * dynamics in the module (RD_SIMD: simd.py's rds<L>_mass_nle and tree LDLᵀ on vectors, the
  * same operations as the scalar ones in the same order), on L lanes at once; else row by row. */
 #ifdef RD_SIMD
+/* M of L rows (q: L rows of RD_NV, M: L rows of RD_NV²) by the SIMD dynamics' mass kernel. */
+#define RDD_MASS(L, S, rows_q, rows_M)                                                                    \
+    do {                                                                                                 \
+        S q_[RD_NV], M_[RD_NV * RD_NV];                                                                  \
+        S##_load(rows_q, RD_NV, q_);                                                                     \
+        S##_mass(q_, M_);                                                                                \
+        S##_store(M_, RD_NV * RD_NV, rows_M);                                                            \
+    } while (0)
 #define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
     static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
@@ -136,6 +144,8 @@ typedef struct {
         return 0;                                                                                        \
     }
 #else
+#define RDD_MASS(L, S, rows_q, rows_M)                                                                    \
+    for (int l = 0; l < L; ++l) rd_mass((rows_q) + l * RD_NV, (rows_M) + l * RD_NV * RD_NV)
 #define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
     static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
@@ -171,11 +181,10 @@ typedef struct {
             dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
         }                                                                                                \
         T##_tau_derivatives(q, v, a, dq, dv);                                                            \
-        for (int l = 0; l < L; ++l) {                                                                    \
-            rd_mass(q[l], out[2] + l * size);                                                            \
+        RDD_MASS(L, S, in[0], out[2]);                                                                   \
+        for (int l = 0; l < L; ++l)                                                                      \
             for (int k = 0; k < 3; ++k)                                                                  \
                 if (!rd_finite(out[k] + l * size, RD_NV * RD_NV)) return 2;                              \
-        }                                                                                                \
         return 0;                                                                                        \
     }                                                                                                    \
     RDD_FD_BLOCK(T, L, S, ATTR)                                                                          \
