@@ -878,6 +878,18 @@ def bench_compiled_derivatives_batch(quick: bool) -> list[dict]:
             loop = lambda: [theirs(model, data, q[i], v[i], third[i]) for i in range(count)]  # noqa: E731
             loop_s = median_once(loop, repeats=1)
             loop_cpu = median_once(loop, repeats=1, clock=time.process_time)
+            # alternated, this thread's CPU per state, one thread each (the 2-thread loop at
+            # perfect scaling against the 2-thread batch at perfect scaling): steadier under load
+            one = 4000
+            compiled.threads = 1
+            pairs_cpu = []
+            for _ in range(7):
+                ours_one = timeit.timeit(lambda: ours(q[:one], v[:one], third[:one]), number=1, timer=time.thread_time)
+                loop_one = timeit.timeit(
+                    lambda: [theirs(model, data, q[i], v[i], third[i]) for i in range(one)], number=1, timer=time.thread_time
+                )
+                pairs_cpu.append(loop_one / ours_one)
+            compiled.threads = 2
             rows.append(
                 {
                     "robot": label,
@@ -888,6 +900,8 @@ def bench_compiled_derivatives_batch(quick: bool) -> list[dict]:
                     "python_loop_states_per_s": count / loop_s,
                     "speedup_vs_2_thread_loop": loop_s / 2 / ours_s,
                     "speedup_cpu_time": loop_cpu / ours_cpu,
+                    "speedup_cpu_alternated": statistics.median(pairs_cpu),
+                    "instruction_set": compiled._derivatives().info()["instruction_set"],
                     "load_average": os.getloadavg()[0],
                 }
             )
