@@ -58,7 +58,7 @@ def main() -> None:
         robot, controller="task-space", target=[0.7, 0.7], frame="end_effector", q0=[0.0, 0.1], duration=1.0
     )
     made = recording(robot, trajectory, target=summary["target_m"])
-    made.still(DOCS / "rp_arm_poster.png", at=0.25)
+    made.still(DOCS / "rp_arm_poster.png", at=made.duration)  # the poster: the final pose, the whole path drawn
     made.filmstrip(DOCS / "rp_arm_filmstrip.png", 5, size=(320, 240))
     rows = sweep("rp_arm", forces=((0.0, 0.0, 0.0), (0.0, 0.0, -10.0)))
     plot_whatif(rows, robot.joint_names, [dof.effort_unit for dof in robot.dofs], DOCS / "rp_arm_whatif.png",

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import robodyn
+from robodyn.common.text import counted
 from robodyn.exceptions import InputError
 
 
@@ -26,8 +27,12 @@ def vector(text: str) -> list[float]:
         raise argparse.ArgumentTypeError(f"not a list of numbers: {text!r}") from None
 
 
+#: What the model argument takes (every command that reads a robot).
+MODEL_HELP = "a URDF, .xacro or MJCF file path, a robot name (see 'robodyn list'), or URDF/xacro/MJCF text"
+
+
 def add_model_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("model", help="URDF path, robot name (see 'robodyn list') or URDF text")
+    parser.add_argument("model", help=MODEL_HELP)
     base = parser.add_mutually_exclusive_group()
     base.add_argument(
         "--floating-base", dest="floating_base", action="store_true", default=None, help="give the root a free-flyer joint"
@@ -37,7 +42,10 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
         "--no-check-inertia", dest="check_inertia", action="store_false", help="accept physically impossible link inertias"
     )
     parser.add_argument(
-        "--gravity", type=vector, metavar="GX,GY,GZ", help="gravity in the world frame, in [m/s²] (default 0,0,-9.81)"
+        "--gravity",
+        type=vector,
+        metavar="GX,GY,GZ",
+        help="gravity in the world frame, in [m/s²] (default: the file's, else 0,0,-9.81)",
     )
     parser.add_argument(
         "--strict", action="store_true", help="refuse what robodyn otherwise loads with a warning (e.g. the triangle inequality)"
@@ -52,13 +60,19 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_file_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable)."""
+    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable), ``--xacro-env``."""
     parser.add_argument(
         "--xacro-arg",
         dest="xacro_arg",
         action="append",
         metavar="NAME:=VALUE",
         help="a xacro argument of a .xacro model (repeatable)",
+    )
+    parser.add_argument(
+        "--xacro-env",
+        dest="xacro_env",
+        action="store_true",
+        help="let a xacro model read environment variables ($(env NAME), $(optenv NAME)); refused otherwise",
     )
     parser.add_argument(
         "--package",
@@ -112,6 +126,7 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
         lock=lock_values(getattr(arguments, "lock", None)),
         xacro_args=xacro_arguments(getattr(arguments, "xacro_arg", None)) or None,
         packages=package_arguments(getattr(arguments, "package", None)) or None,
+        xacro_env=bool(getattr(arguments, "xacro_env", False)),
     )
 
 
@@ -119,7 +134,7 @@ def state(robot: robodyn.Robot, values: list[float] | None, name: str, size: int
     if values is None:
         return default
     if len(values) != size:
-        raise InputError(f"--{name}", f"{size} values ({', '.join(robot.joint_names)})", f"{len(values)} values")
+        raise InputError(f"--{name}", f"{counted(size, 'value')} ({', '.join(robot.joint_names)})", counted(len(values), "value"))
     return np.array(values)
 
 

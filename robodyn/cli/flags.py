@@ -14,6 +14,11 @@ from robodyn.exceptions import InputError, RobodynError
 
 #: Library parameter name -> the flag that sets it.
 FLAGS: dict[str, str] = {
+    "ground": "--ground",
+    "height": "--ground",
+    "friction": "--friction",
+    "contacts": "--contact",
+    "integrator": "--integrator",
     "target": "--target",
     "frame": "--frame",
     "q0": "--q0",
@@ -35,6 +40,7 @@ FLAGS: dict[str, str] = {
     "external": "--force-at",
     "observer_gain": "--observer-gain",
     "observer": "--observer-gain",
+    "limits": "--limits",
     "gain": "--gain",
     "threshold": "--threshold",
     "torque": "--torque",
@@ -50,6 +56,8 @@ FLAGS: dict[str, str] = {
     "reference": "--reference",
     "engine": "--engine",
     "control_period": "--control-period",
+    "kp": "--kp",
+    "kd": "--kd",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.
@@ -59,7 +67,11 @@ SWITCHES: dict[str, str] = {
     "check_inertia=False": "--no-check-inertia",
     "strict=True": "--strict",
     "joint_friction=False": "--no-joint-friction",
+    "xacro_env=True": "--xacro-env",
 }
+
+#: Boolean parameters whose switch turns them off: an error asking for ``False`` names the switch.
+OFF_SWITCHES: dict[str, str] = {"joint_friction": "--no-joint-friction"}
 
 #: ``name=`` or ``name='word'`` in a message: a keyword argument the library suggests.
 _KEYWORD = re.compile(r"\b(" + "|".join(map(re.escape, FLAGS)) + r")=(?:'(\w+)'(?!\w))?")
@@ -80,6 +92,16 @@ def error_text(error: RobodynError) -> str:
     text = str(error)
     if isinstance(error, InputError) and error.argument in FLAGS:
         text = printable(f"{flag(error.argument)} must be {error.expected}, got {error.received}.")
+    elif isinstance(error, InputError) and error.argument in OFF_SWITCHES and error.expected.startswith("False "):
+        needed = error.expected.removeprefix("False ")
+        text = printable(f"{OFF_SWITCHES[error.argument]} is needed {needed}, got {error.received}.")
+    return command_line_text(text)
+
+
+def command_line_text(text: str) -> str:
+    """A library sentence as the command line says it: a keyword argument it suggests
+    (``engine='compiled'``) becomes the flag (``--engine compiled``), a boolean one
+    (``joint_friction=False``) its switch (``--no-joint-friction``)."""
     for keyword, switch in SWITCHES.items():
         text = text.replace(keyword, switch)
     return _KEYWORD.sub(_keyword_flag, text)

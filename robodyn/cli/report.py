@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robodyn.common.text import printable
+from robodyn.common.text import counted, printable
 from robodyn.dynamics import frames
 from robodyn.dynamics.robot import Robot
 
@@ -100,7 +100,7 @@ def info_text(robot: Robot) -> str:
     also = f' ("{printable(robot.name)}")' if robot.name != robot.spec.name else ""
     kind = {"xacro": ", expanded from xacro", "mjcf": ", read from MJCF"}.get(robot.source.file_format, "")
     lines = [
-        f"robot {printable(robot.spec.name)}{also}{kind}: {robot.nv} degrees of freedom (nq = {robot.nq}), "
+        f"robot {printable(robot.spec.name)}{also}{kind}: {counted(robot.nv, 'degree')} of freedom (nq = {robot.nq}), "
         f"{'floating' if robot.floating_base else 'fixed'} base, gravity {_vector(robot.gravity_vector, 4)} m/s²",
         f"end effector (default task frame): {printable(end_effector) if end_effector else reason}",
         "",

@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 
-from robodyn.common.text import printable
+from robodyn.common.text import counted, printable
 from robodyn.exceptions import InputError
 
 
@@ -33,10 +33,10 @@ def as_state(value: object, name: str, size: int) -> np.ndarray:
     array = _real_array(value, name, size)
     if array.ndim == 1:
         if array.shape[0] != size:
-            raise InputError(name, f"{size} values", f"{array.shape[0]} values")
+            raise InputError(name, counted(size, "value"), counted(array.shape[0], "value"))
     elif array.ndim == 2:
         if array.shape[1] != size:
-            raise InputError(name, f"{size} values a row", f"{array.shape[1]} values a row")
+            raise InputError(name, f"{counted(size, 'value')} a row", f"{counted(array.shape[1], 'value')} a row")
     else:
         raise InputError(
             name, f"a 1-D array of {size} values or a 2-D array with one state a row", f"{array.ndim}-D shape {array.shape}"

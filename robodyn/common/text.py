@@ -189,8 +189,21 @@ def identifier(name: str, taken: set[str] | None = None, *, prefix: str = "") ->
     return candidate
 
 
+def counted(count: int, noun: str, plural: str | None = None) -> str:
+    """A count with its noun in the right number: ``"1 value"``, ``"2 values"``, ``"0 errors"``,
+    ``"1 degree of freedom"`` (``noun="degree"``, then append the rest).
+
+    Args:
+        count: How many.
+        noun: The singular noun.
+        plural: The plural when it is not ``noun + "s"`` (e.g. ``"entries"``).
+    """
+    return f"{count} {noun if count == 1 else (plural or noun + 's')}"
+
+
 __all__ = [
     "comment_text",
+    "counted",
     "identifier",
     "is_printable",
     "json_text",

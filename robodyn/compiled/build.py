@@ -99,10 +99,18 @@ def toolchain_key(compiler: str) -> str:
     return "\n".join([identity, " ".join(FLAGS), sysconfig.get_config_var("EXT_SUFFIX") or "", np.__version__, sys.version])
 
 
+def runtime_source() -> str:
+    """``runtime.c`` after the controllers' generated constants (kinds, parameter layouts:
+    :func:`robodyn.compiled.controllers.c_constants`)."""
+    from robodyn.compiled.controllers import c_constants
+
+    return c_constants() + _RUNTIME.read_text(encoding="utf-8")
+
+
 def module_source(kernels: str, module_name: str) -> str:
     """The full C source: includes, the robot's kernels, the runtime and the module init."""
     init = f'PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module("{module_name}"); }}\n'
-    return prelude() + kernels + "\n" + _RUNTIME.read_text(encoding="utf-8") + "\n" + init
+    return prelude() + kernels + "\n" + runtime_source() + "\n" + init
 
 
 def _suffix() -> str:
@@ -278,11 +286,6 @@ def keyed_extension(key: str, source: Callable[[], str], *, init: str, label: st
                 entry = f'PyMODINIT_FUNC PyInit_{name}(void) {{ return {init}("{name}"); }}\n'
                 _compile(compiler, prelude() + source() + "\n" + entry, cache_dir(), target, label)
     return _import(name, target)
-
-
-def runtime_source() -> str:
-    """``runtime.c``'s text (what follows a robot's kernels in every module of its dynamics)."""
-    return _RUNTIME.read_text(encoding="utf-8")
 
 
 __all__ = [

@@ -7,9 +7,11 @@ what the code depends on,
 - the robot: its URDF text (locked joints, mimic joints, the file's armature are in it), its
   floating base, its gravity and the armature given to :func:`robodyn.load`;
 - the generator: the source of every module the generated code can depend on, found by
-  walking the folders of :data:`GENERATOR_PACKAGES` (every ``.py`` and ``.c`` file in them):
-  a change anywhere there, by anyone, never reuses what was generated before it. Nobody keeps
-  a list of modules or a version number.
+  walking the whole package (every ``.py``, ``.c`` and ``.h`` file) but the subpackages
+  of the layers above the code generator (:data:`ABOVE_GENERATOR`, which the import
+  contracts forbid it to import): a change anywhere else, by anyone, in a package added
+  later too, never reuses what was generated before it. Nobody keeps a list of modules or
+  a version number.
 
 The folder is ``$ROBODYN_CACHE``, else ``$XDG_CACHE_HOME/robodyn``, else ``~/.cache/robodyn``
 (subfolder ``compiled/``). Every file is written under a temporary name and renamed into
@@ -36,9 +38,11 @@ from robodyn.common.files import atomic_write_text
 if TYPE_CHECKING:
     from robodyn.dynamics.robot import Robot
 
-#: The packages of robodyn whose source decides the generated code (the layers below the
-#: compiled engine, the engine itself and the export that prints the same programs).
-GENERATOR_PACKAGES = ("common", "urdf", "reference", "dynamics", "equations", "compiled", "export")
+#: The subpackages of robodyn that cannot decide the generated code: the layers above the
+#: compiled engine (the import contracts in pyproject.toml; a test holds the two together),
+#: except ``export``, which prints the same programs. Everything else is hashed, so a new
+#: lower package is hashed without anyone adding it.
+ABOVE_GENERATOR = ("cli", "viz", "scale", "optimize", "sim", "verify", "ident", "trajectory")
 #: Rotation entries this close to 0, ±1, ±½, ... are taken as exact when the programs are
 #: derived (:mod:`robodyn.compiled.programs`): float rounding only (cos(π/2) = 6e-17,
 #: sin(π) = 1.2e-16), so the compiled model is the URDF's. Not more: URDFs write π to 12
@@ -69,12 +73,13 @@ def digest(*parts: str) -> str:
 
 
 def generator_files() -> list[Path]:
-    """Every source file of :data:`GENERATOR_PACKAGES` (``.py`` and ``.c``), sorted."""
+    """Every source file of robodyn (``.py``, ``.c``, ``.h``) outside :data:`ABOVE_GENERATOR`, sorted."""
     files = [
         path
-        for package in GENERATOR_PACKAGES
-        for path in (_ROOT / package).rglob("*")
-        if path.suffix in (".py", ".c", ".h") and "__pycache__" not in path.parts
+        for path in _ROOT.rglob("*")
+        if path.suffix in (".py", ".c", ".h")
+        and "__pycache__" not in path.parts
+        and path.relative_to(_ROOT).parts[0] not in ABOVE_GENERATOR
     ]
     return sorted(files)
 

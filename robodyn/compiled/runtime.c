@@ -14,11 +14,11 @@
  *   simulate(q0, v0, dt, steps, t0, rk4, kind, hold, params, controller, out_q, out_v,
  *            out_a, out_tau[, frame]) -> -1, or the step after which the state stopped being finite
  * integrates in C (RK4 or semi-implicit Euler); kind 0 holds params[0:n] as the torque,
- * 1 is PD + gravity, 2 computed torque along a quintic, both on the controller's model
- * (a capsule of another compiled robot's kernels, `_kernels`); 3 task space, 4 operational
- * space, 5 impedance, on the controller's model and a frame's kernels (the capsule `_frame`
- * of a frame module, robodyn/compiled/kinematics.py).
- */
+ * the others are the controllers' compiled twins (robodyn/compiled/controllers.py declares
+ * each one's kind RD_KIND_<LAW> and parameter layout RD_<LAW>_<FIELD>(n), generated as C
+ * macros prepended to this file), on the controller's model (a capsule of another compiled
+ * robot's kernels, `_kernels`) and, for the frame laws, a frame's kernels (the capsule
+ * `_frame` of a frame module, robodyn/compiled/kinematics.py). */
 
 #ifndef RD_NQ
 #define RD_NQ RD_NV /* a floating base's q has one entry more than v (its quaternion) */
@@ -215,7 +215,7 @@ typedef struct {
     int kind, hold;
     const double *params;
     const rd_kernels *model;
-    const void *frame; /* kinds 3-5: the controlled frame's rd_frame_kernels */
+    const void *frame; /* the frame laws: the controlled frame's rd_frame_kernels */
     const double *damping; /* the plant's joint damping b (the torque − b v at every stage), or NULL */
 } rd_controller;
 
@@ -509,7 +509,7 @@ static void rdc_orientation_command(const double *R, const double *Rd, const dou
     rdc_rot(R, x, angular, 0);
 }
 
-/* params: target (3), kp, kd, damping, joint_damping  (robodyn.sim.control.TaskSpace) */
+/* params: RD_TS_* (robodyn.compiled.controllers.CompiledTaskSpace's layout; robodyn.sim.control.TaskSpace) */
 static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
                            const double *v, double *tau) {
     const int n = RD_NV;
@@ -518,16 +518,16 @@ static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *fram
     for (int i = 0; i < 3; ++i) {
         double velocity = 0.0;
         for (int j = 0; j < n; ++j) velocity += J[i * n + j] * v[j];
-        desired[i] = p[3] * (p[i] - x[i]) - p[4] * velocity - bias[i];
+        desired[i] = p[RD_TS_KP(n)] * (p[RD_TS_TARGET(n) + i] - x[i]) - p[RD_TS_KD(n)] * velocity - bias[i];
         for (int k = 0; k < 3; ++k) {
             double g = 0.0;
             for (int j = 0; j < n; ++j) g += J[i * n + j] * J[k * n + j];
-            gram[i * 3 + k] = g + (i == k) * p[5];
+            gram[i * 3 + k] = g + (i == k) * p[RD_TS_DAMPING(n)];
         }
     }
     memcpy(pinv, J, sizeof(double) * 3 * n); /* gram⁻¹ J, then pinv = (gram⁻¹ J)ᵀ = Jᵀ gram⁻¹ */
     rdc_solve(gram, pinv, 3, n);
-    for (int j = 0; j < n; ++j) jv[j] = p[6] * v[j];
+    for (int j = 0; j < n; ++j) jv[j] = p[RD_TS_JOINT_DAMPING(n)] * v[j];
     for (int i = 0; i < n; ++i) { /* N = I - pinv J; command = pinv desired - N jv */
         double Nrow = 0.0, pd = 0.0;
         for (int j = 0; j < n; ++j) {
@@ -542,11 +542,11 @@ static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *fram
     model->tau(q, v, command, tau);
 }
 
-/* params: rows m, position (3), R_d (9), kp, kd, damping, posture_kp, posture_kd, has_posture,
- * posture (n)  (robodyn.sim.operational_space.OperationalSpace, fixed target) */
+/* params: RD_OSC_* (CompiledOperationalSpace's layout; robodyn.sim.operational_space.OperationalSpace,
+ * fixed target) */
 static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
                                   const double *v, double *tau, double *a) {
-    const int n = RD_NV, m = (int)p[0];
+    const int n = RD_NV, m = (int)p[RD_OSC_ROWS(n)];
     double x[3], R[9], J[6 * RD_NV], bias[6], command[6], M[RD_NV * RD_NV], L[RD_NV * RD_NV], h[RD_NV];
     double MiJt[6 * RD_NV], A[36], Lam[36], f[6], posture[RD_NV], y[6];
     frame->all(q, v, x, R, J, bias);
@@ -555,8 +555,9 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
         velocity[i] = 0.0;
         for (int j = 0; j < n; ++j) velocity[i] += J[i * n + j] * v[j];
     }
-    for (int i = 0; i < 3; ++i) command[i] = 0.0 + p[14] * (0.0 - velocity[i]) + p[13] * (p[1 + i] - x[i]);
-    if (m == 6) rdc_orientation_command(R, p + 4, velocity + 3, p[13], p[14], command + 3);
+    for (int i = 0; i < 3; ++i)
+        command[i] = 0.0 + p[RD_OSC_KD(n)] * (0.0 - velocity[i]) + p[RD_OSC_KP(n)] * (p[RD_OSC_POSITION(n) + i] - x[i]);
+    if (m == 6) rdc_orientation_command(R, p + RD_OSC_ROTATION(n), velocity + 3, p[RD_OSC_KP(n)], p[RD_OSC_KD(n)], command + 3);
     model->mass_nle(q, v, M, h);
     memcpy(L, M, sizeof M);
     if (rd_ldl_factor(L)) {
@@ -577,14 +578,15 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
             for (int j = 0; j < n; ++j) s += J[i * n + j] * MiJt[k * n + j];
             A[i * m + k] = A[k * m + i] = s;
         }
-    rdc_task_inertia(A, p[15], m, Lam);
+    rdc_task_inertia(A, p[RD_OSC_DAMPING(n)], m, Lam);
     for (int i = 0; i < m; ++i) y[i] = command[i] - bias[i];
     for (int i = 0; i < m; ++i) {
         f[i] = 0.0;
         for (int k = 0; k < m; ++k) f[i] += Lam[i * m + k] * y[k];
     }
     double rate[RD_NV];
-    for (int j = 0; j < n; ++j) rate[j] = p[16] * (p[18] ? p[19 + j] - q[j] : 0.0) - p[17] * v[j];
+    for (int j = 0; j < n; ++j)
+        rate[j] = p[RD_OSC_POSTURE_KP(n)] * (p[RD_OSC_HAS_POSTURE(n)] ? p[RD_OSC_POSTURE(n) + j] - q[j] : 0.0) - p[RD_OSC_POSTURE_KD(n)] * v[j];
     for (int i = 0; i < n; ++i) { /* posture = M (kp0 (q0 - q) - kd0 v) */
         double s = 0.0;
         for (int j = 0; j < n; ++j) s += M[i * n + j] * rate[j];
@@ -609,25 +611,25 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     }
 }
 
-/* params: rows m, position (3), R_d (9), stiffness (6), damping (6), null_damping
- * (robodyn.sim.operational_space.Impedance) */
+/* params: RD_IMP_* (CompiledImpedance's layout; robodyn.sim.operational_space.Impedance) */
 static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame, const double *p, const double *q,
                           const double *v, double *tau) {
-    const int n = RD_NV, m = (int)p[0];
+    const int n = RD_NV, m = (int)p[RD_IMP_ROWS(n)];
+    const double *Rd = p + RD_IMP_ROTATION(n);
     double x[3], R[9], J[6 * RD_NV], bias[6], error[6], wrench[6], gram[36], GJ[6 * RD_NV], g[RD_NV], dv[RD_NV];
     frame->all(q, v, x, R, J, bias);
-    for (int i = 0; i < 3; ++i) error[i] = p[1 + i] - x[i];
+    for (int i = 0; i < 3; ++i) error[i] = p[RD_IMP_POSITION(n) + i] - x[i];
     if (m == 6) {
         double RtRd[9], e[3];
         for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) RtRd[i * 3 + j] = R[i] * p[4 + j] + R[3 + i] * p[7 + j] + R[6 + i] * p[10 + j];
+            for (int j = 0; j < 3; ++j) RtRd[i * 3 + j] = R[i] * Rd[j] + R[3 + i] * Rd[3 + j] + R[6 + i] * Rd[6 + j];
         rdc_log3(RtRd, e);
         rdc_rot(R, e, error + 3, 0);
     }
     for (int i = 0; i < m; ++i) {
         double velocity = 0.0;
         for (int j = 0; j < n; ++j) velocity += J[i * n + j] * v[j];
-        wrench[i] = p[13 + i] * error[i] - p[19 + i] * velocity;
+        wrench[i] = p[RD_IMP_STIFFNESS(n) + i] * error[i] - p[RD_IMP_DAMPING(n) + i] * velocity;
         for (int k = 0; k < m; ++k) {
             double s = 0.0;
             for (int j = 0; j < n; ++j) s += J[i * n + j] * J[k * n + j];
@@ -636,7 +638,7 @@ static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame
     }
     memcpy(GJ, J, sizeof(double) * m * n);
     rdc_solve(gram, GJ, m, n); /* gram⁻¹ J; N = I - Jᵀ gram⁻¹ J */
-    for (int j = 0; j < n; ++j) dv[j] = p[25] * v[j];
+    for (int j = 0; j < n; ++j) dv[j] = p[RD_IMP_NULL_DAMPING(n)] * v[j];
     model->gravity(q, g);
     for (int j = 0; j < n; ++j) { /* Nᵀ dv = dv - (gram⁻¹ J)ᵀ J dv: N is symmetric up to rounding; use Nᵀ */
         double Jw = 0.0, Ntdv = dv[j];
@@ -652,23 +654,23 @@ static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame
 
 static void rd_control_frame(const rd_controller *c, const double *q, const double *v, double *tau) {
     const rd_frame_kernels *frame = (const rd_frame_kernels *)c->frame;
-    if (c->kind == 3) rdc_task_space(c->model, frame, c->params, q, v, tau);
-    if (c->kind == 4) rdc_operational_space(c->model, frame, c->params, q, v, tau, NULL);
-    if (c->kind == 5) rdc_impedance(c->model, frame, c->params, q, v, tau);
+    if (c->kind == RD_KIND_TS) rdc_task_space(c->model, frame, c->params, q, v, tau);
+    if (c->kind == RD_KIND_OSC) rdc_operational_space(c->model, frame, c->params, q, v, tau, NULL);
+    if (c->kind == RD_KIND_IMP) rdc_impedance(c->model, frame, c->params, q, v, tau);
 }
 
 
-/* params: S u_eq (n), S K (n × 2n, row-major), x_eq = (q_eq, v_eq) (2n)
+/* params: RD_LQR_*: S u_eq (n), S K (n × 2n, row-major), x_eq = (q_eq, v_eq) (2n)
  * (robodyn.sim.control.LQR: tau = S (u_eq − K (x − x_eq)), S selecting the actuated joints) */
 static void rdc_lqr(const double *p, const double *q, const double *v, double *tau) {
     const int n = RD_NV;
-    const double *K = p + n, *x_eq = p + n + 2 * n * n;
+    const double *u = p + RD_LQR_U(n), *K = p + RD_LQR_K(n), *x_eq = p + RD_LQR_X_EQ(n);
     double e[2 * RD_NV];
     for (int j = 0; j < n; ++j) e[j] = q[j] - x_eq[j], e[n + j] = v[j] - x_eq[n + j];
     for (int i = 0; i < n; ++i) {
         double s = 0.0;
         for (int j = 0; j < 2 * n; ++j) s += K[i * 2 * n + j] * e[j];
-        tau[i] = p[i] - s;
+        tau[i] = u[i] - s;
     }
 }
 
@@ -691,21 +693,22 @@ static void rd_free_base_torques(const rd_kernels *model, const double *q, const
     for (int i = 0; i < 6; ++i) tau[i] = 0.0;
 }
 
-/* PD + gravity (kind 1) and computed torque along a quintic (kind 2) on a floating robot's
+/* PD + gravity (RD_KIND_PD) and computed torque along a quintic (RD_KIND_CT) on a floating robot's
  * joints, its base free (robodyn.sim.control: _floating_pd, ComputedTorque): params as for a
  * fixed base, of the joints only. */
 static void rd_control_free_base(const rd_controller *c, double t, const double *q, const double *v, double *tau) {
     const int m = RD_NV - 6;
     const double *p = c->params;
     double a[RD_NV] = {0}, zero[RD_NV] = {0};
-    if (c->kind == 1) {
+    if (c->kind == RD_KIND_PD) {
         double holding[RD_NV];
         rd_free_base_torques(c->model, q, zero, a, holding);
         for (int i = 0; i < 6; ++i) tau[i] = 0.0;
-        for (int i = 0; i < m; ++i) tau[6 + i] = p[m + i] * (p[i] - q[7 + i]) - p[2 * m + i] * v[6 + i] + holding[6 + i];
+        for (int i = 0; i < m; ++i)
+            tau[6 + i] = p[RD_PD_KP(m) + i] * (p[RD_PD_TARGET(m) + i] - q[7 + i]) - p[RD_PD_KD(m) + i] * v[6 + i] + holding[6 + i];
         return;
     }
-    const double duration = p[4 * m];
+    const double duration = p[RD_CT_DURATION(m)];
     double s = t / duration;
     s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
     const int moving = 0 < t && t < duration;
@@ -713,9 +716,9 @@ static void rd_control_free_base(const rd_controller *c, double t, const double 
     const double speed = moving ? (30 * pow(s, 2) - 60 * pow(s, 3) + 30 * pow(s, 4)) / duration : 0.0;
     const double acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
     for (int i = 0; i < m; ++i) {
-        const double delta = p[m + i] - p[i];
-        const double q_d = p[i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
-        a[6 + i] = a_d + p[3 * m + i] * (v_d - v[6 + i]) + p[2 * m + i] * (q_d - q[7 + i]);
+        const double delta = p[RD_CT_Q_END(m) + i] - p[RD_CT_Q_START(m) + i];
+        const double q_d = p[RD_CT_Q_START(m) + i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
+        a[6 + i] = a_d + p[RD_CT_KD(m) + i] * (v_d - v[6 + i]) + p[RD_CT_KP(m) + i] * (q_d - q[7 + i]);
     }
     rd_free_base_torques(c->model, q, v, a, tau);
 }
@@ -725,23 +728,23 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
     const int n = RD_NV;
     const double *p = c->params;
 #if RD_NQ != RD_NV
-    if (c->kind == 1 || c->kind == 2) { /* the joints' laws with the base free */
+    if (c->kind == RD_KIND_PD || c->kind == RD_KIND_CT) { /* the joints' laws with the base free */
         rd_control_free_base(c, t, q, v, tau);
         return;
     }
 #endif
     if (c->kind == 0) {
         for (int i = 0; i < n; ++i) tau[i] = p[i];
-    } else if (c->kind == 1) { /* params: target, kp, kd */
+    } else if (c->kind == RD_KIND_PD) {
         double g[RD_NV];
         c->model->gravity(q, g);
-        for (int i = 0; i < n; ++i) tau[i] = p[n + i] * (p[i] - q[i]) - p[2 * n + i] * v[i] + g[i];
-    } else if (c->kind == 6) {
+        for (int i = 0; i < n; ++i) tau[i] = p[RD_PD_KP(n) + i] * (p[RD_PD_TARGET(n) + i] - q[i]) - p[RD_PD_KD(n) + i] * v[i] + g[i];
+    } else if (c->kind == RD_KIND_LQR) {
         rdc_lqr(p, q, v, tau);
-    } else if (c->kind >= 3) { /* task space, operational space, impedance */
+    } else if (c->kind != RD_KIND_CT) { /* task space, operational space, impedance */
         rd_control_frame(c, q, v, tau);
-    } else { /* params: q_start, q_end, kp, kd, duration */
-        const double duration = p[4 * n];
+    } else { /* computed torque along a quintic */
+        const double duration = p[RD_CT_DURATION(n)];
         double s = t / duration;
         s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
         const int moving = 0 < t && t < duration;
@@ -750,9 +753,9 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
         const double acceleration = moving ? (60 * s - 180 * pow(s, 2) + 120 * pow(s, 3)) / pow(duration, 2) : 0.0;
         double command[RD_NV];
         for (int i = 0; i < n; ++i) {
-            const double delta = p[n + i] - p[i];
-            const double q_d = p[i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
-            command[i] = a_d + p[3 * n + i] * (v_d - v[i]) + p[2 * n + i] * (q_d - q[i]);
+            const double delta = p[RD_CT_Q_END(n) + i] - p[RD_CT_Q_START(n) + i];
+            const double q_d = p[RD_CT_Q_START(n) + i] + position * delta, v_d = speed * delta, a_d = acceleration * delta;
+            command[i] = a_d + p[RD_CT_KD(n) + i] * (v_d - v[i]) + p[RD_CT_KP(n) + i] * (q_d - q[i]);
         }
         c->model->tau(q, v, command, tau);
     }
@@ -763,7 +766,7 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
  * 1 when done (a NaN for a singular M), 0 when the caller is to call rd_control and rd_fd_raw.
  * Bit-identical to those two: the same M, h and the same LDLᵀ arithmetic. */
 static int rd_control_fd(const rd_controller *c, const double *q, const double *v, double *tau, double *a) {
-    if (c->kind != 4 || c->model != &rd_self || c->damping) return 0;
+    if (c->kind != RD_KIND_OSC || c->model != &rd_self || c->damping) return 0;
     rdc_operational_space(c->model, (const rd_frame_kernels *)c->frame, c->params, q, v, tau, a);
     return 1;
 }
@@ -908,12 +911,11 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
     const long rk4 = PyLong_AsLong(args[5]), kind = PyLong_AsLong(args[6]), hold = PyLong_AsLong(args[7]);
     if (PyErr_Occurred()) return NULL;
     const int n = RD_NV, nj = RD_NV - 6 * (RD_NQ - RD_NV); /* a floating base's PD and CT params: its joints' */
-    const npy_intp sizes[7] = {n, 3 * nj, 4 * nj + 1, 7, 19 + n, 26, 2 * n * n + 3 * n};
-    if (kind < 0 || kind > 6 || steps < 0) {
+    if (kind < 0 || kind >= RD_KINDS || steps < 0) {
         PyErr_SetString(PyExc_ValueError, "bad controller kind or step count");
         return NULL;
     }
-    const double *q0 = rd_array(args[0], RD_NQ, 0), *v0 = rd_array(args[1], n, 0), *params = rd_array(args[8], sizes[kind], 0);
+    const double *q0 = rd_array(args[0], RD_NQ, 0), *v0 = rd_array(args[1], n, 0), *params = rd_array(args[8], RD_PARAM_SIZE(kind, n, nj), 0);
     double *oq = rd_array(args[10], (steps + 1) * RD_NQ, 1), *ov = rd_array(args[11], (steps + 1) * n, 1);
     double *oa = rd_array(args[12], (steps + 1) * n, 1), *otau = rd_array(args[13], (steps + 1) * n, 1);
     const rd_kernels *model = &rd_self;
@@ -925,12 +927,12 @@ static PyObject *py_simulate(PyObject *m, PyObject *const *args, Py_ssize_t narg
         PyErr_SetString(PyExc_ValueError, "simulate: arrays of the wrong type or size");
         return NULL;
     }
-    const rd_frame_kernels *frame = NULL; /* the 15th argument: the frame capsule of kinds 3-5 */
+    const rd_frame_kernels *frame = NULL; /* the 15th argument: the frame capsule of the frame laws */
     if (nargs >= 15 && args[14] != Py_None) {
         frame = (const rd_frame_kernels *)PyCapsule_GetPointer(args[14], RD_FRAME_CAPSULE);
         if (!frame) return NULL;
     }
-    if (kind >= 3 && kind <= 5 && (!frame || frame->nv != n)) {
+    if ((kind == RD_KIND_TS || kind == RD_KIND_OSC || kind == RD_KIND_IMP) && (!frame || frame->nv != n)) {
         PyErr_SetString(PyExc_ValueError, "simulate: a frame controller needs its frame's kernels");
         return NULL;
     }

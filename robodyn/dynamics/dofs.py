@@ -13,7 +13,7 @@ only) and ``base.rx, base.ry, base.rz`` (angular velocity in [rad/s], base frame
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -117,6 +117,7 @@ def robot_dofs(
     damping: Sequence[float] | None = None,
     friction: Sequence[float] | None = None,
     armature: Sequence[float] | None = None,
+    actuated: Collection[str] | None = None,
 ) -> tuple[Dof, ...]:
     """The degrees of freedom of a robot's joints (``Robot.joints``, root joint first).
 
@@ -128,6 +129,8 @@ def robot_dofs(
         damping, friction, armature: Per degree of freedom (length nv; default zeros): the
             model's ``model.damping``, ``model.friction``, ``model.armature``
             (:mod:`robodyn.dynamics.joint_dynamics`).
+        actuated: The joints an actuator drives, by name (the file's actuators,
+            :attr:`robodyn.urdf.sources.URDFSource.actuated`); ``None``: every joint.
     """
     inf = float("inf")
     dofs: list[Dof] = []
@@ -138,8 +141,20 @@ def robot_dofs(
                 dofs.append(Dof(name, joint.name, "floating", kind, len(dofs), -inf, inf, inf, inf, actuated=False))
             continue
         kind = "linear" if joint.type == "prismatic" else "angular"
+        driven = actuated is None or joint.name in actuated
         dofs.append(
-            Dof(joint.name, joint.name, joint.type, kind, len(dofs), joint.lower, joint.upper, joint.velocity, joint.effort)
+            Dof(
+                joint.name,
+                joint.name,
+                joint.type,
+                kind,
+                len(dofs),
+                joint.lower,
+                joint.upper,
+                joint.velocity,
+                joint.effort,
+                actuated=driven,
+            )
         )
     return tuple(_with_dynamics(dof, damping, friction, armature) for dof in dofs)
 

@@ -53,13 +53,14 @@ def pinocchio_xml(spec: URDFSpec) -> str:
 
 def data_memory_estimate(nv: int, njoints: int) -> int:
     """Bytes one Pinocchio ``Data`` needs for a model of ``nv`` velocities and ``njoints``
-    joints (universe included), an upper bound of ``60 njoints nv² + 1600 nv² + 2 MB``.
+    joints (universe included), an upper bound of ``60 njoints nv² + 1600 nv² + 3.5 MB``.
 
     Fitted on Pinocchio 4.1 (growth of the peak resident size in ``createData``): chains
-    and stars of 25, 50, 100 and 150 joints took 5.0, 13.5, 74.6 and 234 MB (chains and
-    stars alike); the fit gives 4.0 GB for a 400-joint star (measured: 4.1 GB).
+    and stars of 25, 40, 50, 100 and 150 joints took 5.0, 8.9, 13.5, 74.6 and 234 MB (chains
+    and stars alike; measured in a process that imports Pinocchio only); the fit gives 4.0 GB
+    for a 400-joint star (measured: 4.1 GB).
     """
-    return int(60 * njoints * nv * nv + 1600 * nv * nv + 2_000_000)
+    return int(60 * njoints * nv * nv + 1600 * nv * nv + 3_500_000)
 
 
 def load(
@@ -77,6 +78,7 @@ def load(
     packages: Mapping[str, str | os.PathLike] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
+    xacro_env: bool = False,
     engine: str | None = None,
 ) -> Robot:
     """Load a robot.
@@ -87,8 +89,9 @@ def load(
             (``"rp_arm"``); ``robodyn list`` prints the names. See docs/robot-files.md.
         floating_base: Give the root link a free-flyer joint. ``None``: true for zoo
             robots that walk, swim or fly, false otherwise.
-        gravity: Gravity acceleration in the world frame, in [m/s²]; default
-            ``(0, 0, -9.81)``.
+        gravity: Gravity acceleration in the world frame, in [m/s²]; default the
+            file's (MJCF ``<option gravity>``, zero under ``<flag gravity="disable"/>``),
+            else ``(0, 0, -9.81)``.
         check_inertia: Refuse inertias that are not positive semi-definite on moving links
             (set false to load published models that have them).
         strict: Refuse what loads with a :class:`~robodyn.exceptions.RobodynWarning`
@@ -112,8 +115,11 @@ def load(
             ``FrameAnchor``, ``PointContact`` or a list of them), after those the file
             declares (MJCF ``<equality>``); :attr:`Robot.constraints` lists them all. See
             docs/constraints.md.
-        engine: ``"auto"`` (default; ``$ROBODYN_ENGINE`` may set another): the single calls (``tau``, ``M``, ``G``, ``C v + G``,
-            forward dynamics) go through the robot's compiled kernels when they are built
+        xacro_env: Let a xacro source read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); without it they are refused. See docs/robot-files.md for
+            everything a xacro may do.
+        engine: ``"auto"`` (default; ``$ROBODYN_ENGINE`` may set another): the single
+            calls (``tau``, ``M``, ``G``, ``C v + G``, forward dynamics) go through the robot's compiled kernels when they are built
             already (``robodyn.compile`` once, in any process: the cache), never building
             them, else through Pinocchio; the same checks, errors and numbers (to 1e-13),
             and ``robot.model`` is then read-only. ``"pinocchio"``: always Pinocchio (what
@@ -134,14 +140,22 @@ def load(
         RobodynWarning: For what ``strict=True`` refuses.
     """
     folders = {str(name): os.fspath(folder) for name, folder in (packages or {}).items()}
-    resolved = resolve_source(source, max_bytes=max_bytes, xacro_args=xacro_args, packages=folders, strict=strict)
+    resolved = resolve_source(
+        source,
+        max_bytes=max_bytes,
+        xacro_args=xacro_args,
+        packages=folders,
+        strict=strict,
+        max_dof=max_dof,
+        xacro_env=xacro_env,
+    )
     floating = resolved.floating_base if floating_base is None else bool(floating_base)
     _report_equalities(resolved, strict)
     if lock:
         resolved = locked_source(resolved, lock, floating_base=floating, check_inertia=check_inertia, strict=strict)
     options = load_options(
         floating_base=floating,
-        gravity=gravity,
+        gravity=resolved.gravity if gravity is None else gravity,
         check_inertia=check_inertia,
         strict=strict,
         lock=lock,
@@ -152,6 +166,7 @@ def load(
         packages=folders,
         armature=armature,
         constraints=constraints,
+        xacro_env=xacro_env,
         engine=engine,
     )
     return build_robot(resolved, options)

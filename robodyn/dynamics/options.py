@@ -34,7 +34,8 @@ class LoadOptions:
 
     Attributes:
         floating_base: Whether the root got a free-flyer joint.
-        gravity: Gravity in the world frame, in [m/s²].
+        gravity: Gravity in the world frame, in [m/s²]: ``gravity=`` if given, else the
+            file's (MJCF ``<option gravity>``), else (0, 0, −9.81).
         check_inertia: Whether impossible inertias on moving links were refused.
         threads: Native threads for batches (``None``: every available core).
         strict: Whether warnings of the validator were treated as errors.
@@ -52,6 +53,8 @@ class LoadOptions:
             [kg])`` pairs (on top of what the file says).
         constraints: Constraints added to the robot (:mod:`robodyn.constraints`), after
             those its file declares.
+        xacro_env: Whether a xacro source could read environment variables (the source
+            carries the expanded text).
         engine: Who answers the single calls (:mod:`robodyn.dynamics.engines`): ``"auto"``
             the robot's compiled kernels when they are built already (never building them),
             else Pinocchio; ``"pinocchio"`` always Pinocchio.
@@ -69,6 +72,7 @@ class LoadOptions:
     packages: tuple[tuple[str, str], ...] = ()
     armature: tuple[tuple[str, float], ...] = ()
     constraints: tuple[Constraint, ...] = ()
+    xacro_env: bool = False
     engine: str = "auto"
 
 
@@ -86,6 +90,7 @@ def load_options(
     packages: Mapping[str, str] | None = None,
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
+    xacro_env: bool = False,
     engine: str | None = None,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
@@ -110,6 +115,7 @@ def load_options(
         packages=tuple((str(name), str(folder)) for name, folder in (packages or {}).items()),
         armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
         constraints=as_constraints(constraints),
+        xacro_env=bool(xacro_env),
         engine=check_engine(engine),
     )
 

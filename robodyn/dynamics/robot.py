@@ -23,6 +23,7 @@ the functions of the handle in :mod:`~robodyn.dynamics.kinematics`,
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import cached_property
 from pathlib import Path
 
@@ -30,7 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 from robodyn.constraints import Constraint, from_equalities
-from robodyn.dynamics import configurations, constrained, derivatives, energies, frames, kinematics
+from robodyn.dynamics import centroidal, configurations, constrained, derivatives, energies, frames, kinematics, mujoco_state
 from robodyn.dynamics import regressor as identification
 from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
@@ -109,7 +110,7 @@ class Robot:
         self.joints: list[JointInfo] = joint_infos(model, spec)
         self.joint_names: list[str] = [joint.name for joint in self.joints]
         self.dofs: tuple[Dof, ...] = robot_dofs(
-            self.joints, damping=model.damping, friction=model.friction, armature=model.armature
+            self.joints, damping=model.damping, friction=model.friction, armature=model.armature, actuated=source.actuated
         )
         self.configuration_names: list[str] = configuration_names(self.joints)
 
@@ -553,6 +554,39 @@ class Robot:
     def constraint_rank(self, q: np.ndarray, constraints: object = None) -> int:
         """Independent rows of the constraints at ``q`` (nq,) (:func:`robodyn.dynamics.constrained.constraint_rank`)."""
         return constrained.constraint_rank(self, q, constraints)
+
+    # ----------------------------------------------------------------------------------
+    # MuJoCo's state (robodyn.dynamics.mujoco_state)
+    # ----------------------------------------------------------------------------------
+    def to_mujoco(self, q: np.ndarray, v: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
+        """MuJoCo's ``(qpos, qvel)`` of ``(q, v)``: joints by name in MuJoCo's order, ``ref``
+        offsets, the free joint's w-first quaternion and world linear velocity. See
+        :mod:`robodyn.dynamics.mujoco_state` (``joint_names``: MuJoCo's order, needed
+        unless the robot was read from MJCF)."""
+        return mujoco_state.to_mujoco(self, q, v, joint_names=joint_names)
+
+    def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
+        """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`)."""
+        return mujoco_state.from_mujoco(self, qpos, qvel, joint_names=joint_names)
+
+    # ----------------------------------------------------------------------------------
+    # Centroidal quantities (robodyn.dynamics.centroidal)
+    # ----------------------------------------------------------------------------------
+    def center_of_mass(self, q: np.ndarray) -> np.ndarray:
+        """The moving bodies' centre of mass (a floating robot's: all of it) in [m], world
+        axes, shape (3,) or (N, 3)
+        (:func:`robodyn.dynamics.centroidal.center_of_mass`)."""
+        return centroidal.center_of_mass(self.handle, q)
+
+    def centroidal_momentum(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Linear [kg m/s] then angular momentum about the centre of mass [kg m²/s], world
+        axes, shape (6,) or (N, 6) (:func:`robodyn.dynamics.centroidal.centroidal_momentum`)."""
+        return centroidal.centroidal_momentum(self.handle, q, v)
+
+    def centroidal_momentum_matrix(self, q: np.ndarray) -> np.ndarray:
+        """``A_G(q)`` with ``h = A_G v``, shape (6, nv) or (N, 6, nv)
+        (:func:`robodyn.dynamics.centroidal.centroidal_momentum_matrix`)."""
+        return centroidal.centroidal_momentum_matrix(self.handle, q)
 
 
 def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:

@@ -69,6 +69,7 @@ class Request:
     precision: int = DEFAULT_PRECISION
     xacro_args: Mapping[str, str] | None = None
     packages: Mapping[str, str] | None = None
+    xacro_env: bool = False
 
 
 def equations_document(
@@ -87,7 +88,7 @@ def equations_document(
         **options: The fields of :class:`Request`: ``format`` (one of :data:`FORMATS` for
             ``what``), ``form``, ``keep_params``, ``gravity`` in [m/s²], ``lock``,
             ``floating_base``, ``frame`` (a link, for ``"kinematics"``), ``precision``,
-            ``xacro_args`` and ``packages`` (as for :func:`robodyn.load`).
+            ``xacro_args``, ``packages`` and ``xacro_env`` (as for :func:`robodyn.load`).
 
     Raises:
         InputError: For a format the document does not come in, a lecture of another
@@ -95,8 +96,10 @@ def equations_document(
         MissingToolError: For a PDF without pdflatex.
     """
     request = Request(**options)  # type: ignore[arg-type]
-    if request.xacro_args or request.packages:  # read once, as robodyn.load reads it
-        source = resolve_source(source, xacro_args=request.xacro_args, packages=request.packages).text
+    if request.xacro_args or request.packages or request.xacro_env:  # read once, as robodyn.load reads it
+        source = resolve_source(
+            source, xacro_args=request.xacro_args, packages=request.packages, xacro_env=request.xacro_env
+        ).text
     _check(source, what, request)
     if what == "lecture":
         return Document(lecture_text(), "the lecture's RP arm")

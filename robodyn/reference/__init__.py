@@ -42,7 +42,8 @@ def load(
     Args:
         source: As for :func:`robodyn.load`: a URDF path, URDF text, a zoo name or a
             generated robot's name.
-        gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
+        gravity: Gravity in the world frame, in [m/s²]; default the file's (MJCF
+            ``<option gravity>``, as :func:`robodyn.load`), else ``(0, 0, -9.81)``.
         check_inertia, lock: As for :func:`robodyn.load`.
         floating_base: Give the root six degrees of freedom (Pinocchio's free-flyer
             convention for ``q`` and ``v``); unlike :func:`robodyn.load` the default is
@@ -65,7 +66,8 @@ def load(
     spec = spec_with_armature(spec, armature or {}, locked=lock or {})
     tree = build_tree(spec, resolved.text, floating_base=floating_base)
     name = spec.name if resolved.name == "robot" else resolved.name
-    gravity_vector = np.array(STANDARD_GRAVITY) if gravity is None else as_state(gravity, "gravity", 3)
+    default = STANDARD_GRAVITY if resolved.gravity is None else resolved.gravity
+    gravity_vector = np.array(default) if gravity is None else as_state(gravity, "gravity", 3)
     return ReferenceRobot(tree, name=name, urdf=resolved.text, spec=spec, gravity=gravity_vector)
 
 

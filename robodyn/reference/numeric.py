@@ -30,6 +30,7 @@ import numpy as np
 
 from robodyn.common.inputs import as_states
 from robodyn.common.rotations import skew
+from robodyn.reference import centroidal
 from robodyn.reference.tree import KinematicTree
 from robodyn.urdf.validation import URDFSpec
 
@@ -66,6 +67,20 @@ def _base_bias(v: np.ndarray) -> np.ndarray:
     bias[:, :3] = np.cross(angular, linear)
     bias[:, 3:6] = -np.stack([angular[:, 1] * angular[:, 2], -angular[:, 0] * angular[:, 2], angular[:, 0] * angular[:, 1]], -1)
     return bias
+
+
+def _pair_cross(columns: np.ndarray, others: np.ndarray) -> np.ndarray:
+    """``out[n, i, j] = Σ_b columns[n, b, i] × others[n, b, j]``, shape (N, n, n, 3): from the
+    nine sums ``Σ_b columns[n, b, i, d] others[n, b, j, e]``, each one matrix product a state."""
+    products = np.einsum("nbid,nbje->nijde", columns, others, optimize=True)
+    return np.stack(
+        [
+            products[..., 1, 2] - products[..., 2, 1],
+            products[..., 2, 0] - products[..., 0, 2],
+            products[..., 0, 1] - products[..., 1, 0],
+        ],
+        axis=-1,
+    )
 
 
 class ReferenceRobot:
@@ -194,22 +209,31 @@ class ReferenceRobot:
         return terms
 
     def _mass_derivative(self, linear, angular, weighted, world_inertia, axes) -> np.ndarray:
-        """``dM[n, i, j, k] = ∂M_ij/∂θ_k`` (see the module docstring)."""
-        z_k = axes[:, None, None, :, :]  # (N, 1, 1, K, 3)
-        rotating = self._mask_rotating[None, None, :, :, None]
-        lever = self._mask_lever[None, None, :, :, None]
-        d_linear = rotating * np.cross(z_k, linear[:, :, :, None, :]) + lever * np.cross(
-            axes[:, None, :, None, :], linear[:, :, None, :, :]
-        )
-        d_angular = rotating * np.cross(z_k, angular[:, :, :, None, :])
-        spin = skew(axes)  # (N, K, 3, 3)
-        moving = (self.tree.ancestors & self._revolute[None, :])[None, :, :, None, None]  # (1, B, K, 1, 1)
-        d_inertia = moving * (spin[:, None] @ world_inertia[:, :, None] - world_inertia[:, :, None] @ spin[:, None])
-        inertia_angular = world_inertia @ np.swapaxes(angular, -1, -2)  # (N, B, 3, n)
-        translational = np.einsum("nbika,nbja->nijk", d_linear, weighted, optimize=True)
-        rotational = np.einsum("nbika,nbaj->nijk", d_angular, inertia_angular, optimize=True)
-        spin_term = np.einsum("nbia,nbkac,nbjc->nijk", angular, d_inertia, angular, optimize=True)
-        return translational + np.swapaxes(translational, 1, 2) + rotational + np.swapaxes(rotational, 1, 2) + spin_term
+        """``dM[n, i, j, k] = ∂M_ij/∂θ_k`` (see the module docstring).
+
+        ``∂M_ij/∂θ_k = Σ_b m_b (∂J_v[b,i]/∂θ_k · J_v[b,j] + J_v[b,i] · ∂J_v[b,j]/∂θ_k)`` plus the
+        rotational terms; each ``∂J/∂θ_k`` is a cross product with a joint axis, so by the
+        triple product ``(z × x) · y = z · (x × y)`` the sums over bodies are taken first (one
+        3-vector per pair of joints) and dotted with the axes after.
+        """
+        rotating, lever = self._mask_rotating, self._mask_lever  # [i, k]
+        moving = (self.tree.ancestors & self._revolute[None, :]).astype(float)  # [b, k]
+        inertia_angular = world_inertia @ np.swapaxes(angular, -1, -2)  # (N, B, 3, n): I_b J_ω[b, j]
+        inertia_angular = np.swapaxes(inertia_angular, -1, -2)  # (N, B, n, 3)
+        # P[n, i, j] = Σ_b J_v[b, i] × m_b J_v[b, j];  Q[n, i, j] = Σ_b J_ω[b, i] × I_b J_ω[b, j]
+        linear_pairs = _pair_cross(linear, weighted)
+        angular_pairs = _pair_cross(angular, inertia_angular)
+        # (z_k × J[b,i]) · Y[b,j] = z_k · (J[b,i] × Y[b,j]);  (z_i × J_v[b,k]) · W[b,j] = z_i · P[k, j]
+        along_k = np.einsum("nija,nka->nijk", linear_pairs + angular_pairs, axes, optimize=True) * rotating[None, :, None, :]
+        along_i = np.einsum("nkja,nia->nijk", linear_pairs, axes, optimize=True) * lever[None, :, None, :]
+        half = along_k + along_i
+        # Σ_b J_ω[b,i] · (∂(R I Rᵀ)/∂θ_k) J_ω[b,j] = Σ_b moving[b,k] z_k · (I J_ω[b,j] × J_ω[b,i] − J_ω[b,j] × I J_ω[b,i])
+        spin = np.cross(inertia_angular[:, :, None, :, :], angular[:, :, :, None, :]) - np.cross(
+            angular[:, :, None, :, :], inertia_angular[:, :, :, None, :]
+        )  # (N, B, i, j, 3)
+        summed = np.einsum("bk,nbija->nijka", moving, spin, optimize=True)  # Σ_b moving[b, k] (…)[b, i, j]
+        spin_term = np.einsum("nijka,nka->nijk", summed, axes, optimize=True)
+        return half + np.swapaxes(half, 1, 2) + spin_term
 
     def _evaluate(self, q: np.ndarray, v: np.ndarray | None, a: np.ndarray | None) -> dict[str, np.ndarray]:
         """All terms in the independent coordinates, for stacks q, v, a (chunked)."""
@@ -257,6 +281,15 @@ class ReferenceRobot:
     # ----------------------------------------------------------------------------------
     # Public API, mirroring robodyn.Robot
     # ----------------------------------------------------------------------------------
+    def terms(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
+        """Every term at once, for stacks of states (one a row): ``tau``, ``M``, ``Cv``, ``G``
+        and, on a fixed base, ``C`` and ``Mdot`` (shapes as their methods give for a stack),
+        in one pass: ``∂M/∂q`` is computed once, not once a method."""
+        (q, v, a), _ = as_states({"q": (q, self.nq), "v": (v, self.nv), "a": (a, self.nv)})
+        values = self._evaluate(np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a))
+        names = ("tau", "M", "Cv", "G") if self.floating_base else ("tau", "M", "Cv", "G", "C", "Mdot")
+        return {name: values[name] for name in names}
+
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """``tau = M a + C v + G``, shape (n,) or (N, n)."""
         return self._call("tau", q=q, v=v, a=a)
@@ -300,3 +333,41 @@ class ReferenceRobot:
         """``U = −Σ m_b gᵀ p_b`` in [J]: a float or shape (N,)."""
         energy = self._call("U", q=q)
         return energy if np.ndim(energy) else float(energy)
+
+    # ----------------------------------------------------------------------------------
+    # Centroidal quantities (robodyn.reference.centroidal), body by body
+    # ----------------------------------------------------------------------------------
+    def body_motion(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The robot's bodies (armature rotors left out) at stacked states: masses (B,),
+        centres of mass (N, B, 3) [m], their velocities (N, B, 3) [m/s], inertias about
+        them in world axes (N, B, 3, 3) [kg m²], angular velocities (N, B, 3) [rad/s]."""
+        base = None
+        if self.floating_base:  # the virtual joints sit at zero, hanging from the base pose
+            base = (_quaternion_matrix(q[:, 3:7]), q[:, :3])
+            q = np.hstack([np.zeros((len(q), 6)), q[:, 7:]])
+        theta = q @ self._selection.T + self._offset
+        rotations, positions, axes, joint_origins = self._kinematics(theta, base)
+        coms = positions + np.einsum("nbij,bj->nbi", rotations, self._coms)
+        linear, angular = self._jacobians(coms, axes, joint_origins, self.tree.ancestors)
+        rate = v @ self._selection.T  # θ̇: a floating base's virtual rates are its body-frame twist
+        inertias = rotations @ self._inertias[None] @ np.swapaxes(rotations, -1, -2)
+        keep = np.array([not body.rotor for body in self.tree.bodies])
+        velocities = np.einsum("nbia,ni->nba", linear, rate)
+        omegas = np.einsum("nbia,ni->nba", angular, rate)
+        return self._masses[keep], coms[:, keep], velocities[:, keep], inertias[:, keep], omegas[:, keep]
+
+    def center_of_mass(self, q: np.ndarray) -> np.ndarray:
+        """``Σ mᵢ pᵢ / m`` in [m], world axes, shape (3,) or (N, 3)."""
+        (q,), batch = as_states({"q": (q, self.nq)})
+        stacked = q if batch else q[None]
+        masses, coms, *_ = self.body_motion(stacked, np.zeros((len(stacked), self.nv)))
+        result = centroidal.center_of_mass(masses, coms)
+        return result if batch else result[0]
+
+    def centroidal_momentum(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``(Σ mᵢ vᵢ, Σ (pᵢ − c) × mᵢ vᵢ + Iᵢ ωᵢ)``: linear [kg m/s] then angular
+        [kg m²/s] momentum about the centre of mass, world axes, shape (6,) or (N, 6)."""
+        (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
+        stacked = [q, v] if batch else [q[None], v[None]]
+        result = centroidal.centroidal_momentum(*self.body_motion(*stacked))
+        return result if batch else result[0]

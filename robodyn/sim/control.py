@@ -33,6 +33,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
@@ -40,6 +41,15 @@ from robodyn.common.text import quoted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.linearize import StepIntegrator, actuation_matrix, linearize
+from robodyn.sim.twin import compiled_model, law_refusal
+
+if TYPE_CHECKING:
+    from robodyn.compiled.controllers import (
+        CompiledComputedTorque,
+        CompiledLQR,
+        CompiledPDGravity,
+        CompiledTaskSpace,
+    )
 
 #: A joint reference: time in [s] -> (q_d, v_d, a_d).
 JointReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -67,6 +77,16 @@ class PDGravity:
             return _floating_pd(self, q, v)
         return self.kp * (self.target - q) - self.kd * v + self.model.gravity(q)
 
+    def twin_refusal(self) -> str | None:
+        """Why this controller has no compiled twin (``None``: it has one; floating bases too)."""
+        return law_refusal(self, PDGravity)
+
+    def compiled(self) -> CompiledPDGravity:
+        """The same law in C (:class:`~robodyn.compiled.controllers.CompiledPDGravity`)."""
+        from robodyn.compiled.controllers import CompiledPDGravity
+
+        return CompiledPDGravity(compiled_model(self.model, self.twin_refusal()), self.target, self.kp, self.kd)
+
 
 @dataclass
 class ComputedTorque:
@@ -93,6 +113,21 @@ class ComputedTorque:
             return free_base_torques(self.model, q, v, command)
         command = a_d + self.kd * (v_d - v) + self.kp * (q_d - q)
         return self.model.inverse_dynamics(q, v, command)
+
+    def twin_refusal(self) -> str | None:
+        """Why this controller has no compiled twin: a reference other than a
+        :class:`QuinticReference` (whose formulas the C loop has), or a changed law."""
+        if not isinstance(self.reference, QuinticReference):
+            return "computed torque compiles along a quintic_reference only"
+        return law_refusal(self, ComputedTorque)
+
+    def compiled(self) -> CompiledComputedTorque:
+        """The same law in C along the same quintic (:class:`~robodyn.compiled.controllers.CompiledComputedTorque`)."""
+        from robodyn.compiled.controllers import CompiledComputedTorque
+
+        model, reference = compiled_model(self.model, self.twin_refusal()), self.reference
+        assert isinstance(reference, QuinticReference)  # twin_refusal checked it
+        return CompiledComputedTorque(model, reference.q_start, reference.q_end, reference.duration, self.kp, self.kd)
 
 
 @dataclass
@@ -122,6 +157,8 @@ class TaskSpace:
     kd: float = 20.0
     damping: float = 1e-6
     joint_damping: float = 5.0
+    #: The compiled twin's frame kinematics model fixed bases.
+    twin_fixed_base: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         self.frame = self._frame = self.model.task_frame(self.frame, "task-space control")
@@ -142,6 +179,17 @@ class TaskSpace:
         null_space = np.eye(self.model.nv) - pseudo_inverse @ jacobian
         command = pseudo_inverse @ desired - null_space @ (self.joint_damping * v)
         return self.model.inverse_dynamics(q, v, command)
+
+    def twin_refusal(self) -> str | None:
+        """Why this controller has no compiled twin (a floating base: its frame kernels model fixed bases)."""
+        return law_refusal(self, TaskSpace)
+
+    def compiled(self) -> CompiledTaskSpace:
+        """The same law in C (:class:`~robodyn.compiled.controllers.CompiledTaskSpace`)."""
+        from robodyn.compiled.controllers import CompiledTaskSpace
+
+        model = compiled_model(self.model, self.twin_refusal())
+        return CompiledTaskSpace(model, self._frame, self.target, self.kp, self.kd, self.damping, self.joint_damping)
 
 
 @dataclass(frozen=True)
@@ -258,6 +306,8 @@ class LQR:
     dt: float | None = None
     actuated: list[str] | None = None
     integrator: StepIntegrator = "rk4"
+    #: LQR is designed about a fixed base's equilibrium.
+    twin_fixed_base: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         self.gain, self.u_eq, self.actuation = lqr_gain(
@@ -268,6 +318,16 @@ class LQR:
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         error = np.concatenate([q, v]) - self.x_eq
         return self.actuation @ (self.u_eq - self.gain @ error)
+
+    def twin_refusal(self) -> str | None:
+        """Why this controller has no compiled twin (``None``: it has one)."""
+        return law_refusal(self, LQR)
+
+    def compiled(self) -> CompiledLQR:
+        """The same law in C (:class:`~robodyn.compiled.controllers.CompiledLQR`)."""
+        from robodyn.compiled.controllers import CompiledLQR
+
+        return CompiledLQR(compiled_model(self.model, self.twin_refusal()), self.gain, self.u_eq, self.actuation, self.x_eq)
 
 
 def lqr_gain(

@@ -26,16 +26,24 @@ from typing import Any, Literal
 import numpy as np
 import pinocchio as pin
 
+from robodyn.common.text import counted
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, JointLimitWarning
+from robodyn.sim.contact_checks import start_above
+from robodyn.sim.contact_run import ground_lines
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
+from robodyn.sim.gains import LQR_ACCELERATION as LQR_ACCELERATION
+from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_gains
+from robodyn.sim.ground import Ground
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
 from robodyn.sim.reach import check_reach
 from robodyn.sim.report import ObserverOutcome, Push, SimulationSummary, TaskOutcome
+from robodyn.sim.requests import TrajectoryReference, check_planar, pose_target, push_wrenches, task_target, tracked
 from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate_run
+from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_dofs
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
@@ -54,65 +62,6 @@ def controller_model(robot: Robot) -> Robot:
     return rebuild(robot)
 
 
-def task_target(values: list[float] | np.ndarray) -> np.ndarray:
-    """A task-space target from ``X,Z`` (planar arms, ``Y = 0``) or ``X,Y,Z``, in [m]."""
-    values = np.asarray(values, dtype=float)
-    if values.shape == (2,):
-        return np.array([values[0], 0.0, values[1]])
-    if values.shape == (3,):
-        return values
-    raise InputError("target", "X,Z or X,Y,Z in [m] for task-space control", f"{values.size} values")
-
-
-def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """A pose target from ``X,Y,Z`` (position only) or ``X,Y,Z,ROLL,PITCH,YAW``.
-
-    Returns:
-        The position in [m], shape (3,), and roll, pitch, yaw in [rad], shape (3,) (``None``
-        for a position target).
-    """
-    values = np.asarray(values, dtype=float)
-    if values.shape not in ((3,), (6,)) or not np.isfinite(values).all():
-        raise InputError("target", "X,Y,Z in [m] or X,Y,Z,ROLL,PITCH,YAW (rad) for pose control", f"{values.size} values")
-    return values[:3], (values[3:] if values.size == 6 else None)
-
-
-def parse_push(text: str) -> Push:
-    """A push from ``T:FX,FY,FZ`` or ``T:FX,FY,FZ@FRAME`` (time in [s], force in [N])."""
-    head, _, frame = text.partition("@")
-    start, _, force = head.partition(":")
-    try:
-        time_ = float(start)
-        values = [float(value) for value in force.replace(",", " ").split()]
-    except ValueError:
-        values, time_ = [], float("nan")
-    if len(values) != 3 or not np.isfinite([time_, *values]).all() or time_ < 0:
-        raise InputError("force_at", "T:FX,FY,FZ[@FRAME] (a time >= 0 in [s], a force in [N])", repr(text))
-    return Push(time_, (values[0], values[1], values[2]), frame.strip() or None)
-
-
-class _StepForce:
-    """A force that starts at a time: zero before, constant after (a callable wrench)."""
-
-    def __init__(self, start: float, force: tuple[float, ...]) -> None:
-        self.start, self.force, self.zero = start, np.asarray(force, dtype=float), np.zeros(3)
-
-    def __call__(self, t: float) -> np.ndarray:
-        return self.force if t >= self.start else self.zero
-
-
-def push_wrenches(
-    robot: Robot, pushes: Sequence[str | Push], frame: str | None = None
-) -> tuple[tuple[Push, ...], list[ExternalWrench]]:
-    """The pushes (frames resolved: ``frame`` when a push names none, then the robot's end
-    effector) and their wrenches."""
-    resolved = []
-    for push in pushes:
-        push = parse_push(push) if isinstance(push, str) else push
-        resolved.append(replace(push, frame=robot.task_frame(push.frame or frame, "a push")))
-    return tuple(resolved), [ExternalWrench(push.frame, _StepForce(push.time, push.force)) for push in resolved]  # type: ignore[arg-type]
-
-
 def run_simulation(
     robot: Robot,
     *,
@@ -122,7 +71,7 @@ def run_simulation(
     q0: list[float] | None = None,
     duration: float = 3.0,
     dt: float = 1e-3,
-    integrator: Integrator = "rk4",
+    integrator: Integrator | None = None,
     limits: LimitMode = "warn",
     engine: Engine = "auto",
     posture: list[float] | None = None,
@@ -134,13 +83,17 @@ def run_simulation(
     reference: Trajectory | None = None,
     control_period: float | None = None,
     joint_friction: bool = True,
+    kp: float | list[float] | None = None,
+    kd: float | list[float] | None = None,
+    ground: Ground | None = None,
+    contacts: str | Sequence[str] = "collision",
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
 
     Args:
         robot: The plant.
-        controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target; a floating
-            robot's gains from its joints' inertia, :func:`free_base_gains`),
+        controller: ``"passive"``, ``"pd"`` (PD + gravity to a joint target, gains scaled
+            to each joint's inertia (its largest at ``q0`` and the target), :func:`robodyn.sim.gains.pd_gains`),
             ``"computed-torque"`` (quintic from ``q0`` to a joint target in half the
             duration), ``"task-space"`` (drive ``frame`` to a position target), ``"osc"``
             (operational-space control of ``frame``'s position or pose) or
@@ -163,7 +116,10 @@ def run_simulation(
         force_at: Pushes, each a :class:`~robodyn.sim.report.Push` or ``T:FX,FY,FZ[@FRAME]``
             (default frame: the controlled frame, or the end effector).
         observer_gain: ``K_O`` in [1/s]: run a momentum observer along (``None``: none).
-        actuated: lqr only: the actuated joints (default all; the others get zero torque).
+        actuated: pd, computed-torque and lqr: the actuated joints (default: those whose
+            :attr:`~robodyn.dynamics.dofs.Dof.actuated`, i.e. the file's actuators, else all);
+            the others get zero torque (pd and computed torque then hold or drive the
+            actuated joints with the others free, :mod:`robodyn.sim.underactuated`).
         reference: computed-torque only: a motion to track instead of the quintic
             (:class:`TrajectoryReference`; e.g. ``robodyn optimize``'s); it starts at its first
             sample (unless ``q0`` is given) and its last configuration is the target.
@@ -171,6 +127,12 @@ def run_simulation(
             torque (zero-order hold; the summary says so); ``None``: every stage.
         joint_friction: As for :func:`robodyn.simulate`: the joints' damping and friction
             act (``False``: the rigid-body motion). The controllers' models are rigid-body.
+        kp, kd: pd: stiffness and damping, a scalar or one value a joint, in [N m/rad] and
+            [N m s/rad] (default: scaled to each joint's inertia,
+            :func:`~robodyn.sim.gains.pd_gains`); computed-torque: in [1/s²] and [1/s]
+            (default 400 and 40). Refused with the other controllers.
+        ground, contacts: As for :func:`robodyn.simulate`: the robot on a plane with
+            friction (docs/contact.md); the summary gives its contact lines.
 
     Returns:
         The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`
@@ -180,16 +142,26 @@ def run_simulation(
         InputError: Naming the parameter (``controller``, ``target``, ``frame``, ...).
     """
     if reference is not None:
-        reference, target, q0 = _tracked(robot, controller, reference, target, q0)
+        reference, target, q0 = tracked(robot, controller, reference, target, q0)
     _check_request(robot, controller, target, frame, limits)
     _check_pose_options(controller, posture, stiffness, damping)
     if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
         raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
+    lifted: tuple[str, ...] = ()
+    if q0 is None and ground is not None and robot.floating_base:  # dropped from 5 cm, not started in the floor
+        start, lift = start_above(robot, start, ground, contacts)
+        lifted = (f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point 5 cm above it)",)
     options: dict[str, Any] = {"posture": posture, "stiffness": stiffness, "damping": damping}
-    if actuated is not None and controller != "lqr":
-        raise InputError("actuated", "given only with the lqr controller", f"{len(actuated)} joints")
+    if actuated is not None and controller not in ("pd", "computed-torque", "lqr"):
+        raise InputError("actuated", "given only with the pd, computed-torque or lqr controller", f"{len(actuated)} joints")
+    options["driven"] = driven_dofs(robot, actuated)
     options["actuated"] = actuated
+    if (kp is not None or kd is not None) and controller not in ("pd", "computed-torque"):
+        raise InputError(
+            "kp" if kp is not None else "kd", "given only with the pd or computed-torque controller", repr(controller)
+        )
+    options["gains"] = {"kp": kp, "kd": kd}
     law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
     if reference is not None:
         law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
@@ -200,11 +172,11 @@ def run_simulation(
         trajectory, run = simulate_run(
             robot, start, np.zeros(robot.nv), duration, dt, controller=law, integrator=integrator, limits=limits,
             engine=engine, external=external, observer=observer, control_period=control_period,
-            joint_friction=joint_friction,
+            joint_friction=joint_friction, ground=ground, contacts=contacts,
         )  # fmt: skip
     settings = {
         "controller": controller,
-        "integrator": integrator,
+        "integrator": integrator or ("semi-implicit-euler" if ground is not None else "rk4"),
         "limits": limits,
         "engine": run.engine,
         "duration": duration,
@@ -213,7 +185,7 @@ def run_simulation(
     summary = replace(
         _summary(robot, trajectory, settings, run.loop_time), pushes=pushes, engine_reason=run.reason,
         control_period=run.control_period, controller_in_c=run.controller_in_c, loop_time=run.loop_time,
-        compile_time=run.compile_time,
+        compile_time=run.compile_time, ground=lifted + ground_lines(robot, run.contact), contact=run.contact,
     )  # fmt: skip
     if observer is not None:
         summary = replace(summary, observer=_observer_outcome(robot, trajectory, observer, external))
@@ -223,47 +195,12 @@ def run_simulation(
         return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
     if controller != "passive":
         joints = np.asarray(target, float)
-        error = float(np.abs(trajectory.q[-1][robot.nq - joints.size :] - joints).max())
-        return trajectory, replace(summary, final_joint_error=error)
+        missed = np.abs(trajectory.q[-1][robot.nq - joints.size :] - joints)
+        driven = options["driven"][6:] if robot.floating_base else options["driven"]
+        if driven.size == missed.size and driven.any():  # the joints no actuator drives have no target to reach
+            missed = missed[driven]
+        return trajectory, replace(summary, final_joint_error=float(missed.max()))
     return trajectory, summary
-
-
-class TrajectoryReference:
-    """A recorded motion as a joint reference ``t -> (q_d, v_d, a_d)`` for computed torque:
-    each column interpolated linearly between samples; before the first sample its state,
-    after the last one at rest there.
-
-    Args:
-        trajectory: The motion (fixed base: ``q`` and ``v`` of the same size), in the
-            robot's joint order.
-    """
-
-    def __init__(self, trajectory: Trajectory) -> None:
-        self.t, self.q, self.v, self.a = trajectory.t, trajectory.q, trajectory.v, trajectory.a
-        self.rest = np.zeros(trajectory.v.shape[1])
-
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        if t >= self.t[-1]:
-            return self.q[-1], self.rest, self.rest
-        t = max(float(t), float(self.t[0]))
-        k = int(np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.t) - 2))
-        s = (t - self.t[k]) / (self.t[k + 1] - self.t[k])
-        return tuple((1 - s) * x[k] + s * x[k + 1] for x in (self.q, self.v, self.a))
-
-
-def _tracked(
-    robot: Robot, controller: str, reference: Trajectory, target: list[float] | None, q0: list[float] | None
-) -> tuple[Trajectory, list[float], list[float]]:
-    """The reference in the robot's joint order, its goal as the target and its start as ``q0``
-    (unless given); refused with another controller, a target, a floating base or one sample."""
-    if controller != "computed-torque":
-        raise InputError("reference", "given only with the computed-torque controller", repr(controller))
-    if target is not None:
-        raise InputError("target", "left out with a reference (its last sample is the target)", f"{np.size(target)} values")
-    reference = reference.for_robot(robot)
-    if robot.floating_base or len(reference) < 2:
-        raise InputError("reference", "a fixed-base robot's motion of at least two samples", f"{len(reference)} samples")
-    return reference, list(reference.q[-1]), list(reference.q[0]) if q0 is None else q0
 
 
 def _summary(robot: Robot, trajectory: Trajectory, settings: dict[str, Any], elapsed: float) -> SimulationSummary:
@@ -294,17 +231,19 @@ def _check_request(robot: Robot, controller: str, target: list[float] | None, fr
     if controller != "passive" and target is None:
         raise InputError("target", f"given for the {controller} controller", "nothing")
     if controller == "passive" and target is not None:
-        raise InputError("target", "given only with a controller (the passive run has no target)", f"{np.size(target)} values")
+        raise InputError(
+            "target", "given only with a controller (the passive run has no target)", counted(np.size(target), "value")
+        )
     # Under the other controllers a frame names only the path a recording draws (checked by it).
 
 
 def _check_pose_options(controller: str, posture: Any, stiffness: Any, damping: Any) -> None:
     """Refuse a posture without osc, and impedance gains without the impedance controller."""
     if posture is not None and controller != "osc":
-        raise InputError("posture", "given only with the osc controller", f"{np.size(posture)} values")
+        raise InputError("posture", "given only with the osc controller", counted(np.size(posture), "value"))
     for name, value in (("stiffness", stiffness), ("damping", damping)):
         if value is not None and controller != "impedance":
-            raise InputError(name, "given only with the impedance controller", f"{np.size(value)} values")
+            raise InputError(name, "given only with the impedance controller", counted(np.size(value), "value"))
 
 
 def _control_law(
@@ -323,18 +262,30 @@ def _control_law(
     if controller in ("pd", "computed-torque", "lqr"):  # the joints' positions (a floating base stays free)
         assert target is not None  # checked by _check_request
         joints = joint_target(robot, target, controller)
-    if controller == "pd" and robot.floating_base:
-        law = PDGravity(controller_model(robot), joints, *free_base_gains(robot, start))
-    elif controller == "pd":
-        law = PDGravity(controller_model(robot), joints)
+    gains, driven = options["gains"], options["driven"]
+    every_joint = bool(driven[6:].all() if robot.floating_base else driven.all())
+    if controller == "pd":
+        goal = start.copy()
+        goal[robot.nq - joints.size :] = joints  # the inertia at the start and at the target
+        pd = pd_gains(robot, np.array([start, goal]), driven=driven, **gains)
+        model = controller_model(robot)
+        law = PDGravity(model, joints, *pd) if every_joint else UnderactuatedPD(model, joints, *pd, driven=driven)
     elif controller == "computed-torque":
-        law = ComputedTorque(controller_model(robot), quintic_reference(start[robot.nq - joints.size :], joints, duration / 2))
+        reference = quintic_reference(start[robot.nq - joints.size :], joints, duration / 2)
+        ct, model = computed_torque_gains(joints.size, **gains), controller_model(robot)
+        law = (
+            ComputedTorque(model, reference, *ct)
+            if every_joint
+            else UnderactuatedComputedTorque(model, reference, *ct, driven=driven)
+        )
     elif controller == "lqr":
-        law = _lqr_law(robot, joints, options["actuated"])
+        names = [dof.joint for dof in robot.dofs if driven[dof.index]]
+        law = _lqr_law(robot, joints, options["actuated"] if every_joint or options["actuated"] else names)
     elif controller == "task-space":
         assert target is not None  # checked by _check_request
         task = task_target(target)
         controlled = robot.task_frame(frame, "task-space control")
+        check_planar(robot, controlled, start, len(target))
         check_reach(robot, controlled, task, parameter="target")
         law = TaskSpace(controller_model(robot), controlled, task)
     elif controller in POSE_CONTROLLERS:
@@ -344,43 +295,6 @@ def _control_law(
         check_reach(robot, controlled, task, parameter="target")
         law = _pose_law(robot, controller, controlled, task, rpy, options)
     return law, task, controlled
-
-
-def free_base_gains(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """PD gains for a floating robot's joints: ``100 m`` and ``20 m`` (a critically damped
-    10 rad/s) with ``m`` each joint's inertia at ``q`` with the base free (the diagonal of
-    ``M_jj − M_jb M_bb⁻¹ M_bj``), in [N m/rad] and [N m s/rad]. A legged robot's light
-    legs (solo12's knees: 3e-4 kg m²) make the fixed-base defaults (100, 20) unstable at
-    any practical step."""
-    mass = robot.mass_matrix(q)
-    inertia = np.diag(mass[6:, 6:] - mass[6:, :6] @ np.linalg.solve(mass[:6, :6], mass[:6, 6:]))
-    return 100.0 * inertia, 20.0 * inertia
-
-
-#: The largest joint acceleration [rad/s²] / [m/s²] the default LQR weights budget for.
-LQR_ACCELERATION = 100.0
-
-
-def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The LQR weights ``simulate --controller lqr`` uses (Bryson's rule): ``Q`` with
-    1 / (0.3 rad)² per position and 1 / (1 rad/s)² per velocity (prismatic: 0.03 m,
-    0.1 m/s); ``R`` with 1 / u_j² per actuated joint, ``u_j`` the smaller of its effort
-    limit and ``M_jj(q_eq)`` × :data:`LQR_ACCELERATION` (so light distal joints are not
-    given gains too stiff for a millisecond step).
-    """
-    positions = [1 / 0.03**2 if dof.linear else 1 / 0.3**2 for dof in robot.dofs]
-    velocities = [100.0 if dof.linear else 1.0 for dof in robot.dofs]
-    chosen = robot.joint_names if actuated is None else actuated
-    inertia = np.diag(robot.mass_matrix(q_eq))
-    scales = [
-        min(
-            dof.effort_limit if np.isfinite(dof.effort_limit) and dof.effort_limit > 0 else np.inf,
-            inertia[dof.index] * LQR_ACCELERATION,
-        )
-        for dof in robot.dofs
-        if dof.joint in chosen
-    ]
-    return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))
 
 
 def _lqr_law(robot: Robot, target: np.ndarray, actuated: list[str] | None) -> LQR:
@@ -396,7 +310,7 @@ def _pose_law(
     if controller == "osc":
         posture = options["posture"]
         if posture is not None and np.size(posture) != robot.nq:
-            raise InputError("posture", f"{robot.nq} joint values", f"{np.size(posture)} values")
+            raise InputError("posture", f"{robot.nq} joint values", counted(np.size(posture), "value"))
         return OperationalSpace(
             controller_model(robot),
             frame,
@@ -407,7 +321,7 @@ def _pose_law(
     gains: dict[str, Any] = {n: np.asarray(options[n], float) for n in ("stiffness", "damping") if options[n] is not None}
     for name, values in gains.items():
         if values.size not in (1, 3, 6):
-            raise InputError(name, "1, 3 or 6 values", f"{values.size} values")
+            raise InputError(name, "1, 3 or 6 values", counted(values.size, "value"))
     return Impedance(controller_model(robot), frame, position, orientation=rpy, **gains)
 
 

@@ -28,22 +28,22 @@ from __future__ import annotations
 import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from robodyn.common.text import printable, quoted
+from robodyn.compiled.loop_rules import INTEGRATORS, Integrator, check_integrator
 from robodyn.dynamics.dofs import Dof
 from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 
-#: The integrators of :func:`robodyn.simulate` (the same names as
-#: :data:`robodyn.sim.simulation.INTEGRATORS`, not imported: the simulator imports the
-#: controllers, which import this module).
-StepIntegrator = Literal["rk4", "semi-implicit-euler"]
-STEP_INTEGRATORS: tuple[StepIntegrator, ...] = ("rk4", "semi-implicit-euler")
+#: The integrators of :func:`robodyn.simulate` (:mod:`robodyn.compiled.loop_rules`, the
+#: rules both simulation loops share).
+StepIntegrator = Integrator
+STEP_INTEGRATORS: tuple[StepIntegrator, ...] = INTEGRATORS
 
 
 @dataclass(frozen=True)
@@ -231,8 +231,7 @@ def linearization(
     selection = _actuation(robot, actuation)
     if dt is not None and not (isinstance(dt, numbers.Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0):
         raise InputError("dt", "a finite step > 0 in [s] (or None for continuous time)", repr(dt))
-    if integrator not in STEP_INTEGRATORS:
-        raise InputError("integrator", f"one of {', '.join(STEP_INTEGRATORS)}", repr(integrator))
+    check_integrator(integrator)
     if dt is None:
         A, B = _continuous(robot, q, v, tau, selection, friction)
     else:

@@ -34,7 +34,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robodyn.common.files import atomic_write_text
-from robodyn.common.text import printable
+from robodyn.common.text import counted, printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.trajectory import Trajectory
@@ -49,7 +49,9 @@ def _gain(robot: Robot, gain: float | np.ndarray) -> np.ndarray:
     """``K_O`` as (nv,) positive finite values in [1/s]."""
     gains = np.broadcast_to(np.asarray(gain, dtype=float), (robot.nv,)) if np.ndim(gain) == 0 else np.asarray(gain, float)
     if gains.shape != (robot.nv,) or not (np.isfinite(gains).all() and (gains > 0).all()):
-        raise InputError("gain", f"a positive scalar or {robot.nv} positive values in [1/s]", f"{np.asarray(gain).size} values")
+        raise InputError(
+            "gain", f"a positive scalar or {robot.nv} positive values in [1/s]", counted(np.asarray(gain).size, "value")
+        )
     return np.array(gains)
 
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import KW_ONLY, dataclass, field
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 import pinocchio as pin
@@ -39,6 +40,10 @@ from robodyn.common.rotations import rpy_matrix, skew
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.reach import check_reach
+from robodyn.sim.twin import compiled_model, law_refusal
+
+if TYPE_CHECKING:
+    from robodyn.compiled.controllers import CompiledImpedance, CompiledOperationalSpace
 
 #: Damping of the task inertia, relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
 TASK_DAMPING = 1e-8
@@ -218,6 +223,8 @@ class OperationalSpace:
     damping: float = TASK_DAMPING
     _frame_id: int = field(init=False, repr=False)
     _rotation: np.ndarray | None = field(init=False, repr=False)
+    #: The compiled twin's frame kinematics model fixed bases.
+    twin_fixed_base: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         self.frame = self.model.task_frame(self.frame, "operational-space control")
@@ -272,6 +279,24 @@ class OperationalSpace:
         task = jacobian.T @ (inertia @ (command - bias))
         return task + model.nonlinear_effects(q, v) + null_space.T @ posture
 
+    def twin_refusal(self) -> str | None:
+        """Why this controller has no compiled twin: a path target (the C law holds a fixed
+        one), a floating base, or a changed law."""
+        if callable(self.position):
+            return f"{type(self).__name__} compiles with a fixed target, not a path"
+        return law_refusal(self, OperationalSpace)
+
+    def compiled(self) -> CompiledOperationalSpace:
+        """The same law in C for the same fixed target (:class:`~robodyn.compiled.controllers.CompiledOperationalSpace`)."""
+        from robodyn.compiled.controllers import CompiledOperationalSpace
+
+        model = compiled_model(self.model, self.twin_refusal())
+        assert self.frame is not None and not callable(self.position)  # resolved; twin_refusal checked
+        return CompiledOperationalSpace(
+            model, self.frame, self.position, self._rotation, self.kp, self.kd, self.posture, self.posture_kp,
+            self.posture_kd, self.damping,
+        )  # fmt: skip
+
 
 def _gains(value: float | np.ndarray | list[float], rows: int, name: str, units: str) -> np.ndarray:
     """Impedance gains as a (rows,) array: a scalar, ``rows`` values, or 6 when ``rows`` is 3
@@ -317,6 +342,8 @@ class Impedance:
     null_damping: float = 1.0
     _frame_id: int = field(init=False, repr=False)
     _rotation: np.ndarray | None = field(init=False, repr=False)
+    #: The compiled twin's frame kinematics model fixed bases.
+    twin_fixed_base: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         self.frame = self.model.task_frame(self.frame, "impedance control")
@@ -352,3 +379,16 @@ class Impedance:
         gram = jacobian @ jacobian.T + PSEUDO_INVERSE_DAMPING * np.eye(rows)
         null_space = np.eye(model.nv) - jacobian.T @ np.linalg.solve(gram, jacobian)
         return model.gravity(q) + jacobian.T @ wrench - null_space.T @ (self.null_damping * v)
+
+    def twin_refusal(self) -> str | None:
+        """Why this controller has no compiled twin (a floating base, or a changed law)."""
+        return law_refusal(self, Impedance)
+
+    def compiled(self) -> CompiledImpedance:
+        """The same law in C (:class:`~robodyn.compiled.controllers.CompiledImpedance`)."""
+        from robodyn.compiled.controllers import CompiledImpedance
+
+        model = compiled_model(self.model, self.twin_refusal())
+        assert self.frame is not None  # resolved by __post_init__
+        stiffness, damping = np.asarray(self.stiffness), np.asarray(self.damping)
+        return CompiledImpedance(model, self.frame, self.position, self._rotation, stiffness, damping, self.null_damping)

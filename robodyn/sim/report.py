@@ -170,6 +170,11 @@ class SimulationSummary:
             cached, kernels in [s] (importing the code generator included).
         startup_time: Wall-clock time from the process's start to the run in [s]
             (interpreter, imports, loading the robot; ``robodyn simulate`` fills it in).
+        ground: The contact summary of a run on the ground (peak normal force, slip,
+            penetration, what is not modelled), or for a floating robot without one
+            ``"no ground: the base falls freely"``.
+        contact: A run on the ground: its :class:`~robodyn.sim.contact_run.ContactSimulation`
+            (forces, gaps; not in :meth:`to_dict`), else ``None``.
     """
 
     robot: str
@@ -199,6 +204,8 @@ class SimulationSummary:
     loop_time: float | None = None
     compile_time: float = 0.0
     startup_time: float | None = None
+    ground: tuple[str, ...] = ()
+    contact: Any = field(default=None, repr=False, compare=False)  # the ContactSimulation, for the files
 
     def with_startup(self, seconds: float | None) -> SimulationSummary:
         """The same summary with the start-up time in [s] (process start to the run)."""
@@ -237,6 +244,8 @@ class SimulationSummary:
         if self.observer is not None:
             data |= self.observer.to_dict()
         data["limit_violations"] = [violation.as_dict() for violation in self.violations]
+        if self.ground:
+            data["ground"] = list(self.ground)
         return data | dict(self.files)
 
     def _timing_dict(self) -> dict[str, Any]:
@@ -311,6 +320,7 @@ class SimulationSummary:
         ]
         lines.append(f"peak |torque|: {', '.join(peaks)}")
         lines.append(f"energy change: {_number(self.energy_change, 4)} J")
+        lines += [printable(line) for line in self.ground]
         if self.observer is not None:
             lines += [
                 f"observer (gain {_number(self.observer.gain)} /s): final tau_ext {vector_text(self.observer.final_estimate, 4)}",

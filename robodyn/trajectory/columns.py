@@ -31,6 +31,10 @@ KINDS = ("q", "v", "a", "tau")
 EXTRA_KINDS = ("G", "M", "tau_ext", "tau_env")
 _COLUMN = re.compile(r"^(q|v|a|tau)\[(.*)\]$", re.DOTALL)
 _EXTRA = re.compile(r"^(G|M|tau_ext|tau_env)\[(.*)\]$", re.DOTALL)
+#: A contact simulation's columns (:func:`contact_header`), skipped on reading as a trajectory:
+#: each contact's force on the robot in world axes ``f[<contact>].x/.y/.z`` [N] and whether
+#: it pushes, ``contact[<contact>]`` (1 or 0).
+_CONTACT = re.compile(r"^(f\[(.*)\]\.[xyz]|contact\[(.*)\])$", re.DOTALL)
 _LEGACY_Q = re.compile(r"^q(\d+)$")
 
 
@@ -53,6 +57,28 @@ def coordinate_names(joint_names: list[str], floating_base: bool) -> tuple[list[
 def coordinate_names_to_joints(v_names: list[str], floating_base: bool) -> list[str]:
     """``Robot.joint_names`` from velocity coordinate names (inverse of :func:`coordinate_names`)."""
     return [ROOT_JOINT, *v_names[len(BASE_V_NAMES) :]] if floating_base else list(v_names)
+
+
+def contact_header(contacts: list[str]) -> list[str]:
+    """The columns of a contact simulation's forces and active flags, for contacts named
+    ``contacts``: ``f[<c>].x``, ``f[<c>].y``, ``f[<c>].z`` of each, then ``contact[<c>]``."""
+    forces = [f"f[{name}].{axis}" for name in contacts for axis in "xyz"]
+    return forces + [f"contact[{name}]" for name in contacts]
+
+
+def contact_columns(header: list[str], table: np.ndarray, contacts: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """A table's contact forces (N, k, 3) [N] and active flags (N, k) (:func:`contact_header`).
+
+    Raises:
+        TrajectoryError: When a column of those contacts is missing.
+    """
+    names = contact_header(contacts)
+    missing = [name for name in names if name not in header]
+    if missing:
+        raise TrajectoryError("the table", f"missing columns {short_list(missing)}")
+    values = np.asarray(table, dtype=float)[:, [header.index(name) for name in names]]
+    count = len(contacts)
+    return values[:, : 3 * count].reshape(len(values), count, 3), values[:, 3 * count :] > 0.5
 
 
 def short_list(names: list[str], limit: int = 4) -> str:
@@ -114,7 +140,7 @@ def parse_header(header: list[str], source: str, *, width: int | None = None) ->
         match = _COLUMN.match(name)
         if match:
             found[match.group(1)][match.group(2)] = index
-        elif name != "t" and not _EXTRA.match(name):
+        elif name != "t" and not _EXTRA.match(name) and not _CONTACT.match(name):
             unknown.append(name)
     if unknown:
         raise TrajectoryError(

@@ -20,19 +20,11 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from robodyn.exceptions import MeshPathError
-from robodyn.urdf.packages import PackageLookup
+from robodyn.urdf.packages import PackageLookup, package_folders
 
 
 def _roots(package_dirs: Sequence[Path] | PackageLookup) -> tuple[Path, ...]:
     return package_dirs.roots() if isinstance(package_dirs, PackageLookup) else tuple(Path(d) for d in package_dirs)
-
-
-def _package_folders(package: str, package_dirs: Sequence[Path] | PackageLookup) -> list[Path]:
-    """The folders package ``package`` may be: the lookup's one, or ``NAME`` under each folder."""
-    if isinstance(package_dirs, PackageLookup):
-        found = package_dirs.find(package)
-        return [found] if found is not None else []
-    return [Path(folder) / package for folder in package_dirs]
 
 
 def looked_in(filename: str, package_dirs: Sequence[Path] | PackageLookup) -> str:
@@ -69,7 +61,7 @@ def resolve_mesh(filename: str, *, base_dir: Path | None, package_dirs: Sequence
     if filename.startswith("package://"):
         relative = filename[len("package://") :].lstrip("/")
         package, _, rest = relative.partition("/")
-        for folder in _package_folders(package, package_dirs):
+        for folder in package_folders(package, package_dirs, path=filename):
             candidate = folder / rest
             if not _inside(candidate, folder):
                 raise MeshPathError(filename, f"leaves its package {package!r}")

@@ -12,16 +12,20 @@ A package named ``NAME`` is searched, in order, in
 :func:`package_roots` gives the folders *holding* packages (what
 :func:`robodyn.urdf.meshes.resolve_mesh` searches ``NAME/...`` under): for an explicit
 folder, its parent is not used; the lookup keeps the ``NAME -> folder`` map instead.
+
+A package name is a name: empty, ``.``, ``..`` and names with ``/``, ``\\`` or NUL are
+refused (:func:`name_problem`) by :meth:`PackageLookup.require` (``$(find NAME)``) and
+:func:`package_folders` (``package://NAME/...``) alike, before any folder is looked at.
 This module does not import Pinocchio.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from robodyn.exceptions import InputError, MissingExtraError, URDFError
+from robodyn.exceptions import InputError, MeshPathError, MissingExtraError, URDFError
 
 #: How deep below a ``$ROS_PACKAGE_PATH`` entry a ``package.xml`` is searched for (a
 #: catkin / colcon workspace's ``src/`` holds packages one or two levels down).
@@ -72,7 +76,10 @@ class PackageLookup(tuple[Path, ...]):
         return f"PackageLookup(explicit={self.explicit!r}, ros_path={self.ros_path!r}, zoo_dirs={self.zoo_dirs!r})"
 
     def find(self, name: str) -> Path | None:
-        """The folder of package ``name``, or ``None`` if no place holds it."""
+        """The folder of package ``name``, or ``None`` if no place holds it (or it is not a
+        package name: :func:`name_problem`)."""
+        if name_problem(name) is not None:
+            return None
         for package, folder in self.explicit:
             if package == name:
                 return folder
@@ -96,8 +103,12 @@ class PackageLookup(tuple[Path, ...]):
         """The folder of package ``name``.
 
         Raises:
-            URDFError: Naming the package and the places looked in.
+            URDFError: Naming the package and the places looked in, or why ``name`` is not
+                a package name.
         """
+        problem = name_problem(name)
+        if problem is not None:
+            raise URDFError(label, f"package {name!r} {problem}")
         found = self.find(name)
         if found is None:
             raise URDFError(
@@ -118,6 +129,31 @@ class PackageLookup(tuple[Path, ...]):
         }
 
 
+def name_problem(name: str) -> str | None:
+    """Why ``name`` is not a package name (empty, ``.``, ``..``, a ``/``, ``\\`` or NUL), or ``None``."""
+    if name in ("", ".", ".."):
+        return "is not a package name (empty, '.' and '..' name folders, not packages)"
+    if any(character in name for character in "/\\\x00"):
+        return "is not a package name (it contains '/', '\\' or NUL)"
+    return None
+
+
+def package_folders(name: str, package_dirs: Sequence[Path] | PackageLookup, *, path: str) -> list[Path]:
+    """The folders package ``name`` may be, for the ``package://`` path ``path``: the
+    lookup's one, or ``NAME`` under each folder of a plain sequence (the zoo's folders).
+
+    Raises:
+        MeshPathError: If ``name`` is not a package name (:func:`name_problem`).
+    """
+    problem = name_problem(name)
+    if problem is not None:
+        raise MeshPathError(path, f"names package {name!r}, which {problem}")
+    if isinstance(package_dirs, PackageLookup):
+        found = package_dirs.find(name)
+        return [found] if found is not None else []
+    return [Path(folder) / name for folder in package_dirs]
+
+
 def package_lookup(packages: Mapping[str, str | os.PathLike] | None = None, *, zoo: bool = True) -> PackageLookup:
     """The lookup in force: ``packages``, then ``$ROS_PACKAGE_PATH``, then the zoo's folders.
 
@@ -131,8 +167,8 @@ def package_lookup(packages: Mapping[str, str | os.PathLike] | None = None, *, z
     explicit = []
     for name, folder in (packages or {}).items():
         name = str(name)
-        if not name or "/" in name or "\x00" in name or name in (".", ".."):
-            raise InputError("packages", "package names (no '/') with their folders", repr(name))
+        if name_problem(name) is not None:
+            raise InputError("packages", "package names (no '/', '\\', '.' or '..') with their folders", repr(name))
         path = Path(os.fspath(folder)).expanduser()
         if "\x00" in str(path) or not path.is_dir():
             raise InputError("packages", f"an existing folder for package {name!r}", repr(str(path)))

@@ -15,52 +15,19 @@ import re
 import stat
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from robodyn.exceptions import RobodynWarning, UnknownRobotError, URDFError
 from robodyn.urdf import zoo
 from robodyn.urdf.edit import lock_joints
-from robodyn.urdf.equality import EqualityRecord
+from robodyn.urdf.mjcf import mjcf_source
 from robodyn.urdf.models import GENERATED
 from robodyn.urdf.packages import PackageLookup, package_lookup
+from robodyn.urdf.source_type import URDFSource
 from robodyn.urdf.validation import Problem, URDFSpec, lint_urdf, parse_urdf
 from robodyn.urdf.xacro_files import expand_xacro, is_xacro_text
 from robodyn.urdf.xmltext import parse_number
-
-
-@dataclass(frozen=True)
-class URDFSource:
-    """A URDF document and where it came from.
-
-    Attributes:
-        text: The URDF document.
-        name: A short name for the robot (zoo or generated name, file stem, ``"robot"``).
-        label: Where it came from, for messages: a path, a robot name or ``"<string>"``.
-        path: The file it was read from, if any.
-        floating_base: Whether the robot is floating by default (zoo robots that walk or fly).
-        package_dirs: Where ``package://`` paths resolve: the zoo's folders, or (files
-            and text) the package lookup (:class:`~robodyn.urdf.packages.PackageLookup`,
-            a tuple of folders that also knows ``packages=`` and ``$ROS_PACKAGE_PATH``).
-        file_format: What the user's file was: ``"urdf"``, ``"xacro"`` (``text`` is its
-            expansion) or ``"mjcf"`` (``text`` is the URDF robodyn's MJCF reader wrote).
-        equalities: Equality constraints the file declares (MJCF ``<equality>``), as
-            records :mod:`robodyn.constraints` turns into the robot's constraints.
-    """
-
-    text: str
-    name: str
-    label: str
-    path: Path | None = None
-    floating_base: bool = False
-    package_dirs: tuple[Path, ...] = field(default_factory=tuple)
-    file_format: str = "urdf"
-    equalities: tuple[EqualityRecord, ...] = ()
-
-    @property
-    def mesh_context(self) -> dict:
-        """Keyword arguments locating mesh files (for :func:`robodyn.urdf.validation.parse_urdf`)."""
-        return {"base_dir": self.path.parent if self.path is not None else None, "package_dirs": self.package_dirs}
 
 
 def robot_names() -> list[str]:
@@ -162,6 +129,8 @@ class _Reading:
     lookup: PackageLookup
     strict: bool
     interpret: bool = True
+    max_dof: int | None = None
+    xacro_env: bool = False
 
 
 _ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
@@ -188,19 +157,26 @@ def _interpret(source: URDFSource, reading: _Reading) -> URDFSource:
             "first (e.g. 'gz sdf -p model.sdf > model.urdf')",
         )
     if tag == "mujoco":
-        from robodyn.urdf.mjcf import mjcf_source
-
-        return mjcf_source(source, strict=reading.strict, lookup=reading.lookup)
+        return mjcf_source(
+            source,
+            strict=reading.strict,
+            lookup=reading.lookup,
+            max_dof=reading.max_dof,
+            read_file=lambda path: read_text(path, reading.limit),
+            max_bytes=reading.limit,
+        )
     source = replace(source, package_dirs=reading.lookup)
     is_xacro = source.path is not None and source.path.suffix == ".xacro"
     if is_xacro or (tag == "robot" and is_xacro_text(source.text)):
         text = expand_xacro(
-            path=source.path if source.path is not None else None,
+            path=source.path,
             text=source.text,
             label=source.label,
             args=reading.xacro_args,
             lookup=reading.lookup,
             read_file=lambda path: read_text(path, reading.limit),
+            limit=reading.limit,
+            env=reading.xacro_env,
         )
         name = source.name.removesuffix(".urdf") if is_xacro else source.name
         return replace(source, text=text, name=name, file_format="xacro")
@@ -215,6 +191,8 @@ def resolve_source(
     packages: Mapping[str, str] | None = None,
     strict: bool = False,
     interpret: bool = True,
+    max_dof: int | None = None,
+    xacro_env: bool = False,
 ) -> URDFSource:
     """Find the URDF a source names.
 
@@ -229,6 +207,10 @@ def resolve_source(
         strict: Refuse MJCF elements robodyn cannot take instead of warning.
         interpret: Expand a xacro, convert an MJCF file and refuse SDF (``False``: the text
             as read, for telling reading errors from the document's own problems).
+        max_dof: Most degrees of freedom of an MJCF file, counted while it is read
+            (default 300, :data:`robodyn.dynamics.options.MAX_DOF`).
+        xacro_env: Let a xacro read environment variables (``$(env NAME)``,
+            ``$(optenv NAME)``); refused otherwise.
 
     Raises:
         URDFError: If a file cannot be read, is not a regular file or is too large, a
@@ -236,7 +218,7 @@ def resolve_source(
         UnknownRobotError: If a name is neither a robot nor an existing file.
     """
     limit = max_urdf_bytes(max_bytes)
-    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret)
+    reading = _Reading(limit, xacro_args, package_lookup(packages), strict, interpret, max_dof=max_dof, xacro_env=bool(xacro_env))
     if isinstance(source, os.PathLike):
         return _read_file(Path(source), limit, reading)
     if not isinstance(source, str):
@@ -318,25 +300,35 @@ def lint_source(
     floating_base: bool | None = None,
     xacro_args: Mapping[str, str] | None = None,
     packages: Mapping[str, str] | None = None,
+    xacro_env: bool = False,
 ) -> list[Problem]:
     """Every problem of a robot file (a path, text or robot name), errors and warnings.
 
     A document that is not even well-formed XML gives one error problem, and so does one
     robodyn cannot read as a robot (SDF, a xacro that does not expand, an MJCF element it
     refuses). A xacro is linted as its expansion, an MJCF file as the URDF robodyn reads it
-    into.
+    into; what the import reports (MJCF elements left out) is among the warnings.
 
     Raises:
         UnknownRobotError, URDFError: If the source cannot be found or read.
     """
     resolve_source(source, interpret=False)  # a file that cannot be read is an error, not a problem
     try:
-        resolved = resolve_source(source, xacro_args=xacro_args, packages=packages)
+        with warnings.catch_warnings(record=True) as caught:  # what the import reports is reported here
+            warnings.simplefilter("always", RobodynWarning)
+            resolved = resolve_source(source, xacro_args=xacro_args, packages=packages, xacro_env=xacro_env)
     except URDFError as error:
         return [Problem(error.element, error.rule)]
+    reported = [_import_problem(str(item.message)) for item in caught if issubclass(item.category, RobodynWarning)]
     floating = resolved.floating_base if floating_base is None else floating_base
     try:
         _, problems = lint_urdf(resolved.text, resolved.label, floating_base=floating, strict=True, **resolved.mesh_context)
     except URDFError as error:
-        return [Problem(error.element, error.rule)]
-    return problems
+        return [*reported, Problem(error.element, error.rule)]
+    return [*reported, *problems]
+
+
+def _import_problem(message: str) -> Problem:
+    """A warning of the import (``"label: what"``) as a warning problem."""
+    element, _, rule = message.partition(": ")
+    return Problem(element, rule or message, "warning")

@@ -21,7 +21,9 @@ Conventions enforced here and relied on downstream:
       (a warning ``lint`` shows);
     - a revolute or prismatic joint with ``lower > upper`` (Bullet's encoding of an
       unlimited joint, e.g. pybullet_data's cube_no_rotation.urdf) has no position limit,
-      with a loud warning.
+      with a loud warning;
+    - revolute limits that look written in degrees (±90, ±180, ±270, ±360, or beyond four
+      turns) are kept as written, with a loud warning naming the values in radians.
 
 The pieces live in :mod:`robodyn.urdf.xmltext` (XML and numbers), :mod:`robodyn.urdf.spec`
 (the result types) and :mod:`robodyn.urdf.inertias` (mass properties).
@@ -221,12 +223,34 @@ def _read_limits(reader: _Reader, where: str, node: ET.Element, joint_type: str)
                 loud=True,
             )
             lower, upper = -math.inf, math.inf
+        elif joint_type == "revolute" and _in_degrees(lower, upper):
+            reader.warn(
+                where,
+                f"limits [{lower:g}, {upper:g}] look like degrees (URDF limits are radians: {max(abs(lower), abs(upper)):g} rad"
+                f" is {max(abs(lower), abs(upper)) / math.tau:.3g} turns); in radians they would be "
+                f"[{math.radians(lower):.6g}, {math.radians(upper):.6g}]",
+                loud=True,
+            )
     for label, value in (("effort", effort), ("velocity", velocity)):
         if value is not None and value < 0:
             reader.error(where, f"{label} limit {value} must not be negative")
         elif value == 0 and joint_type != "fixed":
             reader.warn(where, f"{label} limit is zero: the joint cannot move under that limit")
     return lower, upper, effort, velocity
+
+
+#: Turns beyond which a revolute limit is taken for degrees whatever its value (30° written
+#: as 30 is 4.8 turns; placeholders such as ±10 rad, 1.6 turns, are radians).
+DEGREE_TURNS = 4.0
+#: Limits in degrees that no joint limit in radians is written as (each beyond a turn).
+_RIGHT_ANGLES = (90.0, 180.0, 270.0, 360.0)
+
+
+def _in_degrees(lower: float, upper: float) -> bool:
+    """Whether a revolute joint's limits look written in degrees: beyond
+    :data:`DEGREE_TURNS` turns, or a whole multiple of 90 such as ±180."""
+    largest = max(abs(lower), abs(upper))
+    return largest > DEGREE_TURNS * math.tau or any(abs(value) in _RIGHT_ANGLES for value in (lower, upper))
 
 
 def _read_mimic(reader: _Reader, where: str, node: ET.Element) -> tuple[bool, Mimic | None]:

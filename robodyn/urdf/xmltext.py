@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from typing import cast
 
 from robodyn.exceptions import URDFError
@@ -17,13 +18,18 @@ MAX_XML_DEPTH = 100
 _FORBIDDEN_XML = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
 
 
-def parse_xml(text: str, source: str, *, root: str = "robot") -> ET.Element:
+def parse_xml(
+    text: str, source: str, *, root: str = "robot", on_event: Callable[[str, ET.Element], None] | None = None
+) -> ET.Element:
     """Parse URDF text strictly and return its ``<robot>`` element (``root``: the
     root element expected instead, e.g. MJCF's ``"mujoco"``).
 
     Whitespace (and a byte-order mark) before the XML declaration is accepted, as urdfdom
     does. Elements nested deeper than :data:`MAX_XML_DEPTH` are refused while parsing
     (the parser never recurses, nor does anything downstream get such a tree).
+    ``on_event`` is called with each ``"start"`` / ``"end"`` event and its element while
+    parsing (the element's attributes are read at its start): a reader counts there, and
+    refuses by raising, before the whole tree is built.
 
     Raises:
         URDFError: If the text is not well-formed XML, declares a DOCTYPE or entities,
@@ -42,6 +48,8 @@ def parse_xml(text: str, source: str, *, root: str = "robot") -> ET.Element:
                 # only "start"/"end" events were asked for: each is an (event, Element) pair
                 event, element = cast("tuple[str, ET.Element]", item)
                 depth += 1 if event == "start" else -1
+                if on_event is not None:
+                    on_event(event, element)
                 top = element if top is None else top
                 if depth > MAX_XML_DEPTH:
                     raise URDFError(source, f"XML elements are nested deeper than {MAX_XML_DEPTH} levels (<{element.tag}>)")

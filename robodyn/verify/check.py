@@ -19,15 +19,23 @@ may differ while both keep ``Ṁ − 2C`` skew.)
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from robodyn import reference
+from robodyn.common.text import quoted
 from robodyn.dynamics.loading import load
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
 from robodyn.verify.constrained import DESCRIPTIONS as CONSTRAINT_DESCRIPTIONS
 from robodyn.verify.constrained import constraint_values
+
+#: ``progress(stage, done, total)``: called as the reference evaluates the samples.
+Progress = Callable[[str, int, int], None]
+#: Most progress reports a check makes (the samples are evaluated in as many slices).
+PROGRESS_STEPS = 20
 
 #: Default tolerance on the relative error of every compared quantity.
 DEFAULT_TOLERANCE = 1e-9
@@ -159,6 +167,7 @@ def check_robot(
     check_inertia: bool = True,
     reference_source: str | os.PathLike | None = None,
     constraints: object = None,
+    progress: Progress | None = None,
 ) -> CheckReport:
     """Compare Pinocchio with the reference at random states within the joint limits.
 
@@ -178,14 +187,20 @@ def check_robot(
             with constraints (these, or its file's ``<equality>``) also has ``Φ``, ``J``,
             ``J̇ v`` and the constrained ``v̇`` and ``λ`` compared
             (:mod:`robodyn.verify.constrained`).
+        progress: Called as ``progress("reference", done, samples)`` as the reference
+            (the slow side: seconds a sample on a 60-joint robot) evaluates the states.
 
     Returns:
         The report; ``report.passed`` tells whether every error is within tolerance, and
         ``report.failures`` names each failed quantity and the joint where it is worst. When
         the two models do not have the same joints, the report has one failed comparison,
         ``joints``, naming them (``max_abs``: how many differ).
+
+    Raises:
+        InputError: For a robot with no moving mass (every term is zero: nothing to compare).
     """
     robot = source if isinstance(source, Robot) else load(source, check_inertia=check_inertia, constraints=constraints)
+    _check_moving_mass(robot)
     model = reference.load(
         robot.urdf if reference_source is None else reference_source,
         gravity=tuple(robot.gravity_vector),
@@ -203,12 +218,37 @@ def check_robot(
     v = rng.normal(size=(samples, robot.nv))
     a = rng.normal(size=(samples, robot.nv))
     matched = _Matched(robot, model)
-    report.comparisons.update(_compare_dynamics(robot, matched, q, v, a, tolerance))
+    report.comparisons.update(_compare_dynamics(robot, matched, (q, v, a), tolerance, progress))
     if robot.constraints:
         tau = rng.normal(size=(samples, robot.nv))
         for name, (actual, expected, floor, names) in constraint_values(robot, matched, q, v, tau).items():
             report.comparisons[name] = _compare(actual, expected, tolerance, floor, names)
     return report
+
+
+def _check_moving_mass(robot: Robot) -> None:
+    """Refuse a robot none of whose moving bodies has mass or inertia (``M``, ``C``, ``G``
+    and ``tau`` are zero in both models: a PASSED would say nothing)."""
+    model = robot.model
+    bodies = [model.inertias[i] for i in range(1, model.njoints)]  # fixed links are merged into their joint's body
+    if robot.nv == 0 or all(body.mass <= 0 and not np.any(body.inertia) for body in bodies):
+        raise InputError(
+            "source",
+            "a robot with some moving mass (with none every dynamic term is zero: there is nothing to compare)",
+            f"{quoted(robot.name)}, whose {robot.nv} joints move no mass and no inertia",
+        )
+
+
+def _reference_terms(model, states: tuple[np.ndarray, ...], progress: Progress | None) -> dict[str, np.ndarray]:
+    """The reference's terms at every state (one pass a slice of samples, progress after each)."""
+    count = len(states[0])
+    size = max(1, -(-count // PROGRESS_STEPS))
+    slices = []
+    for start in range(0, max(count, 1), size):  # one empty slice for no samples
+        slices.append(model.terms(*(x[start : start + size] for x in states)))
+        if progress:
+            progress("reference", min(start + size, count), count)
+    return {name: np.concatenate([part[name] for part in slices]) for name in slices[0]}
 
 
 def _unmatched_joints(robot_joints: list[str], reference_joints: list[str]) -> Comparison | None:
@@ -251,18 +291,16 @@ class _Matched:
 
 
 def _compare_dynamics(
-    robot: Robot, matched: _Matched, q: np.ndarray, v: np.ndarray, a: np.ndarray, tolerance: float
+    robot: Robot, matched: _Matched, states: tuple[np.ndarray, ...], tolerance: float, progress: Progress | None = None
 ) -> dict[str, Comparison]:
     """``tau``, ``M``, ``C v``, ``G`` (and, on a fixed base, ``C`` and ``Ṁ − 2C`` skew) of
     both implementations at the states ``q`` (N, nq), ``v`` and ``a`` (N, nv)."""
-    model, from_reference = matched.model, matched.from_reference
-    q_ref, v_ref, a_ref = matched.states(q, v, a)
-    reference_values = {
-        "tau": from_reference(model.inverse_dynamics(q_ref, v_ref, a_ref)),
-        "M": from_reference(model.mass_matrix(q_ref)),
-        "Cv": from_reference(model.coriolis_forces(q_ref, v_ref)),
-        "G": from_reference(model.gravity(q_ref)),
+    q, v, a = states
+    from_reference = matched.from_reference
+    every = {
+        name: from_reference(value) for name, value in _reference_terms(matched.model, matched.states(q, v, a), progress).items()
     }
+    reference_values = {name: every[name] for name in ("tau", "M", "Cv", "G")}
     coriolis = robot.coriolis_matrix(q, v)
     pinocchio_values = {
         "tau": robot.inverse_dynamics(q, v, a),
@@ -280,7 +318,7 @@ def _compare_dynamics(
     }
     if robot.floating_base:  # C (and Ṁ − 2C) are in other coordinates there: τ, M, C v, G suffice
         return comparisons
-    reference_c = from_reference(model.coriolis_matrix(q_ref, v_ref))
+    reference_c = every["C"]
     comparisons["C"] = _compare(coriolis, reference_c, tolerance, floors["C"], dofs)
     step = 1e-6
     m_dot = (robot.mass_matrix(q + step * v) - robot.mass_matrix(q - step * v)) / (2 * step)
@@ -288,7 +326,7 @@ def _compare_dynamics(
     # (the finite difference's rounding error scales with M, not with Ṁ).
     scale = max(_largest(m_dot), mass_scale * speed)
     comparisons["skew_pinocchio"] = skewness(m_dot - 2 * coriolis, scale, FINITE_DIFFERENCE_TOLERANCE, dofs)
-    m_dot_reference = from_reference(model.mass_matrix_derivative(q_ref, v_ref))
+    m_dot_reference = every["Mdot"]
     comparisons["skew_reference"] = skewness(m_dot_reference - 2 * reference_c, scale, tolerance, dofs)
     return comparisons
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from robodyn.common.files import outputs_together
 from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
 from robodyn.sim.experiment import applied_torques, push_wrenches, run_simulation
 from robodyn.sim.observer import ObservationRun, observe_file
 from robodyn.sim.operational_space import target_rotation
@@ -44,10 +45,11 @@ def run_experiment(
 
     Args:
         robot: The plant.
-        out: Trajectory file (``.csv`` or ``.npz``).
+        out: Trajectory file (``.csv`` or ``.npz``; a run on the ground: ``.csv``, with its
+            contact forces, docs/contact.md).
         plot: PNG figure: positions, torques, task error, energy.
         record: Self-contained HTML animation (meshcat).
-        png: With ``record``: a still of the first frame (needs Chromium).
+        png: With ``record``: a poster, the final frame with the path drawn (needs Chromium).
         **settings: ``controller``, ``target``, ``frame``, ``q0``, ``duration``, ``dt``,
             ``integrator``, ``limits``, ``engine``, ``posture``, ``stiffness``,
             ``damping``, ``force_at``, ``observer_gain``, ``actuated``, ``control_period``.
@@ -58,6 +60,8 @@ def run_experiment(
         applied, ``tau_env[<joint>]``;
         ``plot``, ``recording`` (the target pose as a triad, pushes as arrows), ``poster``).
     """
+    if out and settings.get("ground") is not None and Path(out).suffix != ".csv":
+        raise InputError("out", "a .csv file for a run on the ground (its contact forces are columns)", repr(str(out)))
     trajectory, summary = run_simulation(robot, **settings)
     # The controlled frame, else the frame asked for (it names the drawn path), else none.
     frame = summary.task.frame if summary.task is not None else settings.get("frame")
@@ -67,7 +71,8 @@ def run_experiment(
             extras = {} if summary.observer is None else {"tau_ext": summary.observer.residual}
             if summary.pushes:
                 extras["tau_env"] = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes)[1])
-            summary = summary.with_file("trajectory", str(write_with_extras(Path(out), trajectory, extras)))
+            written = summary.contact.save(out, extras) if summary.contact else write_with_extras(Path(out), trajectory, extras)
+            summary = summary.with_file("trajectory", str(written))
         if plot:
             from robodyn.viz.plots import plot_simulation  # matplotlib: only when a figure is asked for
 
@@ -77,6 +82,7 @@ def run_experiment(
 
             rpy = None if summary.task is None or summary.task.target_rpy is None else summary.task.target_rpy
             _, forces = push_wrenches(robot, summary.pushes, frame)
+            forces += summary.contact.force_arrows() if summary.contact else ()  # each contact frame's force
             written = write_recording(
                 robot, trajectory, record, png=png, target=task, frame=frame,
                 target_rotation=None if rpy is None else target_rotation(np.asarray(rpy)), forces=tuple(forces),

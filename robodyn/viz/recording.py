@@ -277,7 +277,7 @@ def record(
     *,
     fps: float = 30.0,
     png: str | os.PathLike | None = None,
-    at: float = 0.0,
+    at: float | None = None,
     target=None,
     frame: str | None = None,
     axes: tuple[str, ...] = (),
@@ -293,7 +293,9 @@ def record(
         path: The HTML file to write (atomically).
         fps: Frames per second of the animation.
         png: Also write a still (needs Chromium), of the frame at ``at`` seconds.
-        at: Time of the still in [s], from the motion's start.
+        at: Time of the still in [s], from the motion's start; ``None`` (default): the
+            motion's end, the final pose with the whole path drawn (a poster of the motion,
+            not of the robot at rest before it).
         target: Task target drawn as a marker, X,Z or X,Y,Z in [m].
         frame: Frame whose path is drawn (default ``robot.end_effector``).
         axes: Links that carry an x/y/z triad.
@@ -312,5 +314,5 @@ def record(
         target_rotation=target_rotation, forces=forces,
     )  # fmt: skip
     if png is not None:
-        made.still(png, at=at)
+        made.still(png, at=made.duration if at is None else at)
     return made.save(path)

@@ -185,14 +185,24 @@ def link_placements(robot: Robot, q: np.ndarray, data: pin.Data | None = None) -
     return {name: data.oMf[frames[name]].homogeneous for name in robot.spec.links if name in frames}
 
 
-def resample(trajectory: Trajectory, fps: float) -> tuple[np.ndarray, np.ndarray]:
-    """Times and configurations at ``fps`` frames per second (linear interpolation;
-    a floating base's quaternion renormalised)."""
+def resample(trajectory: Trajectory, fps: float, *, floating_base: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Times and configurations at ``fps`` frames per second (linear interpolation).
+
+    With ``floating_base``, each sample's quaternion (``q[3:7]``) first takes the sign
+    nearest the previous one's (``q`` and ``−q`` are one rotation: interpolated across a
+    sign flip the base would turn the long way round, or through a zero quaternion); the
+    caller renormalises.
+    """
     if len(trajectory) == 0:
         raise ViewerError("the trajectory is empty: nothing to record.")
     duration = float(trajectory.t[-1] - trajectory.t[0])
     times = trajectory.t[0] + np.arange(int(np.floor(duration * fps + 1e-9)) + 1) / fps
-    q = np.column_stack([np.interp(times, trajectory.t, trajectory.q[:, i]) for i in range(trajectory.q.shape[1])])
+    samples = trajectory.q
+    if floating_base:
+        samples = samples.copy()
+        turns = np.einsum("ij,ij->i", samples[1:, 3:7], samples[:-1, 3:7]) < 0
+        samples[1:, 3:7] *= np.where(np.logical_xor.accumulate(turns), -1.0, 1.0)[:, None]
+    q = np.column_stack([np.interp(times, trajectory.t, samples[:, i]) for i in range(samples.shape[1])])
     return times, q
 
 
@@ -235,7 +245,7 @@ def lower_animation(clips: dict[tuple[str, ...], AnimationClip]) -> dict:
 
 def motion(robot: Robot, trajectory: Trajectory, fps: float = 30.0) -> tuple[Motion, dict[tuple[str, ...], AnimationClip]]:
     """Every link's poses at ``fps`` over a trajectory, as animation clips."""
-    times, configurations = resample(trajectory, fps)
+    times, configurations = resample(trajectory, fps, floating_base=robot.floating_base)
     if robot.floating_base:
         configurations[:, 3:7] /= np.linalg.norm(configurations[:, 3:7], axis=1, keepdims=True)
     clips: dict[tuple[str, ...], AnimationClip] = {}

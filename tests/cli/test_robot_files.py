@@ -99,3 +99,45 @@ def test_symbolic_equations_of_a_xacro_take_its_packages_and_arguments(capsys, m
     assert names and all(name.startswith("left_") for name in names)
     status, _, err = run(capsys, "equations", str(PACKAGE / "urdf" / "arm.urdf.xacro"), "--symbolic")
     assert status == 2 and "package 'robodyn_test_arm' not found" in err and "--package" in err
+
+
+HOSTILE_XACRO = {
+    "python.vars": "<link name=\"${python.vars(python.type)['mro'](python.type(()))}\"/>",
+    "load_yaml": "<link name=\"${xacro.load_yaml('/etc/passwd')}\"/>",
+    "optenv": '<link name="x$(optenv HOME)"/>',
+    "power": '<link name="${10**10**10}"/>',
+}
+
+
+@pytest.mark.parametrize("name", ["robot.xacro", "plain.urdf"])
+@pytest.mark.parametrize("kind", sorted(HOSTILE_XACRO))
+def test_info_on_a_hostile_xacro_is_one_stderr_line_and_exit_2(capsys, tmp_path, name, kind):
+    path = tmp_path / name
+    path.write_text(
+        f'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">{HOSTILE_XACRO[kind]}<link name="base"/></robot>'
+    )
+    status, out, err = run(capsys, "info", str(path))
+    assert status == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"robodyn: error: {path}: xacro: ")
+    assert "root:" not in err and "<class" not in err
+
+
+def test_xacro_env_lets_a_xacro_read_the_environment_and_the_refusal_names_the_flag(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("ROBODYN_TEST_PREFIX", "env_")
+    text = (PACKAGE / "urdf" / "arm.urdf.xacro").read_text().replace("$(arg prefix)", "$(optenv ROBODYN_TEST_PREFIX)")
+    (tmp_path / "arm.urdf.xacro").write_text(text.replace("$(find robodyn_test_arm)/urdf", str(PACKAGE / "urdf")))
+    model = [str(tmp_path / "arm.urdf.xacro"), *PACKAGE_FLAG]
+    status, _, err = run(capsys, "info", *model)
+    assert status == 2 and "'ROBODYN_TEST_PREFIX'" in err and "unless --xacro-env" in err and "xacro_env=True" not in err
+    status, out, _ = run(capsys, "info", *model, "--xacro-env", "--json")
+    assert status == 0 and json.loads(out)["joint_dynamics"][0]["joint"] == "env_shoulder"
+    status, out, _ = run(capsys, "equations", *model, "--xacro-env", "--symbolic", "--format", "json")
+    assert status == 0 and json.loads(out)["joint_names"][0] == "env_shoulder"
+
+
+def test_lint_names_a_urdf_holding_xacro_by_its_path_however_long(capsys, tmp_path):
+    path = tmp_path / ("a_long_robot_description_name_" * 3 + ".urdf")
+    text = (PACKAGE / "urdf" / "arm.urdf.xacro").read_text()
+    path.write_text(text.replace("$(find robodyn_test_arm)/urdf", str(PACKAGE / "urdf")))
+    status, out, _ = run(capsys, "lint", str(path), *PACKAGE_FLAG)
+    assert status == 0 and out.splitlines()[-1] == f"{path}: 0 errors, 0 warnings" and len(str(path)) > 80

@@ -27,7 +27,7 @@ def robot():
 @pytest.mark.parametrize(
     ("call", "argument", "fragment"),
     [
-        (lambda r: r.inverse_dynamics([0.1], [0, 0], [0, 0]), "q", "2 values, got 1 values"),
+        (lambda r: r.inverse_dynamics([0.1], [0, 0], [0, 0]), "q", "2 values, got 1 value."),
         (lambda r: r.inverse_dynamics([0.1, 0.2], [0, 0, 0], [0, 0]), "v", "2 values, got 3"),
         (lambda r: r.inverse_dynamics([0.1, 0.2], [0, 0], [np.nan, 0]), "a", "finite, got nan at index 0"),
         (lambda r: r.forward_dynamics([0.1, 0.2], [0, 0], [0, np.inf]), "tau", "finite, got inf at index 1"),

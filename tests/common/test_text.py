@@ -302,3 +302,28 @@ def test_a_closed_pipe_ends_quietly():
     reader.stdout.close()  # like `robodyn list | head -c 10`
     assert reader.wait(timeout=60) == 0
     assert b"Traceback" not in reader.stderr.read()
+
+
+def test_a_count_of_one_takes_the_singular():
+    from robodyn.common.text import counted
+
+    assert [counted(n, "value") for n in (0, 1, 2)] == ["0 values", "1 value", "2 values"]
+    assert counted(1, "entry", "entries") == "1 entry" and counted(3, "entry", "entries") == "3 entries"
+
+
+def test_messages_about_one_thing_say_one_thing(capsys):
+    import robodyn
+    from robodyn.cli import main
+    from robodyn.exceptions import InputError
+
+    with pytest.raises(InputError, match=r"^q must be 2 values, got 1 value\.$"):
+        robodyn.load("rp_arm").inverse_dynamics([0.1], [0.0, 0.0], [0.0, 0.0])
+    pendulum = (
+        '<robot name="one"><link name="a"/><joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint><link name="b"><inertial>'
+        '<mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>'
+    )
+    assert main(["info", pendulum]) == 0
+    assert "1 degree of freedom" in capsys.readouterr().out
+    assert main(["lint", pendulum]) == 0
+    assert "0 errors, 0 warnings" in capsys.readouterr().out

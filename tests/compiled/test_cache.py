@@ -133,3 +133,21 @@ def test_lookup_in_an_empty_cache_or_without_a_compiler_is_none(rp_arm, tmp_path
     assert build.lookup(robot) is not None  # negative control: the fixture compiled it
     monkeypatch.setenv("CC", "no-such-compiler-robodyn")
     assert build.lookup(robot) is None
+
+
+def test_the_packages_left_out_of_the_key_are_the_layers_above_the_generator():
+    """``ABOVE_GENERATOR`` is read off the import contracts, not kept by hand: exactly the
+    packages of the layers above ``robodyn.compiled`` (but ``export``, which prints the same
+    programs), so a package added below is hashed by default."""
+    import tomllib
+
+    layers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]["layers"]
+    above: set[str] = set()
+    for layer in layers:
+        names = [part.strip() for part in layer.replace(":", "|").split("|")]
+        if "robodyn.compiled" in names:
+            break
+        above.update(name.removeprefix("robodyn.") for name in names)
+    assert above - {"export"} == set(cache.ABOVE_GENERATOR)
+    assert "constraints" not in cache.ABOVE_GENERATOR  # negative control: a lower package is hashed
+    assert any(path.parent.name == "constraints" for path in cache.generator_files())

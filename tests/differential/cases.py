@@ -93,10 +93,12 @@ def _load(case: Case) -> robodyn.Robot:
 
 @functools.lru_cache(maxsize=64)
 def _reference(case: Case):
+    """The reference given every input ``robodyn.load`` got (but ``threads``: the reference has none)."""
     options = case.options
     return robodyn.reference.load(
         case.source, gravity=options.get("gravity"), lock=options.get("lock"), floating_base=case.floating,
-        armature=options.get("armature"),
+        armature=options.get("armature"), xacro_args=options.get("xacro_args"), packages=options.get("packages"),
+        check_inertia=options.get("check_inertia", True),
     )  # fmt: skip
 
 
@@ -219,6 +221,44 @@ def _root_has_mass(path: Path) -> bool:
     return mass is not None and float(mass.get("value", "0")) > 0
 
 
+#: The xacro test arm and its package (a mimic joint, damping and friction in ``<dynamics>``).
+XACRO_PACKAGE = ROOT / "tests" / "data" / "packages" / "robodyn_test_arm"
+XACRO_ARM = XACRO_PACKAGE / "urdf" / "arm.urdf.xacro"
+#: The MJCF test files (defaults classes, damping, frictionloss, armature; one floats).
+MJCF_FILES = sorted((ROOT / "tests" / "data" / "mjcf").glob("*.xml"))
+
+
+def xacro_arm(seed: int) -> Case:
+    """The xacro test arm with drawn xacro arguments (a prefix on every name, the upper
+    link's mass, the finger and its mimic joint or not) and its package map, then the
+    usual options (gravity, a lock, armature; its root is massless: a fixed base)."""
+    rng = np.random.default_rng(seed)
+    xacro_args = {
+        "prefix": ["", "left_", "r2_"][int(rng.integers(3))],
+        "upper_mass": f"{rng.uniform(0.5, 3.0):.4f}",
+        "finger": ["true", "false"][int(rng.integers(2))],
+    }
+    packages = {"robodyn_test_arm": str(XACRO_PACKAGE)}
+    text = robodyn.reference.load(XACRO_ARM, xacro_args=xacro_args, packages=packages).urdf
+    options = {**draw_options(rng, text, floating=False), "xacro_args": xacro_args, "packages": packages}
+    label = f"arm.urdf.xacro ({', '.join(f'{k}:={v}' for k, v in xacro_args.items())})"
+    return Case("xacro_arm", seed, label, XACRO_ARM, options)
+
+
+def mjcf_file(seed: int) -> Case:
+    """An MJCF test file, with the usual options (its own base: floating.xml floats)."""
+    rng = np.random.default_rng(seed)
+    path = MJCF_FILES[seed % len(MJCF_FILES)]
+    floating = "<freejoint" in path.read_text()
+    text = robodyn.reference.load(path, floating_base=floating).urdf
+    options = draw_options(rng, text, floating=floating)
+    return Case("mjcf", seed, path.name, path, options)
+
+
+#: Generators of sources the reference reads with options of its own (xacro arguments,
+#: package maps, MJCF): tests/differential/test_sources.py.
+SOURCE_GENERATORS: dict[str, Callable[[int], Case]] = {"xacro_arm": xacro_arm, "mjcf": mjcf_file}
+
 #: Every generator of cases, by name. Add one entry per new kind of robot source.
 GENERATORS: dict[str, Callable[[int], Case]] = {
     "random_tree": random_tree,
@@ -238,15 +278,15 @@ def replayed() -> tuple[str, int] | None:
 
 
 def draw_cases(count_per_generator: int, *, base_seed: int, generators: tuple[str, ...] | None = None) -> list[Case]:
-    """``count_per_generator`` cases of each generator, seeds derived from ``base_seed``
-    (or only the replayed case, when :data:`SEED_VARIABLE` is set)."""
+    """``count_per_generator`` cases of each generator (default :data:`GENERATORS`), seeds
+    derived from ``base_seed`` (or only the replayed case, when :data:`SEED_VARIABLE` is set
+    and names one of these generators)."""
+    table = {**GENERATORS, **SOURCE_GENERATORS}
+    names = generators or tuple(GENERATORS)
     replay = replayed()
     if replay is not None:
-        return [GENERATORS[replay[0]](replay[1])]
-    names = generators or tuple(GENERATORS)
-    return [
-        GENERATORS[name](base_seed + 1000 * index + k) for index, name in enumerate(names) for k in range(count_per_generator)
-    ]
+        return [table[replay[0]](replay[1])] if replay[0] in names else []
+    return [table[name](base_seed + 1000 * index + k) for index, name in enumerate(names) for k in range(count_per_generator)]
 
 
 def random_state_batch(robot, rng: np.random.Generator, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

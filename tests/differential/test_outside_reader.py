@@ -166,7 +166,8 @@ def _axis(model: pin.Model, joint_id: int) -> tuple[str, np.ndarray]:
     data = model.createData()
     q = pin.neutral(model)
     pin.computeJointJacobians(model, data, q)
-    column = pin.getJointJacobian(model, data, joint_id, pin.LOCAL)[:, model.joints[joint_id].idx_v]
+    jacobian = pin.getJointJacobian(model, data, joint_id, pin.LOCAL).reshape(6, -1)  # (6,) for a 1-DoF model
+    column = jacobian[:, model.joints[joint_id].idx_v]
     linear, angular = column[:3], column[3:]
     return ("P", linear) if np.linalg.norm(angular) < 1e-12 else ("R", angular)
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
@@ -137,3 +138,84 @@ def test_simulate_tracks_the_motion_with_computed_torque_to_the_goal(tmp_path, c
     )
     assert json.loads(capsys.readouterr().out)["limit_violations"] != []
     assert main([*command[:3], "pd", *command[4:]]) == 2  # a reference is for computed torque only
+
+
+DAMPED_PENDULUM = ROOT / "tests" / "data" / "robots" / "damped_pendulum.urdf"
+
+
+@pytest.fixture(scope="module")
+def damped_pendulum():
+    robot = robodyn.load(DAMPED_PENDULUM)
+    assert robot.joint_damping[0] == 0.1 and np.abs(robot.gravity(np.array([np.pi / 2]))[0]) > 5.0  # 1 N m cannot lift it
+    return robot
+
+
+@pytest.fixture(scope="module")
+def damped_swing_up(damped_pendulum):
+    """The damped pendulum's minimum-effort swing-up over 12 s (the straight-line start fails)."""
+    return point_to_point(damped_pendulum, [0.0], [np.pi], 12.0, intervals=100)
+
+
+def test_a_damped_swing_up_replayed_open_loop_by_simulate_ends_at_the_goal(damped_pendulum, damped_swing_up):
+    trajectory = damped_swing_up.trajectory
+    assert damped_swing_up.starts > 1 and max(damped_swing_up.peak_torque) <= 1.0  # found by the retry, within 1 N m
+    replayed = replay(damped_pendulum, trajectory)  # simulate applies the file's damping by default
+    assert abs(replayed.q[-1][0] - np.pi) <= 1e-6 and abs(replayed.v[-1][0]) <= 1e-5
+    # the trajectory's accelerations are those of the damped plant: RNEA(q, v, a) = tau − b v
+    model, data = damped_pendulum.model, damped_pendulum.data
+    for q, v, a, tau in zip(trajectory.q, trajectory.v, trajectory.a, trajectory.tau, strict=True):
+        assert abs(pin.rnea(model, data, q, v, a)[0] - (tau[0] - 0.1 * v[0])) <= 1e-9
+    # Negative control: the rigid plan, replayed on the damped plant, misses the goal.
+    rigid = point_to_point(damped_pendulum, [0.0], [np.pi], 12.0, intervals=100, joint_friction=False)
+    assert abs(replay(damped_pendulum, rigid.trajectory).q[-1][0] - np.pi) > 0.1
+
+
+def test_feasible_durations_are_found_by_the_retry_and_a_short_one_is_refused_as_local(damped_pendulum, damped_swing_up):
+    fastest = point_to_point(damped_pendulum, [0.0], [np.pi], 12.0, intervals=100, cost="time")
+    assert fastest.duration < 12.0 and fastest.status == "Solve_Succeeded"
+    assert abs(replay(damped_pendulum, fastest.trajectory).q[-1][0] - np.pi) <= 1e-6
+    slack = point_to_point(damped_pendulum, [0.0], [np.pi], 10.0, intervals=100)  # longer than the fastest: found
+    assert slack.duration == 10.0 and slack.cost > damped_swing_up.cost  # less time, more effort
+    with pytest.raises(OptimizationError, match=r"Infeasible_Problem_Detected \(from a straight line.*local verdict") as error:
+        point_to_point(damped_pendulum, [0.0], [np.pi], 3.0, intervals=60)  # binds: shorter than any swing-up found
+    assert error.value.status == "Infeasible_Problem_Detected"
+
+
+def _hanging_still(robot: robodyn.Robot, shoulder: float) -> np.ndarray:
+    """A configuration with the shoulder at ``shoulder`` where the shoulder needs no torque to rest."""
+    from scipy.optimize import brentq
+
+    elbow = brentq(lambda x: robot.gravity(np.array([shoulder, x]))[0], -np.pi / 2, 0.0)
+    return np.array([shoulder, elbow])
+
+
+def test_only_the_actuated_joints_get_torque(capsys, tmp_path):
+    robot = robodyn.load(weak_double_pendulum(shoulder=5.0, elbow=5.0))
+    goal = _hanging_still(robot, 0.1)
+    motion = point_to_point(robot, [0.0, 0.0], goal, 3.0, intervals=40, actuated=["elbow"])
+    assert np.all(motion.trajectory.tau[:, 0] == 0.0) and np.abs(motion.trajectory.tau[:, 1]).max() > 0.1
+    replayed = replay(robot, motion.trajectory)
+    assert np.abs(replayed.q[-1] - goal).max() <= 1e-6
+    with pytest.raises(InputError, match=r"^actuated must be"):
+        point_to_point(robot, [0.0, 0.0], goal, 3.0, actuated=["wrist"])
+    # Negative control: with both joints driven (the default), the shoulder helps.
+    assert np.abs(point_to_point(robot, [0.0, 0.0], goal, 3.0, intervals=40).trajectory.tau[:, 0]).max() > 0.01
+    # The default set is the joints whose Dof.actuated (a file's actuators say which)
+    robot.dofs = tuple(replace(dof, actuated=dof.name == "elbow") for dof in robot.dofs)
+    by_default = point_to_point(robot, [0.0, 0.0], goal, 3.0, intervals=40)
+    np.testing.assert_array_equal(by_default.trajectory.tau, motion.trajectory.tau)
+    out = str(tmp_path / "m.csv")
+    argv = ["optimize", weak_double_pendulum(shoulder=5.0, elbow=5.0), "--start", "0,0", "--goal", ",".join(map(str, goal))]
+    assert main([*argv, "--duration", "3", "--intervals", "40", "--actuated", "elbow", "--out", out]) == 0
+    assert np.all(Trajectory.load(out).tau[:, 0] == 0.0)
+
+
+def test_coulomb_friction_is_refused_unless_planned_rigid(capsys, tmp_path):
+    arm = ROOT / "tests" / "data" / "robots" / "student_arm.urdf"
+    robot = robodyn.load(arm)
+    with pytest.raises(InputError, match=r"^joint_friction must be False to plan joints with Coulomb friction"):
+        point_to_point(robot, np.zeros(5), np.full(5, 0.1), 2.0, intervals=10)
+    argv = ["optimize", str(arm), "--start", "0,0,0,0,0", "--goal", "0.1,0.1,0.1,0.1,0.1", "--duration", "2"]
+    assert main([*argv, "--intervals", "10", "--out", str(tmp_path / "m.csv")]) == 2
+    assert capsys.readouterr().err.startswith("robodyn: error: --no-joint-friction is needed to plan joints")
+    assert main([*argv, "--intervals", "10", "--no-joint-friction", "--out", str(tmp_path / "m.csv")]) == 0

@@ -236,3 +236,22 @@ def test_euler_lagrange_from_the_energies_equals_m_c_g():
             assert all(
                 abs(float(c)) < 1e-12 for c in sp.Poly(entry, *equations.q, *equations.qd, *equations.qdd, sp.cos(q1)).coeffs()
             )
+
+
+@pytest.mark.parametrize(("name", "floating"), [("panda", False), ("solo12", True)])
+def test_every_term_in_one_pass_equals_each_method(name, floating):
+    model = reference.load(robodyn.load(name).urdf, floating_base=floating)
+    robot = robodyn.load(name)
+    rng = np.random.default_rng(3)
+    q = robot.random_configuration(rng, 7)  # not a multiple of the chunk
+    v, a = rng.normal(size=(7, model.nv)), rng.normal(size=(7, model.nv))
+    terms = model.terms(q, v, a)
+    methods = {
+        "tau": model.inverse_dynamics(q, v, a), "M": model.mass_matrix(q), "Cv": model.coriolis_forces(q, v),
+        "G": model.gravity(q),
+    }  # fmt: skip
+    if not floating:
+        methods |= {"C": model.coriolis_matrix(q, v), "Mdot": model.mass_matrix_derivative(q, v)}
+    assert set(terms) == set(methods)
+    for key, value in methods.items():
+        np.testing.assert_array_equal(terms[key], value)

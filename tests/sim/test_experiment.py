@@ -13,9 +13,10 @@ import pytest
 
 import robodyn
 from robodyn.exceptions import InputError
-from robodyn.sim.experiment import parse_push, run_simulation
+from robodyn.sim.experiment import run_simulation
 from robodyn.sim.observer import MomentumObserver, estimate_external_torques
 from robodyn.sim.report import Push
+from robodyn.sim.requests import parse_push
 
 RP_TARGET = [0.9, 0.0, 0.5]
 RP_START = [0.5, 0.13]
@@ -140,10 +141,10 @@ def test_pose_options_are_refused_where_they_do_not_apply(rp_arm):
 
 
 def test_the_compiled_engine_refuses_pushes_and_observers_by_name(rp_arm):
-    with pytest.raises(InputError) as raised:
+    with pytest.raises(InputError, match="external wrenches") as raised:
         run_simulation(rp_arm, force_at=["0:1,0,0"], duration=0.01, engine="compiled")
     assert raised.value.argument == "external"
-    with pytest.raises(InputError) as raised:
+    with pytest.raises(InputError, match="momentum observer") as raised:
         run_simulation(rp_arm, observer_gain=10.0, duration=0.01, engine="compiled")
     assert raised.value.argument == "observer"
 
@@ -156,3 +157,32 @@ def test_a_robot_without_a_default_end_effector_still_simulates_and_its_pushes_n
     assert summary.pushes == (Push(0.0, (0.0, 0.0, -5.0), "FL_FOOT"),)
     with pytest.raises(robodyn.RobodynError, match="FL_FOOT"):  # negative control: no frame, no default to push at
         run_simulation(robot, duration=0.004, dt=2e-3, limits="ignore", force_at=["0:0,0,-5"])
+
+
+XY_ARM = """<robot name="xy_arm">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="3"/></joint>
+  <link name="l1"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.4 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="3"/></joint>
+  <link name="l2"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="tip" type="fixed"><parent link="l2"/><child link="tip"/><origin xyz="0.4 0 0"/></joint>
+  <link name="tip"/>
+</robot>"""
+
+
+def test_a_two_value_target_is_refused_for_an_arm_that_moves_along_y():
+    """An arm in the XY plane (like dm_control's reacher): X,Z would set Y = 0, a point it was
+    never asked to reach; the XZ-plane RP arm takes X,Z (the negative control)."""
+    robot = robodyn.load(XY_ARM)
+    with pytest.raises(InputError, match="3 values X,Y,Z") as raised:
+        run_simulation(robot, controller="task-space", target=[0.1, 0.12], frame="tip", duration=0.01)
+    assert raised.value.argument == "target"
+    _, summary = run_simulation(robot, controller="task-space", target=[0.5, 0.3, 0.0], frame="tip", duration=0.01)
+    assert summary.task is not None
+    rp_arm = robodyn.load("rp_arm")
+    _, summary = run_simulation(rp_arm, controller="task-space", target=[0.7, 0.7], duration=0.01)
+    assert summary.task is not None and summary.task.target[1] == 0.0

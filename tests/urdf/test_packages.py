@@ -10,7 +10,7 @@ import warnings
 import pytest
 
 import robodyn
-from robodyn.exceptions import InputError, MeshWarning, URDFError
+from robodyn.exceptions import InputError, MeshPathError, MeshWarning, URDFError
 from robodyn.urdf.meshes import resolve_mesh
 from robodyn.urdf.packages import package_lookup
 from robodyn.urdf.sources import lint_source
@@ -71,3 +71,38 @@ def test_lint_reports_a_mesh_it_cannot_find_with_the_places_it_looked(monkeypatc
     problems = lint_source(URDF)
     assert problems and all(problem.severity == "warning" for problem in problems)
     assert "not found (looked in /nowhere/ros ($ROS_PACKAGE_PATH)" in problems[0].rule
+
+
+NOT_NAMES = ["", ".", "..", "a/b", "a\\b", "a\x00b"]
+
+
+@pytest.mark.parametrize("name", NOT_NAMES)
+def test_a_name_that_is_not_a_package_name_is_refused_by_find_and_the_lookup(name, monkeypatch):
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(PACKAGE.parent))
+    lookup = package_lookup()
+    assert lookup.find(name) is None
+    with pytest.raises(URDFError, match=r"is not a package name") as raised:
+        lookup.require(name, "arm.xacro")
+    assert "\n" not in str(raised.value)
+
+
+@pytest.mark.parametrize("kind", ["the zoo's folders", "the lookup"])
+def test_package_dot_dot_cannot_reach_the_folder_above_the_packages(tmp_path, kind):
+    share = tmp_path / "share"
+    (share / "robodyn_test_arm").mkdir(parents=True)
+    (tmp_path / "secret.stl").write_text("solid x\nendsolid x\n")  # one folder above the package folders
+    folders = [share] if kind == "the zoo's folders" else package_lookup({"robodyn_test_arm": share / "robodyn_test_arm"})
+    for path in ("package://../secret.stl", "package://./../secret.stl", "package://..\\secret.stl"):
+        with pytest.raises(MeshPathError, match=r"is not a package name"):
+            resolve_mesh(path, base_dir=None, package_dirs=folders)
+
+
+def test_find_dot_dot_in_a_xacro_and_package_dot_dot_in_a_urdf_are_one_line_each(tmp_path):
+    xacro_text = (
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:include filename="$(find ..)/lib/x.xacro"/><link name="a"/></robot>'
+    )
+    with pytest.raises(URDFError, match=r"package '\.\.' is not a package name"):
+        robodyn.load(xacro_text)
+    mesh = '<robot name="r"><link name="a"><visual><geometry><mesh filename="package://../x.stl"/></geometry></visual></link></robot>'
+    assert [p.rule for p in lint_source(mesh) if "is not a package name" in p.rule]

@@ -145,16 +145,17 @@ def test_too_many_degrees_of_freedom_are_refused_before_pinocchio_allocates():
     assert MAX_DOF == 300 and data_memory_estimate(401, 401) > 3.9e9  # star_400: 4.1 GB measured
 
 
+#: Measured in a process that imports Pinocchio only (the URDF comes on stdin): robodyn's own
+#: imports would leave the heap in a state that changes what ``createData`` maps anew.
 MEASURE = """
 import sys
 import pinocchio as pin
-from tests.data.make_hostile_corpus import chain
 
 def resident():
     with open("/proc/self/statm") as stream:
         return int(stream.read().split()[1]) * 4096
 
-model = pin.buildModelFromXML(chain(int(sys.argv[1])))
+model = pin.buildModelFromXML(sys.stdin.read())
 before = resident()
 data = model.createData()
 print(resident() - before)
@@ -165,8 +166,10 @@ print(resident() - before)
 def test_the_memory_estimate_bounds_what_pinocchio_takes(joints):
     if not os.path.exists("/proc/self/statm"):
         pytest.skip("needs Linux's /proc")
+    from tests.data.make_hostile_corpus import chain
+
     result = subprocess.run(
-        [sys.executable, "-c", MEASURE, str(joints)], capture_output=True, text=True, check=True, cwd=os.getcwd()
+        [sys.executable, "-c", MEASURE], input=chain(joints), capture_output=True, text=True, check=True, cwd=os.getcwd()
     )
     measured = int(result.stdout.split()[-1])
     estimate = data_memory_estimate(joints, joints + 1)
@@ -175,3 +178,28 @@ def test_the_memory_estimate_bounds_what_pinocchio_takes(joints):
 
 def test_errors_of_this_family_are_robodyn_errors():
     assert issubclass(URDFError, RobodynError)
+
+
+@pytest.mark.parametrize(
+    ("text", "is_xacro"),
+    [
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a"/></robot>', False),
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="p" value="1"/></robot>', True),
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${1}"/></robot>', True),
+        ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="$(arg a)"/></robot>', True),
+        ('<robot name="r"><link name="${1}"/></robot>', False),  # no namespace: a plain URDF (its name is odd)
+        ('\n\n<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:if value="1"/></robot>', True),
+    ],
+)
+def test_xacro_is_expanded_where_the_namespace_and_xacro_use_meet(text, is_xacro):
+    from robodyn.urdf.xacro_files import is_xacro_text
+
+    assert is_xacro_text(text) is is_xacro
+
+
+def test_a_urdf_file_holding_xacro_is_named_by_its_path_in_a_refusal(tmp_path):
+    path = tmp_path / "plain.urdf"
+    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${().__class__}"/></robot>')
+    with pytest.raises(URDFError) as raised:
+        robodyn.load(path)
+    assert str(raised.value).startswith(f"{path}: xacro: the expression '().__class__'")

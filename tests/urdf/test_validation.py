@@ -188,3 +188,39 @@ def test_joint_dynamics_are_read_and_bad_values_refused_naming_the_joint():
         assert 'joint "shoulder"' in str(raised.value) and "\n" not in str(raised.value)
     _, problems = lint_urdf(DYNAMICS_ARM.format(shoulder="", weld='<dynamics damping="3"/>'))
     assert [(p.element, p.severity) for p in problems if "dynamics" in p.rule] == [('joint "weld"', "warning")]
+
+
+ONE_JOINT = (
+    '<robot name="d"><link name="a"/><joint name="j" type="TYPE"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+    '<limit lower="LO" upper="UP" effort="1" velocity="1"/></joint><link name="b"><inertial><mass value="1"/>'
+    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>'
+)
+
+
+def _one_joint(lower: str, upper: str, joint_type: str = "revolute") -> str:
+    return ONE_JOINT.replace("TYPE", joint_type).replace("LO", lower).replace("UP", upper)
+
+
+@pytest.mark.parametrize(("lower", "upper"), [("-180", "180"), ("-90", "45"), ("0", "360"), ("-30", "30")])
+def test_revolute_limits_written_in_degrees_are_a_loud_warning_and_strict_refuses_them(lower, upper):
+    with pytest.warns(RobodynWarning, match=r"limits \[.*\] look like degrees .* in radians they would be"):
+        robot = robodyn.load(_one_joint(lower, upper))
+    assert robot.dofs[0].upper == float(upper)  # kept as written: a warning, not a rewrite
+    with pytest.raises(URDFError, match="look like degrees"):
+        robodyn.load(_one_joint(lower, upper), strict=True)
+
+
+@pytest.mark.parametrize(
+    ("lower", "upper", "joint_type"),
+    [
+        ("-3.14159", "3.14159", "revolute"),
+        ("-6.2832", "6.2832", "revolute"),  # one turn to four digits (UR's wrists)
+        ("-10", "10", "revolute"),  # ODRI's placeholder (solo12): 1.6 turns
+        ("-12.566", "12.566", "revolute"),  # two turns, cable-limited
+        ("-180", "180", "prismatic"),  # metres: not an angle
+    ],
+)
+def test_radian_limits_and_prismatic_ones_pass_silently(lower, upper, joint_type):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RobodynWarning)
+        robodyn.load(_one_joint(lower, upper, joint_type), strict=True)

@@ -16,6 +16,7 @@ Also here:
 from __future__ import annotations
 
 import json
+import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -25,6 +26,7 @@ from hypothesis import HealthCheck, given, settings
 
 import robodyn
 from robodyn.cli import main
+from robodyn.exceptions import InputError
 from robodyn.verify.check import check_robot, report_text, skewness
 from tests.random_robots import random_urdfs
 
@@ -252,8 +254,13 @@ def test_check_skew_test_fails_when_coriolis_is_not_skew_compatible(monkeypatch)
 def test_check_reference_skew_test_fails_on_a_wrong_mass_matrix_derivative(monkeypatch):
     from robodyn.reference.numeric import ReferenceRobot
 
-    original = ReferenceRobot.mass_matrix_derivative
-    monkeypatch.setattr(ReferenceRobot, "mass_matrix_derivative", lambda self, q, v: 1.5 * original(self, q, v))
+    original = ReferenceRobot.terms
+
+    def wrong_derivative(self, q, v, a):
+        terms = original(self, q, v, a)
+        return terms | {"Mdot": 1.5 * terms["Mdot"]}
+
+    monkeypatch.setattr(ReferenceRobot, "terms", wrong_derivative)
     report = check_robot(robodyn.load(OBLIQUE), samples=SAMPLES)
     assert not report.comparisons["skew_reference"].passed
     assert report.comparisons["skew_pinocchio"].passed
@@ -275,3 +282,68 @@ def test_random_trees_agree(urdf):
 @given(random_urdfs)
 def test_many_random_trees_agree(urdf):
     assert_agree(urdf)
+
+
+HOLLOW_ARM = """<robot name="hollow">
+  <link name="base"><inertial><mass value="3"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="a" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="l1"/>
+  <joint name="b" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="l2">TIP</link>
+</robot>"""
+
+
+def test_a_robot_with_no_moving_mass_is_refused_in_one_line(capsys):
+    with pytest.raises(InputError, match=r"some moving mass.*'hollow', whose 2 joints move no mass and no inertia"):
+        check_robot(HOLLOW_ARM.replace("TIP", ""), samples=3)
+    assert main(["check", HOLLOW_ARM.replace("TIP", "")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1 and "nothing to compare" in captured.err
+    # Slack: a gram at the tip is something to compare, and it agrees
+    tip = '<inertial><origin xyz="0.1 0 0"/><mass value="0.001"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>'
+    assert check_robot(HOLLOW_ARM.replace("TIP", tip), samples=3).passed
+
+
+def test_progress_is_reported_as_the_reference_evaluates_and_shown_only_on_a_terminal(capsys, monkeypatch):
+    calls = []
+    check_robot(robodyn.load("rp_arm"), samples=45, progress=lambda stage, done, total: calls.append((stage, done, total)))
+    assert calls[-1] == ("reference", 45, 45) and [done for _, done, _ in calls] == sorted({done for _, done, _ in calls})
+    assert 10 <= len(calls) <= 23
+    assert main(["check", "rp_arm", "--samples", "5"]) == 0
+    assert capsys.readouterr().err == ""  # not a terminal: nothing on stderr
+    import robodyn.cli.common as common
+
+    monkeypatch.setattr(common, "_is_terminal", lambda stream: True)
+    monkeypatch.setattr(common.Progress, "DELAY", 0.0)
+    assert main(["check", "rp_arm", "--samples", "5"]) == 0
+    assert "\rchecking rp_arm: reference" in capsys.readouterr().err
+
+
+def chain_urdf(joints: int, seed: int = 1) -> str:
+    """A serial chain of ``joints`` revolute joints on oblique axes, with offset centres of mass."""
+    rng = np.random.default_rng(seed)
+    parts = [f'<robot name="chain{joints}"><link name="l0"/>']
+    for i in range(1, joints + 1):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        x, y, z = rng.uniform(-0.1, 0.1, 3)
+        parts.append(
+            f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+            f'<origin xyz="{x:.4f} {y:.4f} {z:.4f}" rpy="0.1 0.2 0.3"/><axis xyz="{axis[0]:.6f} {axis[1]:.6f} {axis[2]:.6f}"/>'
+            f'<limit lower="-1" upper="1" effort="10" velocity="5"/></joint><link name="l{i}"><inertial>'
+            f'<origin xyz="0.02 0.01 0.03"/><mass value="{rng.uniform(0.1, 2.0):.3f}"/>'
+            '<inertia ixx="0.01" ixy="0.001" ixz="0" iyy="0.012" iyz="0" izz="0.008"/></inertial></link>'
+        )
+    return "".join([*parts, "</robot>"])
+
+
+@pytest.mark.slow
+def test_a_62_joint_chain_checks_in_under_a_minute():
+    robot = robodyn.load(chain_urdf(62))
+    began = time.perf_counter()
+    report = check_robot(robot, samples=100)
+    elapsed = time.perf_counter() - began
+    assert report.passed and elapsed < 60.0, elapsed
+    print(f"62-joint chain, 100 samples: {elapsed:.1f} s, worst relative error {report.worst_relative_error:.2e}")

@@ -12,7 +12,7 @@ from robodyn.cli import main
 from robodyn.dynamics.display import robot_html
 from robodyn.exceptions import InputError
 from robodyn.trajectory import Trajectory
-from robodyn.viz.recording import MAX_FRAMES, frame_count, recording
+from robodyn.viz.recording import MAX_FRAMES, frame_count, record, recording
 
 HOSTILE = """<robot name="r&lt;script&gt;alert(1)&lt;/script&gt;">
   <link name="base"/>
@@ -122,3 +122,20 @@ def test_record_of_a_trajectory_ending_at_1e9_s_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "frames" in err
     assert not (tmp_path / "m.html").exists()
+
+
+def test_the_poster_is_the_motions_last_frame_with_its_path_unless_a_time_is_given(tmp_path, monkeypatch, capsys):
+    """``--png`` shows the motion (the final pose, the whole path drawn), not the robot at
+    rest before it; an explicit time still picks its frame."""
+    from robodyn.viz.recording import Recording
+
+    asked: list[float] = []
+    monkeypatch.setattr(Recording, "still", lambda self, png, *, at=0.0, size=(800, 600): asked.append(at))
+    argv = ["simulate", "rp_arm", "--controller", "task-space", "--q0", "0,0.1", "--target", "0.7,0.7", "--duration", "1.5"]
+    assert main([*argv, "--record", str(tmp_path / "m.html"), "--png", str(tmp_path / "m.png")]) == 0
+    assert asked == [pytest.approx(1.5)]
+    robot = robodyn.load("rp_arm")
+    t = np.linspace(0.0, 2.0, 21)
+    trajectory = Trajectory(t, np.column_stack([t, 0.1 + 0 * t]), np.zeros((21, 2)), np.zeros((21, 2)))
+    record(robot, trajectory, tmp_path / "r.html", png=tmp_path / "r.png", at=0.5)
+    assert asked[-1] == 0.5

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import RANGES, add_model_arguments, load_robot
+from robodyn.cli.common import RANGES, Progress, add_model_arguments, load_robot
 from robodyn.common.text import json_text
 
 
@@ -35,17 +35,22 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from robodyn.common.text import printable_lines
+    from robodyn.common.text import printable, printable_lines
     from robodyn.verify.check import check_robot
 
     robot = load_robot(arguments)
-    report = check_robot(
-        robot,
-        samples=arguments.samples,
-        seed=arguments.seed,
-        tolerance=arguments.tolerance,
-        check_inertia=arguments.check_inertia,
-        reference_source=arguments.reference,
-    )
+    progress = Progress(f"checking {printable(robot.name)[:60]}")  # on a terminal only, after 0.5 s
+    try:
+        report = check_robot(
+            robot,
+            samples=arguments.samples,
+            seed=arguments.seed,
+            tolerance=arguments.tolerance,
+            check_inertia=arguments.check_inertia,
+            reference_source=arguments.reference,
+            progress=progress,
+        )
+    finally:
+        progress.close()
     print(json_text(report.to_dict()) if arguments.json else printable_lines(report.text()))
     return 0 if report.passed else 1

@@ -92,6 +92,7 @@ def _symbolic(arguments: argparse.Namespace) -> int:
             keep_params=arguments.keep_params, gravity=arguments.gravity, lock=lock_values(arguments.lock),
             floating_base=arguments.floating_base, frame=arguments.kinematics, precision=arguments.precision,
             xacro_args=xacro_arguments(arguments.xacro_arg) or None, packages=package_arguments(arguments.package) or None,
+            xacro_env=arguments.xacro_env,
         )  # fmt: skip
     finally:
         progress.close()

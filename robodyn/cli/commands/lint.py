@@ -5,14 +5,14 @@ from __future__ import annotations
 import argparse
 import json
 
-from robodyn.cli.common import add_file_arguments, package_arguments, xacro_arguments
-from robodyn.common.text import printable
+from robodyn.cli.common import MODEL_HELP, add_file_arguments, package_arguments, xacro_arguments
+from robodyn.common.text import counted, printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("lint", help="every problem of a URDF at once (exit 1 if any error)")
-    parser.add_argument("model", help="URDF path, robot name or URDF text")
+    parser.add_argument("model", help=MODEL_HELP)
     parser.add_argument(
         "--floating-base", dest="floating_base", action="store_true", default=None, help="check as a floating-base robot"
     )
@@ -29,6 +29,7 @@ def run(arguments: argparse.Namespace) -> int:
         floating_base=arguments.floating_base,
         xacro_args=xacro_arguments(arguments.xacro_arg) or None,
         packages=package_arguments(arguments.package) or None,
+        xacro_env=arguments.xacro_env,
     )
     errors = sum(problem.severity == "error" for problem in problems)
     if arguments.json:
@@ -46,7 +47,7 @@ def run(arguments: argparse.Namespace) -> int:
         for problem in problems:
             print(f"{problem.severity}: {problem}")
         print(
-            f"{printable(arguments.model) if len(arguments.model) < 80 else '<URDF text>'}: {errors} errors, "
-            f"{len(problems) - errors} warnings"
+            f"{'<URDF text>' if arguments.model.lstrip().startswith('<') else printable(arguments.model)}: "
+            f"{counted(errors, 'error')}, {counted(len(problems) - errors, 'warning')}"
         )
     return 1 if errors else 0

@@ -19,6 +19,17 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--duration", type=float, required=True, help="duration in [s] (with --cost time: its upper bound)")
     parser.add_argument("--intervals", type=int, default=50, help="shooting intervals (samples: intervals + 1; default 50)")
     parser.add_argument("--cost", choices=["effort", "time"], default="effort", help="minimise effort (default) or time")
+    parser.add_argument(
+        "--actuated",
+        help="the joints the motors drive, comma-separated (default: the file's actuated joints, else all); the others "
+        "get no torque",
+    )
+    parser.add_argument(
+        "--no-joint-friction",
+        dest="joint_friction",
+        action="store_false",
+        help="plan the rigid-body motion (default: with the joints' damping, as simulate applies it)",
+    )
     parser.add_argument("--out", required=True, help="trajectory file to write (.csv or .npz)")
     parser.set_defaults(run=run)
 
@@ -32,7 +43,8 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         motion = point_to_point(
             robot, arguments.start, arguments.goal, arguments.duration, intervals=arguments.intervals, cost=arguments.cost,
-            progress=progress,
+            actuated=None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")],
+            joint_friction=arguments.joint_friction, progress=progress,
         )  # fmt: skip
     finally:
         progress.close()

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 
 from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector, warn
+from robodyn.cli.flags import command_line_text
 from robodyn.common.text import json_text, printable
 from robodyn.exceptions import InputError
 
@@ -31,7 +33,13 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
     parser.add_argument("--dt", type=float, default=1e-3, help=f"step, {RANGES['dt'].text()}, at most --duration (default 0.001)")
-    parser.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], default="rk4")
+    parser.add_argument(
+        "--integrator",
+        choices=["rk4", "semi-implicit-euler"],
+        default=None,
+        help="default rk4; with --ground semi-implicit-euler (the contact step's scheme, the only one there)",
+    )
+    _add_ground_arguments(parser)
     parser.add_argument(
         "--limits",
         choices=["warn", "enforce", "ignore"],
@@ -42,8 +50,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--compiled",
         action="store_true",
-        help="integrate in C (robodyn.compile; fixed base, a C compiler needed); PD, computed torque, task-space, osc and"
-        " impedance run in C too (the same as --engine compiled)",
+        help="integrate in C (robodyn.compile; a C compiler needed; fixed or floating base, the joints' damping "
+        "included, Coulomb friction refused); PD, computed torque, lqr run in C too, and task-space, osc and impedance "
+        "on a fixed base (the same as --engine compiled)",
     )
     _add_engine_arguments(parser)
     no_friction = "leave out the joints' damping and friction (<dynamics>): the rigid-body motion"
@@ -55,7 +64,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--plot", help="PNG figure: positions, torques, task error, energy")
     parser.add_argument("--record", help="HTML animation (meshcat, self-contained, plays on open)")
-    parser.add_argument("--png", help="with --record: a still of the first frame (needs Chromium)")
+    parser.add_argument(
+        "--png", help="with --record: a poster of the motion, its final frame with the path drawn (needs Chromium)"
+    )
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.set_defaults(run=run)
 
@@ -94,13 +105,17 @@ def run(arguments: argparse.Namespace) -> int:
         observer_gain=arguments.observer_gain,
         actuated=None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")],
         joint_friction=arguments.joint_friction,
+        kp=arguments.kp,
+        kd=arguments.kd,
         out=arguments.out,
         plot=arguments.plot,
         record=arguments.record,
         png=arguments.png,
         **_reference(arguments),
+        **_ground(arguments),
     )
-    summary = summary.with_startup(startup)
+    # the library's summary names its parameters (engine='compiled'); the command line, its flags
+    summary = replace(summary.with_startup(startup), engine_reason=command_line_text(summary.engine_reason))
     warn(summary.warnings())
     if summary.task is not None and not summary.task.reached and summary.task.deflection is None:
         warn([
@@ -137,7 +152,54 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         type=float,
         help="run a momentum observer of this gain [1/s]; --out then has tau_ext[<joint>] columns",
     )
-    parser.add_argument("--actuated", help="lqr: the actuated joints, comma-separated (default all; the others get no torque)")
+    parser.add_argument(
+        "--kp",
+        type=vector,
+        help="pd: stiffness, one value or one a joint, in [N m/rad] / [N/m] (default: 100 x each joint's inertia, a "
+        "critically damped 10 rad/s); computed-torque: in [1/s^2] (default 400)",
+    )
+    parser.add_argument(
+        "--kd",
+        type=vector,
+        help="pd: damping in [N m s/rad] / [N s/m] (default: 20 x each joint's inertia, or critical for a given --kp); "
+        "computed-torque: in [1/s] (default 40)",
+    )
+    parser.add_argument(
+        "--actuated",
+        help="pd, computed-torque, lqr: the actuated joints, comma-separated (default: the file's actuated joints, else "
+        "all); the others get no torque",
+    )
+
+
+def _add_ground_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--ground``, ``--friction`` and ``--contact`` (docs/contact.md)."""
+    parser.add_argument(
+        "--ground",
+        type=float,
+        nargs="?",
+        const=0.0,
+        metavar="HEIGHT",
+        help="stand the robot on a flat ground at this height in [m] (default 0 when given without a value): "
+        "point contacts with Coulomb friction; the summary gives peak normal force, slip and penetration",
+    )
+    parser.add_argument("--friction", type=float, default=1.0, help="with --ground: the friction coefficient mu (default 1)")
+    parser.add_argument(
+        "--contact",
+        metavar="FRAME[,...]",
+        help="with --ground: the frames that touch it, comma-separated (default: the URDF's collision spheres and boxes)",
+    )
+
+
+def _ground(arguments: argparse.Namespace) -> dict:
+    """``ground=`` and ``contacts=`` of ``--ground``, ``--friction`` and ``--contact``."""
+    if arguments.ground is None:
+        if arguments.contact is not None:
+            raise InputError("--contact", "given only with --ground", repr(arguments.contact))
+        return {}
+    from robodyn.sim.ground import Ground
+
+    contacts = "collision" if arguments.contact is None else [name.strip() for name in arguments.contact.split(",")]
+    return {"ground": Ground(height=arguments.ground, friction=arguments.friction), "contacts": contacts}
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from robodyn.cli.common import RANGES, vector
-from robodyn.common.text import json_text
+from robodyn.common.text import counted, json_text
 from robodyn.exceptions import InputError
 
 
@@ -34,7 +34,7 @@ def run(arguments: argparse.Namespace) -> int:
     from robodyn.viz.experiment import run_whatif
 
     if arguments.force and len(arguments.force) != 3:
-        raise InputError("--force", "3 values FX,FY,FZ in [N]", f"{len(arguments.force)} values")
+        raise InputError("--force", "3 values FX,FY,FZ in [N]", counted(len(arguments.force), "value"))
     table = run_whatif(
         arguments.model,
         scheduler=arguments.scheduler,

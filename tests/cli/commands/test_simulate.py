@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -32,9 +33,45 @@ def test_outputs_are_written_together_when_all_succeed(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert (tmp_path / "m.npz").is_file() and (tmp_path / "m.png").is_file()
     # --engine auto (default): the engine choose_engine names (compiled once rp_arm is in the cache)
+    from robodyn.cli.flags import command_line_text
     from robodyn.sim.simulation import choose_engine
 
-    assert (summary["engine"], summary["engine_reason"]) == choose_engine(robodyn.load("rp_arm"), None)
+    engine, reason = choose_engine(robodyn.load("rp_arm"), None)
+    assert (summary["engine"], summary["engine_reason"]) == (engine, command_line_text(reason))
+
+
+def test_the_summary_names_flags_not_library_parameters(capsys):
+    from robodyn.cli.flags import command_line_text
+
+    reason = "not compiled yet (engine='compiled' builds it once, in seconds to minutes; auto uses it from then on)"
+    assert command_line_text(reason) == (
+        "not compiled yet (--engine compiled builds it once, in seconds to minutes; auto uses it from then on)"
+    )
+    assert main(["simulate", "rp_arm", "--duration", "0.01", "--engine", "pinocchio"]) == 0
+    out = capsys.readouterr().out
+    assert "engine: pinocchio (asked for (--engine pinocchio))" in out and "engine=" not in out
+
+
+STUDENT_ARM = str(Path(__file__).parents[2] / "data" / "robots" / "student_arm.urdf")
+STUDENT_TARGET = "0.5,-0.5,0.3,0.05,0.02"
+
+
+def test_pd_on_a_light_wrist_settles_at_one_millisecond_with_the_default_gains(capsys):
+    status = main(["simulate", STUDENT_ARM, "--controller", "pd", "--target", STUDENT_TARGET, "--no-joint-friction", "--json"])
+    assert status == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["final_joint_error"] < 1e-5
+
+
+def test_kp_and_kd_set_the_pd_gains_and_a_wrong_count_is_one_line(capsys):
+    soft = ["simulate", STUDENT_ARM, "--controller", "pd", "--target", STUDENT_TARGET, "--no-joint-friction", "--json"]
+    assert main([*soft, "--kp", "0.05", "--duration", "1"]) == 0
+    assert json.loads(capsys.readouterr().out)["final_joint_error"] > 0.1  # far softer than the default: far off after 1 s
+    assert main([*soft, "--kp", "1,2"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.count("\n") == 0 and error.startswith("robodyn: error: --kp must be") and "5 (one a joint)" in error
+    assert main(["simulate", "rp_arm", "--controller", "osc", "--target", "0.9,0,0.5", "--kd", "3"]) == 2
+    assert "--kd must be given only with the pd or computed-torque controller" in capsys.readouterr().err
 
 
 @pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")

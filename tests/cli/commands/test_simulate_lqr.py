@@ -29,7 +29,7 @@ def test_an_unheld_target_and_a_misplaced_actuated_flag_are_one_line_errors(tmp_
     common = ["simulate", str(path), "--duration", "0.1"]
     for arguments, flag in (
         (["--controller", "lqr", "--actuated", "joint2", "--target", "3.4,0"], "--target"),
-        (["--controller", "pd", "--actuated", "joint2", "--target", "0,0"], "--actuated"),
+        (["--controller", "task-space", "--actuated", "joint2", "--target", "0.1,0.2"], "--actuated"),
         (["--controller", "lqr", "--actuated", "elbow", "--target", "0,0"], "--actuated"),
     ):
         assert main([*common, *arguments]) == 2

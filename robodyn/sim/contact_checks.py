@@ -1,0 +1,77 @@
+"""What a simulation run on the ground may ask, checked when its plan is made.
+
+The contact step (:mod:`robodyn.sim.contact`) is semi-implicit Euler at the velocity level
+with the controller sampled once a step; it has no momentum observer and does not enforce
+joint limits. A plan asking for those with a ground is refused, naming the parameter, as
+is a start with a contact point deeper than :data:`START_PENETRATION` below the ground.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
+from robodyn.sim.contact import contact_kinematics
+from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
+
+#: Deepest a contact point may start below the ground, in [m] (deeper: refused; the
+#: push-out of a deep penetration would launch the robot).
+START_PENETRATION = 1e-3
+
+
+def check_contact_run(
+    robot: Robot,
+    ground: Ground | None,
+    contacts: str | Sequence[str | ContactPoint],
+    *,
+    q0: np.ndarray,
+    integrator: str,
+    every: int | None,
+    limits: str,
+    observer: object,
+) -> Contacts | None:
+    """The contact points of a run on ``ground`` (``None`` without one), or an
+    :class:`InputError` naming what a contact run does not do."""
+    if ground is None:
+        if not (isinstance(contacts, str) and contacts == "collision"):
+            raise InputError("contacts", "given only with a ground", repr(contacts)[:80])
+        return None
+    if not isinstance(ground, Ground):
+        raise InputError("ground", "a robodyn.sim.ground.Ground (a plane, its normal and friction)", repr(ground)[:80])
+    refusals = [
+        (integrator != "semi-implicit-euler", "integrator", "'semi-implicit-euler' with a ground (the contact step's scheme)", repr(integrator)),
+        (every not in (None, 1), "control_period", "the step dt with a ground (the contact step samples the controller each step)", f"{every} steps"),
+        (limits == "enforce", "limits", "'warn' or 'ignore' with a ground (the contact step does not enforce limits)", repr(limits)),
+        (observer is not None, "observer", "none with a ground (the contact step runs no observer)", "an observer"),
+    ]  # fmt: skip
+    for refused, name, expected, received in refusals:
+        if refused:
+            raise InputError(name, expected, received)
+    found = contact_points(robot, contacts)
+    gaps = contact_kinematics(robot, q0, ground, found.points)[0]
+    if gaps.min() < -START_PENETRATION:
+        deepest = int(gaps.argmin())
+        raise InputError(
+            "q0",
+            f"a configuration with every contact point above the ground (at most {START_PENETRATION} m below)",
+            f"{found.names[deepest]!r} {-gaps[deepest]:.3g} m below",
+        )
+    return found
+
+
+def start_above(
+    robot: Robot, q0: np.ndarray, ground: Ground, contacts: str | Sequence[str | ContactPoint], clearance: float = 0.05
+) -> tuple[np.ndarray, float]:
+    """A floating robot's configuration moved along the ground's normal so that its lowest
+    contact point is ``clearance`` [m] above the plane, and how far it moved [m]."""
+    gaps = contact_kinematics(robot, q0, ground, contact_points(robot, contacts).points)[0]
+    lift = clearance - float(gaps.min())
+    moved = np.array(q0, dtype=float)
+    moved[:3] += lift * np.array(ground.normal)
+    return moved, lift
+
+
+__all__ = ["START_PENETRATION", "check_contact_run", "start_above"]

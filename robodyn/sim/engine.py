@@ -1,0 +1,116 @@
+"""The engine choice and the run: a plan handed to the backend that runs it.
+
+:func:`choose` names the backend for a plan and why (``engine="auto"``: the compiled one
+when the whole loop runs in C there, the robot was compiled before and a C compiler exists,
+else the Pinocchio one, with the first reason); :func:`run` runs the plan on it, wraps the
+arrays in a :class:`~robodyn.trajectory.Trajectory` and reports the joint limits broken.
+Choosing costs a cache lookup (:mod:`robodyn.compiled.lookup`), never the code generator.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from time import perf_counter
+from typing import Any, Literal
+
+from robodyn.exceptions import CompileError, InputError, JointLimitWarning, RobodynWarning
+from robodyn.sim import compiled_backend, pinocchio_loop
+from robodyn.sim.limits import JointLimits, warning_text
+from robodyn.sim.plan import Outcome, RunPlan
+from robodyn.sim.stability import step_warning, task_warning
+from robodyn.trajectory import Trajectory
+
+
+@dataclass(frozen=True)
+class EngineRun:
+    """How a run went: the engine that ran, why, and where the time went.
+
+    Attributes:
+        engine: ``"pinocchio"`` or ``"compiled"``: the engine that ran.
+        reason: Why that engine, one sentence (with ``engine="auto"``: why it was chosen).
+        loop_time: Wall-clock time of the integration loop alone, in [s].
+        compile_time: Wall-clock time spent choosing the engine and compiling (or loading
+            the cached) kernels, in [s] (0 when ``engine="pinocchio"`` was asked for).
+        control_period: The period in [s] at which the controller was sampled and its
+            torque held; ``None`` when it was evaluated at every integrator stage (or there
+            is none).
+        controller_in_c: Whether the controller ran in C (passive runs: ``False``).
+        contact: A run on the ground: its contact forces, gaps and summary
+            (:class:`robodyn.sim.contact_run.ContactSimulation`); ``None`` without a ground.
+    """
+
+    engine: Literal["pinocchio", "compiled"]
+    reason: str
+    loop_time: float
+    compile_time: float = 0.0
+    control_period: float | None = None
+    controller_in_c: bool = False
+    contact: Any = None
+
+
+def choose(plan: RunPlan) -> tuple[Literal["pinocchio", "compiled"], str]:
+    """The engine a plan runs on, and why (one phrase).
+
+    Raises:
+        InputError: With ``engine="compiled"``, for what the compiled engine does not
+            model (:func:`robodyn.sim.compiled_backend.unsupported`'s first reason).
+    """
+    if plan.engine == "pinocchio":
+        return "pinocchio", "asked for (engine='pinocchio')"
+    reasons = compiled_backend.unsupported(plan)
+    if plan.engine == "compiled":
+        if reasons:
+            first = reasons[0]
+            parameter = getattr(first, "parameter", "engine")
+            if parameter == "engine":
+                raise InputError("engine", f"'pinocchio' or 'auto' for a run with {first}", "'compiled'")
+            raise InputError(parameter, f"left out for engine='compiled': {first}", "given")
+        return "compiled", "asked for (engine='compiled')"
+    reasons += compiled_backend.not_ready(plan)
+    if reasons:
+        return "pinocchio", reasons[0]
+    return "compiled", compiled_backend.ready_reason(plan)
+
+
+def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
+    """Run a plan on the engine :func:`choose` names: the trajectory and how it went.
+
+    Raises:
+        CompileError: With ``engine="compiled"``, if the build fails (with ``"auto"`` the
+            run falls back to the Pinocchio engine, saying why).
+        SingularMassMatrixError, SimulationError: As :func:`robodyn.simulate`.
+
+    Warns:
+        RobodynWarning: At the start, when the step exceeds the largest stable step of the
+            fastest mode, or an operational-space task starts near a singularity
+            (:mod:`robodyn.sim.stability`).
+        JointLimitWarning: With ``limits="warn"``, for the limits the run broke.
+    """
+    for sentence in (step_warning(plan), task_warning(plan)):  # stack level 4: the caller of simulate
+        if sentence:
+            warnings.warn(RobodynWarning(sentence), stacklevel=4)
+    began = perf_counter()
+    engine, reason = choose(plan)
+    outcome: Outcome | None = None
+    if engine == "compiled":
+        try:
+            prepared = compiled_backend.prepare(plan)
+        except CompileError as error:  # CompilerNotFoundError included
+            if plan.engine == "compiled":
+                raise
+            engine, reason = "pinocchio", f"the compiled engine does not apply: {error}"
+        else:
+            compile_time = perf_counter() - began
+            outcome = compiled_backend.run(plan, prepared)
+    if outcome is None:
+        compile_time = 0.0 if plan.engine == "pinocchio" else perf_counter() - began
+        outcome = pinocchio_loop.run(plan)
+    robot = plan.robot
+    trajectory = Trajectory(plan.times(), *outcome.arrays[1:], list(robot.joint_names), robot.name)
+    violations = [] if plan.limits == "ignore" else JointLimits(robot).violations(trajectory)
+    if violations:  # stack level 4: the caller of simulate / simulate_run
+        warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=4)
+    return trajectory, EngineRun(
+        engine, reason, outcome.loop_time, compile_time, plan.control_period, outcome.controller_in_c, outcome.contact
+    )

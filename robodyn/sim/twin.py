@@ -1,0 +1,50 @@
+"""What a controller's compiled twin needs, shared by the controllers that own one.
+
+Each controller of :mod:`robodyn.sim.control` and :mod:`robodyn.sim.operational_space` that
+the C loop can run has two methods (the protocol
+:class:`robodyn.compiled.controllers.HasTwin`): ``twin_refusal()``, why it has no twin now
+(``None``: it has one), and ``compiled()``, the twin on its own model compiled. These
+helpers give the refusals every such controller shares; the code generator is imported
+only when a twin is made.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import CompileError
+
+if TYPE_CHECKING:
+    from robodyn.compiled.robot import CompiledRobot
+
+
+def fixed_base_only(controller: object) -> bool:
+    """Whether the controller's twin models fixed bases only (its class's ``twin_fixed_base``:
+    the frame laws' compiled kinematics and LQR)."""
+    return bool(getattr(type(controller), "twin_fixed_base", False))
+
+
+def law_refusal(controller: object, owner: type) -> str | None:
+    """Why ``controller`` (an instance of ``owner`` or a subclass) has no twin: a subclass
+    that changes the law (its ``__call__``), or, for a twin of fixed bases only
+    (:func:`fixed_base_only`), a floating model; ``None`` when it has one."""
+    if type(controller).__call__ is not owner.__call__:
+        return f"{type(controller).__name__} changes {owner.__name__}'s law; its compiled twin is {owner.__name__}'s"
+    model = getattr(controller, "model", None)
+    if fixed_base_only(controller) and isinstance(model, Robot) and model.floating_base:
+        return f"it has a floating base; {owner.__name__} compiles for fixed-base robots"
+    return None
+
+
+def compiled_model(model: Robot, refusal: str | None) -> CompiledRobot:
+    """A controller's own model, compiled (loading the code generator), after its refusal.
+
+    Raises:
+        CompileError: With the refusal, when there is one.
+    """
+    if refusal is not None:
+        raise CompileError(model.name, refusal)
+    from robodyn.compiled.robot import compile
+
+    return compile(model)

@@ -1,0 +1,226 @@
+"""What an MJCF body holds, written into its URDF link: the inertial (``<inertial>``, or the
+body's solid geoms where MuJoCo's ``inertiafromgeom`` would take them), geoms as visuals
+and sites as frames; ``<compiler settotalmass>``.
+
+This module does not import Pinocchio or MuJoCo.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from robodyn.exceptions import URDFError
+from robodyn.urdf.geom_inertia import SOLIDS, combine, solid_properties
+from robodyn.urdf.mjcf_state import MjcfRobot, attributes
+from robodyn.urdf.mjcf_values import (
+    BOOLEAN,
+    ORIENTATIONS,
+    floats,
+    fromto_pose,
+    keyword,
+    number,
+    pose,
+    text,
+    translation,
+    write_origin,
+)
+from robodyn.urdf.xmltext import split_numbers
+
+#: MuJoCo's geom types.
+GEOM_TYPES = ("plane", "hfield", "sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "sdf")
+#: How many ``size`` numbers each solid needs.
+SIZES = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}
+
+
+def write_link(robot: MjcfRobot, body: ET.Element, name: str, link: ET.Element, offset: np.ndarray, childclass: str) -> float:
+    """The body's inertial, visuals and sites, placed in the link frame (``offset`` from
+    the body frame); returns the body's mass in [kg]."""
+    shift = translation(-offset)
+    inertial = body.find("inertial")
+    geoms = [
+        (geom, _geom_values(robot, geom, f'geom #{index + 1} of body "{name}"', childclass))
+        for index, geom in enumerate(body.findall("geom"))
+    ]
+    needs_geoms = robot.compiler.inertiafromgeom == "true" or (inertial is None and robot.compiler.inertiafromgeom == "auto")
+    mass = 0.0
+    if geoms and needs_geoms:
+        mass = _write_geom_inertial(robot, geoms, name, link, shift)
+    elif inertial is not None:
+        mass = _write_inertial(robot, inertial, name, link, shift)
+    for index, (_, values) in enumerate(geoms):
+        _write_visual(robot, values, f'geom #{index + 1} of body "{name}"', link, shift)
+    _write_sites(robot, body, name, shift, childclass)
+    return mass
+
+
+def _write_sites(robot: MjcfRobot, body: ET.Element, name: str, shift: np.ndarray, childclass: str) -> None:
+    """The body's sites as frames: massless links on fixed joints, named as the site, or
+    ``site:NAME`` where a body has the name (MuJoCo's bodies and sites are separate
+    namespaces; robodyn's links are one)."""
+    for index, site in enumerate(body.findall("site")):
+        values = attributes(robot, site, childclass)
+        given = site.get("name") or f"{name}_site{index}"
+        site_name = robot.unique(f"site:{given}" if given in robot.bodies else given, "an MJCF site")
+        joint = ET.SubElement(robot.urdf, "joint", name=robot.unique(f"{site_name}_site", "a site's joint"), type="fixed")
+        write_origin(joint, shift @ pose(robot, f'site "{given}"', values))
+        ET.SubElement(joint, "parent", link=name)
+        ET.SubElement(joint, "child", link=site_name)
+        ET.SubElement(robot.urdf, "link", name=site_name)
+
+
+def _geom_values(robot: MjcfRobot, geom: ET.Element, where: str, childclass: str) -> dict[str, str]:
+    """A geom's attributes, checked as MuJoCo checks them: its type, positive sizes, and
+    (in the inertia groups) a mass and density that are not negative.
+
+    Raises:
+        URDFError: Naming the geom and the value MuJoCo refuses.
+    """
+    values = attributes(robot, geom, childclass)
+    kind = keyword(robot.label, where, "type", values.get("type", "sphere"), GEOM_TYPES)
+    keyword(robot.label, where, "shellinertia", values.get("shellinertia", "false"), BOOLEAN)
+    size = [number(robot.label, f"{where}: size", token) for token in split_numbers(values.get("size", ""))]
+    if "fromto" in values and kind not in ("capsule", "cylinder"):
+        raise URDFError(robot.label, f"{where}: fromto on a {kind} is not read by robodyn")
+    needed = 1 if "fromto" in values else SIZES.get(kind, 0)
+    if len(size) < needed:
+        raise URDFError(robot.label, f"{where}: a {kind} needs {needed} size numbers")
+    if any(value <= 0 for value in size[:needed]):
+        raise URDFError(robot.label, f"{where}: size {values['size']!r} must be positive, as MuJoCo requires")
+    low, high = robot.compiler.inertiagroups
+    if low <= int(number(robot.label, f"{where}: group", values.get("group", "0"))) <= high:
+        for key in ("mass", "density"):
+            if key in values and number(robot.label, f"{where}: {key}", values[key]) < 0:
+                raise URDFError(robot.label, f"{where}: {key}={values[key]!r} is negative (MuJoCo refuses it)")
+    return values
+
+
+def _write_inertial(robot: MjcfRobot, node: ET.Element, name: str, link: ET.Element, shift: np.ndarray) -> float:
+    where = f'the <inertial> of body "{name}"'
+    if "mass" not in node.attrib:
+        raise URDFError(robot.label, f"{where} needs a mass")
+    given = [key for key in ORIENTATIONS if key in node.attrib]
+    if "fullinertia" in node.attrib and given:
+        raise URDFError(robot.label, f"{where}: fullinertia cannot have an orientation ({given[0]}), as in MuJoCo")
+    placed = shift @ pose(robot, where, dict(node.attrib))
+    if "fullinertia" in node.attrib:
+        ixx, iyy, izz, ixy, ixz, iyz = floats(robot.label, where, node.attrib["fullinertia"], 6)
+    elif "diaginertia" in node.attrib:
+        (ixx, iyy, izz), ixy, ixz, iyz = floats(robot.label, where, node.attrib["diaginertia"], 3), 0.0, 0.0, 0.0
+    else:
+        raise URDFError(robot.label, f"{where} needs diaginertia or fullinertia")
+    mass = number(robot.label, f"{where}: mass", node.attrib["mass"])
+    if mass < 0 or min(ixx, iyy, izz) < 0:
+        raise URDFError(robot.label, f"{where}: a mass or principal inertia is negative (MuJoCo refuses it)")
+    element = ET.SubElement(link, "inertial")
+    write_origin(element, placed)
+    ET.SubElement(element, "mass", value=repr(mass))
+    values = {"ixx": ixx, "iyy": iyy, "izz": izz, "ixy": ixy, "ixz": ixz, "iyz": iyz}
+    ET.SubElement(element, "inertia", {key: repr(float(value)) for key, value in values.items()})
+    return mass
+
+
+def _write_geom_inertial(
+    robot: MjcfRobot, geoms: list[tuple[ET.Element, dict[str, str]]], name: str, link: ET.Element, shift: np.ndarray
+) -> float:
+    """The body's inertia from its geoms, as MuJoCo's compiler computes it (uniform
+    solids); returns its mass in [kg]."""
+    parts = []
+    low, high = robot.compiler.inertiagroups
+    for index, (_, values) in enumerate(geoms):
+        where = f'geom #{index + 1} of body "{name}"'
+        kind = values.get("type", "sphere")
+        if not low <= int(number(robot.label, where, values.get("group", "0"))) <= high or kind in ("plane", "hfield"):
+            continue
+        if kind not in SOLIDS or values.get("shellinertia", "false") == "true":
+            raise URDFError(
+                robot.label,
+                f'body "{name}" has no <inertial> and a {kind} geom robodyn does not compute inertia from '
+                "(solid sphere, capsule, cylinder, ellipsoid, box): add <inertial>",
+            )
+        size, placed = _geom_size_and_pose(robot, where, values, kind)
+        given = values.get("mass")
+        density = number(robot.label, where, values.get("density", "1000"))
+        try:
+            mass, principal = solid_properties(
+                kind, size, density=density, mass=None if given is None else number(robot.label, where, given)
+            )
+        except OverflowError:
+            mass, principal = math.inf, np.full(3, math.inf)
+        if not (math.isfinite(mass) and np.isfinite(principal).all()):
+            raise URDFError(
+                robot.label,
+                f"{where}: its mass or inertia overflows (size {values.get('size', '')!r}); robodyn reads finite ones",
+            )
+        placed = shift @ placed
+        parts.append((mass, placed[:3, 3], placed[:3, :3], principal))
+    mass, centre, inertia = combine(parts)
+    if mass <= 0:
+        return 0.0
+    if not (math.isfinite(mass) and np.isfinite(centre).all() and np.isfinite(inertia).all()):
+        raise URDFError(robot.label, f'body "{name}": the mass properties of its geoms overflow; robodyn reads finite ones')
+    element = ET.SubElement(link, "inertial")
+    ET.SubElement(element, "origin", xyz=text(centre), rpy="0 0 0")
+    ET.SubElement(element, "mass", value=repr(mass))
+    entries = {"ixx": (0, 0), "iyy": (1, 1), "izz": (2, 2), "ixy": (0, 1), "ixz": (0, 2), "iyz": (1, 2)}
+    ET.SubElement(element, "inertia", {key: repr(float(inertia[i, j])) for key, (i, j) in entries.items()})
+    return mass
+
+
+def _geom_size_and_pose(robot: MjcfRobot, where: str, values: dict[str, str], kind: str) -> tuple[list[float], np.ndarray]:
+    """A geom's ``size`` and pose in its body's frame (``fromto`` for capsules and cylinders)."""
+    size = [number(robot.label, where, token) for token in split_numbers(values.get("size", ""))]
+    needed = SIZES.get(kind, 0)
+    if "fromto" not in values:
+        if len(size) < needed:
+            raise URDFError(robot.label, f"{where}: a {kind} needs {needed} size numbers")
+        return size, pose(robot, where, values)
+    if kind not in ("capsule", "cylinder"):
+        raise URDFError(robot.label, f"{where}: fromto on a {kind} is not read by robodyn")
+    placed, half = fromto_pose(robot, where, values["fromto"])
+    if not size:
+        raise URDFError(robot.label, f"{where}: a {kind} needs a radius")
+    return [size[0], half], placed
+
+
+def _write_visual(robot: MjcfRobot, values: dict[str, str], where: str, link: ET.Element, shift: np.ndarray) -> None:
+    """A geom as a URDF visual (drawings only); planes, height fields and meshes are skipped."""
+    kind = values.get("type", "sphere")
+    size = [number(robot.label, where, token) for token in split_numbers(values.get("size", ""))]
+    placed = pose(robot, where, {key: value for key, value in values.items() if key != "fromto"})
+    if "fromto" in values:
+        placed, half = fromto_pose(robot, where, values["fromto"])
+        size = [*size[:1], half]
+    shape = _shape(kind, size)
+    if shape is None:
+        return
+    visual = ET.SubElement(link, "visual")
+    write_origin(visual, shift @ placed)
+    geometry = ET.SubElement(visual, "geometry")
+    ET.SubElement(geometry, shape[0], shape[1])
+
+
+def _shape(kind: str, size: list[float]) -> tuple[str, dict[str, str]] | None:
+    """The URDF shape drawing a geom (mesh assets are drawn as nothing yet)."""
+    if kind == "box" and len(size) >= 3:
+        return "box", {"size": text(2 * np.array(size[:3]))}
+    if kind in ("sphere", "ellipsoid") and size:
+        return "sphere", {"radius": repr(max(size))}
+    if kind in ("capsule", "cylinder") and len(size) >= 2:
+        return "cylinder", {"radius": repr(size[0]), "length": repr(2 * size[1])}
+    return None
+
+
+def set_total_mass(urdf: ET.Element, total: float) -> None:
+    """Scale every mass and inertia so that they add up to ``total`` (``<compiler settotalmass>``)."""
+    inertials = urdf.findall("link/inertial")
+    current = sum(float(mass.get("value", "0")) for mass in urdf.findall("link/inertial/mass"))
+    if current <= 0:
+        return
+    for node in inertials:
+        for element in (node.find("mass"), node.find("inertia")):
+            assert element is not None  # written by this module
+            for key, value in element.attrib.items():
+                element.set(key, repr(float(value) * total / current))

@@ -1,0 +1,56 @@
+"""`robodyn simulate --ground [HEIGHT] --friction MU --contact FRAME[,...]`: a robot on the ground."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from robodyn.cli.app import main
+
+BOX = str(Path(__file__).parents[1] / "data" / "contact" / "box.urdf")
+FEET = "FL_FOOT,FR_FOOT,HL_FOOT,HR_FOOT"
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    status = main(list(argv))
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_solo12_lands_on_its_feet_and_stands_under_a_pd_hold(capsys, tmp_path):
+    out = tmp_path / "solo.csv"
+    status, text, _ = run(
+        capsys, "simulate", "solo12", "--ground", "--contact", FEET, "--controller", "pd", "--target", ",".join(["0"] * 12),
+        "--kp", "5", "--kd", "0.1", "--duration", "0.6", "--out", str(out), "--record", str(tmp_path / "solo.html"),
+    )  # fmt: skip
+    assert status == 0 and (tmp_path / "solo.html").stat().st_size > 0  # with each foot's force as an arrow
+    assert "engine: pinocchio (contact with a ground (the compiled engine models none))" in text
+    assert "integrator semi-implicit-euler" in text and "contacts active at the end: 4 of 4" in text
+    assert "final total 24.525 N" in text  # m g of solo12's 2.5 kg
+    with out.open() as stream:
+        next(stream)
+        header = next(csv.reader([next(stream)]))
+    assert "f[FL_FOOT].z" in header and "contact[HR_FOOT]" in header
+
+
+def test_a_floating_robot_without_a_ground_says_its_base_falls_freely(capsys):
+    status, text, _ = run(capsys, "simulate", BOX, "--floating-base", "--duration", "0.01", "--engine", "pinocchio")
+    assert status == 0 and "no ground: the base falls freely" in text
+
+
+@pytest.mark.parametrize(
+    ("flags", "said"),
+    [
+        (["--contact", "box"], "--contact must be given only with --ground"),
+        (["--ground", "--friction", "-1"], "--friction must be"),
+        (["--ground", "--integrator", "rk4"], "--integrator must be 'semi-implicit-euler' with a ground"),
+        (["--ground", "--compiled"], "--ground must be left out for --engine compiled"),
+        (["--ground", "--out", "x.npz"], "--out must be a .csv file for a run on the ground"),
+        (["--ground", "--contact", "nope"], "has no frame named 'nope'"),
+    ],
+)
+def test_impossible_ground_runs_are_one_stderr_line_and_exit_2(capsys, flags, said):
+    status, _, err = run(capsys, "simulate", BOX, "--floating-base", "--duration", "0.01", *flags)
+    assert status == 2 and said in err and len(err.strip().splitlines()) == 1

@@ -1,0 +1,138 @@
+"""The step against the fastest mode: a run that will diverge is warned about at its start,
+with the step that would not; a divergence inside a step is reported as a divergence."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import robodyn
+from robodyn.exceptions import RobodynWarning, SimulationError
+from robodyn.sim.control import PDGravity
+from robodyn.sim.plan import plan
+from robodyn.sim.stability import largest_stable_step, step_warning
+
+LIGHT_DAMPED = """<robot name="light_damped">
+  <link name="base"/>
+  <joint name="arm" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="10" velocity="30"/></joint>
+  <link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="finger" type="revolute"><parent link="arm"/><child link="finger"/><origin xyz="0.4 0 0"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="30"/><dynamics damping="0.01"/></joint>
+  <link name="finger"><inertial><origin xyz="0 0 0"/><mass value="1e-3"/>
+    <inertia ixx="1e-7" ixy="0" ixz="0" iyy="1e-7" iyz="0" izz="1e-7"/></inertial></link>
+</robot>"""
+
+
+def _run(robot, dt, steps, **options):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            trajectory = robodyn.simulate(
+                robot, options.pop("q0"), np.zeros(robot.nv), steps * dt, dt, limits="ignore", engine="pinocchio", **options
+            )
+        except SimulationError as error:
+            trajectory = error
+    return trajectory, [str(w.message) for w in caught if issubclass(w.category, RobodynWarning)]
+
+
+def test_stiff_gains_are_warned_about_and_the_suggested_step_holds():
+    """rp_arm under PD with kp = 1e7: the fastest mode needs dt under ~7e-4 s. At 1 ms the run
+    is warned about and diverges (a SimulationError, not an input error); at half the
+    suggested step it stays finite and nothing is said."""
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+    law = PDGravity(robot, q0 + 0.1, kp=1e7, kd=20.0)
+    limit, joint, cause = largest_stable_step(plan(robot, q0, np.zeros(2), 0.1, 1e-3, controller=law))
+    assert 1e-4 < limit < 1e-3 and cause == "the PDGravity gains" and joint == "joint1"
+    diverged, said = _run(robot, 1e-3, 100, q0=q0, controller=law)
+    assert isinstance(diverged, SimulationError) and type(diverged) is SimulationError
+    assert len(said) == 1 and f"use dt <= {limit:.2g} s" in said[0] and "PDGravity gains" in said[0]
+    calm, said = _run(robot, limit / 2, 200, q0=q0, controller=law)
+    assert not isinstance(calm, SimulationError) and np.isfinite(calm.q).all() and said == []
+
+
+def test_damping_on_a_light_link_is_warned_about_and_named():
+    """A finger of 1e-7 kg m² with damping 0.01 N m s/rad: the rate b / m = 1e5 1/s needs
+    dt under ~3e-5 s; the same robot without its damping is not warned about."""
+    robot = robodyn.load(LIGHT_DAMPED)
+    q0 = np.array([0.3, 0.2])
+    diverged, said = _run(robot, 1e-3, 50, q0=q0)
+    assert isinstance(diverged, SimulationError)
+    assert len(said) == 1 and "'finger'" in said[0] and "damping" in said[0]
+    calm, said = _run(robot, 2e-5, 100, q0=q0)
+    assert np.isfinite(calm.q).all() and said == []
+    _, said = _run(robot, 1e-3, 50, q0=q0, joint_friction=False)
+    assert said == []
+
+
+def test_a_users_controller_is_not_called_by_the_check():
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+    calls = []
+
+    def law(t, q, v):
+        calls.append(t)
+        return -v
+
+    assert step_warning(plan(robot, q0, np.zeros(2), 0.01, 1e-3, controller=law)) is None
+    assert calls == []
+    robodyn.simulate(robot, q0, np.zeros(2), 0.01, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    assert len(calls) == 4 * 10  # the four RK4 stages of each step, nothing more
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi-implicit-euler"])
+def test_the_limit_follows_the_integrators_stability_region(integrator):
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+    law = PDGravity(robot, q0, kp=1e6, kd=20.0)
+    limit, _, _ = largest_stable_step(plan(robot, q0, np.zeros(2), 0.1, 1e-3, controller=law, integrator=integrator))
+    rk4, _, _ = largest_stable_step(plan(robot, q0, np.zeros(2), 0.1, 1e-3, controller=law))
+    assert limit == pytest.approx(rk4 * (2.0 / 2.78 if integrator != "rk4" else 1.0))
+
+
+def test_an_operational_space_task_starting_at_a_singularity_is_warned_about():
+    """ur5 stretched (elbow straight): the default damping lets the task inertia blow up (the
+    run stops within 10 ms); the damping the warning suggests keeps the torques under 100 N m.
+    A bent start, and the planar RP arm's direction it never moves in, are not warned about."""
+    from robodyn.sim.operational_space import OperationalSpace
+    from robodyn.sim.stability import task_warning
+
+    robot = robodyn.load("ur5")
+    stretched = np.array([0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0])
+    law = OperationalSpace(robot, None, [0.3, 0.2, 0.4], orientation=[0.0, 0.0, 0.0])
+    said = task_warning(plan(robot, stretched, np.zeros(6), 0.01, 1e-3, controller=law))
+    assert said is not None and "singularity" in said and "OperationalSpace damping (1e-3" in said
+    stopped, _ = _run(robot, 1e-3, 200, q0=stretched, controller=law)
+    assert isinstance(stopped, SimulationError)
+    damped = OperationalSpace(robot, None, [0.3, 0.2, 0.4], orientation=[0.0, 0.0, 0.0], damping=1e-3)
+    calm, _ = _run(robot, 1e-3, 200, q0=stretched, controller=damped)
+    assert np.abs(calm.tau).max() < 100.0
+    assert task_warning(plan(robot, stretched + 0.4, np.zeros(6), 0.01, 1e-3, controller=law)) is None
+    rp_arm = robodyn.load("rp_arm")
+    planar = OperationalSpace(rp_arm, None, [0.7, 0.0, 0.7])
+    assert task_warning(plan(rp_arm, np.array([0.3, 0.1]), np.zeros(2), 0.01, 1e-3, controller=planar)) is None
+
+
+def test_a_checked_call_failing_on_a_blown_up_state_is_a_divergence_not_a_singular_mass_matrix():
+    """A law whose checked dynamics call fails on a state that blew up (here: it raises what
+    such a call raises) while M was regular: the run reports a divergence, naming the time and
+    the fastest joint, never a singular mass matrix."""
+    from robodyn.exceptions import SingularMassMatrixError
+
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+
+    def law(t, q, v):
+        if np.abs(v).max() > 50.0:
+            raise SingularMassMatrixError(robot.name, [])
+        return 1e7 * (q0 + 0.1 - q) - 20.0 * v
+
+    with pytest.raises(SimulationError) as raised, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robodyn.simulate(robot, q0, np.zeros(2), 0.1, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    assert type(raised.value) is SimulationError and "diverged" in str(raised.value)
+    assert not isinstance(raised.value, SingularMassMatrixError)
