@@ -42,6 +42,10 @@ from robodyn.exceptions import (
 from robodyn.urdf.models import RPArmParameters, rp_arm_urdf
 from robodyn.urdf.sources import robot_names
 
+# Registers the compiled kernels as the engine of robots loaded with engine="auto" when they
+# are built already (robodyn.dynamics.engines; no sympy, no Pinocchio, never a build).
+importlib.import_module("robodyn.compiled.engine")
+
 __version__ = "0.1.0"
 
 # Public name -> module that defines it (imported lazily: these modules import Pinocchio).

@@ -758,7 +758,8 @@ def _generated_c(function, folder: Path):
 
 def bench_export(quick: bool) -> list[dict]:
     """CasADi graph sizes (M + C v + G) against adam's, and forward dynamics through CasADi's
-    generated C against pin.aba (10 000 states in one mapped call, per state)."""
+    generated C against pin.aba (10 000 states in one mapped call, per state; this thread's
+    CPU time, the two alternated: wall time on a loaded machine swung the ratio 0.8-2x)."""
     import tempfile
 
     from robodyn.export import casadi_functions
@@ -773,14 +774,20 @@ def bench_export(quick: bool) -> list[dict]:
         count = 1000 if quick else 10_000
         Q = robot.random_configuration(rng, count)
         V, TAU = rng.normal(size=(2, count, robot.nv))
+        model, data = robot.model, robot.model.createData()
+        q, v, tau = Q[0], V[0], TAU[0]
         with tempfile.TemporaryDirectory() as folder:
             mapped = _generated_c(functions["forward_dynamics"], Path(folder)).map(count, "serial")
             arguments = (Q.T.copy(), V.T.copy(), TAU.T.copy())
-            casadi_s = median_once(lambda: mapped(*arguments), repeats=3 if quick else 7) / count
             error = float(np.max(np.abs(np.array(mapped(*arguments)).T - robot.forward_dynamics(Q, V, TAU))))
-        model, data = robot.model, robot.model.createData()
-        q, v, tau = Q[0], V[0], TAU[0]
-        aba_s = min(timeit.repeat(lambda: pin.aba(model, data, q, v, tau), number=2000, repeat=5)) / 2000
+            # CPU time of this thread (CasADi's serial map runs here), alternated with pin.aba
+            casadi_times, aba_times = [], []
+            for _ in range(5 if quick else 11):
+                casadi_times.append(timeit.timeit(lambda: mapped(*arguments), number=1, timer=time.thread_time) / count)
+                aba_times.append(
+                    timeit.timeit(lambda: pin.aba(model, data, q, v, tau), number=count, timer=time.thread_time) / count
+                )
+        casadi_s, aba_s = statistics.median(casadi_times), statistics.median(aba_times)
         rows.append(
             {
                 "robot": label,
@@ -789,6 +796,10 @@ def bench_export(quick: bool) -> list[dict]:
                 "ratio": None if adam is None else sum(ours) / sum(adam),
                 "fd casadi C us/state": casadi_s * 1e6,
                 "pin.aba us/call": aba_s * 1e6,
+                "fd casadi / pin.aba (CPU, alternated)": statistics.median(
+                    [c / a for c, a in zip(casadi_times, aba_times, strict=True)]
+                ),
+                "load_average": os.getloadavg()[0],
                 "fd max error vs pin": error,
             }
         )
@@ -867,6 +878,18 @@ def bench_compiled_derivatives_batch(quick: bool) -> list[dict]:
             loop = lambda: [theirs(model, data, q[i], v[i], third[i]) for i in range(count)]  # noqa: E731
             loop_s = median_once(loop, repeats=1)
             loop_cpu = median_once(loop, repeats=1, clock=time.process_time)
+            # alternated, this thread's CPU per state, one thread each (the 2-thread loop at
+            # perfect scaling against the 2-thread batch at perfect scaling): steadier under load
+            one = 4000
+            compiled.threads = 1
+            pairs_cpu = []
+            for _ in range(7):
+                ours_one = timeit.timeit(lambda: ours(q[:one], v[:one], third[:one]), number=1, timer=time.thread_time)
+                loop_one = timeit.timeit(
+                    lambda: [theirs(model, data, q[i], v[i], third[i]) for i in range(one)], number=1, timer=time.thread_time
+                )
+                pairs_cpu.append(loop_one / ours_one)
+            compiled.threads = 2
             rows.append(
                 {
                     "robot": label,
@@ -877,6 +900,8 @@ def bench_compiled_derivatives_batch(quick: bool) -> list[dict]:
                     "python_loop_states_per_s": count / loop_s,
                     "speedup_vs_2_thread_loop": loop_s / 2 / ours_s,
                     "speedup_cpu_time": loop_cpu / ours_cpu,
+                    "speedup_cpu_alternated": statistics.median(pairs_cpu),
+                    "instruction_set": compiled._derivatives().info()["instruction_set"],
                     "load_average": os.getloadavg()[0],
                 }
             )
@@ -1232,6 +1257,68 @@ def bench_compiled_floating(quick: bool) -> list[dict]:
     return rows
 
 
+def _cpu_three(functions: list[Callable[[], object]], repeats: int) -> list[list[float]]:
+    """Per-repeat CPU times (this thread's) of functions measured alternately, one list a function."""
+    number = 2000
+    times: list[list[float]] = [[] for _ in functions]
+    for _ in range(repeats):
+        for index, function in enumerate(functions):
+            times[index].append(timeit.timeit(function, number=number, timer=time.thread_time) / number)
+    return times
+
+
+def bench_robot_engine(quick: bool) -> list[dict]:
+    """``Robot``'s single calls through its compiled kernels (``engine="auto"``, kernels built)
+    and through Pinocchio (``engine="pinocchio"``, the figure before) against the raw
+    Pinocchio call, the three alternated in the same run (CPU-time medians; ratio: median of
+    the per-repeat ratios). The mimic panda's raw forward dynamics: CRBA + solve (ABA refuses
+    mimic joints). Issue 43's target: each compiled ratio < 1 (a Robot faster than raw Pinocchio)."""
+    rows = []
+    for label, name, options in (("ur5", "ur5", {}), ("panda arm", "panda", PANDA_ARM), ("panda (mimic finger)", "panda", {})):
+        robodyn.compile(robodyn.load(name, **options))
+        fast, slow = robodyn.load(name, **options), robodyn.load(name, engine="pinocchio", **options)
+        assert fast.handle.engine == "compiled" and slow.handle.engine == "pinocchio"
+        model, data = slow.model, slow.model.createData()
+        rng = np.random.default_rng(0)
+        q = slow.random_configuration(rng).copy()
+        v, a = rng.normal(size=slow.nv), rng.normal(size=slow.nv)
+        tau = slow.inverse_dynamics(q, v, a)
+        raw_fd = (
+            (lambda: pin.aba(model, data, q, v, tau))
+            if slow.mimic is None
+            else (lambda: np.linalg.solve(pin.crba(model, data, q), tau - pin.nonLinearEffects(model, data, q, v)))
+        )
+        cases = {
+            "tau vs pin.rnea": (lambda r: r.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, q, v, a)),
+            "M vs pin.crba": (lambda r: r.mass_matrix(q), lambda: pin.crba(model, data, q)),
+            "G vs pin.computeGeneralizedGravity": (lambda r: r.gravity(q), lambda: pin.computeGeneralizedGravity(model, data, q)),
+            "C v + G vs pin.nonLinearEffects": (
+                lambda r: r.nonlinear_effects(q, v),
+                lambda: pin.nonLinearEffects(model, data, q, v),
+            ),
+            "forward dynamics vs " + ("pin.aba" if slow.mimic is None else "CRBA + solve"): (
+                lambda r: r.forward_dynamics(q, v, tau),
+                raw_fd,
+            ),
+        }
+        for method, (call, raw) in cases.items():
+            compiled_t, pinocchio_t, raw_t = _cpu_three(
+                [lambda c=call: c(fast), lambda c=call: c(slow), raw], repeats=7 if quick else 21
+            )
+            rows.append(
+                {
+                    "robot": label, "call": method,
+                    "compiled_us": statistics.median(compiled_t) * 1e6,
+                    "pinocchio_engine_us": statistics.median(pinocchio_t) * 1e6,
+                    "raw_us": statistics.median(raw_t) * 1e6,
+                    "ratio_after": statistics.median([c / r for c, r in zip(compiled_t, raw_t, strict=True)]),
+                    "ratio_before": statistics.median([p / r for p, r in zip(pinocchio_t, raw_t, strict=True)]),
+                    "load_average": os.getloadavg()[0],
+                }
+            )  # fmt: skip
+    return rows
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -1256,6 +1343,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compile-scaling": bench_compile_scaling,
     "engines": bench_engines,
     "compiled-floating": bench_compiled_floating,
+    "robot-engine": bench_robot_engine,
 }
 
 

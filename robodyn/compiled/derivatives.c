@@ -4,6 +4,7 @@
  * Python entry points (METH_FASTCALL; one state 1-D, a batch 2-D with one state a row):
  *   tau_derivatives(q, v, a, threads) -> (dtau_dq, dtau_dv, M)
  *   fd_derivatives(q, v, tau, threads) -> (dqdd_dq, dqdd_dv, Minv)
+ *   info() -> {"nv", "instruction_set" (of batches: "scalar", "sse2", "avx2", "avx512"), "lanes"}
  * Each returns a tuple of three new float64 arrays (nv, nv) or (rows, nv, nv), or None when
  * an argument is not a C-contiguous native float64 array of the right shape (the caller then
  * checks and converts it), or an int status as the runtime's: 1 a non-finite input, 2 a
@@ -84,9 +85,163 @@ static int rdd_pair_fd(const double *const *in0, const double *const *in1, doubl
 }
 #endif
 
+/* L rows at once (a batch): derivatives.py's rdd<L>_tau_derivatives, one per instruction set
+ * built (RDD_BLOCKS(X) lists them as X(type, L, name, GCC target, target attribute)), the rest
+ * of each row (its checks, M, the forward dynamics' factorisation and solves) as the single
+ * call does it. A block's status is the worst of its rows'; a failing block's rows are done
+ * again one by one (their exact statuses). RDD_BLOCKS's entries: X(type, L, name, GCC target,
+ * target attribute, the SIMD dynamics' vector prefix, the exit's vzeroupper). */
+typedef int (*rdd_block)(const double *const *in, double *const *out);
+
+/* rd_finite's answer on a block's outputs, without a branch an entry: x * 0 is ±0 for a
+ * finite x and NaN otherwise (four sums: no one chain of dependent additions). */
+static inline int rdd_finite(const double *x, int n) {
+    double z0 = 0.0, z1 = 0.0, z2 = 0.0, z3 = 0.0;
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        z0 += x[i] * 0.0;
+        z1 += x[i + 1] * 0.0;
+        z2 += x[i + 2] * 0.0;
+        z3 += x[i + 3] * 0.0;
+    }
+    for (; i < n; ++i) z0 += x[i] * 0.0;
+    return (z0 + z1) + (z2 + z3) == 0.0;
+}
+typedef struct {
+    const char *name;
+    int lanes;
+    rdd_block tau, fd;
+} rdd_variant;
+
+/* The forward dynamics' part of a block around the derivatives: with the robot's SIMD
+ * dynamics in the module (RD_SIMD: simd.py's rds<L>_mass_nle and tree LDLᵀ on vectors, the
+ * same operations as the scalar ones in the same order), on L lanes at once; else row by row. */
+#ifdef RD_SIMD
+/* M of L rows (q: L rows of RD_NV, M: L rows of RD_NV²) by the SIMD dynamics' mass kernel. */
+#define RDD_MASS(L, S, rows_q, rows_M)                                                                    \
+    do {                                                                                                 \
+        S q_[RD_NV], M_[RD_NV * RD_NV];                                                                  \
+        S##_load(rows_q, RD_NV, q_);                                                                     \
+        S##_mass(q_, M_);                                                                                \
+        S##_store(M_, RD_NV * RD_NV, rows_M);                                                            \
+    } while (0)
+#define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
+    static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
+        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
+        S q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], h[RD_NV], X[RD_NV * RD_NV];                   \
+        double acc[L * RD_NV];                                                                           \
+        S##_load(in[0], RD_NV, q);                                                                       \
+        S##_load(in[1], RD_NV, v);                                                                       \
+        S##_load(in[2], RD_NV, tau);                                                                     \
+        if (S##_bad(q, RD_NV) || S##_bad(v, RD_NV) || S##_bad(tau, RD_NV)) return 1;                    \
+        S##_mass_nle(q, v, M, h);                                                                        \
+        for (int i = 0; i < RD_NV; ++i) h[i] = tau[i] - h[i];                                            \
+        if (S##_ldl_factor(M)) return 3;                                                                 \
+        S##_ldl_apply(M, h);                                                                             \
+        S##_store(h, RD_NV, acc);                                                                        \
+        const double *qs[L], *vs[L], *as[L];                                                             \
+        double *dq[L], *dv[L];                                                                           \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            qs[l] = in[0] + l * n, vs[l] = in[1] + l * n, as[l] = acc + l * n;                           \
+            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
+        }                                                                                                \
+        T##_tau_derivatives(qs, vs, as, dq, dv);                                                         \
+        for (int k = 0; k < 3; ++k) {                                                                    \
+            if (k < 2) S##_load(out[k], RD_NV * RD_NV, X);                                               \
+            else                                                                                         \
+                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = S##_splat((i % (RD_NV + 1)) == 0 ? 1.0 : 0.0); \
+            S##_ldl_apply_columns(M, X, RD_NV);                                                          \
+            if (k < 2)                                                                                   \
+                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = -X[i];                                    \
+            if (S##_bad(X, RD_NV * RD_NV)) return 3;                                                     \
+            S##_store(X, RD_NV * RD_NV, out[k]);                                                         \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }
+#else
+#define RDD_MASS(L, S, rows_q, rows_M)                                                                    \
+    for (int l = 0; l < L; ++l) rd_mass((rows_q) + l * RD_NV, (rows_M) + l * RD_NV * RD_NV)
+#define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
+    static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
+        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
+        double M[L][RD_NV * RD_NV], acc[L][RD_NV];                                                       \
+        const double *q[L], *v[L], *a[L];                                                                \
+        double *dq[L], *dv[L];                                                                           \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            const double *row[3] = {in[0] + l * n, in[1] + l * n, in[2] + l * n};                        \
+            const int status = rdd_fd_start(row, M[l], acc[l]);                                          \
+            if (status) return status;                                                                   \
+            q[l] = row[0], v[l] = row[1], a[l] = acc[l];                                                 \
+            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
+        }                                                                                                \
+        T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        int worst = 0;                                                                                   \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            double *const row[3] = {out[0] + l * size, out[1] + l * size, out[2] + l * size};            \
+            const int status = rdd_fd_finish(M[l], row);                                                 \
+            if (status > worst) worst = status;                                                          \
+        }                                                                                                \
+        return worst;                                                                                    \
+    }
+#endif
+
+#define RDD_BLOCK_DEFINE(T, L, NAME, TARGET, ATTR, S, VZEROUPPER)                                         \
+    static ATTR int T##_tau_inner(const double *const *in, double *const *out) {                         \
+        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
+        const double *q[L], *v[L], *a[L];                                                                \
+        double *dq[L], *dv[L];                                                                           \
+        for (int l = 0; l < L; ++l) {                                                                    \
+            q[l] = in[0] + l * n, v[l] = in[1] + l * n, a[l] = in[2] + l * n;                            \
+            if (!rd_finite(q[l], RD_NV) || !rd_finite(v[l], RD_NV) || !rd_finite(a[l], RD_NV)) return 1; \
+            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
+        }                                                                                                \
+        T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        RDD_MASS(L, S, in[0], out[2]);                                                                   \
+        for (int l = 0; l < L; ++l)                                                                      \
+            for (int k = 0; k < 3; ++k)                                                                  \
+                if (!rdd_finite(out[k] + l * size, RD_NV * RD_NV)) return 2;                             \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    RDD_FD_BLOCK(T, L, S, ATTR)                                                                          \
+    /* each clears the vector registers' upper halves on its way out (see simd.c) */                     \
+    static ATTR int T##_block_tau(const double *const *in, double *const *out) {                         \
+        const int status = T##_tau_inner(in, out);                                                       \
+        VZEROUPPER                                                                                       \
+        return status;                                                                                   \
+    }                                                                                                    \
+    static ATTR int T##_block_fd(const double *const *in, double *const *out) {                          \
+        const int status = T##_fd_inner(in, out);                                                        \
+        VZEROUPPER                                                                                       \
+        return status;                                                                                   \
+    }                                                                                                    \
+    static const rdd_variant T##_variant = {NAME, L, T##_block_tau, T##_block_fd};
+
+#define RDD_CHOOSE(T, L, NAME, TARGET, ATTR, S, VZEROUPPER) \
+    if (!chosen && __builtin_cpu_supports(TARGET)) chosen = &T##_variant;
+
+RDD_BLOCKS(RDD_BLOCK_DEFINE)
+
+/* The widest variant built that this CPU runs (chosen once), or NULL: rows and pairs. */
+static const rdd_variant *rdd_current(void) {
+    static int chosen_yet = 0;
+    static const rdd_variant *current = NULL;
+    if (!chosen_yet) {
+        const rdd_variant *chosen = NULL;
+#if defined(__x86_64__) && defined(__GNUC__)
+        __builtin_cpu_init();
+        RDD_BLOCKS(RDD_CHOOSE)
+#endif
+        current = chosen;
+        chosen_yet = 1;
+    }
+    return current;
+}
+
 typedef struct {
     rdd_row row;
     rdd_pair pair; /* NULL: one row at a time */
+    rdd_block block; /* NULL: no blocks of lanes rows */
+    int lanes;
     const double *in[3];
     double *out[3];
 } rdd_job;
@@ -100,7 +255,19 @@ static int rdd_rows(const void *work, Py_ssize_t begin, Py_ssize_t end) {
         const double *in[3] = {job->in[0] + r * RD_NV, job->in[1] + r * RD_NV, job->in[2] + r * RD_NV};
         double *out[3] = {job->out[0] + r * size, job->out[1] + r * size, job->out[2] + r * size};
         int status;
-        if (job->pair && r + 1 < end) {
+        if (job->block && r + job->lanes <= end) {
+            status = job->block(in, out);
+            if (status) { /* its rows again one by one: their exact statuses */
+                status = 0;
+                for (int l = 0; l < job->lanes; ++l) {
+                    const double *row_in[3] = {in[0] + l * RD_NV, in[1] + l * RD_NV, in[2] + l * RD_NV};
+                    double *row_out[3] = {out[0] + l * size, out[1] + l * size, out[2] + l * size};
+                    const int row_status = job->row(row_in, row_out);
+                    if (row_status > status) status = row_status;
+                }
+            }
+            r += job->lanes;
+        } else if (job->pair && r + 1 < end) {
             const double *in1[3] = {in[0] + RD_NV, in[1] + RD_NV, in[2] + RD_NV};
             double *out1[3] = {out[0] + size, out[1] + size, out[2] + size};
             status = job->pair(in, in1, out, out1);
@@ -128,7 +295,12 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
     npy_intp dims[3] = {rows, RD_NV, RD_NV};
     PyObject *result = PyTuple_New(3);
     if (!result) return NULL;
-    rdd_job job = {row, pair, {0, 0, 0}, {0, 0, 0}};
+    const rdd_variant *variant = ndim == 2 ? rdd_current() : NULL;
+    rdd_job job = {row, pair, NULL, 1, {0, 0, 0}, {0, 0, 0}};
+    if (variant) {
+        job.block = row == rdd_row_tau ? variant->tau : variant->fd;
+        job.lanes = variant->lanes;
+    }
     for (int k = 0; k < 3; ++k) {
         PyObject *out = PyArray_SimpleNew(ndim + 1, ndim == 2 ? dims : dims + 1, NPY_DOUBLE);
         if (!out) {
@@ -144,7 +316,7 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         status = row(job.in, job.out);
     } else {
         Py_BEGIN_ALLOW_THREADS
-        status = rd_parallel(rdd_rows, &job, rows, 1, threads);
+        status = rd_parallel(rdd_rows, &job, rows, job.lanes, threads);
         Py_END_ALLOW_THREADS
     }
     if (status) {
@@ -164,7 +336,11 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
 static PyObject *py_tau_derivatives(PyObject *m, PyObject *const *a, Py_ssize_t n) { return rdd_entry(a, n, rdd_row_tau, RDD_PAIR_TAU); }
 static PyObject *py_fd_derivatives(PyObject *m, PyObject *const *a, Py_ssize_t n) { return rdd_entry(a, n, rdd_row_fd, RDD_PAIR_FD); }
 
-static PyObject *py_derivative_info(PyObject *m, PyObject *unused) { return Py_BuildValue("{s:i}", "nv", RD_NV); }
+static PyObject *py_derivative_info(PyObject *m, PyObject *unused) {
+    const rdd_variant *variant = rdd_current();
+    return Py_BuildValue("{s:i,s:s,s:i}", "nv", RD_NV, "instruction_set", variant ? variant->name : "scalar", "lanes",
+                         variant ? variant->lanes : (RDD_PAIRS ? 2 : 1));
+}
 
 static PyMethodDef rdd_methods[] = {
     {"tau_derivatives", (PyCFunction)(void (*)(void))py_tau_derivatives, METH_FASTCALL, "tau_derivatives(q, v, a, threads)"},

@@ -16,25 +16,28 @@ The forward dynamics' derivatives follow: ``q̈ = FD(q, v, τ)`` (the LDLᵀ of 
 ``∂q̈/∂x = −M⁻¹ ∂τ/∂x`` at ``a = q̈`` and ``∂q̈/∂τ = M⁻¹``, the three solved with the one
 factorisation (``derivatives.c``).
 
-The kernels make a module of their own, built the first time a derivative is asked for
-(:func:`derivative_module`) and cached like the robot's (:mod:`robodyn.compiled.build`):
-the dynamics compile no slower for them (the derivative build costs about as much CPU as the
-robot's ``tau`` program: 1 s for ur5, 3 s for the panda arm, plus the C compiler). The
-generated functions::
+The kernels make a module of their own, built on the first derivative asked for
+(:func:`derivative_module`) and cached like the robot's (:mod:`robodyn.compiled.build`;
+about as much CPU as the robot's ``tau`` program, plus the C compiler). The functions::
 
     static void rdd_tau_derivatives(const double *q, const double *v, const double *a,
                                     double *dq, double *dv);   /* (nv, nv) row-major each */
-    static void rdd_tau_derivatives2(...);  /* two states at once, one a SIMD lane */
+    static void rdd_tau_derivatives2(...);  /* 2 states, SSE2; rdd8_...: 8 states, AVX-512 */
 
-A batch goes two rows at a time through ``rdd_tau_derivatives2`` (GCC/Clang vector
-extension, two doubles a lane pair: the same IEEE operations in the same order, so each row is
-bit-identical to a single call); ``cos``/``sin`` are called lane by lane.
+A batch goes ``L`` rows at a time through the variant of the instruction set the build chose
+(:func:`robodyn.compiled.simd.build_variants`, as the dynamics' SIMD blocks: the widest the
+CPU runs, or ``$ROBODYN_SIMD``; 2, 4 or 8 lanes, compiled with that ``target`` attribute and
+chosen at run time with ``__builtin_cpu_supports``), else two at a time
+(``rdd_tau_derivatives2``, plain SSE2), on the runtime's thread pool. Each is a GCC/Clang
+vector extension of the same statements: the same IEEE operations in the same order (no
+FMA: contraction is off), so each row is bit-identical to a single call; ``cos``/``sin``
+are the kernels' own (``trig.c``: ``rd_sin`` in the single call, its vector form in the
+blocks, as the dynamics' SIMD blocks; libm's, lane by lane, were 19 % of a block's time).
 
-Why forward mode through the program and not the analytical recursions (Carpentier and
-Mansard 2018) in C: the program is already exact for every robot the compiled engine takes
-(mimic joints, oblique axes, prismatic joints), its constants are folded and its structural
-zeros known, so the generated code is straight-line arithmetic without spatial-algebra
-loops (``make bench``, sections ``compiled-derivatives-*``, has the numbers).
+Why forward mode through the program, not the analytical recursions (Carpentier and Mansard
+2018): the program is exact for every robot the compiled engine takes (mimic joints, oblique
+axes, prismatic joints), constants folded, structural zeros known: straight-line arithmetic
+(its cost: ~10 000 operations a panda-arm state; ``make bench``, ``compiled-derivatives-*``).
 """
 
 from __future__ import annotations
@@ -48,7 +51,7 @@ from typing import cast
 import numpy as np
 import sympy as sp
 
-from robodyn.compiled import build
+from robodyn.compiled import build, simd
 from robodyn.compiled.cache import robot_key
 from robodyn.compiled.programs import dynamics_programs, robot_bodies
 from robodyn.dynamics.robot import Robot
@@ -58,6 +61,8 @@ from robodyn.exceptions import CompileError, NonFiniteResultError, SingularMassM
 
 _RUNTIME = Path(__file__).with_name("derivatives.c")
 
+#: A scalar call left in a vector statement (the vector forms take none).
+_SCALAR_CALL = re.compile(r"(?<!\w)(?:rd_)?(?:cos|sin|pow)\(")
 #: A value in the generated code: ``coefficient * name`` (``name`` None: the constant).
 Term = tuple[float, str | None]
 
@@ -101,8 +106,11 @@ class TangentWriter:
         offset: Shape (n_bodies,).
     """
 
-    def __init__(self, program: Program, selection: np.ndarray, offset: np.ndarray):
+    def __init__(
+        self, program: Program, selection: np.ndarray, offset: np.ndarray, variants: Sequence[tuple[str, int, str]] = ()
+    ):
         self.program = program
+        self.variants = tuple(variants)
         self.selection = np.asarray(selection, float)
         self.offset = np.asarray(offset, float)
         self.bodies, self.nv = self.selection.shape
@@ -110,7 +118,7 @@ class TangentWriter:
         inputs = (program.inputs["q"], program.inputs["qd"], program.inputs["qdd"])
         for symbols, local in zip(inputs, ("th", "thd", "thdd"), strict=True):
             self.names.update({symbol: f"{local}{b}" for b, symbol in enumerate(symbols)})
-        self.printer = CPrinter(self.names)
+        self.printer = CPrinter(self.names, trig="rd_")  # the kernels' own sin and cos (trig.c)
         # Each quantity's derivatives: direction -> coefficient * name (or a constant).
         self.tangents: dict[sp.Symbol, dict[int, Term]] = {}
         for b in range(self.bodies):
@@ -220,14 +228,14 @@ class TangentWriter:
             "}",
             "",
         ]
-        return "\n".join(scalar + self._pairs(used, results))
+        return "\n".join(scalar + self._pairs(used, results) + self._blocks(used, results))
 
     def _pairs(self, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
         """``rdd_tau_derivatives2``: the same statements on two states, one a SIMD lane
         (GCC/Clang vector extension; the same IEEE operations, so bit-identical results)."""
-        pattern = re.compile(r"= (cos|sin)\((\w+)\);$")
+        pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
         body = [pattern.sub(r"= rdd_\1_2(\2);", line).replace("const double ", "const rdd_v2 ") for line in self.lines]
-        if any(call in line for line in body for call in ("cos(", "sin(", "pow(")):
+        if any(_SCALAR_CALL.search(line) for line in body):
             return ["#define RDD_PAIRS 0", ""]
         lanes = zip(self._coordinates(used, "0"), self._coordinates(used, "1"), strict=True)
         head = [
@@ -243,8 +251,8 @@ class TangentWriter:
         return [
             "#define RDD_PAIRS 1",
             "typedef double rdd_v2 __attribute__((vector_size(16)));",
-            "static inline rdd_v2 rdd_cos_2(rdd_v2 x) { const rdd_v2 r = {cos(x[0]), cos(x[1])}; return r; }",
-            "static inline rdd_v2 rdd_sin_2(rdd_v2 x) { const rdd_v2 r = {sin(x[0]), sin(x[1])}; return r; }",
+            "static inline rdd_v2 rdd_cos_2(rdd_v2 x) { const rdd_v2 r = {rd_cos(x[0]), rd_cos(x[1])}; return r; }",
+            "static inline rdd_v2 rdd_sin_2(rdd_v2 x) { const rdd_v2 r = {rd_sin(x[0]), rd_sin(x[1])}; return r; }",
             "static void rdd_tau_derivatives2(const double *q0, const double *v0, const double *a0, const double *q1,",
             "                                 const double *v1, const double *a1, double *dq0, double *dv0, double *dq1, double *dv1) {",
             *head,
@@ -253,6 +261,66 @@ class TangentWriter:
             "}",
             "",
         ]
+
+    def _blocks(self, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
+        """``rdd<L>_tau_derivatives``: the same statements on ``L`` states at once, one a lane
+        of a vector of the instruction set of each of :attr:`variants` (``(name, L, GCC
+        target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
+        with its ``target`` attribute; ``cos``/``sin`` the SIMD dynamics' (``rds<L>_sin``: the
+        single call's ``rd_sin`` on every lane). ``RDD_BLOCKS`` names the variants for
+        ``derivatives.c``'s blocks and dispatch."""
+        pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
+        out: list[str] = []
+        names: list[str] = []
+        for name, lanes, target in self.variants:
+            vector, attribute = f"rdd{lanes}", f'__attribute__((target("{target}")))'
+            body = [pattern.sub(rf"= {vector}_\1(\2);", line).replace("const double ", f"const {vector} ") for line in self.lines]
+            if any(_SCALAR_CALL.search(line) for line in body):
+                return ["#define RDD_BLOCKS(X)", ""]
+            lane_values = [self._coordinates(used, str(lane)) for lane in range(lanes)]
+            head = []
+            for i, first in enumerate(lane_values[0]):
+                values = ", ".join(lane_values[lane][i].split(" = ", 1)[1][:-1] for lane in range(lanes))
+                head.append(f"    const {vector} {first.split(' = ')[0].split()[-1]} = {{{values}}};")
+            tail = []
+            for array, index, value in results:
+                try:  # a constant: the same in every lane
+                    constant = c_number(float(value))
+                    tail.append("    " + " = ".join(f"{array}{lane}[{index}]" for lane in range(lanes)) + f" = {constant};")
+                except ValueError:
+                    stores = " ".join(f"{array}{lane}[{index}] = o[{lane}];" for lane in range(lanes))
+                    tail.append(f"    {{ const {vector} o = {value}; {stores} }}")
+            pointers = [
+                f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];"
+                f" double *dq{lane} = dq[{lane}], *dv{lane} = dv[{lane}];"
+                for lane in range(lanes)
+            ]
+            inline = f"static inline __attribute__((always_inline)) {attribute}"
+            lane_loop = f"{vector} r; for (int l = 0; l < {lanes}; ++l) r[l] ="
+            out += [
+                f"typedef double {vector} __attribute__((vector_size({8 * lanes})));",
+                "#ifdef RD_SIMD",  # the SIMD dynamics' sin and cos on vectors: rd_sin's operations on every lane
+                f"{inline} {vector} {vector}_cos({vector} x) {{ return rds{lanes}_cos(x); }}",
+                f"{inline} {vector} {vector}_sin({vector} x) {{ return rds{lanes}_sin(x); }}",
+                "#else",
+                f"{inline} {vector} {vector}_cos({vector} x) {{ {lane_loop} rd_cos(x[l]); return r; }}",
+                f"{inline} {vector} {vector}_sin({vector} x) {{ {lane_loop} rd_sin(x[l]); return r; }}",
+                "#endif",
+                f"static {attribute} void {vector}_tau_derivatives(const double *const *q, const double *const *v,",
+                "        const double *const *a, double *const *dq, double *const *dv) {",
+                *pointers,
+                *head,
+                *body,
+                *tail,
+                "}",
+                "",
+            ]
+            vzeroupper = "__builtin_ia32_vzeroupper();" if lanes > 2 else ""
+            names.append(f'X({vector}, {lanes}, "{name}", "{target}", {attribute}, rds{lanes}, {vzeroupper})')
+        if not out:
+            return ["#define RDD_BLOCKS(X)", ""]
+        guard = "#if defined(__x86_64__) && defined(__GNUC__)"
+        return [guard, *out, f"#define RDD_BLOCKS(X) {' '.join(names)}", "#else", "#define RDD_BLOCKS(X)", "#endif", ""]
 
     def _outputs(self, outputs: Sequence[sp.Symbol]) -> list[tuple[str, int, str]]:
         """``(array, index, C value)`` of every entry of ``dq`` and ``dv``: ``Sᵀ`` times the
@@ -289,16 +357,18 @@ def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType
     Raises:
         CompileError: If the build fails or the module does not match the robot.
     """
-    own = "derivatives-" + robot_key(robot)
+    variants = simd.build_variants()
+    own = "derivatives-" + robot_key(robot) + "-simd=" + " ".join(name for name, _, _ in variants)
 
     def source() -> str:
         derivative = build.cached_kernels(own)
         if derivative is None:
             bodies = robot_bodies(robot)
-            derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset).source()
+            derivative = TangentWriter(dynamics_programs(robot).tau, bodies.selection, bodies.offset, variants).source()
             build.store_kernels(own, derivative)
         runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
-        return kernels() + "\n" + derivative + "\n" + runtime
+        robot_kernels = kernels()  # and their SIMD variants: the forward dynamics' part of a block
+        return robot_kernels + "\n" + simd.vector_source(robot_kernels, variants) + derivative + "\n" + runtime
 
     module = build.keyed_extension(own, source, init="rdd_module", label=robot.name)
     if module.info()["nv"] != robot.nv:

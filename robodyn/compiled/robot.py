@@ -92,7 +92,9 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     source), without generating any source: from this process's memory (about 10 µs), else
     the cache folder (milliseconds, no sympy imported); only a robot never compiled is
     derived (seconds) and built. ``robot.model`` is read-only to the compiled robot (see
-    :class:`CompiledRobot`).
+    :class:`CompiledRobot`). ``robot`` itself is left as it is (it may be the Pinocchio
+    reference a caller compares with); robots loaded afterwards with ``engine="auto"`` (the
+    default) answer their single calls with these kernels (:mod:`robodyn.compiled.engine`).
 
     Args:
         robot: From :func:`robodyn.load` (mimic joints and a floating base are fine).

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from types import ModuleType
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -23,6 +24,7 @@ import pinocchio as pin
 
 from robodyn.common.inputs import as_states
 from robodyn.dynamics.batch import ParallelRunner, PerThreadData
+from robodyn.dynamics.engines import compiled_calls
 from robodyn.dynamics.kernels import Kernel, dynamics_kernels
 from robodyn.dynamics.mimic import MimicExpansion
 from robodyn.exceptions import InputError, NonFiniteResultError
@@ -53,6 +55,8 @@ class ModelHandle:
         frames: Pinocchio index of every frame, by name.
         parallel: Runs Pinocchio's parallel algorithms on batches.
         kernels: The equations of motion as Pinocchio calls (:mod:`robodyn.dynamics.kernels`).
+        calls: The single calls :class:`robodyn.Robot` makes (:class:`SingleCalls`):
+            Pinocchio's, or the compiled kernels' (:meth:`accelerate`).
     """
 
     def __init__(
@@ -82,6 +86,20 @@ class ModelHandle:
             G=self.single_call(kernels.G, pin.computeGeneralizedGravity),
             nle=self.single_call(kernels.nle, pin.nonLinearEffects),
         )
+        #: Pinocchio's single calls (what :attr:`calls` are until :meth:`accelerate`).
+        self.pinocchio_calls = self.calls
+        #: The engine of :attr:`calls`: ``"pinocchio"``, or ``"compiled"`` after :meth:`accelerate`.
+        self.engine = "pinocchio"
+
+    def accelerate(self, module: ModuleType) -> None:
+        """Answer the single calls (and their batches) with a robot's compiled kernels,
+        falling back to Pinocchio's calls for anything the kernels refuse (so errors stay
+        the same): see :mod:`robodyn.dynamics.engines`. The model is then read-only (the
+        kernels are built from the robot's URDF text and load options, not from it)."""
+        self.calls = SingleCalls(
+            *compiled_calls(module, self.pinocchio_calls, self.kernels, self.validate, self.parallel.threads)
+        )
+        self.engine = "compiled"
 
     @property
     def data(self) -> pin.Data:

@@ -35,7 +35,7 @@ import pinocchio as pin
 
 from robodyn.common.text import printable
 from robodyn.constraints import check_frames, equality_notes, from_equalities
-from robodyn.dynamics import pickling
+from robodyn.dynamics import engines, pickling
 from robodyn.dynamics.joint_dynamics import apply_joint_dynamics
 from robodyn.dynamics.mimic import has_mimic, mimic_expansion
 from robodyn.dynamics.options import MAX_DOF, LoadOptions, load_options
@@ -79,6 +79,7 @@ def load(
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
     xacro_env: bool = False,
+    engine: str | None = None,
 ) -> Robot:
     """Load a robot.
 
@@ -117,6 +118,12 @@ def load(
         xacro_env: Let a xacro source read environment variables (``$(env NAME)``,
             ``$(optenv NAME)``); without it they are refused. See docs/robot-files.md for
             everything a xacro may do.
+        engine: ``"auto"`` (default; ``$ROBODYN_ENGINE`` may set another): the single
+            calls (``tau``, ``M``, ``G``, ``C v + G``, forward dynamics) go through the robot's compiled kernels when they are built
+            already (``robodyn.compile`` once, in any process: the cache), never building
+            them, else through Pinocchio; the same checks, errors and numbers (to 1e-13),
+            and ``robot.model`` is then read-only. ``"pinocchio"``: always Pinocchio (what
+            a reference to compare compiled code with needs). See docs/compiled.md.
 
     Returns:
         The robot.
@@ -125,8 +132,9 @@ def load(
         UnknownRobotError: If the name is not a file or known robot.
         URDFError: If the URDF cannot be read, describes an impossible robot or is too
             large for the limits above.
-        InputError: If ``gravity`` is not 3 finite numbers or ``lock`` not numbers, or a
-            constraint names a link the robot does not have (listing its links).
+        InputError: If ``gravity`` is not 3 finite numbers or ``lock`` not numbers, a
+            constraint names a link the robot does not have (listing its links), or
+            ``engine`` is not ``"auto"`` or ``"pinocchio"``.
 
     Warns:
         RobodynWarning: For what ``strict=True`` refuses.
@@ -159,6 +167,7 @@ def load(
         armature=armature,
         constraints=constraints,
         xacro_env=xacro_env,
+        engine=engine,
     )
     return build_robot(resolved, options)
 
@@ -268,7 +277,9 @@ def build_robot(resolved: URDFSource, options: LoadOptions) -> Robot:
     spec = apply_joint_dynamics(spec, model, mimic, options, resolved.label)
     name = spec.name if resolved.name == "robot" else resolved.name
     check_frames((*from_equalities(resolved.equalities), *options.constraints), list(spec.links), name)
-    return Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
+    robot = Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
+    engines.attach(robot)  # engine="auto": its compiled kernels, if they are built
+    return robot
 
 
 def _check_size(spec: URDFSpec, label: str, floating: bool, max_dof: int) -> None:

@@ -16,6 +16,7 @@ from robodyn.common.constants import STANDARD_GRAVITY
 from robodyn.common.inputs import as_state
 from robodyn.common.text import quoted
 from robodyn.constraints import Constraint, as_constraints
+from robodyn.dynamics.engines import check_engine
 from robodyn.exceptions import InputError
 from robodyn.urdf.sources import max_urdf_bytes
 
@@ -54,6 +55,9 @@ class LoadOptions:
             those its file declares.
         xacro_env: Whether a xacro source could read environment variables (the source
             carries the expanded text).
+        engine: Who answers the single calls (:mod:`robodyn.dynamics.engines`): ``"auto"``
+            the robot's compiled kernels when they are built already (never building them),
+            else Pinocchio; ``"pinocchio"`` always Pinocchio.
     """
 
     floating_base: bool
@@ -69,6 +73,7 @@ class LoadOptions:
     armature: tuple[tuple[str, float], ...] = ()
     constraints: tuple[Constraint, ...] = ()
     xacro_env: bool = False
+    engine: str = "auto"
 
 
 def load_options(
@@ -86,13 +91,15 @@ def load_options(
     armature: Mapping[str, float] | None = None,
     constraints: object = None,
     xacro_env: bool = False,
+    engine: str | None = None,
 ) -> LoadOptions:
     """The options :func:`robodyn.load` was given, with the defaults filled in.
 
     Arguments as for :func:`robodyn.load` (``floating_base`` already decided).
 
     Raises:
-        InputError: If ``gravity`` is not 3 finite numbers, or ``constraints`` not constraints.
+        InputError: If ``gravity`` is not 3 finite numbers, ``constraints`` not constraints,
+            or ``engine`` not one of :data:`robodyn.dynamics.engines.ENGINES`.
     """
     vector = STANDARD_GRAVITY if gravity is None else tuple(float(g) for g in as_state(gravity, "gravity", 3))
     return LoadOptions(
@@ -109,6 +116,7 @@ def load_options(
         armature=tuple((str(name), _armature(name, value)) for name, value in (armature or {}).items()),
         constraints=as_constraints(constraints),
         xacro_env=bool(xacro_env),
+        engine=check_engine(engine),
     )
 
 

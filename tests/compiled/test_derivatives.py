@@ -117,6 +117,37 @@ def test_batch_rows_are_bit_identical_to_single_calls(mimic_tree, rng):
             assert all(np.array_equal(b[row], s) for b, s in zip(batch, single, strict=True))
 
 
+def _runs(instruction_set: str) -> bool:
+    from robodyn.compiled.simd import VARIANTS, _cpu_flags
+
+    flags = _cpu_flags() or frozenset()
+    return any(name == instruction_set and target in flags for name, _, target in VARIANTS)
+
+
+@pytest.mark.parametrize(("instruction_set", "lanes"), [("sse2", 2), ("avx2", 4), ("avx512", 8)])
+def test_batches_run_simd_blocks_whose_rows_are_bit_for_bit_the_single_call(instruction_set, lanes, monkeypatch, rng):
+    """Each instruction set's blocks of L rows (the derivative module built for it, as
+    ``$ROBODYN_SIMD`` picks): every row of batches of 1, 7, 2L - 1, 2L + 1 and 129 states (two
+    threads, remainder rows through the pairs and the scalar call) equals its single call, and
+    matches Pinocchio. The module says which blocks ran (negative control: not the pairs)."""
+    if not _runs(instruction_set):
+        pytest.skip(f"this CPU does not run {instruction_set}")
+    monkeypatch.setenv("ROBODYN_SIMD", instruction_set)
+    path, options = NONDEGENERATE_CASES["mimic_tree"]
+    robot, compiled = _pair(path, **options, gravity=GRAVITY)
+    module = compiled._derivatives()
+    assert (module.info()["instruction_set"], module.info()["lanes"]) == (instruction_set, lanes)
+    for count in sorted({1, 7, 2 * lanes - 1, 2 * lanes + 1, 129}):
+        q, v, a, tau = states(robot, rng, count)
+        for method, third in ((compiled.inverse_dynamics_derivatives, a), (compiled.forward_dynamics_derivatives, tau)):
+            batch = method(q, v, third)
+            for row in range(count):
+                single = method(q[row], v[row], third[row])
+                assert all(np.array_equal(b[row], s) for b, s in zip(batch, single, strict=True)), (count, row)
+        if count == 129:
+            compare_with_pinocchio(robot, compiled, q, v, a, tau)
+
+
 def test_identities_dtau_da_is_m_and_dqdd_dtau_inverts_it(mimic_tree, rng):
     robot, compiled = mimic_tree
     q, v, a, tau = states(robot, rng, 7)

@@ -1,7 +1,9 @@
 """The thin single calls (ModelHandle.single_call): Pinocchio's numbers, every bad entry refused, thread-safe.
 
 The fast path checks only the result (and, for M, the world-attached joints' q): a NaN or
-inf anywhere in q, v, a or tau must still come back as an InputError naming it.
+inf anywhere in q, v, a or tau must still come back as an InputError naming it. The robots
+here are loaded with ``engine="pinocchio"`` (their compiled kernels, if built, would answer
+otherwise: tests/compiled/test_engine.py).
 """
 
 from __future__ import annotations
@@ -22,10 +24,10 @@ FIXED = [*FAST_ZOO, "panda_mimic", "gripper", "rp_arm", "oblique", "oblique_lock
 def _load(name):
     if name in NONDEGENERATE_CASES:
         path, options = NONDEGENERATE_CASES[name]
-        return robodyn.load(str(path), **options)
+        return robodyn.load(str(path), **options, engine="pinocchio")
     if name == "panda_mimic":  # as loaded: a mimic finger
-        return robodyn.load("panda")
-    return robodyn.load(name, **({"lock": {"panda_finger_joint1": 0.0}} if name == "panda" else {}))
+        return robodyn.load("panda", engine="pinocchio")
+    return robodyn.load(name, engine="pinocchio", **({"lock": {"panda_finger_joint1": 0.0}} if name == "panda" else {}))
 
 
 def _calls(robot, q, v, a):
@@ -59,7 +61,7 @@ def test_a_nan_or_inf_in_any_entry_is_refused_by_every_single_call(name, rng):
 def test_crba_ignores_the_root_joints_q_so_the_mass_matrix_checks_it():
     """Negative control: raw CRBA returns a finite M for a NaN root q (what checking the
     result alone would let through); the single call refuses it."""
-    robot = robodyn.load("ur5")
+    robot = robodyn.load("ur5", engine="pinocchio")
     q = robot.neutral_configuration()
     q[0] = np.nan
     assert np.isfinite(pin.crba(robot.model, robot.model.createData(), q)).all()
@@ -82,7 +84,7 @@ def test_single_calls_are_pinocchios_numbers(name, rng):
 
 
 def test_one_robot_used_from_several_threads_gives_each_its_own_results(rng):
-    robot = robodyn.load("ur5")
+    robot = robodyn.load("ur5", engine="pinocchio")
     states = [(robot.random_configuration(rng), rng.normal(size=6), rng.normal(size=6)) for _ in range(7)]
     expected = [(robot.inverse_dynamics(*s), robot.mass_matrix(s[0]), robot.forward_dynamics(*s)) for s in states]
     failures = []
@@ -109,7 +111,7 @@ def test_pinocchios_python_crba_returns_both_triangles_which_the_mass_matrix_rel
     reference's M (independent of Pinocchio)."""
     from robodyn.reference import load as load_reference
 
-    robot = robodyn.load("ur5")
+    robot = robodyn.load("ur5", engine="pinocchio")
     q = robot.random_configuration(rng)
     mass = pin.crba(robot.model, robot.model.createData(), q)
     assert np.array_equal(mass, mass.T) and np.abs(np.tril(mass, -1)).max() > 0.01
@@ -177,7 +179,7 @@ def test_a_column_or_a_batch_of_one_keeps_the_shape_rule(name, rng):
 
 
 def test_threads_hammering_different_states_get_their_own_gravity_and_mass_matrix(rng):
-    robot = robodyn.load("panda", lock={"panda_finger_joint1": 0.0})
+    robot = robodyn.load("panda", lock={"panda_finger_joint1": 0.0}, engine="pinocchio")
     states = [(robot.random_configuration(rng), rng.normal(size=robot.nv)) for _ in range(5)]
     expected = [(robot.gravity(q), robot.mass_matrix(q), robot.nonlinear_effects(q, v)) for q, v in states]
     failures = []

@@ -11,6 +11,7 @@ compiled runs are fast; the compiled runs of ur5, panda and solo12 compile those
 from __future__ import annotations
 
 import json
+import os
 import warnings
 from pathlib import Path
 
@@ -37,9 +38,19 @@ def oracle():
 
 @pytest.fixture(scope="module", autouse=True)
 def cache():
-    """The session's compile cache (never the user's)."""
-    with shared_cache() as folder:
-        yield folder
+    """The session's compile cache (never the user's), and every robot loaded on Pinocchio
+    (``$ROBODYN_ENGINE``), as when the oracle was recorded: a robot compiled earlier in the
+    session would otherwise answer its controller's calls with its kernels (``engine="auto"``)."""
+    previous = os.environ.get("ROBODYN_ENGINE")
+    os.environ["ROBODYN_ENGINE"] = "pinocchio"
+    try:
+        with shared_cache() as folder:
+            yield folder
+    finally:
+        if previous is None:
+            os.environ.pop("ROBODYN_ENGINE", None)
+        else:
+            os.environ["ROBODYN_ENGINE"] = previous
 
 
 def _marks(case) -> list:
