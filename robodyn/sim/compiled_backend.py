@@ -71,6 +71,8 @@ def unsupported(plan: RunPlan) -> list[str]:
             "joint_friction=False simulates the rigid-body motion compiled)"
         )
         reasons.append(Reason(text, "joint_friction"))
+    if robot.constraints:
+        reasons.append(Reason("closed loops or welds (robot.constraints: the compiled engine models none)", "engine"))
     if robot.massless_joints or robot.nv == 0:
         reasons.append(Reason("no moving mass to compile (the compiled engine models none)", "engine"))
     return reasons

@@ -15,7 +15,7 @@ import numpy as np
 from robodyn.compiled.simulation import SimulationArrays
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import SingularMassMatrixError
-from robodyn.sim import contact_backend
+from robodyn.sim import constrained_backend, contact_backend
 from robodyn.sim.joint_friction import JointFriction
 from robodyn.sim.limits import JointLimits
 from robodyn.sim.plan import Controller, ExternalWrench, Outcome, RunPlan, external_torques
@@ -41,6 +41,8 @@ def run(plan: RunPlan) -> Outcome:
         raise SingularMassMatrixError(robot.name, robot.massless_joints)
     if plan.ground is not None:
         return contact_backend.run(plan)  # on the ground: robodyn.sim.contact's step
+    if robot.constraints:
+        return constrained_backend.run(plan)  # closed loops and welds: robodyn.sim.constrained
     joint_limits = JointLimits(robot)
     enforce = plan.limits == "enforce"
     controller = _saturated(plan.controller, joint_limits) if enforce else plan.controller

@@ -21,6 +21,7 @@ from typing import Any, Literal, NamedTuple
 
 import numpy as np
 
+from robodyn.common.text import counted, quoted
 from robodyn.compiled.loop_rules import INTEGRATORS, Integrator, check_integrator, period_steps, step_count
 from robodyn.compiled.simulation import SimulationArrays
 from robodyn.dynamics.robot import Robot
@@ -200,6 +201,9 @@ def plan(
         InputError: For a bad initial state, step, duration, integrator, limits mode,
             engine or control period (or one given without a controller).
         FrameError: An external wrench on a frame that is unknown or that no joint moves.
+        InputError: A robot with constraints (closed loops, welds: ``robot.constraints``)
+            with what its loop does not model (another integrator than RK4, a control period,
+            enforced limits, an observer, a ground, Coulomb friction).
     """
     integrator = integrator or ("semi-implicit-euler" if ground is not None else "rk4")
     check_integrator(integrator)
@@ -215,8 +219,46 @@ def plan(
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
     for item in external:
         robot.task_frame(item.frame, "an external wrench")
+    _check_constrained(robot, integrator, every, limits, observer, ground)
     found = check_contact_run(robot, ground, contacts, q0=q, integrator=integrator, every=every, limits=limits, observer=observer)
     return RunPlan(
         robot, q, v, float(dt), steps, integrator, controller, every, limits, joint_friction and has_joint_friction(robot),
         tuple(external), observer, engine, ground, found,
     )  # fmt: skip
+
+
+def _check_constrained(robot: Robot, integrator: str, every: int | None, limits: str, observer: object, ground: object) -> None:
+    """Refuse what a robot with constraints (its file's ``<equality>``, ``load(constraints=)``)
+    cannot be simulated with: the constrained loop is RK4 plus a projection, evaluates the
+    controller at every stage, and models no ground, enforced limits, observer or Coulomb
+    friction (simulating the open tree instead would be a different mechanism)."""
+    if not robot.constraints:
+        return
+    names = ", ".join(quoted(c.name or type(c).__name__) for c in robot.constraints[:4])
+    held = f"{robot.name} has {counted(len(robot.constraints), 'constraint')} ({names})"
+    refusals = [
+        (
+            "integrator",
+            integrator != "rk4",
+            "'rk4' for a robot with constraints (RK4, then a projection onto them)",
+            repr(integrator),
+        ),
+        (
+            "control_period",
+            every not in (None, 1),
+            "left out for a robot with constraints (the controller runs at every stage)",
+            held,
+        ),
+        ("limits", limits == "enforce", "'warn' or 'ignore' for a robot with constraints", repr(limits)),
+        ("observer", observer is not None, "left out for a robot with constraints", held),
+        ("ground", ground is not None, "left out for a robot with constraints (contacts with loops are not modelled yet)", held),
+    ]
+    for name, refused, expected, received in refusals:
+        if refused:
+            raise InputError(name, expected, received)
+    if robot.joint_friction.any():
+        raise InputError(
+            "joint_friction",
+            "False for a robot with constraints and Coulomb friction (stick-slip is not modelled with loops)",
+            held,
+        )

@@ -190,14 +190,16 @@ def joint_effort(robot: MjcfRobot, where: str, name: str, values: dict[str, str]
 
 
 def read_equalities(root: ET.Element, robot: MjcfRobot) -> tuple[EqualityRecord, ...]:
-    """The ``connect`` and ``weld`` equalities between bodies, in the links' frames."""
+    """The ``connect`` and ``weld`` equalities between bodies, in the links' frames (the
+    robot's constraints, :attr:`robodyn.Robot.constraints`); any other equality (joint,
+    tendon, distance, between sites) is noted as left out."""
     records = []
     for section in root.findall("equality"):
         for index, node in enumerate(section):
             name = node.get("name")
-            robot.note("equality constraints", name or f"<{node.tag}> #{index + 1}")
             values = attributes(robot, node, "main")
             if node.tag not in ("connect", "weld") or "body1" not in values:
+                robot.note("equality constraints other than body connect/weld", name or f"<{node.tag}> #{index + 1}")
                 continue
             records.append(_equality(robot, node.tag, name, values))
     return tuple(records)
