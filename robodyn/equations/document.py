@@ -9,11 +9,12 @@ derivation starts.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal, cast
 
-from robodyn.common.text import printable
+from robodyn.common.text import counted, printable, quoted
 from robodyn.equations.christoffel import render_christoffel
 from robodyn.equations.derive import Form, derive_equations
 from robodyn.equations.kinematics import KinematicsFormat, derive_kinematics, render_kinematics
@@ -22,7 +23,7 @@ from robodyn.equations.output import Format, render
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
 from robodyn.equations.render_derivation import DerivationFormat, derivation_document
 from robodyn.equations.render_latex import tex_engine
-from robodyn.exceptions import InputError, MissingToolError
+from robodyn.exceptions import InputError, MissingToolError, RobodynWarning
 from robodyn.urdf.sources import resolve_source
 
 #: Which document: the equations of motion, their Christoffel symbols, a frame's
@@ -103,6 +104,7 @@ def equations_document(
     _check(source, what, request)
     if what == "lecture":
         return Document(lecture_text(), "the lecture's RP arm")
+    _note_constraints(source)
     if what == "derivation":
         content = derivation_document(
             source, format=cast(DerivationFormat, request.format), keep_params=request.keep_params,
@@ -138,3 +140,18 @@ def _check(source: str | os.PathLike, what: str, request: Request) -> None:
         raise InputError("model", f"{LECTURE_ROBOT} for the lecture (the lecture's arm)", repr(printable(str(source))))
     if what == "kinematics" and not request.frame:
         raise InputError("frame", "a link of the robot for its kinematics", repr(request.frame))
+
+
+def _note_constraints(source: str | os.PathLike) -> None:
+    """One warning line when the file declares constraints (MJCF ``<equality>``): the
+    equations derived are the open tree's, never silently the constrained robot's."""
+    resolved = resolve_source(source)
+    if resolved.equalities:
+        names = ", ".join(quoted(record.name or record.kind) for record in resolved.equalities[:4])
+        warnings.warn(
+            f"{resolved.label}: these equations are the open tree's; not in them: "
+            f"{counted(len(resolved.equalities), 'equality constraint')} ({names}) "
+            "(Robot.constrained_forward_dynamics gives q̈ and λ; docs/constraints.md)",
+            RobodynWarning,
+            stacklevel=3,
+        )

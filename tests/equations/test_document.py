@@ -9,7 +9,7 @@ import pytest
 from robodyn.equations import derive_equations
 from robodyn.equations.document import FORMATS, equations_document
 from robodyn.equations.output import render
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, RobodynWarning
 
 
 def test_the_equations_document_is_the_rendering_of_the_derived_equations():
@@ -42,3 +42,16 @@ def test_kinematics_need_a_frame_and_give_the_frames_document():
     assert error.value.argument == "frame"
     document = equations_document("rp_arm", "kinematics", frame="end_effector", format="json")
     assert json.loads(document.content)["frame"] == "end_effector"
+
+
+def test_the_equations_of_a_file_with_constraints_say_they_are_the_open_trees():
+    from tests.conftest import ROOT
+
+    four_bar = ROOT / "tests" / "data" / "constraints" / "four_bar.xml"
+    with pytest.warns(RobodynWarning, match="open tree's; not in them: 1 equality constraint \\('loop'\\)"):
+        equations_document(four_bar, "equations")
+    import warnings
+
+    with warnings.catch_warnings():  # negative control: a robot without constraints says nothing
+        warnings.simplefilter("error", RobodynWarning)
+        equations_document("rp_arm", "equations")
