@@ -33,7 +33,11 @@ def _no_build() -> str:
 
 def built_module(robot: Robot) -> ModuleType | None:
     """The robot's compiled kernels if they are built (this process, else the cache folder),
-    else ``None``; never builds, never raises (a cache it cannot read is no kernels)."""
+    else ``None``; never builds, never raises (a cache it cannot read is no kernels).
+
+    Args:
+        robot: The robot whose kernels are looked up (by its cache key).
+    """
     try:
         module = build.loaded(robot)
         if module is None:

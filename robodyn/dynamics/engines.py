@@ -61,13 +61,21 @@ def check_engine(engine: object) -> str:
 
 
 def register(finder: Finder) -> None:
-    """Add a finder of compiled kernels (see the module docstring); registering twice is a no-op."""
+    """Add a finder of compiled kernels (see the module docstring); registering twice is a no-op.
+
+    Args:
+        finder: ``finder(robot) -> module or None``: the robot's built kernels, never building them.
+    """
     if finder not in _finders:
         _finders.append(finder)
 
 
 def find(robot: Robot) -> ModuleType | None:
-    """The robot's compiled kernels from the first finder that has them, or ``None``."""
+    """The robot's compiled kernels from the first finder that has them, or ``None``.
+
+    Args:
+        robot: The robot whose kernels are looked for.
+    """
     for finder in _finders:
         module = finder(robot)
         if module is not None:
@@ -77,7 +85,11 @@ def find(robot: Robot) -> ModuleType | None:
 
 def attach(robot: Robot) -> bool:
     """Route the single calls of a robot loaded with ``engine="auto"`` through its compiled
-    kernels, if a finder has them built. Returns whether it did."""
+    kernels, if a finder has them built. Returns whether it did.
+
+    Args:
+        robot: A robot just built (its ``options.engine`` says whether it may be routed).
+    """
     if robot.options.engine != "auto":
         return False
     module = find(robot)

@@ -95,7 +95,11 @@ class ModelHandle:
         """Answer the single calls (and their batches) with a robot's compiled kernels,
         falling back to Pinocchio's calls for anything the kernels refuse (so errors stay
         the same): see :mod:`robodyn.dynamics.engines`. The model is then read-only (the
-        kernels are built from the robot's URDF text and load options, not from it)."""
+        kernels are built from the robot's URDF text and load options, not from it).
+
+        Args:
+            module: The robot's compiled extension module (:mod:`robodyn.compiled.engine`).
+        """
         self.calls = SingleCalls(
             *compiled_calls(module, self.pinocchio_calls, self.kernels, self.validate, self.parallel.threads)
         )

@@ -21,7 +21,11 @@ from robodyn.sim.plan import Outcome, RunPlan, external_torques
 
 
 def run(plan: RunPlan) -> Outcome:
-    """Run a plan whose robot has constraints (the plan refused what this loop does not model)."""
+    """Run a plan whose robot has constraints (the plan refused what this loop does not model).
+
+    Args:
+        plan: The run plan (its robot has constraints; RK4, no ground, no observer).
+    """
     robot, controller, external = plan.robot, plan.controller, plan.external
     damping = robot.joint_damping if plan.friction else None
 

@@ -21,8 +21,11 @@ from robodyn.sim.control import ComputedTorque, PDGravity, TaskSpace
 from robodyn.sim.experiment import CONTROLLERS, run_simulation
 from tests.conftest import ROOT
 
-#: The controllers without a twin, each with its reason (none today).
-NO_TWIN: dict[str, str] = {}
+#: The controllers without a twin, each with its reason.
+NO_TWIN: dict[str, str] = {
+    "Stand": "a QP a step (Clarabel) over contact forces on a ground, which the compiled engine does not model",
+    "HybridForceMotion": "the third lecture's force/motion law runs from Python (pressing a surface: a constrained plant, which the compiled engine does not model)",
+}
 
 
 def library_controllers() -> list[type]:
