@@ -103,13 +103,12 @@ def stand_law(
     feet = _feet(robot, start, ground, contact_points(robot, contacts).points)
     com = robot.center_of_mass(start) + shift
     margin = support_margin(robot, start, feet, com)
+    if not np.isfinite(margin):
+        raise InputError("contacts", "feet spanning a support polygon (three points or more off one line)", f"{len(feet)} points")
     if not margin > 0:
-        outside = (
-            f"{-margin:.3g} m outside it"
-            if np.isfinite(margin)
-            else "contacts with no polygon (fewer than three points off one line)"
+        raise InputError(
+            "target", "a centre of mass shift that stays over the support polygon of the feet", f"{-margin:.3g} m outside it"
         )
-        raise InputError("target", "a centre of mass shift that stays over the support polygon of the feet", outside)
     rotation = pin.Quaternion(start[6], start[3], start[4], start[5]).toRotationMatrix()
     line = (
         f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point on it: stand's feet do not move)"

@@ -129,7 +129,7 @@ def run(arguments: argparse.Namespace) -> int:
     if summary.com_error is not None and summary.com_error >= 1e-3:
         warn([
             f"{printable(summary.robot)}: the centre of mass missed its target by {summary.com_error:.3g} m "
-            "(legs stretched straight cannot shift it: a --q0 with bent legs, a longer --duration?)"
+            "(a push still acting, a longer --duration, or legs stretched straight: a --q0 with bent legs?)"
         ])  # fmt: skip
     print(json_text(summary.to_dict()) if arguments.json else summary.text())
     return 0

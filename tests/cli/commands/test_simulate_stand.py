@@ -40,6 +40,8 @@ def test_solo12_stands_on_the_ground_for_a_second(tmp_path, capsys):
         (["solo12", "--ground", "--target", "0,0.5,0"], "--target"),
         (["solo12"], "--ground"),
         (["panda", "--ground"], "--controller"),
+        (["solo12", "--ground", "--contact", "FL_FOOT,HR_FOOT"], "--contact"),
+        (["solo12", "--ground", "--friction", "0"], "--friction"),
     ],
 )
 def test_a_stand_it_cannot_do_is_one_line_naming_the_flag(arguments, flag, capsys):
@@ -49,3 +51,27 @@ def test_a_stand_it_cannot_do_is_one_line_naming_the_flag(arguments, flag, capsy
     assert error.count("\n") == 0 and flag in error
     if arguments[0] == "panda":
         assert "'panda'" in error
+
+
+def test_named_feet_stand_and_a_shift_not_reached_is_one_warning_line(capsys):
+    feet = "FL_FOOT,FR_FOOT,HL_FOOT,HR_FOOT"
+    status = main(
+        [
+            "simulate",
+            "solo12",
+            "--ground",
+            "--contact",
+            feet,
+            "--controller",
+            "stand",
+            "--target",
+            "0,0.02,0",
+            "--duration",
+            "0.05",
+        ]
+    )
+    assert status == 0
+    captured = capsys.readouterr()
+    assert "support margin" in captured.out and "4 contact points" in captured.out
+    warning = captured.err.strip()
+    assert warning.count("\n") == 0 and "centre of mass missed its target" in warning
