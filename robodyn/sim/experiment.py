@@ -40,15 +40,18 @@ from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
 from robodyn.sim.reach import check_reach
-from robodyn.sim.report import ObserverOutcome, Push, SimulationSummary, TaskOutcome
+from robodyn.sim.report import Push, SimulationSummary, TaskOutcome
 from robodyn.sim.requests import TrajectoryReference, check_planar, pose_target, push_wrenches, task_target, tracked
-from robodyn.sim.simulation import Engine, ExternalWrench, Integrator, external_torques, simulate_run
+from robodyn.sim.requests import applied_torques as applied_torques  # robodyn.viz.experiment imports it here
+from robodyn.sim.requests import observer_outcome as observer_outcome
+from robodyn.sim.simulation import Engine, Integrator, simulate_run
+from robodyn.sim.stand_run import RecordedStand, stand_law, stand_outcome
 from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_dofs
 from robodyn.trajectory import Trajectory
 
 #: The controllers a run can use, by name.
-ControllerName = Literal["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr"]
-CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr")
+ControllerName = Literal["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand"]
+CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand")
 #: The controllers of a frame's pose (position, or position and attitude).
 POSE_CONTROLLERS = ("osc", "impedance")
 #: The controllers that drive a frame (``frame`` applies to them).
@@ -99,7 +102,9 @@ def run_simulation(
             (operational-space control of ``frame``'s position or pose) or
             ``"impedance"`` (Cartesian impedance about the target pose) or ``"lqr"``
             (:class:`~robodyn.sim.control.LQR` about the joint target held still, gain of
-            the continuous Riccati equation, weights :func:`lqr_weights`).
+            the continuous Riccati equation, weights :func:`lqr_weights`) or ``"stand"``
+            (a floating robot on ``ground`` held by the whole-body QP, started on its feet;
+            ``target``: its centre of mass's shift DX,DY,DZ, :mod:`robodyn.sim.stand_run`).
         target: Joint target (nq values; a floating base's joints only, nq − 7: the base
             stays free and gets no torque), task target (X,Z or X,Y,Z in [m]) or, for osc
             and impedance, X,Y,Z in [m] with optionally ROLL,PITCH,YAW in [rad].
@@ -144,25 +149,16 @@ def run_simulation(
     if reference is not None:
         reference, target, q0 = tracked(robot, controller, reference, target, q0)
     _check_request(robot, controller, target, frame, limits)
-    _check_pose_options(controller, posture, stiffness, damping)
     if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
         raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
-    start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
-    lifted: tuple[str, ...] = ()
-    if q0 is None and ground is not None and robot.floating_base:  # dropped from 5 cm, not started in the floor
-        start, lift = start_above(robot, start, ground, contacts)
-        lifted = (f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point 5 cm above it)",)
-    options: dict[str, Any] = {"posture": posture, "stiffness": stiffness, "damping": damping}
-    if actuated is not None and controller not in ("pd", "computed-torque", "lqr"):
-        raise InputError("actuated", "given only with the pd, computed-torque or lqr controller", f"{len(actuated)} joints")
-    options["driven"] = driven_dofs(robot, actuated)
-    options["actuated"] = actuated
-    if (kp is not None or kd is not None) and controller not in ("pd", "computed-torque"):
-        raise InputError(
-            "kp" if kp is not None else "kd", "given only with the pd or computed-torque controller", repr(controller)
-        )
-    options["gains"] = {"kp": kp, "kd": kd}
-    law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
+    options = _options(robot, controller, posture, stiffness, damping, actuated, kp, kd)
+    start, lifted = _start(robot, controller, q0, ground, contacts)
+    law: Any
+    if controller == "stand":  # started on its feet (gap 0), stand_run's docstring
+        law, start, placed = stand_law(robot, controller_model(robot), start, target, ground, contacts)
+        lifted, task, controlled = (placed,), None, ""
+    else:
+        law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
     if reference is not None:
         law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
     pushes, external = push_wrenches(robot, force_at, controlled or None)
@@ -188,9 +184,11 @@ def run_simulation(
         compile_time=run.compile_time, ground=lifted + ground_lines(robot, run.contact), contact=run.contact,
     )  # fmt: skip
     if observer is not None:
-        summary = replace(summary, observer=_observer_outcome(robot, trajectory, observer, external))
+        summary = replace(summary, observer=observer_outcome(robot, trajectory, observer, external))
     if isinstance(law, OperationalSpace | Impedance):
         return trajectory, replace(summary, task=_pose_outcome(robot, trajectory, law, pushes))
+    if isinstance(law, RecordedStand):
+        return trajectory, replace(summary, **stand_outcome(robot, law, run.contact))
     if task is not None:
         return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
     if controller != "passive":
@@ -201,6 +199,18 @@ def run_simulation(
             missed = missed[driven]
         return trajectory, replace(summary, final_joint_error=float(missed.max()))
     return trajectory, summary
+
+
+def _start(
+    robot: Robot, controller: str, q0: list[float] | None, ground: Ground | None, contacts: Any
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """The start configuration and its summary line: a floating robot on a ground with no
+    ``q0`` is dropped from 5 cm, not started in the floor (stand: placed by :func:`stand_law`)."""
+    start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
+    if q0 is None and ground is not None and robot.floating_base and controller != "stand":
+        start, lift = start_above(robot, start, ground, contacts)
+        return start, (f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point 5 cm above it)",)
+    return start, ()
 
 
 def _summary(robot: Robot, trajectory: Trajectory, settings: dict[str, Any], elapsed: float) -> SimulationSummary:
@@ -228,13 +238,28 @@ def _check_request(robot: Robot, controller: str, target: list[float] | None, fr
     if controller not in CONTROLLERS:
         raise InputError("controller", f"one of {', '.join(CONTROLLERS)}", repr(controller))
     check_mode(limits)
-    if controller != "passive" and target is None:
+    if controller not in ("passive", "stand") and target is None:
         raise InputError("target", f"given for the {controller} controller", "nothing")
     if controller == "passive" and target is not None:
         raise InputError(
             "target", "given only with a controller (the passive run has no target)", counted(np.size(target), "value")
         )
     # Under the other controllers a frame names only the path a recording draws (checked by it).
+
+
+def _options(
+    robot: Robot, controller: str, posture: Any, stiffness: Any, damping: Any, actuated: Any, kp: Any, kd: Any
+) -> dict[str, Any]:
+    """The controllers' options; refused (naming it) where the controller takes none."""
+    _check_pose_options(controller, posture, stiffness, damping)
+    if actuated is not None and controller not in ("pd", "computed-torque", "lqr"):
+        raise InputError("actuated", "given only with the pd, computed-torque or lqr controller", f"{len(actuated)} joints")
+    if (kp is not None or kd is not None) and controller not in ("pd", "computed-torque"):
+        raise InputError(
+            "kp" if kp is not None else "kd", "given only with the pd or computed-torque controller", repr(controller)
+        )
+    return {"posture": posture, "stiffness": stiffness, "damping": damping, "driven": driven_dofs(robot, actuated),
+            "actuated": actuated, "gains": {"kp": kp, "kd": kd}}  # fmt: skip
 
 
 def _check_pose_options(controller: str, posture: Any, stiffness: Any, damping: Any) -> None:
@@ -366,19 +391,3 @@ def _pose_outcome(
     return replace(
         outcome, deflection=tuple(deflection.tolist()), expected_deflection=tuple(expected.tolist()), deflection_error=relative
     )
-
-
-def applied_torques(robot: Robot, trajectory: Trajectory, external: Sequence[ExternalWrench]) -> np.ndarray:
-    """The joint torques external wrenches applied at each sample, ``Σ J(q)ᵀ w(t)``, shape (N, nv)."""
-    return np.array([external_torques(robot, q, float(t), external) for t, q in zip(trajectory.t, trajectory.q, strict=True)])
-
-
-def _observer_outcome(
-    robot: Robot, trajectory: Trajectory, observer: MomentumObserver, external: list[ExternalWrench]
-) -> ObserverOutcome:
-    """The observer's residual at every sample, against the external torques applied there."""
-    residual = np.array(observer.residuals)
-    applied = applied_torques(robot, trajectory, external)
-    gain = float(np.max(np.asarray(observer.gain, dtype=float)))
-    error = float(np.abs(residual[-1] - applied[-1]).max())
-    return ObserverOutcome(gain, tuple(residual[-1].tolist()), tuple(applied[-1].tolist()), error, residual, applied)

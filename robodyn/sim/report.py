@@ -175,6 +175,9 @@ class SimulationSummary:
             ``"no ground: the base falls freely"``.
         contact: A run on the ground: its :class:`~robodyn.sim.contact_run.ContactSimulation`
             (forces, gaps; not in :meth:`to_dict`), else ``None``.
+        com_error: stand: the final centre of mass's distance to its target in [m].
+        force_difference: stand: the largest ``|f_QP − f_simulated|`` of a contact over the run, in [N].
+        support_margin: stand: how far the final centre of mass lies inside the support polygon, in [m].
     """
 
     robot: str
@@ -206,6 +209,9 @@ class SimulationSummary:
     startup_time: float | None = None
     ground: tuple[str, ...] = ()
     contact: Any = field(default=None, repr=False, compare=False)  # the ContactSimulation, for the files
+    com_error: float | None = None
+    force_difference: float | None = None
+    support_margin: float | None = None
 
     def with_startup(self, seconds: float | None) -> SimulationSummary:
         """The same summary with the start-up time in [s] (process start to the run)."""
@@ -246,6 +252,9 @@ class SimulationSummary:
         data["limit_violations"] = [violation.as_dict() for violation in self.violations]
         if self.ground:
             data["ground"] = list(self.ground)
+        for key, unit in (("com_error", "m"), ("force_difference", "N"), ("support_margin", "m")):
+            if getattr(self, key) is not None:
+                data[f"{key}_{unit}"] = getattr(self, key)
         return data | dict(self.files)
 
     def _timing_dict(self) -> dict[str, Any]:
@@ -321,6 +330,12 @@ class SimulationSummary:
         lines.append(f"peak |torque|: {', '.join(peaks)}")
         lines.append(f"energy change: {_number(self.energy_change, 4)} J")
         lines += [printable(line) for line in self.ground]
+        if self.com_error is not None:
+            lines.append(f"centre of mass: final error {_number(self.com_error, 3)} m")
+        if self.force_difference is not None:
+            lines.append(f"contact forces: commanded vs measured, largest difference {_number(self.force_difference, 3)} N")
+        if self.support_margin is not None:
+            lines.append(f"support margin: {_number(self.support_margin, 4)} m (centre of mass inside the feet's polygon)")
         if self.observer is not None:
             lines += [
                 f"observer (gain {_number(self.observer.gain)} /s): final tau_ext {vector_text(self.observer.final_estimate, 4)}",

@@ -18,8 +18,9 @@ import numpy as np
 from robodyn.common.text import counted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
-from robodyn.sim.plan import ExternalWrench
-from robodyn.sim.report import Push
+from robodyn.sim.observer import MomentumObserver
+from robodyn.sim.plan import ExternalWrench, external_torques
+from robodyn.sim.report import ObserverOutcome, Push
 from robodyn.trajectory import Trajectory
 
 
@@ -133,3 +134,32 @@ def tracked(
     if robot.floating_base or len(reference) < 2:
         raise InputError("reference", "a fixed-base robot's motion of at least two samples", counted(len(reference), "sample"))
     return reference, list(reference.q[-1]), list(reference.q[0]) if q0 is None else q0
+
+
+def applied_torques(robot: Robot, trajectory: Trajectory, external: Sequence[ExternalWrench]) -> np.ndarray:
+    """The joint torques external wrenches applied at each sample, ``Σ J(q)ᵀ w(t)``, shape (N, nv).
+
+    Args:
+        robot: The plant.
+        trajectory: The run.
+        external: The wrenches it applied.
+    """
+    return np.array([external_torques(robot, q, float(t), external) for t, q in zip(trajectory.t, trajectory.q, strict=True)])
+
+
+def observer_outcome(
+    robot: Robot, trajectory: Trajectory, observer: MomentumObserver, external: list[ExternalWrench]
+) -> ObserverOutcome:
+    """The observer's residual at every sample, against the external torques applied there.
+
+    Args:
+        robot: The plant.
+        trajectory: The run.
+        observer: The observer run along it.
+        external: The external wrenches the run applied.
+    """
+    residual = np.array(observer.residuals)
+    applied = applied_torques(robot, trajectory, external)
+    gain = float(np.max(np.asarray(observer.gain, dtype=float)))
+    error = float(np.abs(residual[-1] - applied[-1]).max())
+    return ObserverOutcome(gain, tuple(residual[-1].tolist()), tuple(applied[-1].tolist()), error, residual, applied)

@@ -16,13 +16,16 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
     add_model_arguments(parser)
     parser.add_argument(
-        "--controller", choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr"], default="passive"
+        "--controller",
+        choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand"],
+        default="passive",
     )
     parser.add_argument(
         "--target",
         type=vector,
         help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
-        "pd / computed-torque: joint target; lqr: the equilibrium (joint values) to balance at",
+        "pd / computed-torque: joint target; lqr: the equilibrium (joint values) to balance at; "
+        "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it)",
     )
     parser.add_argument(
         "--frame",
@@ -122,6 +125,11 @@ def run(arguments: argparse.Namespace) -> int:
         warn([
             f"{printable(summary.robot)}: the target was not reached: final error {summary.task.final_error:.3g} m "
             "(a longer --duration, another --q0 or --target?)"
+        ])  # fmt: skip
+    if summary.com_error is not None and summary.com_error >= 1e-3:
+        warn([
+            f"{printable(summary.robot)}: the centre of mass missed its target by {summary.com_error:.3g} m "
+            "(a push still acting, a longer --duration, or legs stretched straight: a --q0 with bent legs?)"
         ])  # fmt: skip
     print(json_text(summary.to_dict()) if arguments.json else summary.text())
     return 0

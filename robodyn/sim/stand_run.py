@@ -1,0 +1,140 @@
+"""``controller="stand"`` of :func:`robodyn.sim.experiment.run_simulation`: a floating robot on
+the ground held by the whole-body QP (:class:`robodyn.sim.whole_body.Stand`).
+
+The robot starts with its lowest contact point on the ground (gap 0, not the 5 cm drop of
+the other controllers: the QP assumes feet that do not move), its feet (the run's contact
+points) become sticking :class:`~robodyn.constraints.PointContact` s of the ground's normal
+and friction, and the controller holds the base attitude and the centre of mass at its
+start shifted by ``target`` (DX, DY, DZ in [m]; refused outside the support polygon). The
+summary gains the centre of mass's final error, the largest difference between the QP's
+and the simulated contact forces, and the final centre of mass's support margin.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from robodyn.common.text import counted
+from robodyn.constraints import PointContact
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
+from robodyn.sim.contact_checks import start_above
+from robodyn.sim.ground import ContactPoint, Ground, contact_points
+from robodyn.sim.whole_body import Stand, support_margin
+
+
+class RecordedStand:
+    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N]."""
+
+    def __init__(self, law: Stand) -> None:
+        self.law = law
+        self.forces: list[np.ndarray] = []
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        tau = self.law(t, q, v)
+        self.forces.append(self.law.last_forces.copy())
+        return tau
+
+
+def _feet(robot: Robot, q: np.ndarray, ground: Ground, points: Sequence[ContactPoint]) -> tuple[PointContact, ...]:
+    """Each contact point's lowest point (a sphere's centre minus ``radius · n``) as a
+    sticking point contact on ``ground``, in its link's frame at ``q``."""
+    pin.framesForwardKinematics(robot.model, robot.data, q)
+    feet = []
+    for point in points:
+        placement = robot.data.oMf[robot.frame_id(point.link)]
+        lowest = placement.act(np.array(point.position)) - point.radius * np.array(ground.normal)
+        local = placement.actInv(lowest)
+        feet.append(
+            PointContact(
+                point.link, tuple(local.tolist()), ground.normal, ground.friction, tuple(ground.point.tolist()), point.name
+            )
+        )
+    return tuple(feet)
+
+
+def stand_law(
+    robot: Robot,
+    model: Robot,
+    start: np.ndarray,
+    target: list[float] | None,
+    ground: Ground | None,
+    contacts: str | Sequence[str | ContactPoint],
+) -> tuple[RecordedStand, np.ndarray, str]:
+    """The stand controller (on ``model``, the controller's copy of ``robot``) and its start.
+
+    Args:
+        robot: The plant (a floating base).
+        model: The controller's own copy of it.
+        start: The configuration (nq,) whose base is moved along the ground's normal until
+            its lowest contact point touches the ground.
+        target: The centre of mass's shift DX, DY, DZ in [m] (``None``: hold it).
+        ground: The plane the robot stands on.
+        contacts: The run's contact points (``"collision"`` or frame names).
+
+    Returns:
+        The controller, the start configuration (nq,) and the summary's line saying how
+        far the base moved to put the feet on the ground.
+
+    Raises:
+        InputError: Naming ``ground`` (none), ``controller`` (a fixed base), ``friction`` (0),
+            or ``target`` (not 3 values, or outside the support polygon).
+    """
+    if not robot.floating_base:
+        raise InputError(
+            "controller",
+            "another controller than 'stand' for a fixed-base robot (stand holds a floating one on its feet)",
+            repr(robot.name),
+        )
+    if ground is None:
+        raise InputError("ground", "given for the stand controller (the robot stands on it)", "no ground")
+    if ground.friction <= 0:
+        raise InputError("friction", "a coefficient > 0 for the stand controller (its feet stick)", repr(ground.friction))
+    shift = np.zeros(3) if target is None else np.asarray(target, dtype=float)
+    if shift.shape != (3,) or not np.isfinite(shift).all():
+        raise InputError(
+            "target", "DX,DY,DZ in [m] (the centre of mass's shift) for the stand controller", counted(shift.size, "value")
+        )
+    start, lift = start_above(robot, start, ground, contacts, clearance=0.0)
+    feet = _feet(robot, start, ground, contact_points(robot, contacts).points)
+    com = robot.center_of_mass(start) + shift
+    margin = support_margin(robot, start, feet, com)
+    if not np.isfinite(margin):
+        raise InputError("contacts", "feet spanning a support polygon (three points or more off one line)", f"{len(feet)} points")
+    if not margin > 0:
+        raise InputError(
+            "target", "a centre of mass shift that stays over the support polygon of the feet", f"{-margin:.3g} m outside it"
+        )
+    rotation = pin.Quaternion(start[6], start[3], start[4], start[5]).toRotationMatrix()
+    line = (
+        f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point on it: stand's feet do not move)"
+    )
+    return RecordedStand(Stand(model, feet, com, rotation, start)), start, line
+
+
+def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, Any]:
+    """The summary's stand fields: ``com_error`` (final centre of mass to its target, in [m]),
+    ``force_difference`` (largest ``|f_QP − f_simulated|`` of a contact over the run, in [N])
+    and ``support_margin`` (of the final centre of mass, in [m]).
+
+    Args:
+        robot: The plant.
+        law: The run's controller.
+        contact: The run's :class:`~robodyn.sim.contact_run.ContactSimulation`.
+    """
+    final = contact.trajectory.q[-1]
+    feet = law.law.contacts
+    commanded = np.array(law.forces).reshape(len(law.forces), len(feet), 3)
+    count = min(len(commanded), len(contact.forces))
+    return {
+        "com_error": float(np.linalg.norm(robot.center_of_mass(final) - law.law.com)),
+        "force_difference": float(np.abs(commanded[:count] - contact.forces[:count]).max()),
+        "support_margin": support_margin(robot, final, feet, robot.center_of_mass(final)),
+    }
+
+
+__all__ = ["RecordedStand", "stand_law", "stand_outcome"]
