@@ -9,8 +9,11 @@ Where the points come from (:func:`contact_points`):
 
 - **named frames** (``contacts=["FL_FOOT", ...]``): the frame's origin, radius 0;
 - **the URDF's collision geometry** (``contacts="collision"``): each ``<sphere>`` is one
-  point (its centre, its radius), each ``<box>`` its 8 corners; cylinders, capsules and
-  meshes are not modelled and are reported in one line each (:attr:`Contacts.skipped`).
+  point (its centre, its radius), each ``<box>`` its 8 corners, each ``<capsule>`` (the
+  MJCF reader writes them) the two spheres of its radius at its ends (an approximation:
+  its side between them never touches, said in one line; the MJCF reader writes a capsule
+  as its cylinder in a collision named ``mjcf:capsule``); cylinders, ellipsoids and
+  meshes (and the MJCF reader's ``<mjcf_collision type>`` markers) are not modelled and are reported in one line each (:attr:`Contacts.skipped`).
   With no sphere or box at all, the links named ``*foot`` (solo12's feet are meshes),
   said in one line.
 """
@@ -146,11 +149,31 @@ def _triple(values: np.ndarray) -> tuple[float, float, float]:
     return float(values[0]), float(values[1]), float(values[2])
 
 
+def _shape_points(
+    link: str, index: int, shape: ET.Element, offset: np.ndarray, rotation: np.ndarray
+) -> list[ContactPoint] | None:
+    """The contact points of one collision shape in its link's frame (``None``: not modelled)."""
+    if shape.tag == "sphere":
+        radius = float(_numbers(shape.get("radius"), 1, 0.0)[0])
+        return [ContactPoint(f"{link}.sphere{index}", link, _triple(offset), radius)]
+    if shape.tag == "capsule":  # the spheres at its ends, along its z axis (see collision_points)
+        radius = float(_numbers(shape.get("radius"), 1, 0.0)[0])
+        half_length = 0.5 * float(_numbers(shape.get("length"), 1, 0.0)[0])
+        ends = [offset + rotation @ np.array([0.0, 0.0, sign * half_length]) for sign in (-1.0, 1.0)]
+        return [ContactPoint(f"{link}.capsule{index}.end{end}", link, _triple(where), radius) for end, where in enumerate(ends)]
+    if shape.tag == "box":
+        half = 0.5 * _numbers(shape.get("size"), 3, 0.0)
+        corners = [offset + rotation @ (half * np.array(signs)) for signs in itertools.product((-1.0, 1.0), repeat=3)]
+        return [ContactPoint(f"{link}.box{index}.corner{corner}", link, _triple(where)) for corner, where in enumerate(corners)]
+    return None
+
+
 def collision_points(robot: Robot) -> Contacts:
     """Contact points from the URDF's ``<collision>`` spheres and boxes (module docstring)."""
     root = ET.fromstring(robot.urdf)
     points: list[ContactPoint] = []
     skipped: dict[str, list[str]] = {}  # kind -> the links with one
+    capsules: list[str] = []
     for link in root.findall("link"):
         name = link.get("name") or ""
         for index, element in enumerate(link.findall("collision")):
@@ -159,21 +182,26 @@ def collision_points(robot: Robot) -> Contacts:
             rotation = rpy_matrix(_numbers(None if origin is None else origin.get("rpy"), 3, 0.0))
             geometry = element.find("geometry")
             shape = None if geometry is None or not len(geometry) else geometry[0]
-            if shape is not None and shape.tag == "sphere":
-                radius = float(_numbers(shape.get("radius"), 1, 0.0)[0])
-                points.append(ContactPoint(f"{name}.sphere{index}", name, _triple(offset), radius))
-            elif shape is not None and shape.tag == "box":
-                half = 0.5 * _numbers(shape.get("size"), 3, 0.0)
-                for corner, signs in enumerate(itertools.product((-1.0, 1.0), repeat=3)):
-                    where = offset + rotation @ (half * np.array(signs))
-                    points.append(ContactPoint(f"{name}.box{index}.corner{corner}", name, _triple(where)))
+            if shape is not None and shape.tag == "cylinder" and element.get("name") == "mjcf:capsule":
+                shape = ET.Element("capsule", shape.attrib)  # the MJCF reader's capsule
+            made = None if shape is None else _shape_points(name, index, shape, offset, rotation)
+            if made is not None:
+                points.extend(made)
+                if shape is not None and shape.tag == "capsule":
+                    capsules.append(name)
             else:
                 skipped.setdefault("no geometry" if shape is None else str(shape.tag), []).append(name)
+        for marker in link.findall("mjcf_collision"):  # an MJCF geom with no URDF shape
+            skipped.setdefault(str(marker.get("type")), []).append(name)
     lines = []
     for kind, links in skipped.items():
         named = list(dict.fromkeys(links))  # each link once, in order
         shown = ", ".join(repr(link) for link in named[:3]) + (", …" if len(named) > 3 else "")
-        lines.append(f"collision geometry not modelled as contacts (spheres and boxes are): {kind} × {len(links)} ({shown})")
+        lines.append(
+            f"collision geometry not modelled as contacts (spheres, boxes and capsules are): {kind} × {len(links)} ({shown})"
+        )
+    if capsules:
+        lines.append(f"capsules × {len(capsules)}: approximated by the spheres at their two ends (their sides do not touch)")
     return Contacts(tuple(points), tuple(lines))
 
 
@@ -196,6 +224,29 @@ def _feet(robot: Robot, found: Contacts) -> Contacts:
         return found
     line = f"contacts: the links named *foot ({len(feet)}), the collision geometry has no sphere or box"
     return Contacts(tuple(ContactPoint(name, name) for name in feet), (*found.skipped, line))
+
+
+def resolve_ground(robot: Robot, ground: Ground | str | None) -> Ground | None:
+    """The ground a run stands on: ``ground`` itself, or for ``"file"`` the plane the
+    robot's file states (MJCF: ``<worldbody>``'s plane geom,
+    :attr:`~robodyn.urdf.sources.URDFSource.ground`).
+
+    Args:
+        robot: The robot.
+        ground: A :class:`Ground`, ``"file"`` or ``None`` (no ground).
+
+    Raises:
+        InputError: For ``"file"`` when the file states no plane, or another value.
+    """
+    if ground is None or isinstance(ground, Ground):
+        return ground
+    if not (isinstance(ground, str) and ground == "file"):
+        raise InputError("ground", 'a Ground, "file" (the plane the robot\'s file states) or None', repr(ground)[:80])
+    stated = robot.source.ground
+    if stated is None:
+        raise InputError("ground", "a Ground: the robot's file states no ground plane", '"file"')
+    height, normal, friction = stated
+    return Ground(height, normal, friction)
 
 
 def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -> Contacts:
@@ -231,4 +282,4 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
     return found
 
 
-__all__ = ["ContactPoint", "Contacts", "Ground", "collision_points", "contact_points"]
+__all__ = ["ContactPoint", "Contacts", "Ground", "collision_points", "contact_points", "resolve_ground"]

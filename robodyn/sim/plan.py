@@ -27,7 +27,7 @@ from robodyn.compiled.simulation import SimulationArrays
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.contact_checks import check_contact_run
-from robodyn.sim.ground import ContactPoint, Contacts, Ground
+from robodyn.sim.ground import ContactPoint, Contacts, Ground, resolve_ground
 from robodyn.sim.joint_friction import has_joint_friction
 from robodyn.sim.limits import LimitMode, check_mode
 from robodyn.sim.observer import MomentumObserver
@@ -158,7 +158,7 @@ def plan(
     control_period: float | None = None,
     observer: MomentumObserver | None = None,
     joint_friction: bool = True,
-    ground: Ground | None = None,
+    ground: Ground | str | None = None,
     contacts: str | Sequence[str | ContactPoint] = "collision",
 ) -> RunPlan:
     """Check a run's arguments, once, into its plan.
@@ -193,7 +193,9 @@ def plan(
             stick–slip friction up to ``±f``, :mod:`robodyn.sim.joint_friction`); ``False``
             gives the rigid-body motion.
         ground: A :class:`~robodyn.sim.ground.Ground` the robot stands on (contact with
-            friction, :mod:`robodyn.sim.contact`; the Pinocchio engine only); ``None``: none.
+            friction, :mod:`robodyn.sim.contact`; the Pinocchio engine only); ``"file"``:
+            the plane the robot's file states (an MJCF's, :func:`~robodyn.sim.ground.resolve_ground`);
+            ``None``: none.
         contacts: With a ground, the points that touch it: ``"collision"`` (the URDF's
             collision spheres and boxes) or frame names / ``ContactPoint`` values.
 
@@ -205,6 +207,7 @@ def plan(
             with what its loop does not model (another integrator than RK4, a control period,
             enforced limits, an observer, a ground, Coulomb friction).
     """
+    ground = resolve_ground(robot, ground)
     integrator = integrator or ("semi-implicit-euler" if ground is not None else "rk4")
     check_integrator(integrator)
     check_mode(limits)

@@ -24,6 +24,9 @@ The reading, as MuJoCo's compiler does it (docs/robot-files.md states every rule
   ``ref`` is the offset q = qpos − ref (the body in its modelled pose at q = 0, limits
   shifted); ``<site>`` s are frames (``site:NAME`` where a body has the name);
 - ``<inertial>`` or the inertia of the body's solid geoms (:mod:`robodyn.urdf.geom_inertia`);
+- geoms that collide with the world's plane (``contype`` / ``conaffinity``) as
+  ``<collision>`` s, the first ``<worldbody>`` plane as the robot's ground
+  (:attr:`~robodyn.urdf.sources.URDFSource.ground`, :mod:`~robodyn.urdf.mjcf_geoms`);
 - ``<option gravity>`` / ``<flag gravity>``, actuators (effort limits, the actuated set),
   ``<equality connect/weld>`` records (:mod:`~robodyn.urdf.mjcf_physics`).
 
@@ -51,7 +54,7 @@ import numpy as np
 from robodyn.common.text import printable
 from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.mjcf_bodies import free_joint, read_body
-from robodyn.urdf.mjcf_geoms import set_total_mass
+from robodyn.urdf.mjcf_geoms import plane_ground, read_plane, set_total_mass
 from robodyn.urdf.mjcf_includes import expand_includes
 from robodyn.urdf.mjcf_physics import read_actuators, read_equalities, read_option
 from robodyn.urdf.mjcf_settings import read_compiler, read_defaults
@@ -99,6 +102,7 @@ def mjcf_source(
     expand_includes(root, label=source.label, path=source.path, read_file=read_file, max_bytes=max_bytes, census=census)
     base_dir = source.path.parent if source.path is not None else None
     robot = read_mjcf(root, source.label, base_dir)
+    ground = plane_ground(robot)
     _report(robot, source.label, strict)
     return replace(
         source,
@@ -111,6 +115,7 @@ def mjcf_source(
         gravity=robot.gravity,
         actuated=None if robot.actuated is None else tuple(sorted(robot.actuated)),
         joint_offsets=tuple(robot.refs.items()),
+        ground=ground,
     )
 
 
@@ -149,6 +154,7 @@ def read_mjcf(root: ET.Element, label: str, base_dir: Path | None) -> MjcfRobot:
                 robot.note(kind, element.get("name") or f"<{element.tag}> #{index + 1}")
     robot.gravity = read_option(root, robot)
     read_actuators(root, robot)
+    read_plane(root, robot)
     _read_world(root, robot)
     for joint in sorted(set(robot.efforts) - robot.joints):
         raise URDFError(label, f"an MJCF actuator drives joint {joint!r}, which the model does not have")

@@ -2,17 +2,26 @@
 body's solid geoms where MuJoCo's ``inertiafromgeom`` would take them), geoms as visuals
 and sites as frames; ``<compiler settotalmass>``.
 
+Geoms that collide with the world's plane by MuJoCo's rule (``contype & conaffinity`` of
+the pair, either way; both 1 by default, ``<default>`` classes apply) are also written as
+``<collision>`` s: spheres, boxes and cylinders as their URDF shapes, a capsule as its
+cylinder in a collision named ``mjcf:capsule``; the others (ellipsoids, meshes, height
+fields) as a ``<mjcf_collision type="KIND"/>`` element of the link, which URDF readers
+ignore (the ground code, :mod:`robodyn.sim.ground`, reports what it does not model). ``<worldbody>``'s first plane geom is the robot's ground (:func:`plane_ground`).
+
 This module does not import Pinocchio or MuJoCo.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from robodyn.exceptions import URDFError
+from robodyn.common.text import printable
+from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.geom_inertia import SOLIDS, combine, solid_properties
 from robodyn.urdf.mjcf_state import MjcfRobot, attributes
 from robodyn.urdf.mjcf_values import (
@@ -52,6 +61,9 @@ def write_link(robot: MjcfRobot, body: ET.Element, name: str, link: ET.Element, 
         mass = _write_inertial(robot, inertial, name, link, shift)
     for index, (_, values) in enumerate(geoms):
         _write_visual(robot, values, f'geom #{index + 1} of body "{name}"', link, shift)
+    for index, (_, values) in enumerate(geoms):
+        if collides(robot, values, f'geom #{index + 1} of body "{name}"'):
+            _write_collision(robot, values, f'geom #{index + 1} of body "{name}"', link, shift)
     _write_sites(robot, body, name, shift, childclass)
     return mass
 
@@ -200,6 +212,118 @@ def _write_visual(robot: MjcfRobot, values: dict[str, str], where: str, link: ET
     write_origin(visual, shift @ placed)
     geometry = ET.SubElement(visual, "geometry")
     ET.SubElement(geometry, shape[0], shape[1])
+
+
+def _write_collision(robot: MjcfRobot, values: dict[str, str], where: str, link: ET.Element, shift: np.ndarray) -> None:
+    """A colliding geom as a URDF ``<collision>`` (module docstring)."""
+    kind = values.get("type", "sphere")
+    size = [number(robot.label, where, token) for token in split_numbers(values.get("size", ""))]
+    placed = pose(robot, where, {key: value for key, value in values.items() if key != "fromto"})
+    if "fromto" in values:
+        placed, half = fromto_pose(robot, where, values["fromto"])
+        size = [*size[:1], half]
+    robot.colliding.append(values)
+    if kind not in ("sphere", "box", "capsule", "cylinder"):  # no URDF shape: a marker the ground code reports
+        ET.SubElement(link, "mjcf_collision", type=kind)
+        return
+    shape = ("sphere", {"radius": repr(size[0])}) if kind == "sphere" else _shape("cylinder" if kind == "capsule" else kind, size)
+    assert shape is not None  # sizes checked by _geom_values
+    collision = ET.SubElement(link, "collision", {"name": "mjcf:capsule"} if kind == "capsule" else {})
+    write_origin(collision, shift @ placed)
+    ET.SubElement(ET.SubElement(collision, "geometry"), shape[0], shape[1])
+
+
+def _integer(robot: MjcfRobot, where: str, values: dict[str, str], key: str) -> int:
+    value = number(robot.label, f"{where}: {key}", values.get(key, "1"))
+    if value != int(value) or value < 0:
+        raise URDFError(robot.label, f"{where}: {key}={values.get(key)!r} is not a non-negative integer (MuJoCo refuses it)")
+    return int(value)
+
+
+def collides(robot: MjcfRobot, values: dict[str, str], where: str) -> bool:
+    """Whether a geom collides with the world's plane by MuJoCo's rule: ``(contype &
+    plane.conaffinity) or (plane.contype & conaffinity)`` (the plane's both 1 without one).
+
+    Args:
+        robot: The reading (its :attr:`~robodyn.urdf.mjcf_state.MjcfRobot.plane`).
+        values: The geom's attributes, its defaults under them.
+        where: The geom, for messages.
+
+    Raises:
+        URDFError: For a ``contype`` or ``conaffinity`` that is not a non-negative integer.
+    """
+    plane = robot.plane or {}
+    contype, affinity = _integer(robot, where, values, "contype"), _integer(robot, where, values, "conaffinity")
+    return bool(
+        (contype & _integer(robot, "the plane", plane, "conaffinity"))
+        or (_integer(robot, "the plane", plane, "contype") & affinity)
+    )
+
+
+def read_plane(root: ET.Element, robot: MjcfRobot) -> None:
+    """``<worldbody>``'s first plane geom into :attr:`~robodyn.urdf.mjcf_state.MjcfRobot.plane`;
+    further planes are reported (one line).
+
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The reading.
+    """
+    world = root.find("worldbody")
+    for index, geom in enumerate([] if world is None else world.findall("geom")):
+        values = _geom_values(robot, geom, f"worldbody geom #{index + 1}", "main")
+        if values.get("type", "sphere") != "plane":
+            continue
+        if robot.plane is None:
+            robot.plane = values
+        else:
+            robot.note("ground planes after the first", values.get("name") or f"worldbody geom #{index + 1}")
+
+
+def _friction(robot: MjcfRobot, values: dict[str, str], where: str) -> tuple[float, int]:
+    """A geom's sliding friction and its ``condim``."""
+    tokens = split_numbers(values.get("friction", "1")) or ["1"]
+    sliding = number(robot.label, f"{where}: friction", tokens[0])
+    if sliding < 0:
+        raise URDFError(robot.label, f"{where}: friction={values['friction']!r} is negative")
+    condim = _integer(robot, where, values, "condim") if "condim" in values else 3
+    return sliding, condim
+
+
+def plane_ground(robot: MjcfRobot) -> tuple[float, tuple[float, float, float], float] | None:
+    """The file's ground: ``(height, normal, friction)`` of its plane, or ``None``.
+
+    The plane ``n · (x − p) = 0`` (``p`` its ``pos``, ``n`` its ``z`` axis) meets world ``z``
+    at ``height = n · p / n_z``. The friction is a pair's, combined as MuJoCo does by
+    default: the larger sliding coefficient of the geom and the plane (0 where both have
+    ``condim="1"``); where the colliding geoms' pairs differ, the largest is taken and said
+    in one line. Torsional and rolling friction (``condim`` 4 or 6) are reported in one line.
+    These lines are warnings that ``strict=True`` does not refuse (they concern contacts,
+    not the dynamics).
+
+    Args:
+        robot: The reading, its bodies written (:attr:`~robodyn.urdf.mjcf_state.MjcfRobot.colliding`).
+    """
+    if robot.plane is None:
+        return None
+    name = robot.plane.get("name") or "the worldbody plane"
+    placed = pose(robot, "the worldbody plane", robot.plane)
+    normal, point = placed[:3, 2], placed[:3, 3]
+    if normal[2] < 1e-6:
+        robot.note("ground planes that do not face up (+z)", name)
+        return None
+    plane = _friction(robot, robot.plane, "the worldbody plane")
+    pairs = [(_friction(robot, values, "a geom"), values.get("name") or "geom") for values in robot.colliding]
+    mus = [0.0 if max(condim, plane[1]) == 1 else max(mu, plane[0]) for (mu, condim), _ in pairs] or [plane[0]]
+    lines = []
+    if len(set(mus)) > 1:
+        lines.append(f"friction differs between geoms and the plane: the ground takes the largest, mu = {max(mus)!r}")
+    torsional = [geom for (_, condim), geom in pairs if max(condim, plane[1]) > 3]
+    if torsional:
+        lines.append(f"torsional and rolling friction (condim 4 or 6) of contacts are not modelled ({len(torsional)} geoms)")
+    for line in lines:  # contacts only, not the dynamics: said, never refused by strict=True
+        warnings.warn(f"{robot.label}: MJCF {line} ({printable(name)})", RobodynWarning, stacklevel=6)
+    height = float(normal @ point / normal[2])
+    return height, (float(normal[0]), float(normal[1]), float(normal[2])), float(max(mus))
 
 
 def _shape(kind: str, size: list[float]) -> tuple[str, dict[str, str]] | None:

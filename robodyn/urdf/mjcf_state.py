@@ -104,6 +104,9 @@ class MjcfRobot:
         gravity: The file's gravity in [m/s²] (``None``: it states none).
         disabled: The ``<flag>`` s the file disables that robodyn honours (``damper``, ...).
         equalities: The ``connect`` / ``weld`` records.
+        plane: The attributes of ``<worldbody>``'s first plane geom (its defaults under
+            them), the robot's ground, or ``None``.
+        colliding: The attributes of each geom written as a ``<collision>``.
     """
 
     label: str
@@ -123,6 +126,8 @@ class MjcfRobot:
     gravity: tuple[float, float, float] | None = None
     disabled: set[str] = field(default_factory=set)
     equalities: tuple[EqualityRecord, ...] = ()
+    plane: dict[str, str] | None = None
+    colliding: list[dict[str, str]] = field(default_factory=list)
 
     def note(self, kind: str, name: str) -> None:
         """Report ``name`` under ``kind``, a kind of what the dynamics leaves out (one

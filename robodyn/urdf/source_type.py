@@ -37,6 +37,10 @@ class URDFSource:
             when the file does not say (every joint is actuated).
         joint_offsets: ``(joint, offset)`` pairs: the file's coordinate is robodyn's plus
             the offset (MJCF ``ref``: MuJoCo's qpos = q + ref), in [rad] or [m].
+        ground: The ground plane the file states (MJCF ``<worldbody>``'s plane geom):
+            ``(height, normal, friction)``, the height in [m] of the plane along world
+            ``z`` at ``x = y = 0``, its unit normal and the Coulomb coefficient; ``None``:
+            the file has none (:func:`robodyn.sim.ground.resolve_ground`).
     """
 
     text: str
@@ -50,6 +54,7 @@ class URDFSource:
     gravity: tuple[float, float, float] | None = None
     actuated: tuple[str, ...] | None = None
     joint_offsets: tuple[tuple[str, float], ...] = ()
+    ground: tuple[float, tuple[float, float, float], float] | None = None
 
     @property
     def mesh_context(self) -> dict:
