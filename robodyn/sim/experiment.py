@@ -126,7 +126,8 @@ def run_simulation(
         control_period: Sample the controller every ``control_period`` [s] and hold its
             torque (zero-order hold; the summary says so); ``None``: every stage.
         joint_friction: As for :func:`robodyn.simulate`: the joints' damping and friction
-            act (``False``: the rigid-body motion). The controllers' models are rigid-body.
+            act (``False``: the rigid-body motion); the model-based controllers compensate the
+            viscous damping exactly when it acts (``compensate_damping``).
         kp, kd: pd: stiffness and damping, a scalar or one value a joint, in [N m/rad] and
             [N m s/rad] (default: scaled to each joint's inertia,
             :func:`~robodyn.sim.gains.pd_gains`); computed-torque: in [1/s²] and [1/s]
@@ -163,8 +164,8 @@ def run_simulation(
         )
     options["gains"] = {"kp": kp, "kd": kd}
     law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
-    if reference is not None:
-        law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
+    law = law if reference is None else ComputedTorque(controller_model(robot), TrajectoryReference(reference))
+    _compensate(law, joint_friction)
     pushes, external = push_wrenches(robot, force_at, controlled or None)
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
@@ -221,6 +222,12 @@ def _summary(robot: Robot, trajectory: Trajectory, settings: dict[str, Any], ela
         energy_change=float(energy[-1] - energy[0]),
         violations=() if limits == "ignore" else tuple(limit_violations(robot, trajectory)),
     )  # fmt: skip
+
+
+def _compensate(law: object, joint_friction: bool) -> None:
+    """The model-based laws compensate the joints' viscous damping exactly when the run applies it."""
+    if isinstance(law, ComputedTorque | TaskSpace | OperationalSpace | Impedance):
+        law.compensate_damping = joint_friction
 
 
 def _check_request(robot: Robot, controller: str, target: list[float] | None, frame: str | None, limits: str) -> None:

@@ -340,3 +340,22 @@ def test_a_joint_target_of_a_floating_robot_is_its_joints_and_any_other_length_i
         assert "12 joint values" in str(raised.value) and "'FL_HAA'" in str(raised.value) and "'HR_KFE'" in str(raised.value)
     with pytest.raises(InputError):
         joint_target(robodyn.load("rp_arm"), [0.1, np.nan], "pd")
+
+
+@pytest.mark.parametrize("compensate", [True, False], ids=["compensated", "negative_control_rigid_law"])
+def test_computed_torque_compensating_the_damping_keeps_its_closed_loop_law_on_the_damped_panda(compensate):
+    """The panda's joints are damped (``b`` 0.003 N m s/rad) and the plant applies it by
+    default: with ``compensate_damping`` the tracking error still obeys ë + Kd ė + Kp e = 0
+    (as on the rigid plant); the rigid-body law leaves it by far more."""
+    robot = robodyn.load("panda", lock={"panda_finger_joint1": 0.0})
+    assert robot.joint_damping.all()
+    q0 = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+    v0 = np.array([0.4, -0.3, 0.5, 0.2, -0.6, 0.3, 0.8])
+    reference = quintic_reference(q0 + 0.1, q0 + np.array([0.3, 0.25, -0.3, 0.3, 0.2, -0.3, 0.25]), 0.3)
+    kp, kd = 100.0, 12.0
+    law = ComputedTorque(robot, reference, kp, kd, compensate_damping=compensate)
+    trajectory = robodyn.simulate(robot, q0, v0, 0.5, DT, controller=law, limits="ignore", engine="pinocchio")
+    desired = np.array([reference(t)[0] for t in trajectory.t])
+    exact = _linear_error(reference(0.0)[0] - q0, -v0, kp, kd, trajectory.t)
+    deviation = np.abs(desired - trajectory.q - exact).max() / np.abs(exact).max()
+    assert (deviation < 1e-6) == compensate, deviation
