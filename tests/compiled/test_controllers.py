@@ -189,3 +189,22 @@ def test_each_twin_compensates_the_joint_damping_as_the_python_law_does(kind):
     assert deviation(python, compiled) <= TOLERANCE
     rigid = simulate_compiled(compile(robot), q0, v0, 0.5, 1e-3, controller=dataclasses.replace(twin, viscous=None))
     assert np.abs(rigid.tau[0] - python.tau[0]).max() == pytest.approx(np.abs(robot.joint_damping * v0).max(), rel=1e-9)
+
+
+def test_the_floating_computed_torque_twin_compensates_the_joints_damping_as_the_python_law():
+    """A free body with two damped arms: the twin carries the joints' damping (not the base's
+    six zeros) and gives the Python law's run; negative control: without it, it departs."""
+    from tests.sim.test_control import FLOATING_DAMPED
+
+    robot = robodyn.load(FLOATING_DAMPED, floating_base=True, gravity=[0.3, -0.2, -9.7])
+    q0 = robot.floating_configuration([0.0, 0.0, 1.0], [0.1, -0.2, 0.3], np.array([-0.2, 0.3]))
+    v0 = np.concatenate([0.2 * np.ones(6), [1.5, -2.0]])
+    law = ComputedTorque(robot, quintic_reference(q0[7:], np.array([0.4, -0.3]), 0.3), compensate_damping=True)
+    python = robodyn.simulate(robot, q0, v0, 0.4, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    twin = compiled_controller(law)
+    assert np.array_equal(twin.viscous, robot.joint_damping[6:])
+    compiled = simulate_compiled(compile(robot), q0, v0, 0.4, 1e-3, controller=twin)
+    assert np.abs(compiled.tau[0] - python.tau[0]).max() <= 1e-12 * np.abs(python.tau[0]).max()
+    assert deviation(python, compiled) <= TOLERANCE
+    rigid = simulate_compiled(compile(robot), q0, v0, 0.4, 1e-3, controller=dataclasses.replace(twin, viscous=None))
+    assert np.abs(rigid.tau[0] - python.tau[0]).max() == pytest.approx(np.abs(robot.joint_damping * v0).max(), rel=1e-9)

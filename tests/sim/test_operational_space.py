@@ -3,7 +3,8 @@
 - With a perfect model the task error obeys ``ë + Kd ė + Kp e = 0`` (position exactly,
   orientation by its SO(3) logarithm): the simulated error against the matrix exponential
   over the whole transient (panda full pose with a posture, ur5 along a moving path, the
-  RP arm in its plane). Negative control: without the ``J̇ v`` term the transient is off.
+  RP arm in its plane), and on the damped panda with ``compensate_damping`` (negative
+  control: the rigid-body law). Negative control: without the ``J̇ v`` term the transient is off.
 - The posture acts in the null space only: ``J M⁻¹ Nᵀ = 0`` at random states (negative
   control: the kinematic projector ``I − J⁺ J`` fails it) and the task error is the same
   with and without a posture while the joints move differently.
