@@ -53,6 +53,11 @@ def _gain(value: float | np.ndarray, name: str, nv: int) -> np.ndarray:
     return as_state(np.broadcast_to(np.asarray(value, dtype=float), (nv,)) if np.ndim(value) == 0 else value, name, nv)
 
 
+def _viscous(viscous: np.ndarray | None, n: int) -> np.ndarray:
+    """The damping ``b`` the law adds as ``b ∘ v`` (shape (n,), in [N m s/rad] or [N s/m]); zeros: none."""
+    return np.zeros(n) if viscous is None else _vector(viscous, "viscous", n)
+
+
 def _rotation(rotation: np.ndarray | None) -> tuple[int, np.ndarray]:
     """Task rows (3 without a target attitude, 6 with) and the target rotation (9, row-major)."""
     if rotation is None:
@@ -121,6 +126,8 @@ class CompiledComputedTorque(CompiledLaw):
         q_start, q_end: Ends of the reference, shape (n,).
         duration: Motion time in [s] (then the reference holds ``q_end``).
         kp: Position gain in [1/s²]; kd: velocity gain in [1/s] (scalars or shape (n,)).
+        viscous: The joints' damping ``b`` the law compensates (adds ``b ∘ v``), shape (n,);
+            ``None``: the rigid-body law.
     """
 
     q_start: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -128,9 +135,11 @@ class CompiledComputedTorque(CompiledLaw):
     duration: float = 1.0
     kp: float | np.ndarray = 400.0
     kd: float | np.ndarray = 40.0
+    viscous: np.ndarray | None = None
     law: ClassVar[str] = "CT"
     layout: ClassVar[tuple[Field, ...]] = (
         ("q_start", (0, 1, 0)), ("q_end", (0, 1, 0)), ("kp", (0, 1, 0)), ("kd", (0, 1, 0)), ("duration", (1, 0, 0)),
+        ("viscous", (0, 1, 0)),
     )  # fmt: skip
     floating: ClassVar[bool] = True
 
@@ -138,7 +147,8 @@ class CompiledComputedTorque(CompiledLaw):
         if not (math.isfinite(self.duration) and self.duration > 0):
             raise InputError("duration", "finite and > 0", repr(self.duration))
         ends = [as_state(self.q_start, "q_start", n), as_state(self.q_end, "q_end", n)]
-        return np.concatenate([*ends, _gain(self.kp, "kp", n), _gain(self.kd, "kd", n), [float(self.duration)]])
+        gains = [_gain(self.kp, "kp", n), _gain(self.kd, "kd", n)]
+        return np.concatenate([*ends, *gains, [float(self.duration)], _viscous(self.viscous, n)])
 
 
 @dataclass(frozen=True)
@@ -158,21 +168,24 @@ class CompiledFrameController(CompiledLaw):
 
 @dataclass(frozen=True)
 class CompiledTaskSpace(CompiledFrameController):
-    """:class:`robodyn.sim.control.TaskSpace` in C (same attributes and formulas)."""
+    """:class:`robodyn.sim.control.TaskSpace` in C (same attributes and formulas; ``viscous``:
+    the compensated joint damping ``b``, shape (n,), as for :class:`CompiledComputedTorque`)."""
 
     target: np.ndarray = field(default_factory=lambda: np.zeros(3))
     kp: float = 100.0
     kd: float = 20.0
     damping: float = 1e-6
     joint_damping: float = 5.0
+    viscous: np.ndarray | None = None
     law: ClassVar[str] = "TS"
     layout: ClassVar[tuple[Field, ...]] = (
         ("target", (3, 0, 0)), ("kp", (1, 0, 0)), ("kd", (1, 0, 0)), ("damping", (1, 0, 0)), ("joint_damping", (1, 0, 0)),
+        ("viscous", (0, 1, 0)),
     )  # fmt: skip
 
     def params(self, n: int) -> np.ndarray:
         gains = [_scalar(getattr(self, name), name) for name in ("kp", "kd", "damping", "joint_damping")]
-        return np.concatenate([_vector(self.target, "target", 3), gains])
+        return np.concatenate([_vector(self.target, "target", 3), gains, _viscous(self.viscous, n)])
 
 
 @dataclass(frozen=True)
@@ -183,6 +196,7 @@ class CompiledOperationalSpace(CompiledFrameController):
         position: Target position in [m], shape (3,).
         rotation: Target attitude as a rotation matrix (3, 3); ``None``: position only.
         kp, kd, posture, posture_kp, posture_kd, damping: As the Python controller's.
+        viscous: The compensated joint damping ``b``, shape (n,) (as for :class:`CompiledComputedTorque`).
     """
 
     position: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -193,10 +207,11 @@ class CompiledOperationalSpace(CompiledFrameController):
     posture_kp: float = 25.0
     posture_kd: float = 10.0
     damping: float = 1e-8
+    viscous: np.ndarray | None = None
     law: ClassVar[str] = "OSC"
     layout: ClassVar[tuple[Field, ...]] = (
         ("rows", (1, 0, 0)), ("position", (3, 0, 0)), ("rotation", (9, 0, 0)), ("kp", (1, 0, 0)), ("kd", (1, 0, 0)), ("damping", (1, 0, 0)),
-        ("posture_kp", (1, 0, 0)), ("posture_kd", (1, 0, 0)), ("has_posture", (1, 0, 0)), ("posture", (0, 1, 0)),
+        ("posture_kp", (1, 0, 0)), ("posture_kd", (1, 0, 0)), ("has_posture", (1, 0, 0)), ("posture", (0, 1, 0)), ("viscous", (0, 1, 0)),
     )  # fmt: skip
 
     def params(self, n: int) -> np.ndarray:
@@ -204,8 +219,9 @@ class CompiledOperationalSpace(CompiledFrameController):
         gains = [_scalar(getattr(self, name), name) for name in ("kp", "kd", "damping", "posture_kp", "posture_kd")]
         posture = np.zeros(n) if self.posture is None else as_state(self.posture, "posture", n)
         return np.concatenate(
-            [[rows], _vector(self.position, "position", 3), rotation, gains, [float(self.posture is not None)], posture]
-        )
+            [[rows], _vector(self.position, "position", 3), rotation, gains, [float(self.posture is not None)], posture,
+             _viscous(self.viscous, n)]
+        )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -218,6 +234,7 @@ class CompiledImpedance(CompiledFrameController):
         stiffness: [N/m] then [N m/rad], shape (3,) or (6,) (as many as the task's rows).
         damping: [N s/m] then [N m s/rad], same shape.
         null_damping: In [N m s/rad].
+        viscous: The compensated joint damping ``b``, shape (n,) (as for :class:`CompiledComputedTorque`).
     """
 
     position: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -225,9 +242,11 @@ class CompiledImpedance(CompiledFrameController):
     stiffness: np.ndarray = field(default_factory=lambda: np.array([500.0] * 3))
     damping: np.ndarray = field(default_factory=lambda: np.array([50.0] * 3))
     null_damping: float = 1.0
+    viscous: np.ndarray | None = None
     law: ClassVar[str] = "IMP"
     layout: ClassVar[tuple[Field, ...]] = (
         ("rows", (1, 0, 0)), ("position", (3, 0, 0)), ("rotation", (9, 0, 0)), ("stiffness", (6, 0, 0)), ("damping", (6, 0, 0)), ("null_damping", (1, 0, 0)),
+        ("viscous", (0, 1, 0)),
     )  # fmt: skip
 
     def params(self, n: int) -> np.ndarray:
@@ -236,7 +255,9 @@ class CompiledImpedance(CompiledFrameController):
         stiffness[:rows] = _vector(self.stiffness, "stiffness", rows)
         damping[:rows] = _vector(self.damping, "damping", rows)
         null = [_scalar(self.null_damping, "null_damping")]
-        return np.concatenate([[rows], _vector(self.position, "position", 3), rotation, stiffness, damping, null])
+        return np.concatenate(
+            [[rows], _vector(self.position, "position", 3), rotation, stiffness, damping, null, _viscous(self.viscous, n)]
+        )
 
 
 @dataclass(frozen=True)

@@ -540,6 +540,7 @@ static void rdc_task_space(const rd_kernels *model, const rd_frame_kernels *fram
         command[i] = pd - Nv[i];
     }
     model->tau(q, v, command, tau);
+    for (int j = 0; j < n; ++j) tau[j] += p[RD_TS_VISCOUS(n) + j] * v[j]; /* + b ∘ v (zeros: the rigid law) */
 }
 
 /* params: RD_OSC_* (CompiledOperationalSpace's layout; robodyn.sim.operational_space.OperationalSpace,
@@ -603,7 +604,7 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
     for (int j = 0; j < n; ++j) {
         double task = 0.0, back = 0.0;
         for (int i = 0; i < m; ++i) task += J[i * n + j] * f[i], back += J[i * n + j] * LJP[i];
-        tau[j] = task + h[j] + (posture[j] - back);
+        tau[j] = task + h[j] + (posture[j] - back) + p[RD_OSC_VISCOUS(n) + j] * v[j]; /* + b ∘ v */
     }
     if (a) { /* the plant's accelerations when it is this model: rd_fd_raw's arithmetic on M, h */
         for (int i = 0; i < n; ++i) a[i] = tau[i] - h[i];
@@ -648,7 +649,7 @@ static void rdc_impedance(const rd_kernels *model, const rd_frame_kernels *frame
             for (int i = 0; i < m; ++i) JtGJ += J[i * n + k] * GJ[i * n + j];
             Ntdv -= JtGJ * dv[k];
         }
-        tau[j] = g[j] + Jw - Ntdv;
+        tau[j] = g[j] + Jw - Ntdv + p[RD_IMP_VISCOUS(n) + j] * v[j]; /* + b ∘ v */
     }
 }
 
@@ -728,6 +729,7 @@ static void rd_control_free_base(const rd_controller *c, double t, const double 
         a[6 + i] = a_d + p[RD_CT_KD(m) + i] * (v_d - v[6 + i]) + p[RD_CT_KP(m) + i] * (q_d - q[7 + i]);
     }
     rd_free_base_torques(c->model, q, v, a, tau);
+    for (int i = 0; i < m; ++i) tau[6 + i] += p[RD_CT_VISCOUS(m) + i] * v[6 + i]; /* + b ∘ v on the joints */
 }
 #endif
 
@@ -760,6 +762,7 @@ static void rd_control(const rd_controller *c, double t, const double *q, const 
             command[i] = a_d + p[RD_CT_KD(n) + i] * (v_d - v[i]) + p[RD_CT_KP(n) + i] * (q_d - q[i]);
         }
         c->model->tau(q, v, command, tau);
+        for (int i = 0; i < n; ++i) tau[i] += p[RD_CT_VISCOUS(n) + i] * v[i]; /* + b ∘ v (zeros: the rigid law) */
     }
 }
 

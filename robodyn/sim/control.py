@@ -21,12 +21,15 @@ is the joints' positions only, ``nq − 7`` values (:func:`joint_target` checks 
 stays free and gets no torque (computed torque solves for the base acceleration the joints'
 motion causes).
 
-What the models compensate: every controller here uses its own rigid-body model (armature
-included, :attr:`robodyn.Robot.joint_armature`); none compensates the joints' damping or
-Coulomb friction (:mod:`robodyn.dynamics.joint_dynamics`), which the simulation applies
-by default: with friction in the plant a PD or task-space law stops where its torque falls
-inside the stiction band, and computed torque tracks with an error the friction drives.
-The same holds for the operational-space and impedance controllers re-exported here.
+What the models compensate: every controller uses its own rigid-body model (armature
+included). The model-based laws (:class:`ComputedTorque`, :class:`TaskSpace`, operational
+space, impedance; a floating base's computed torque on its joints) add ``b ∘ v``, the model's
+viscous joint damping (:attr:`robodyn.Robot.joint_damping`), when ``compensate_damping`` is
+on, so their closed-loop law holds on a plant that applies it; off (the classes' default, and
+``run_simulation(joint_friction=False)``) they are the rigid-body laws. Turn it on exactly when
+the run applies the joints' dynamics (:func:`robodyn.simulate`'s ``joint_friction=True``, as
+``run_simulation`` does). PD + gravity compensates no velocity term; no law compensates
+Coulomb friction, so with it a PD or task-space law stops inside the stiction band.
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from robodyn.common.text import quoted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.linearize import StepIntegrator, actuation_matrix, linearize
-from robodyn.sim.twin import compiled_model, law_refusal
+from robodyn.sim.twin import compiled_model, law_refusal, viscous_compensation, viscous_params
 
 if TYPE_CHECKING:
     from robodyn.compiled.controllers import (
@@ -57,7 +60,8 @@ JointReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 @dataclass
 class PDGravity:
-    """PD control with gravity compensation, to a fixed joint target.
+    """PD control with gravity compensation, to a fixed joint target (no velocity term is
+    model-based: the joints' damping is not compensated, it adds to ``kd``).
 
     Attributes:
         model: The controller's model of the robot.
@@ -99,20 +103,22 @@ class ComputedTorque:
             joints' motion causes, and gets no torque).
         kp: Position gain in [1/s²] (scalar or shape (nv,)).
         kd: Velocity gain in [1/s].
+        compensate_damping: Add ``b ∘ v`` (the model's joint damping; see the module's note).
     """
 
     model: Robot
     reference: JointReference
     kp: float | np.ndarray = 400.0
     kd: float | np.ndarray = 40.0
+    compensate_damping: bool = False
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         q_d, v_d, a_d = self.reference(t)
         if self.model.floating_base:
             command = a_d + self.kd * (v_d - v[6:]) + self.kp * (q_d - q[7:])
-            return free_base_torques(self.model, q, v, command)
+            return free_base_torques(self.model, q, v, command) + viscous_compensation(self.model, self.compensate_damping, v)
         command = a_d + self.kd * (v_d - v) + self.kp * (q_d - q)
-        return self.model.inverse_dynamics(q, v, command)
+        return self.model.inverse_dynamics(q, v, command) + viscous_compensation(self.model, self.compensate_damping, v)
 
     def twin_refusal(self) -> str | None:
         """Why this controller has no compiled twin: a reference other than a
@@ -127,7 +133,8 @@ class ComputedTorque:
 
         model, reference = compiled_model(self.model, self.twin_refusal()), self.reference
         assert isinstance(reference, QuinticReference)  # twin_refusal checked it
-        return CompiledComputedTorque(model, reference.q_start, reference.q_end, reference.duration, self.kp, self.kd)
+        viscous = viscous_params(self.model, self.compensate_damping, reference.q_start.size)
+        return CompiledComputedTorque(model, reference.q_start, reference.q_end, reference.duration, self.kp, self.kd, viscous)
 
 
 @dataclass
@@ -148,6 +155,7 @@ class TaskSpace:
             directions the frame cannot move in, e.g. out of the RP arm's plane).
         joint_damping: Damping in [1/s] of the joint motion the task leaves free (the
             null space), so that redundant arms come to rest.
+        compensate_damping: Add ``b ∘ v`` (the model's joint damping; see the module's note).
     """
 
     model: Robot
@@ -157,6 +165,7 @@ class TaskSpace:
     kd: float = 20.0
     damping: float = 1e-6
     joint_damping: float = 5.0
+    compensate_damping: bool = False
     #: The compiled twin's frame kinematics model fixed bases.
     twin_fixed_base: ClassVar[bool] = True
 
@@ -178,7 +187,7 @@ class TaskSpace:
         pseudo_inverse = jacobian.T @ np.linalg.solve(gram, np.eye(3))
         null_space = np.eye(self.model.nv) - pseudo_inverse @ jacobian
         command = pseudo_inverse @ desired - null_space @ (self.joint_damping * v)
-        return self.model.inverse_dynamics(q, v, command)
+        return self.model.inverse_dynamics(q, v, command) + viscous_compensation(self.model, self.compensate_damping, v)
 
     def twin_refusal(self) -> str | None:
         """Why this controller has no compiled twin (a floating base: its frame kernels model fixed bases)."""
@@ -189,7 +198,8 @@ class TaskSpace:
         from robodyn.compiled.controllers import CompiledTaskSpace
 
         model = compiled_model(self.model, self.twin_refusal())
-        return CompiledTaskSpace(model, self._frame, self.target, self.kp, self.kd, self.damping, self.joint_damping)
+        args = (self.target, self.kp, self.kd, self.damping, self.joint_damping)
+        return CompiledTaskSpace(model, self._frame, *args, viscous_params(self.model, self.compensate_damping, self.model.nv))
 
 
 @dataclass(frozen=True)
@@ -265,8 +275,7 @@ def _floating_pd(law: PDGravity, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return torques
 
 
-# Operational-space and impedance control live in their own module; re-exported here with
-# the other controllers.
+# Operational-space and impedance control live in their own module; re-exported here.
 from robodyn.sim.operational_space import Impedance as Impedance  # noqa: E402
 from robodyn.sim.operational_space import OperationalSpace as OperationalSpace  # noqa: E402
 

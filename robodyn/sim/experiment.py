@@ -35,7 +35,7 @@ from robodyn.sim.contact_run import ground_lines
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
 from robodyn.sim.gains import LQR_ACCELERATION as LQR_ACCELERATION
 from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_gains
-from robodyn.sim.ground import Ground
+from robodyn.sim.ground import Ground, resolve_ground
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
@@ -46,6 +46,7 @@ from robodyn.sim.requests import applied_torques as applied_torques  # robodyn.v
 from robodyn.sim.requests import observer_outcome as observer_outcome
 from robodyn.sim.simulation import Engine, Integrator, simulate_run
 from robodyn.sim.stand_run import RecordedStand, stand_law, stand_outcome
+from robodyn.sim.twin import compensate
 from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_dofs
 from robodyn.trajectory import Trajectory
 
@@ -88,7 +89,7 @@ def run_simulation(
     joint_friction: bool = True,
     kp: float | list[float] | None = None,
     kd: float | list[float] | None = None,
-    ground: Ground | None = None,
+    ground: Ground | str | None = None,
     contacts: str | Sequence[str] = "collision",
 ) -> tuple[Trajectory, SimulationSummary]:
     """Simulate ``robot`` under a named controller and summarise.
@@ -131,7 +132,8 @@ def run_simulation(
         control_period: Sample the controller every ``control_period`` [s] and hold its
             torque (zero-order hold; the summary says so); ``None``: every stage.
         joint_friction: As for :func:`robodyn.simulate`: the joints' damping and friction
-            act (``False``: the rigid-body motion). The controllers' models are rigid-body.
+            act (``False``: the rigid-body motion); the model-based controllers compensate the
+            viscous damping exactly when it acts (``compensate_damping``).
         kp, kd: pd: stiffness and damping, a scalar or one value a joint, in [N m/rad] and
             [N m s/rad] (default: scaled to each joint's inertia,
             :func:`~robodyn.sim.gains.pd_gains`); computed-torque: in [1/s²] and [1/s]
@@ -152,6 +154,7 @@ def run_simulation(
     if observer_gain is not None and not (np.isfinite(observer_gain) and observer_gain > 0):
         raise InputError("observer_gain", "a positive gain in [1/s]", repr(observer_gain))
     options = _options(robot, controller, posture, stiffness, damping, actuated, kp, kd)
+    ground = resolve_ground(robot, ground)  # "file": the plane the robot's file states
     start, lifted = _start(robot, controller, q0, ground, contacts)
     law: Any
     if controller == "stand":  # started on its feet (gap 0), stand_run's docstring
@@ -161,6 +164,7 @@ def run_simulation(
         law, task, controlled = _control_law(robot, controller, target, frame, start, duration, options)
     if reference is not None:
         law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
+    compensate(law, joint_friction)
     pushes, external = push_wrenches(robot, force_at, controlled or None)
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns

@@ -40,7 +40,7 @@ from robodyn.common.rotations import rpy_matrix, skew
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.reach import check_reach
-from robodyn.sim.twin import compiled_model, law_refusal
+from robodyn.sim.twin import compiled_model, law_refusal, viscous_compensation, viscous_params
 
 if TYPE_CHECKING:
     from robodyn.compiled.controllers import CompiledImpedance, CompiledOperationalSpace
@@ -203,6 +203,8 @@ class OperationalSpace:
         posture_kp: Posture stiffness in [1/s²]. posture_kd: Posture damping in [1/s]
             (also applied without a posture, so that a redundant arm comes to rest).
         damping: Damping of ``Λ`` relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
+        compensate_damping: Add ``b ∘ v``, the model's joint damping (on exactly when the
+            run applies it: :mod:`robodyn.sim.control`'s note).
 
     Raises:
         FrameError: Unknown frame, or one no joint moves.
@@ -221,6 +223,7 @@ class OperationalSpace:
     posture_kp: float = 25.0
     posture_kd: float = 10.0
     damping: float = TASK_DAMPING
+    compensate_damping: bool = False
     _frame_id: int = field(init=False, repr=False)
     _rotation: np.ndarray | None = field(init=False, repr=False)
     #: The compiled twin's frame kinematics model fixed bases.
@@ -237,8 +240,7 @@ class OperationalSpace:
                 raise InputError("posture", f"one configuration ({self.model.nq} values)", f"shape {self.posture.shape}")
 
     def task_error(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The task error ``e`` and its rate ``ė`` (position in [m], [m/s], then orientation
-        in [rad], [rad/s] with an orientation target), each shape (3,) or (6,)."""
+        """The task error ``e`` and its rate ``ė`` ([m], [m/s], then with an attitude [rad], [rad/s]), each (3,) or (6,)."""
         state = _frame_state(self.model, self._frame_id, q, v)
         error, rate, _ = self._error(t, state, v)
         return error, rate
@@ -277,11 +279,11 @@ class OperationalSpace:
         posture_error = np.zeros(model.nv) if self.posture is None else pin.difference(model.model, q, self.posture)
         posture = mass @ (self.posture_kp * posture_error - self.posture_kd * v)
         task = jacobian.T @ (inertia @ (command - bias))
-        return task + model.nonlinear_effects(q, v) + null_space.T @ posture
+        compensation = viscous_compensation(model, self.compensate_damping, v)
+        return task + model.nonlinear_effects(q, v) + null_space.T @ posture + compensation
 
     def twin_refusal(self) -> str | None:
-        """Why this controller has no compiled twin: a path target (the C law holds a fixed
-        one), a floating base, or a changed law."""
+        """Why this controller has no compiled twin: a path target, a floating base, or a changed law."""
         if callable(self.position):
             return f"{type(self).__name__} compiles with a fixed target, not a path"
         return law_refusal(self, OperationalSpace)
@@ -292,9 +294,10 @@ class OperationalSpace:
 
         model = compiled_model(self.model, self.twin_refusal())
         assert self.frame is not None and not callable(self.position)  # resolved; twin_refusal checked
+        viscous = viscous_params(self.model, self.compensate_damping, self.model.nv)
         return CompiledOperationalSpace(
             model, self.frame, self.position, self._rotation, self.kp, self.kd, self.posture, self.posture_kp,
-            self.posture_kd, self.damping,
+            self.posture_kd, self.damping, viscous,
         )  # fmt: skip
 
 
@@ -326,6 +329,7 @@ class Impedance:
         damping: ``D``: [N s/m], then [N m s/rad].
         null_damping: ``d₀`` in [N m s/rad] (or [N s/m]): damps the joint motion the task
             leaves free; zero at rest.
+        compensate_damping: Add ``b ∘ v`` (the model's joint damping).
 
     Raises:
         FrameError: Unknown frame, or one no joint moves.
@@ -340,6 +344,7 @@ class Impedance:
     stiffness: float | np.ndarray = field(default_factory=lambda: np.array([500.0] * 3 + [50.0] * 3))
     damping: float | np.ndarray = field(default_factory=lambda: np.array([50.0] * 3 + [5.0] * 3))
     null_damping: float = 1.0
+    compensate_damping: bool = False
     _frame_id: int = field(init=False, repr=False)
     _rotation: np.ndarray | None = field(init=False, repr=False)
     #: The compiled twin's frame kinematics model fixed bases.
@@ -358,9 +363,8 @@ class Impedance:
         self.damping = _gains(self.damping, rows, "damping", "[N s/m], then [N m s/rad]")
 
     def deflection(self, q: np.ndarray) -> np.ndarray:
-        """The frame's displacement from rest: position in [m], then (with an orientation)
-        the rotation from rest as a rotation vector in world axes, in [rad]; shape (3,)
-        or (6,). A steady external wrench ``F`` at the frame makes it ``K⁻¹ F``."""
+        """The frame's displacement from rest, shape (3,) or (6,): position in [m], then (with an orientation)
+        the rotation from rest as a rotation vector in world axes in [rad]. A steady wrench ``F`` there gives ``K⁻¹ F``."""
         state = _frame_state(self.model, self._frame_id, q, np.zeros(self.model.nv))
         shift = state.position - np.asarray(self.position)
         if self._rotation is None:
@@ -378,7 +382,8 @@ class Impedance:
         wrench = self.stiffness * error - self.damping * (jacobian @ v)
         gram = jacobian @ jacobian.T + PSEUDO_INVERSE_DAMPING * np.eye(rows)
         null_space = np.eye(model.nv) - jacobian.T @ np.linalg.solve(gram, jacobian)
-        return model.gravity(q) + jacobian.T @ wrench - null_space.T @ (self.null_damping * v)
+        compensation = viscous_compensation(model, self.compensate_damping, v)
+        return model.gravity(q) + jacobian.T @ wrench - null_space.T @ (self.null_damping * v) + compensation
 
     def twin_refusal(self) -> str | None:
         """Why this controller has no compiled twin (a floating base, or a changed law)."""
@@ -390,5 +395,6 @@ class Impedance:
 
         model = compiled_model(self.model, self.twin_refusal())
         assert self.frame is not None  # resolved by __post_init__
-        stiffness, damping = np.asarray(self.stiffness), np.asarray(self.damping)
-        return CompiledImpedance(model, self.frame, self.position, self._rotation, stiffness, damping, self.null_damping)
+        viscous = viscous_params(self.model, self.compensate_damping, self.model.nv)
+        gains = np.asarray(self.stiffness), np.asarray(self.damping), self.null_damping
+        return CompiledImpedance(model, self.frame, self.position, self._rotation, *gains, viscous)

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import CompileError
 
@@ -48,3 +50,40 @@ def compiled_model(model: Robot, refusal: str | None) -> CompiledRobot:
     from robodyn.compiled.robot import compile
 
     return compile(model)
+
+
+def viscous_compensation(model: Robot, compensate: bool, v: np.ndarray) -> np.ndarray | float:
+    """The torque ``b ∘ v`` that cancels the joints' viscous damping (the model's
+    :attr:`~robodyn.Robot.joint_damping`, shape (nv,) like ``v``), or 0 when ``compensate`` is
+    off; the Coulomb term is never compensated (its sign switches at rest).
+
+    Args:
+        model: The controller's model of the robot.
+        compensate: The controller's ``compensate_damping``.
+        v: Joint velocities, shape (nv,), in [rad/s] or [m/s].
+    """
+    return model.joint_damping * v if compensate else 0.0
+
+
+def viscous_params(model: Robot, compensate: bool, joints: int) -> np.ndarray | None:
+    """The damping vector a compiled twin adds as ``b ∘ v`` (the last ``joints`` entries of the
+    model's :attr:`~robodyn.Robot.joint_damping`: a floating base's joints), ``None`` when off.
+
+    Args:
+        model: The controller's model of the robot.
+        compensate: The controller's ``compensate_damping``.
+        joints: The law's coordinates (``nv``, or a floating base's ``nv − 6`` joints).
+    """
+    return np.array(model.joint_damping[model.nv - joints :], dtype=float) if compensate else None
+
+
+def compensate(law: object, joint_friction: bool) -> None:
+    """Make a model-based law (computed torque, task space, operational space, impedance)
+    compensate the joints' viscous damping exactly when the run applies it.
+
+    Args:
+        law: The run's controller (others are left as they are).
+        joint_friction: Whether the run applies the joints' damping (``simulate``'s option).
+    """
+    if hasattr(law, "compensate_damping"):
+        law.compensate_damping = joint_friction

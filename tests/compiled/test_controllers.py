@@ -153,3 +153,58 @@ def test_the_compiled_lqr_leaves_unactuated_joints_free_and_holds_like_the_pytho
     other = dataclasses.replace(twin, gain=twin.gain * 1.0001)
     departed = simulate_compiled(compile(robot), q0, v0, 1.5, 2e-3, controller=other, hold=True, joint_friction=False)
     assert deviation(python, departed) > TOLERANCE
+
+
+#: A damped robot small enough to compile in the fast tier (damping 0.05 N m s/rad a joint).
+DAMPED = "double_pendulum_continuous"
+
+
+def _damped_laws(robot) -> dict[str, object]:
+    """The model-based laws, compensating the model's joint damping (``b ∘ v``)."""
+    q_goal = np.array([0.6, -0.4])
+    target = robot.frame_position(q_goal, robot.end_effector)
+    return {
+        "computed-torque": ComputedTorque(robot, quintic_reference(np.zeros(2), q_goal, 0.3), compensate_damping=True),
+        "task-space": TaskSpace(robot, None, target, kp=60.0, kd=14.0, compensate_damping=True),
+        "operational-space": OperationalSpace(robot, None, target, kp=60.0, kd=14.0, compensate_damping=True),
+        "impedance": Impedance(robot, None, target, compensate_damping=True),
+    }
+
+
+@pytest.mark.parametrize("kind", ["computed-torque", "task-space", "operational-space", "impedance"])
+def test_each_twin_compensates_the_joint_damping_as_the_python_law_does(kind):
+    """On a damped plant (its damping applied in both engines), from a moving start: the
+    twin's torque at the first state within 1e-12 of the Python law's, the runs within 1e-9;
+    negative control: the twin without the damping vector departs by about b v."""
+    robot = robodyn.load(DAMPED, gravity=[0.6, 0.0, -9.7])
+    assert robot.joint_damping.all()
+    law = _damped_laws(robot)[kind]
+    q0, v0 = np.array([0.2, 0.3]), np.array([1.5, -2.0])
+    python = robodyn.simulate(robot, q0, v0, 0.5, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    twin = compiled_controller(law)
+    assert np.array_equal(twin.viscous, robot.joint_damping)
+    compiled = simulate_compiled(compile(robot), q0, v0, 0.5, 1e-3, controller=twin)
+    np.testing.assert_allclose(python.tau[0], law(0.0, q0, v0), rtol=0, atol=1e-12)
+    assert np.abs(compiled.tau[0] - python.tau[0]).max() <= 1e-12 * max(1.0, np.abs(python.tau[0]).max())
+    assert deviation(python, compiled) <= TOLERANCE
+    rigid = simulate_compiled(compile(robot), q0, v0, 0.5, 1e-3, controller=dataclasses.replace(twin, viscous=None))
+    assert np.abs(rigid.tau[0] - python.tau[0]).max() == pytest.approx(np.abs(robot.joint_damping * v0).max(), rel=1e-9)
+
+
+def test_the_floating_computed_torque_twin_compensates_the_joints_damping_as_the_python_law():
+    """A free body with two damped arms: the twin carries the joints' damping (not the base's
+    six zeros) and gives the Python law's run; negative control: without it, it departs."""
+    from tests.sim.test_control import FLOATING_DAMPED
+
+    robot = robodyn.load(FLOATING_DAMPED, floating_base=True, gravity=[0.3, -0.2, -9.7])
+    q0 = robot.floating_configuration([0.0, 0.0, 1.0], [0.1, -0.2, 0.3], np.array([-0.2, 0.3]))
+    v0 = np.concatenate([0.2 * np.ones(6), [1.5, -2.0]])
+    law = ComputedTorque(robot, quintic_reference(q0[7:], np.array([0.4, -0.3]), 0.3), compensate_damping=True)
+    python = robodyn.simulate(robot, q0, v0, 0.4, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    twin = compiled_controller(law)
+    assert np.array_equal(twin.viscous, robot.joint_damping[6:])
+    compiled = simulate_compiled(compile(robot), q0, v0, 0.4, 1e-3, controller=twin)
+    assert np.abs(compiled.tau[0] - python.tau[0]).max() <= 1e-12 * np.abs(python.tau[0]).max()
+    assert deviation(python, compiled) <= TOLERANCE
+    rigid = simulate_compiled(compile(robot), q0, v0, 0.4, 1e-3, controller=dataclasses.replace(twin, viscous=None))
+    assert np.abs(rigid.tau[0] - python.tau[0]).max() == pytest.approx(np.abs(robot.joint_damping * v0).max(), rel=1e-9)

@@ -10,6 +10,8 @@
   the transient is off although the final error is the same).
 - Zero-order hold (``hold=True``) against a step computed by hand on a gantry whose
   dynamics are written down from its URDF.
+- On damped plants (the panda; a floating body with damped arms) computed torque with
+  ``compensate_damping`` keeps its closed-loop law; negative control: the rigid-body law.
 """
 
 from __future__ import annotations
@@ -340,3 +342,54 @@ def test_a_joint_target_of_a_floating_robot_is_its_joints_and_any_other_length_i
         assert "12 joint values" in str(raised.value) and "'FL_HAA'" in str(raised.value) and "'HR_KFE'" in str(raised.value)
     with pytest.raises(InputError):
         joint_target(robodyn.load("rp_arm"), [0.1, np.nan], "pd")
+
+
+@pytest.mark.parametrize("compensate", [True, False], ids=["compensated", "negative_control_rigid_law"])
+def test_computed_torque_compensating_the_damping_keeps_its_closed_loop_law_on_the_damped_panda(compensate):
+    """The panda's joints are damped (``b`` 0.003 N m s/rad) and the plant applies it by
+    default: with ``compensate_damping`` the tracking error still obeys ë + Kd ė + Kp e = 0
+    (as on the rigid plant); the rigid-body law leaves it by far more."""
+    robot = robodyn.load("panda", lock={"panda_finger_joint1": 0.0})
+    assert robot.joint_damping.all()
+    q0 = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+    v0 = np.array([0.4, -0.3, 0.5, 0.2, -0.6, 0.3, 0.8])
+    reference = quintic_reference(q0 + 0.1, q0 + np.array([0.3, 0.25, -0.3, 0.3, 0.2, -0.3, 0.25]), 0.3)
+    kp, kd = 100.0, 12.0
+    law = ComputedTorque(robot, reference, kp, kd, compensate_damping=compensate)
+    trajectory = robodyn.simulate(robot, q0, v0, 0.5, DT, controller=law, limits="ignore", engine="pinocchio")
+    desired = np.array([reference(t)[0] for t in trajectory.t])
+    exact = _linear_error(reference(0.0)[0] - q0, -v0, kp, kd, trajectory.t)
+    deviation = np.abs(desired - trajectory.q - exact).max() / np.abs(exact).max()
+    assert (deviation < 1e-6) == compensate, deviation
+
+
+def _inertial(mass: float, com: str) -> str:
+    return f'<inertial><origin xyz="{com}"/><mass value="{mass}"/><inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0.002" izz="0.025"/></inertial>'
+
+
+#: A free-floating body with two damped arms (an oblique axis, non-default gravity below).
+FLOATING_DAMPED = (
+    f'<robot name="damped_float"><link name="body">{_inertial(2.0, "0 0 0")}</link>'
+    f'<link name="a">{_inertial(0.6, "0.1 0 0")}</link><link name="b">{_inertial(0.4, "0 0.1 0.05")}</link>'
+    '<joint name="ja" type="revolute"><parent link="body"/><child link="a"/><origin xyz="0.2 0 0"/><axis xyz="0 1 0"/>'
+    '<limit lower="-3" upper="3" effort="100" velocity="10"/><dynamics damping="0.3"/></joint>'
+    '<joint name="jb" type="revolute"><parent link="body"/><child link="b"/><origin xyz="0 0.2 0" rpy="0.2 0 0"/>'
+    '<axis xyz="0.3 0 1"/><limit lower="-3" upper="3" effort="100" velocity="10"/><dynamics damping="0.2"/></joint></robot>'
+)
+
+
+@pytest.mark.parametrize("compensate", [True, False], ids=["compensated", "negative_control_rigid_law"])
+def test_computed_torque_of_a_damped_floating_robot_compensates_its_joints_damping(compensate):
+    """Base free, joints damped: with ``compensate_damping`` the joints' error obeys
+    ë + Kd ė + Kp e = 0 and the base still gets no torque; the rigid law leaves the law."""
+    robot = robodyn.load(FLOATING_DAMPED, floating_base=True, gravity=[0.3, -0.2, -9.7])
+    assert robot.floating_base and robot.joint_damping[6:].all() and not robot.joint_damping[:6].any()
+    target, kp, kd = np.array([0.4, -0.3]), 100.0, 12.0
+    q0 = robot.floating_configuration([0.0, 0.0, 1.0], [0.1, -0.2, 0.3], np.array([-0.2, 0.3]))
+    v0 = np.concatenate([np.zeros(6), [1.5, -2.0]])
+    law = ComputedTorque(robot, lambda t: (target, np.zeros(2), np.zeros(2)), kp, kd, compensate_damping=compensate)
+    trajectory = robodyn.simulate(robot, q0, v0, 0.5, DT, controller=law, limits="ignore", engine="pinocchio")
+    exact = _linear_error(target - q0[7:], -v0[6:], kp, kd, trajectory.t)
+    deviation = np.abs((target - trajectory.q[:, 7:]) - exact).max() / np.abs(exact).max()
+    assert np.abs(trajectory.tau[:, :6]).max() == 0.0
+    assert (deviation < 1e-6) == compensate, deviation

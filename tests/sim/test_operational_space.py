@@ -3,7 +3,8 @@
 - With a perfect model the task error obeys ``ë + Kd ė + Kp e = 0`` (position exactly,
   orientation by its SO(3) logarithm): the simulated error against the matrix exponential
   over the whole transient (panda full pose with a posture, ur5 along a moving path, the
-  RP arm in its plane). Negative control: without the ``J̇ v`` term the transient is off.
+  RP arm in its plane), and on the damped panda with ``compensate_damping`` (negative
+  control: the rigid-body law). Negative control: without the ``J̇ v`` term the transient is off.
 - The posture acts in the null space only: ``J M⁻¹ Nᵀ = 0`` at random states (negative
   control: the kinematic projector ``I − J⁺ J`` fails it) and the task error is the same
   with and without a posture while the joints move differently.
@@ -90,6 +91,23 @@ def test_the_panda_pose_error_follows_the_linear_law_position_and_orientation(pa
     deviation, errors = _transient_deviation(law, trajectory)
     assert np.abs(errors[0, 3:]).max() > 0.2  # a real rotation to make, not only a shift
     assert deviation < 1e-5, deviation
+
+
+@pytest.mark.parametrize("compensate", [True, False], ids=["compensated", "negative_control_rigid_law"])
+def test_the_pose_error_follows_the_linear_law_on_the_damped_panda_when_the_damping_is_compensated(compensate):
+    """The plant applies the panda's joint damping (its default): with ``compensate_damping``
+    the transient is the rigid plant's (within 1e-6 of the law); without it, off by ~2e-3."""
+    plant, model = _panda()
+    assert plant.joint_damping.all()
+    goal = PANDA_READY + np.array([0.3, 0.25, -0.3, 0.3, 0.2, -0.3, 0.25])
+    target = _pose(plant, goal, plant.end_effector)
+    law = OperationalSpace(
+        model, None, target.translation, orientation=target.rotation, kp=KP, kd=KD, posture=PANDA_READY + 0.2,
+        compensate_damping=compensate,
+    )  # fmt: skip
+    trajectory = robodyn.simulate(plant, PANDA_READY, np.zeros(7), 0.6, DT, controller=law, limits="ignore", engine="pinocchio")
+    deviation, _ = _transient_deviation(law, trajectory)
+    assert (deviation < 1e-6) == compensate and deviation < 1e-2, deviation
 
 
 def test_the_panda_reaches_the_pose_by_pinocchios_forward_kinematics(panda_runs):
