@@ -320,3 +320,26 @@ def test_a_failure_reason_is_cut_at_200_characters_and_an_expression_too_long_is
 
 def test_a_function_shows_its_own_name():
     assert ours("str(min)") == "<function min>"
+
+
+@pytest.mark.parametrize(
+    ("item", "most"),
+    # A list's text is 2 characters of brackets and, per item, 2 of separator plus the
+    # item's own: a character a character, a float, a bool or a function 24, an integer a
+    # digit per 3 bits (+2).
+    [("'x'", 200_000), ("1.5", 35_714), ("True", 35_714), ("min", 35_714), ("2**30", 62_500)],
+)
+def test_a_repeated_list_is_bounded_by_its_items_text(item, most):
+    assert len(ours(f"[{item}] * {most}")) == most
+    with pytest.raises(ExpressionError, match="repeating a list"):
+        ours(f"[{item}] * {most + 1}")
+
+
+@pytest.mark.slow
+def test_lists_built_by_functions_count_their_items_towards_the_total_built():
+    """Each list of 333,000 one-character strings is about 1,000,000 characters as text:
+    sixteen of them are past the 20,000,000 an expression may build, though each is within."""
+    item = "len(list('x' * 333000))"
+    with pytest.raises(ExpressionError, match="builds more than 20000000 characters"):
+        ours("[" + ", ".join([item] * 16) + "]")
+    assert ours("[" + ", ".join([item] * 2) + "]") == [333_000, 333_000]
