@@ -224,6 +224,7 @@ REFUSALS = [
     ("table[(1, 2)]", "a dict key must be a string or number, not tuple"),
     ("lengths[side]", "a list index must be an integer or a slice"),
     ("lengths[0:side]", "slice bounds must be integers"),
+    ("lengths[0:1, 2]", "a Slice expression is not in the language"),
     ("side(1)", "calling a str is not in the language (only the documented functions)"),
     ("'%s' % side", "string formatting with % is not in the language"),
     ("(-8) ** 0.5", "the result is a complex number, not a real one"),
