@@ -103,3 +103,10 @@ def test_one_driven_joint_feels_the_inertia_with_the_others_giving_way(arm):
     assert np.allclose(joint_inertia(arm, list(q), driven), expected, rtol=1e-10)
     kp, _ = pd_gains(arm, q, driven=driven)
     assert np.allclose(kp, 100.0 * expected, rtol=1e-10)
+
+
+def test_a_zero_or_small_gain_is_accepted(arm):
+    q = np.zeros(arm.nq)
+    for gain in (0.0, 0.5):
+        kp, kd = pd_gains(arm, q, kp=gain, kd=gain)
+        assert np.array_equal(kp, np.full(kp.size, gain)) and np.array_equal(kd, np.full(kd.size, gain))
