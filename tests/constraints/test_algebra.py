@@ -12,7 +12,7 @@ from robodyn.constraints.algebra import rotation_log
 AXIS = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
 
 
-@pytest.mark.parametrize("angle", [0.0, 1e-9, 3e-7, 2e-6, 0.4, 2.0, np.pi - 2e-6, np.pi - 3e-7, np.pi])
+@pytest.mark.parametrize("angle", [0.0, 1e-9, 3e-7, 2e-6, 0.4, 2.0, 2.5, np.pi - 2e-6, np.pi - 3e-7, np.pi])
 @pytest.mark.parametrize("axis", [AXIS, -AXIS, np.array([0.0, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])])
 def test_the_rotation_log_is_the_rotation_vector_of_every_angle(axis, angle):
     rotation = Rotation.from_rotvec(axis * angle).as_matrix()
