@@ -138,17 +138,17 @@ def world_end(end: End, nv: int) -> EndKinematics:
 
 def rotation_log(rotation: np.ndarray) -> np.ndarray:
     """The rotation vector (axis × angle in [rad], angle in [0, π]) of a rotation matrix."""
-    cosine = min(1.0, max(-1.0, (float(np.trace(rotation)) - 1.0) / 2.0))
-    angle = math.acos(cosine)
     vector = 0.5 * np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0], rotation[1, 0] - rotation[0, 1]])
+    sine = float(np.linalg.norm(vector))  # sin(angle) a; atan2 keeps the angle exact near π (acos does not)
+    angle = math.atan2(sine, (float(np.trace(rotation)) - 1.0) / 2.0)
     if angle < 1e-6:
         return vector * (1.0 + angle * angle / 6.0)
     if math.pi - angle > 1e-6:
-        return vector * (angle / math.sin(angle))
-    symmetric = (rotation + np.eye(3)) / 2.0  # ≈ a aᵀ at angle π
+        return vector * (angle / sine)
+    symmetric = ((rotation + rotation.T) / 2.0 + np.eye(3)) / 2.0  # ≈ a aᵀ near π (no sin [a]× part)
     column = int(np.argmax(np.diag(symmetric)))
     axis = symmetric[:, column] / math.sqrt(max(symmetric[column, column], 1e-300))
-    return axis * angle
+    return (-axis if float(axis @ vector) < 0.0 else axis) * angle  # the side sin(angle) a points to
 
 
 def rows(bound: Bound, first: EndKinematics, second: EndKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -88,3 +88,25 @@ def test_bad_gains_are_refused_naming_the_gain(arm, gains, message):
 def test_gains_are_refused_with_a_controller_that_does_not_take_them(arm):
     with pytest.raises(InputError, match=r"^kp must be given only with the pd or computed-torque controller"):
         run_simulation(arm, controller="passive", kp=1.0)
+
+
+def test_one_driven_joint_feels_the_inertia_with_the_others_giving_way(arm):
+    """With only the first joint driven its inertia is 1 / (M⁻¹)₀₀ (the others free), the
+    undriven ones keep M_jj; the default kp follows the same inertia."""
+    q = np.linspace(0.3, -0.4, arm.nq)
+    driven = np.zeros(arm.nv, dtype=int)
+    driven[0] = 1  # integers, as a user may pass them
+    mass = arm.mass_matrix(q)
+    expected = np.diag(mass).copy()
+    expected[0] = 1.0 / np.linalg.inv(mass)[0, 0]
+    assert expected[0] < mass[0, 0] * (1 - 1e-3)  # negative control: the coupling matters here
+    assert np.allclose(joint_inertia(arm, list(q), driven), expected, rtol=1e-10)
+    kp, _ = pd_gains(arm, q, driven=driven)
+    assert np.allclose(kp, 100.0 * expected, rtol=1e-10)
+
+
+def test_a_zero_or_small_gain_is_accepted(arm):
+    q = np.zeros(arm.nq)
+    for gain in (0.0, 0.5):
+        kp, kd = pd_gains(arm, q, kp=gain, kd=gain)
+        assert np.array_equal(kp, np.full(kp.size, gain)) and np.array_equal(kd, np.full(kd.size, gain))
