@@ -336,8 +336,8 @@ ATTACK_NAMES = [
 @pytest.mark.parametrize("kind", ATTACK_NAMES)
 def test_a_hostile_xacro_is_refused_in_one_line_within_seconds(tmp_path, capsys, route, kind):
     body, message = attacks(tmp_path)[kind]
-    with pytest.raises(URDFError) as raised:
-        within(5.0, lambda: load_by(route, tmp_path / "model", robot_document(body)))
+    with pytest.raises(URDFError) as raised:  # 1.4 s at most measured (the 2^40 macro); 15 s leaves a loaded CI room
+        within(15.0, lambda: load_by(route, tmp_path / "model", robot_document(body)))
     text = str(raised.value)
     assert message in text and "\n" not in text and "s3cret" not in text and "root:" not in text
     assert text.startswith("<string>: " if route == "text" else str(tmp_path / "model" / route))
