@@ -114,14 +114,17 @@ def random_gravity(rng: np.random.Generator) -> tuple[float, float, float]:
 
 def lockable(text_or_path: str | Path) -> dict[str, tuple[float, float]]:
     """Moving joints that are no mimic and no mimic's source, with the range to lock them in."""
-    spec = robodyn.reference.load(text_or_path).spec
+    try:
+        spec = robodyn.reference.load(text_or_path).spec
+    except robodyn.URDFError:  # no moving joint (a free body: MJCF contact files): nothing to lock
+        return {}
     sources = {joint.mimic.joint for joint in spec.joints.values() if joint.mimic is not None}
     out = {}
     for joint in spec.joints.values():
         if joint.type == "fixed" or joint.mimic is not None or joint.name in sources:
             continue
         lower, upper = (-3.0, 3.0) if joint.type == "continuous" else (joint.lower, joint.upper)
-        out[joint.name] = (float(lower), float(upper))
+        out[joint.name] = (float(max(lower, -3.0)), float(min(upper, 3.0)))  # an unlimited joint locks within ±3
     return out
 
 
@@ -136,7 +139,7 @@ def draw_options(rng: np.random.Generator, source: str | Path, *, floating: bool
         name = sorted(candidates)[int(rng.integers(len(candidates)))]
         lower, upper = candidates[name]
         position = float(rng.uniform(0.1, 0.9) * (upper if rng.random() < 0.5 else lower))
-        options["lock"] = {name: position if position != 0.0 else 0.05}
+        options["lock"] = {name: position if position != 0.0 else 0.5 * (lower + upper) or 0.05}  # non-zero, inside
     if floating if floating is not None else rng.random() < 0.3:
         options["floating_base"] = True
     else:
@@ -249,7 +252,7 @@ def mjcf_file(seed: int) -> Case:
     """An MJCF test file, with the usual options (its own base: floating.xml floats)."""
     rng = np.random.default_rng(seed)
     path = MJCF_FILES[seed % len(MJCF_FILES)]
-    floating = "<freejoint" in path.read_text()
+    floating = "<freejoint" in path.read_text() or 'type="free"' in path.read_text()
     text = robodyn.reference.load(path, floating_base=floating).urdf
     options = draw_options(rng, text, floating=floating)
     return Case("mjcf", seed, path.name, path, options)
