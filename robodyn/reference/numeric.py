@@ -185,7 +185,10 @@ class ReferenceRobot:
     # ----------------------------------------------------------------------------------
     # The Lagrangian terms in body coordinates
     # ----------------------------------------------------------------------------------
-    def _terms(self, q: np.ndarray, derivative: bool) -> dict[str, np.ndarray]:
+    def _bodies(self, q: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Each body at stacked configurations (N, nq): centres of mass (N, B, 3) [m], their
+        linear and angular Jacobians (N, B, 3, n), inertias about them in world axes
+        (N, B, 3, 3) [kg m²] and the joint axes (the kinematics' own)."""
         base = None
         if self.floating_base:  # the virtual joints sit at zero, hanging from the base pose
             base = (_quaternion_matrix(q[:, 3:7]), q[:, :3])
@@ -195,6 +198,10 @@ class ReferenceRobot:
         coms = positions + np.einsum("nbij,bj->nbi", rotations, self._coms)
         linear, angular = self._jacobians(coms, axes, joint_origins, self.tree.ancestors)
         world_inertia = rotations @ self._inertias[None] @ np.swapaxes(rotations, -1, -2)
+        return coms, linear, angular, world_inertia, axes
+
+    def _terms(self, q: np.ndarray, derivative: bool) -> dict[str, np.ndarray]:
+        coms, linear, angular, world_inertia, axes = self._bodies(q)
         weighted = self._masses[None, :, None, None] * linear
         mass = np.einsum("nbia,nbja->nij", weighted, linear, optimize=True) + np.einsum(
             "nbia,nbac,nbjc->nij", angular, world_inertia, angular, optimize=True
@@ -341,16 +348,8 @@ class ReferenceRobot:
         """The robot's bodies (armature rotors left out) at stacked states: masses (B,),
         centres of mass (N, B, 3) [m], their velocities (N, B, 3) [m/s], inertias about
         them in world axes (N, B, 3, 3) [kg m²], angular velocities (N, B, 3) [rad/s]."""
-        base = None
-        if self.floating_base:  # the virtual joints sit at zero, hanging from the base pose
-            base = (_quaternion_matrix(q[:, 3:7]), q[:, :3])
-            q = np.hstack([np.zeros((len(q), 6)), q[:, 7:]])
-        theta = q @ self._selection.T + self._offset
-        rotations, positions, axes, joint_origins = self._kinematics(theta, base)
-        coms = positions + np.einsum("nbij,bj->nbi", rotations, self._coms)
-        linear, angular = self._jacobians(coms, axes, joint_origins, self.tree.ancestors)
+        coms, linear, angular, inertias, _ = self._bodies(q)
         rate = v @ self._selection.T  # θ̇: a floating base's virtual rates are its body-frame twist
-        inertias = rotations @ self._inertias[None] @ np.swapaxes(rotations, -1, -2)
         keep = np.array([not body.rotor for body in self.tree.bodies])
         velocities = np.einsum("nbia,ni->nba", linear, rate)
         omegas = np.einsum("nbia,ni->nba", angular, rate)
