@@ -10,6 +10,7 @@ import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -115,8 +116,36 @@ def package_arguments(values: Sequence[str] | None) -> dict[str, str]:
     return packages
 
 
+def add_constraints_argument(parser: argparse.ArgumentParser) -> None:
+    """``--constraints FILE``: loop closures, welds and contacts added to the robot (docs/constraints.md).
+
+    Args:
+        parser: The command's parser.
+    """
+    parser.add_argument(
+        "--constraints",
+        metavar="FILE",
+        help="a YAML file of anchor, weld and contact lists added to the robot's constraints, e.g. the loop "
+        "of a linkage written as a URDF (docs/constraints.md)",
+    )
+
+
+def constraints_file(arguments: argparse.Namespace) -> tuple | None:
+    """The constraints of ``--constraints FILE`` (``None`` when not given, or for a command without it).
+
+    Args:
+        arguments: The parsed arguments.
+    """
+    path = getattr(arguments, "constraints", None)
+    if path is None:
+        return None
+    from robodyn.constraints.files import read_constraints
+
+    return read_constraints(Path(path))
+
+
 def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
-    """The robot of a command's model arguments (and its ``--lock``, where it has one)."""
+    """The robot of a command's model arguments (and its ``--lock`` and ``--constraints``, where it has them)."""
     return robodyn.load(
         arguments.model,
         floating_base=arguments.floating_base,
@@ -128,6 +157,7 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
         xacro_args=xacro_arguments(getattr(arguments, "xacro_arg", None)) or None,
         packages=package_arguments(getattr(arguments, "package", None)) or None,
         xacro_env=bool(getattr(arguments, "xacro_env", False)),
+        constraints=constraints_file(arguments),
     )
 
 

@@ -15,6 +15,7 @@ from robodyn.exceptions import InputError, RobodynError
 #: Library parameter name -> the flag that sets it.
 FLAGS: dict[str, str] = {
     "ground": "--ground",
+    "constraints": "--constraints",
     "controller": "--controller",
     "height": "--ground",
     "friction": "--friction",

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Literal, cast
 
 from robodyn.common.text import counted, printable, quoted
+from robodyn.constraints import as_constraints
 from robodyn.equations.christoffel import render_christoffel
 from robodyn.equations.derive import Form, derive_equations
 from robodyn.equations.kinematics import KinematicsFormat, derive_kinematics, render_kinematics
@@ -71,6 +72,7 @@ class Request:
     xacro_args: Mapping[str, str] | None = None
     packages: Mapping[str, str] | None = None
     xacro_env: bool = False
+    constraints: object = None
 
 
 def equations_document(
@@ -89,7 +91,8 @@ def equations_document(
         **options: The fields of :class:`Request`: ``format`` (one of :data:`FORMATS` for
             ``what``), ``form``, ``keep_params``, ``gravity`` in [m/s²], ``lock``,
             ``floating_base``, ``frame`` (a link, for ``"kinematics"``), ``precision``,
-            ``xacro_args``, ``packages`` and ``xacro_env`` (as for :func:`robodyn.load`).
+            ``xacro_args``, ``packages``, ``xacro_env`` and ``constraints`` (as for
+            :func:`robodyn.load`: added to the file's ``<equality>``).
 
     Raises:
         InputError: For a format the document does not come in, a lecture of another
@@ -104,7 +107,7 @@ def equations_document(
     _check(source, what, request)
     if what == "lecture":
         return Document(lecture_text(), "the lecture's RP arm")
-    _note_constraints(source)
+    _note_constraints(source, request.constraints)
     if what == "derivation":
         content = derivation_document(
             source, format=cast(DerivationFormat, request.format), keep_params=request.keep_params,
@@ -142,15 +145,20 @@ def _check(source: str | os.PathLike, what: str, request: Request) -> None:
         raise InputError("frame", "a link of the robot for its kinematics", repr(request.frame))
 
 
-def _note_constraints(source: str | os.PathLike) -> None:
-    """One warning line when the file declares constraints (MJCF ``<equality>``): the
-    equations derived are the open tree's, never silently the constrained robot's."""
+def _note_constraints(source: str | os.PathLike, given: object) -> None:
+    """One warning line when the robot has constraints (its file's ``<equality>``, or
+    ``constraints=``): the equations derived are the open tree's, never silently the
+    constrained robot's."""
     resolved = resolve_source(source)
-    if resolved.equalities:
-        names = ", ".join(quoted(record.name or record.kind) for record in resolved.equalities[:4])
+    named = [record.name or record.kind for record in resolved.equalities]
+    added = [constraint.name or constraint.kind for constraint in as_constraints(given)]
+    noun = "constraint" if added else "equality constraint"
+    named += added
+    if named:
+        names = ", ".join(quoted(name) for name in named[:4])
         warnings.warn(
             f"{resolved.label}: these equations are the open tree's; not in them: "
-            f"{counted(len(resolved.equalities), 'equality constraint')} ({names}) "
+            f"{counted(len(named), noun)} ({names}) "
             "(Robot.constrained_forward_dynamics gives q̈ and λ; docs/constraints.md)",
             RobodynWarning,
             stacklevel=3,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import RANGES, Progress, add_model_arguments, load_robot
+from robodyn.cli.common import RANGES, Progress, add_constraints_argument, add_model_arguments, load_robot
 from robodyn.common.text import json_text
 
 
@@ -12,6 +12,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("check", help="compare Pinocchio with the independent Lagrangian reference")
     add_model_arguments(parser)
+    add_constraints_argument(parser)
     parser.add_argument(
         "--samples",
         type=int,

@@ -9,7 +9,9 @@ import numpy as np
 
 from robodyn.cli.common import (
     Progress,
+    add_constraints_argument,
     add_model_arguments,
+    constraints_file,
     load_robot,
     lock_values,
     package_arguments,
@@ -25,6 +27,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("equations", help="tau, M, C and G of a robot at one state")
     add_model_arguments(parser)
+    add_constraints_argument(parser)
     parser.add_argument("--q", type=vector, help="configuration, comma-separated, in [rad] / [m] (default: neutral)")
     parser.add_argument("--v", type=vector, help="velocity in [rad/s] / [m/s] (default: zeros)")
     parser.add_argument("--a", type=vector, help="acceleration in [rad/s²] / [m/s²] (default: zeros)")
@@ -92,7 +95,7 @@ def _symbolic(arguments: argparse.Namespace) -> int:
             keep_params=arguments.keep_params, gravity=arguments.gravity, lock=lock_values(arguments.lock),
             floating_base=arguments.floating_base, frame=arguments.kinematics, precision=arguments.precision,
             xacro_args=xacro_arguments(arguments.xacro_arg) or None, packages=package_arguments(arguments.package) or None,
-            xacro_env=arguments.xacro_env,
+            xacro_env=arguments.xacro_env, constraints=constraints_file(arguments),
         )  # fmt: skip
     finally:
         progress.close()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from robodyn.cli import report
-from robodyn.cli.common import add_model_arguments, load_robot
+from robodyn.cli.common import add_constraints_argument, add_model_arguments, load_robot
 from robodyn.common.text import json_text
 
 
@@ -13,6 +13,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("info", help="degrees of freedom, joints, limits and masses of a robot")
     add_model_arguments(parser)
+    add_constraints_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.set_defaults(run=run)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 
-from robodyn.cli.common import RANGES, add_model_arguments, load_robot, vector, warn
+from robodyn.cli.common import RANGES, add_constraints_argument, add_model_arguments, load_robot, vector, warn
 from robodyn.cli.flags import command_line_text
 from robodyn.common.text import json_text, printable
 from robodyn.exceptions import InputError
@@ -15,6 +15,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser."""
     parser = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
     add_model_arguments(parser)
+    add_constraints_argument(parser)
     parser.add_argument(
         "--controller",
         choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand"],
