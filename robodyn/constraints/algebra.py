@@ -194,4 +194,29 @@ def stack(
     return tuple(np.concatenate([part[k] for part in parts]) for k in range(3))  # type: ignore[return-value]
 
 
-__all__ = ["Bound", "End", "EndKinematics", "NeutralPose", "bind", "rotation_log", "rows", "stack", "world_end"]
+def row_labels(constraints: Sequence[Constraint]) -> list[tuple[str, str, str]]:
+    """``(constraint, component, unit)`` of every row of ``λ`` (and ``Φ``), in order.
+
+    A constraint is called by its name, else ``<kind><index>`` (``point_anchor0``); a name
+    used twice gets ``#<index>`` appended. Components: ``x``, ``y``, ``z`` [N] of a point
+    anchor or a sticking contact; ``x``, ``y``, ``z`` [N] then ``mx``, ``my``, ``mz``
+    [N m] of a weld; ``n`` [N] of a sliding contact (its normal force). The names are as
+    given: escape them (:mod:`robodyn.common.text`) before printing.
+
+    Args:
+        constraints: The constraints.
+    """
+    names = [c.name or f"{c.kind.replace(' ', '_')}{index}" for index, c in enumerate(constraints)]
+    names = [name if names.count(name) == 1 else f"{name}#{index}" for index, name in enumerate(names)]
+    labels = []
+    for name, constraint in zip(names, constraints, strict=True):
+        if isinstance(constraint, FrameAnchor):
+            labels += [(name, axis, "N") for axis in "xyz"] + [(name, f"m{axis}", "N m") for axis in "xyz"]
+        elif constraint.rows == 1:
+            labels.append((name, "n", "N"))
+        else:
+            labels += [(name, axis, "N") for axis in "xyz"]
+    return labels
+
+
+__all__ = ["Bound", "End", "EndKinematics", "NeutralPose", "bind", "rotation_log", "row_labels", "rows", "stack", "world_end"]

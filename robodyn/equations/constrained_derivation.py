@@ -1,19 +1,27 @@
-"""The derivation with multipliers: a small robot under one constraint, from ``Φ(q) = 0`` to ``λ(q, q̇, τ)``.
+"""The derivation with multipliers: a small robot under constraints, from ``Φ(q) = 0`` to ``λ``.
 
 After the Lagrangian derivation of :mod:`robodyn.equations.derivation` (``M``, ``C q̇``,
-``G``), the steps a lecture adds for a constraint:
+``G``), the steps a lecture adds for constraints:
 
-7. ``Φ(q) = 0``: the constrained point ``p(q)`` from the reference's forward kinematics in
-   closed form (:func:`robodyn.reference.symbolic.body_poses`), and the constraint's rows;
+7. ``Φ(q) = 0``: each constrained point ``p(q)`` from the reference's forward kinematics in
+   closed form (:func:`robodyn.reference.symbolic.body_poses`), and the rows: a point
+   anchor's ``p₁(q) − p₂(q)`` (two links: a loop closure; or a link and the world), a
+   frictionless contact's ``n·(p(q) − c)``. A row that is ``0 = 0`` for every ``q`` (a
+   planar linkage's out-of-plane row) is dropped and said so: its multiplier is zero;
 8. ``J = ∂Φ/∂q`` and ``J̇ q̇ = Σ_k ∂(J q̇)/∂q_k q̇_k`` (the rows' acceleration at ``q̈ = 0``);
-9. ``M q̈ + C q̇ + G = τ + Jᵀ λ`` with ``J q̈ + J̇ q̇ = 0``;
-10. eliminating ``q̈``: ``λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇)``, in closed form.
+9. ``M q̈ + C q̇ + G = τ + Jᵀ λ`` with ``J q̈ + J̇ q̇ = 0``: the KKT system
+   ``[[M, −Jᵀ], [J, 0]] (q̈, λ) = (τ − C q̇ − G, −J̇ q̇)``;
+10. eliminating ``q̈``: ``λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇)`` in closed form
+    when it is small enough to read (at most :data:`CLOSED_FORM_JOINTS` joints and
+    :data:`CLOSED_FORM_ROWS` rows); else ``λ`` is stated as the KKT system's solution.
 
 The worked example is the RP arm whose tip slides without friction on the wall ``x = c``
 (``PointContact("end_effector", normal=(−1, 0, 0), friction=0, plane_point=(c, 0, 0))``):
-``λ`` is the wall's normal force. Constraints whose ``J`` is ``∂Φ/∂q``: a frictionless
-contact (1 row) or a point anchor to the world (3 rows). Numbers are exact (the URDF's as
-rationals); no Pinocchio.
+``λ`` is the wall's normal force. A four-bar's loop (``PointAnchor`` between the coupler
+and the rocker) gives its two in-plane rows and the KKT system. Constraints whose ``J``
+is not ``∂Φ/∂q`` (welds, sticking contacts) are refused. Numbers are exact (the file's as
+rationals); no Pinocchio. :meth:`ConstrainedDerivation.solve` evaluates the derivation's
+own matrices at a state, to check them against robodyn's numeric dynamics.
 """
 
 from __future__ import annotations
@@ -27,11 +35,20 @@ import sympy as sp
 
 from robodyn import reference
 from robodyn.common.text import identifier, printable
-from robodyn.constraints import Constraint, PointAnchor, PointContact, check_frames
+from robodyn.constraints import Constraint, PointAnchor, PointContact, as_constraints
+from robodyn.constraints.algebra import End, row_labels
 from robodyn.equations.derivation import DerivationSteps, derive_steps
+from robodyn.equations.derivation_latex import _names as _latex_names  # steps 1–6: q_1, dot q_1
 from robodyn.exceptions import InputError
-from robodyn.reference.constraints import link_frames
+from robodyn.reference.constraints import bound, link_frames
 from robodyn.reference.symbolic import body_coordinates, body_poses, exact_matrix
+
+#: Most joints for which ``λ`` is put in closed form (beyond: the KKT system).
+CLOSED_FORM_JOINTS = 2
+#: Most rows for which ``λ`` is put in closed form.
+CLOSED_FORM_ROWS = 2
+#: Relative cut-off of the KKT matrix's singular values in :meth:`ConstrainedDerivation.solve`.
+RCOND = 1e-11
 
 
 @dataclass(frozen=True)
@@ -40,136 +57,230 @@ class ConstrainedDerivation:
 
     Attributes:
         steps: Steps 1–6 (:func:`robodyn.equations.derivation.derive_steps`).
-        constraint: The constraint.
-        point: The constrained point in the world, ``p(q)`` (3 × 1), in [m].
-        phi: ``Φ(q)`` (rows × 1), in [m].
+        constraints: The constraints.
+        points: Each constraint's two points in the world, ``(p₁(q), p₂(q))`` (3 × 1 each),
+            in [m] (a contact's second: its plane point).
+        labels: ``(constraint, component, unit)`` of every row
+            (:func:`robodyn.constraints.algebra.row_labels`).
+        kept: Indices (into ``labels``) of the rows derived; the others are ``0 = 0``.
+        phi: ``Φ(q)`` of the kept rows (rows × 1), in [m].
         J: ``∂Φ/∂q`` (rows × n).
         Jdot_qd: ``J̇ q̇`` (rows × 1), in [m/s²].
         tau: The torque symbols ``tau_<joint>`` (n).
-        lam: ``λ(q, q̇, τ)`` in closed form (rows × 1), in [N].
+        lam: ``λ(q, q̇, τ)`` of the kept rows in closed form (rows × 1), in [N]; ``None``
+            when too large (then ``λ`` is the KKT system's solution).
     """
 
     steps: DerivationSteps
-    constraint: Constraint
-    point: sp.Matrix
+    constraints: tuple[Constraint, ...]
+    points: tuple[tuple[sp.Matrix, sp.Matrix], ...]
+    labels: tuple[tuple[str, str, str], ...]
+    kept: tuple[int, ...]
     phi: sp.Matrix
     J: sp.Matrix
     Jdot_qd: sp.Matrix
     tau: tuple[sp.Symbol, ...]
-    lam: sp.Matrix
+    lam: sp.Matrix | None
+
+    @property
+    def constraint(self) -> Constraint:
+        """The first constraint."""
+        return self.constraints[0]
+
+    @property
+    def point(self) -> sp.Matrix:
+        """The first constraint's first point ``p(q)`` (3 × 1), in [m]."""
+        return self.points[0][0]
+
+    @property
+    def dropped(self) -> tuple[tuple[str, str, str], ...]:
+        """The rows ``0 = 0`` for every ``q`` (their multipliers are zero)."""
+        return tuple(label for index, label in enumerate(self.labels) if index not in self.kept)
+
+    def _numbers(self, matrix: sp.Matrix, q: Sequence[float], qd: Sequence[float], tau: Sequence[float]) -> np.ndarray:
+        values = dict(zip((*self.steps.q, *self.steps.qd, *self.tau), (*q, *qd, *tau), strict=True))
+        return np.array(matrix.xreplace({k: sp.Float(float(v), 17) for k, v in values.items()}).evalf(17), dtype=float)
+
+    def solve(self, q: Sequence[float], qd: Sequence[float], tau: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+        """``q̈`` (n,) and ``λ`` (every row, the dropped ones 0) of the derivation's own
+        KKT system at one state, by least squares (the least-norm ``λ`` of redundant rows).
+
+        Args:
+            q, qd, tau: The state and the torques, in the order of ``steps.joint_names``.
+        """
+        n, m = len(self.steps.q), self.J.rows
+        mass = self._numbers(self.steps.M, q, qd, tau)
+        jacobian = self._numbers(self.J, q, qd, tau).reshape(m, n)
+        force = np.asarray(tau, float) - self._numbers(self.steps.Cv + self.steps.G, q, qd, tau).ravel()
+        drift = self._numbers(self.Jdot_qd, q, qd, tau).ravel()
+        kkt = np.block([[mass, -jacobian.T], [jacobian, np.zeros((m, m))]])
+        solution = np.linalg.lstsq(kkt, np.concatenate([force, -drift]), rcond=RCOND)[0]
+        lam = np.zeros(len(self.labels))
+        lam[list(self.kept)] = solution[n:]
+        return solution[:n], lam
 
     def multipliers(self, q: Sequence[float], qd: Sequence[float], tau: Sequence[float]) -> np.ndarray:
-        """``λ`` of the closed form at one state (numbers), shape (rows,)."""
-        values = dict(zip((*self.steps.q, *self.steps.qd, *self.tau), (*q, *qd, *tau), strict=True))
-        return np.array(self.lam.xreplace({k: sp.Float(v, 17) for k, v in values.items()}).evalf(17), dtype=float).ravel()
+        """``λ`` at one state (every row, the dropped ones 0), shape (rows,): the closed form's
+        when there is one, else :meth:`solve`'s.
+
+        Args:
+            q, qd, tau: The state and the torques, in the order of ``steps.joint_names``.
+        """
+        if self.lam is None:
+            return self.solve(q, qd, tau)[1]
+        lam = np.zeros(len(self.labels))
+        lam[list(self.kept)] = self._numbers(self.lam, q, qd, tau).ravel()
+        return lam
 
 
-def _point(model: reference.ReferenceRobot, steps: DerivationSteps, link: str, local: Sequence[float]) -> sp.Matrix:
-    """A point fixed in ``link`` (``local`` in its frame) in world coordinates, as a function of ``q``."""
-    body, to_link = link_frames(model)[link]
-    position = to_link[:3, :3] @ np.asarray(local, float) + to_link[:3, 3]
+def _point(model: reference.ReferenceRobot, steps: DerivationSteps, end: End) -> sp.Matrix:
+    """An end's point in world coordinates, as a function of ``q`` (exact numbers)."""
+    if end.link is None:
+        return exact_matrix(np.asarray(end.position, float)[:, None], 1e-12)
+    body, to_link = link_frames(model)[end.link]
+    position = to_link[:3, :3] @ np.asarray(end.position, float) + to_link[:3, 3]
     offset = exact_matrix(position[:, None], 1e-12)
     if body < 0:
         return offset
     theta, _ = body_coordinates(model, list(steps.q), list(steps.qd))
     rotations, positions, _ = body_poses(model, theta)
-    return sp.simplify(positions[body] + rotations[body] * offset)
+    return sp.expand(positions[body] + rotations[body] * offset)
 
 
-def _rows(constraint: Constraint, point: sp.Matrix) -> sp.Matrix:
-    """``Φ(q)`` of a constraint whose ``J`` is ``∂Φ/∂q``, or an :class:`InputError`."""
-    if isinstance(constraint, PointContact) and constraint.rows == 1:
+def _supported(constraints: Sequence[Constraint]) -> None:
+    """Refuse a constraint whose ``J`` is not ``∂Φ/∂q`` (welds, sticking contacts)."""
+    for index, constraint in enumerate(constraints):
+        if not (isinstance(constraint, PointAnchor) or (isinstance(constraint, PointContact) and constraint.rows == 1)):
+            raise InputError(
+                f"constraints[{index}]" if len(constraints) > 1 else "constraint",
+                "a PointAnchor or a frictionless PointContact (J = ∂Φ/∂q; a weld's and a sticking contact's J is not)",
+                f"a {constraint.kind}{' with friction' if isinstance(constraint, PointContact) else ''}",
+            )
+
+
+def _rows(constraint: Constraint, first: sp.Matrix, second: sp.Matrix) -> sp.Matrix:
+    """``Φ(q)`` of a supported constraint from its two points."""
+    if isinstance(constraint, PointContact):
         normal = exact_matrix(np.array(constraint.normal)[:, None], 1e-12)
-        plane = exact_matrix(np.array(constraint.plane_point)[:, None], 1e-12)
-        return sp.Matrix([sp.expand((normal.T * (point - plane))[0])])
-    if isinstance(constraint, PointAnchor) and constraint.frame2 is None and constraint.point2 is not None:
-        return sp.expand(point - exact_matrix(np.array(constraint.point2)[:, None], 1e-12))
-    raise InputError(
-        "constraint",
-        "a frictionless PointContact or a PointAnchor to a given world point (J = ∂Φ/∂q)",
-        printable(str(constraint)),
-    )
+        return sp.Matrix([sp.expand((normal.T * (first - second))[0])])
+    return sp.expand(first - second)
 
 
 def derive_constrained(
-    source: str | os.PathLike, constraint: Constraint, *, gravity: Sequence[float] | None = None
+    source: str | os.PathLike, constraints: object, *, gravity: Sequence[float] | None = None
 ) -> ConstrainedDerivation:
-    """Work the derivation of a small fixed-base robot under one constraint (steps 1–10).
+    """Work the derivation of a small fixed-base robot under constraints (steps 1–10).
 
     Args:
         source: Anything :func:`robodyn.load` takes (a fixed base, at most
-            :data:`~robodyn.equations.derivation.MAX_MOVING_JOINTS` moving joints).
-        constraint: A frictionless :class:`~robodyn.constraints.PointContact` or a
-            :class:`~robodyn.constraints.PointAnchor` to a given world point.
+            :data:`~robodyn.equations.derivation.MAX_MOVING_JOINTS` moving joints). Its
+            file's own constraints (MJCF ``<equality>``) are not added: pass them.
+        constraints: One constraint or several: :class:`~robodyn.constraints.PointAnchor`
+            (between two links, or a link and the world) and frictionless
+            :class:`~robodyn.constraints.PointContact`.
         gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
 
     Raises:
-        InputError: For another constraint, a link the robot does not have, or a robot
-            too large to work by hand.
+        InputError: For another constraint, none, a link the robot does not have, or a
+            robot too large to work by hand.
     """
-    _rows(constraint, sp.zeros(3, 1))  # refuse an unsupported constraint before any algebra
+    given = as_constraints(constraints, "constraints")
+    if not given:
+        raise InputError("constraints", "at least one constraint", "none")
+    _supported(given)  # refuse before any algebra
     model = reference.load(source, gravity=gravity)
-    check_frames([constraint], list(model.spec.links), model.name)
+    bounds, _ = bound(model, given)
     steps = derive_steps(source, gravity=gravity)
-    if isinstance(constraint, PointContact):
-        link, local = constraint.frame, constraint.point
-    else:
-        assert isinstance(constraint, PointAnchor)  # _rows took no other kind
-        link, local = constraint.frame1, constraint.point1
-    point = _point(model, steps, link, local)
-    phi = _rows(constraint, point)
+    points = tuple((_point(model, steps, b.first), _point(model, steps, b.second)) for b in bounds)
+    every = sp.Matrix.vstack(*(_rows(c, *pair) for c, pair in zip(given, points, strict=True)))
     q, qd = sp.Matrix(steps.q), sp.Matrix(steps.qd)
+    kept = tuple(i for i in range(every.rows) if every[i] != 0)
+    phi = every.extract(list(kept), [0])
     jacobian = sp.simplify(phi.jacobian(q))
-    drift = sp.simplify((jacobian * qd).jacobian(q) * qd)
+    drift = sp.expand((jacobian * qd).jacobian(q) * qd).applyfunc(lambda row: sp.trigsimp(sp.collect(row, list(qd))))
     taken = {str(s) for s in (*steps.q, *steps.qd, *steps.qdd)}
     tau = tuple(sp.Symbol(identifier(name, taken, prefix="tau_"), real=True) for name in steps.joint_names)
-    mass_inverse_jt = steps.M.LUsolve(jacobian.T)
-    free = steps.M.LUsolve(sp.Matrix(tau) - steps.Cv - steps.G)
-    delassus = jacobian * mass_inverse_jt
-    lam = (-delassus.LUsolve(jacobian * free + drift)).applyfunc(sp.simplify)
-    return ConstrainedDerivation(steps, constraint, point, phi, jacobian, drift, tau, lam)
+    lam = None
+    if len(steps.q) <= CLOSED_FORM_JOINTS and len(kept) <= CLOSED_FORM_ROWS:
+        mass_inverse_jt = steps.M.LUsolve(jacobian.T)
+        free = steps.M.LUsolve(sp.Matrix(tau) - steps.Cv - steps.G)
+        lam = (-(jacobian * mass_inverse_jt).LUsolve(jacobian * free + drift)).applyfunc(sp.simplify)
+    return ConstrainedDerivation(steps, given, points, tuple(row_labels(given)), kept, phi, jacobian, drift, tau, lam)
 
 
-def to_text(derivation: ConstrainedDerivation) -> str:
-    """Steps 7–10 as plain text (steps 1–6: :func:`robodyn.equations.render_derivation.to_text`)."""
+def _readable(matrix: sp.Matrix, precision: int) -> sp.Matrix:
+    """Exact numbers as floats of ``precision`` digits, products of constants multiplied out."""
+    return matrix.evalf(17).applyfunc(sp.expand).evalf(precision)
 
-    def show(matrix: sp.Matrix) -> str:
+
+def _row_names(derivation: ConstrainedDerivation, indices: Sequence[int]) -> str:
+    return ", ".join(f"{printable(name)}.{component}" for name, component, _ in (derivation.labels[i] for i in indices))
+
+
+def to_text(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
+    """Steps 7–10 as plain text (steps 1–6: :func:`robodyn.equations.render_derivation.to_text`).
+
+    Args:
+        derivation: The derivation.
+        precision: Significant digits of the printed numbers.
+    """
+
+    def show(matrix: sp.Matrix) -> list[str]:
+        matrix = _readable(matrix, precision)
         rows = (matrix.row(i) for i in range(matrix.rows))
-        return "\n".join(f"    {printable(sp.sstr(row[0] if row.cols == 1 else list(row)))}" for row in rows)
+        return [f"    {printable(sp.sstr(row[0] if row.cols == 1 else list(row)))}" for row in rows]
 
-    return "\n".join(
-        [
-            f"constraint: {printable(str(derivation.constraint))}",
-            "",
-            "step 7: Φ(q) = 0, with the constrained point p(q) =",
-            show(derivation.point),
-            "  Φ(q) =",
-            show(derivation.phi),
-            "step 8: J = ∂Φ/∂q =",
-            show(derivation.J),
-            "  J̇ q̇ =",
-            show(derivation.Jdot_qd),
-            "step 9: M q̈ + C q̇ + G = τ + Jᵀ λ, with J q̈ + J̇ q̇ = 0",
-            "step 10: λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇) =",
-            show(derivation.lam),
-        ]
-    )
+    lines = [f"constraint: {printable(str(c))}" for c in derivation.constraints]
+    lines += ["", "step 7: Φ(q) = 0, with the constrained points p₁(q), p₂(q) ="]
+    for first, second in derivation.points:
+        lines += [*show(first), "  and", *show(second)]
+    lines += [f"  Φ(q) = p₁ − p₂ (rows {_row_names(derivation, derivation.kept)}) ="]
+    lines += show(derivation.phi)
+    if derivation.dropped:
+        dropped = [i for i in range(len(derivation.labels)) if i not in derivation.kept]
+        lines.append(f"  rows {_row_names(derivation, dropped)}: 0 = 0 for every q (dropped; their λ is 0)")
+    lines += ["step 8: J = ∂Φ/∂q =", *show(derivation.J), "  J̇ q̇ =", *show(derivation.Jdot_qd)]
+    lines.append("step 9: M q̈ + C q̇ + G = τ + Jᵀ λ, with J q̈ + J̇ q̇ = 0: [[M, −Jᵀ], [J, 0]] (q̈, λ) = (τ − C q̇ − G, −J̇ q̇)")
+    if derivation.lam is None:
+        lines.append(
+            f"step 10: λ ({len(derivation.kept)} rows) and q̈ solve that system: λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇) "
+            f"(with {len(derivation.steps.q)} joints its closed form is too long to read; least-norm λ for redundant rows)"
+        )
+    else:
+        lines += ["step 10: λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇) =", *show(derivation.lam)]
+    return "\n".join(lines) + "\n"
 
 
-def to_latex(derivation: ConstrainedDerivation) -> str:
-    """Steps 7–10 as LaTeX ``align*`` lines (math only)."""
-    latex = sp.latex
+def to_latex(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
+    """Steps 7–10 as LaTeX ``align*`` lines (math only).
+
+    Args:
+        derivation: The derivation.
+        precision: Significant digits of the printed numbers.
+    """
+
+    names = {**_latex_names(derivation.steps), **{t: rf"\tau_{{{k}}}" for k, t in enumerate(derivation.tau, 1)}}
+
+    def latex(matrix: sp.Matrix) -> str:
+        return sp.latex(_readable(matrix, precision), symbol_names=names)
+
+    points = [rf"p_{{{k + 1}}}(q) &= {latex(a)}, \quad {latex(b)} \\" for k, (a, b) in enumerate(derivation.points)]
+    kkt = r"\begin{pmatrix} M & -J^\top \\ J & 0 \end{pmatrix} \begin{pmatrix} \ddot q \\ \lambda \end{pmatrix}"
+    system = rf"{kkt} &= \begin{{pmatrix}} \tau - C \dot q - G \\ -\dot J \dot q \end{{pmatrix}}"
+    lam = r"\lambda &= -(J M^{-1} J^\top)^{-1} \left(J M^{-1} (\tau - C \dot q - G) + \dot J \dot q\right)"
     return "\n".join(
         [
             r"\begin{align*}",
-            rf"p(q) &= {latex(derivation.point)} \\",
+            *points,
             rf"\Phi(q) &= {latex(derivation.phi)} = 0 \\",
-            rf"J = \frac{{\partial \Phi}}{{\partial q}} &= {latex(derivation.J)}, \quad \dot J \dot q = {latex(derivation.Jdot_qd)} \\",
+            rf"J = \frac{{\partial \Phi}}{{\partial q}} &= {latex(derivation.J)} \\",
+            rf"\dot J \dot q &= {latex(derivation.Jdot_qd)} \\",
             r"M \ddot q + C \dot q + G &= \tau + J^\top \lambda, \quad J \ddot q + \dot J \dot q = 0 \\",
-            rf"\lambda &= -(J M^{{-1}} J^\top)^{{-1}} \left(J M^{{-1}} (\tau - C \dot q - G) + \dot J \dot q\right) = {latex(derivation.lam)}",
+            rf"{system} \\",
+            lam + ("" if derivation.lam is None else f" = {latex(derivation.lam)}"),
             r"\end{align*}",
         ]
     )
 
 
-__all__ = ["ConstrainedDerivation", "derive_constrained", "to_latex", "to_text"]
+__all__ = ["CLOSED_FORM_JOINTS", "CLOSED_FORM_ROWS", "ConstrainedDerivation", "derive_constrained", "to_latex", "to_text"]

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 from typing import Literal, cast
 
 from robodyn.common.text import counted, printable, quoted
-from robodyn.constraints import as_constraints
+from robodyn.constraints import as_constraints, from_equalities
 from robodyn.equations.christoffel import render_christoffel
+from robodyn.equations.constrained_document import constrained_derivation_document
 from robodyn.equations.derive import Form, derive_equations
 from robodyn.equations.kinematics import KinematicsFormat, derive_kinematics, render_kinematics
 from robodyn.equations.lecture import lecture_text
@@ -107,6 +108,13 @@ def equations_document(
     _check(source, what, request)
     if what == "lecture":
         return Document(lecture_text(), "the lecture's RP arm")
+    constraints = _constraints(source, request.constraints)
+    if what == "derivation" and constraints:
+        constrained = constrained_derivation_document(
+            source, constraints, format=request.format, gravity=request.gravity, precision=request.precision,
+            keep_params=request.keep_params, lock=request.lock,
+        )  # fmt: skip
+        return Document(constrained, "derivation with multipliers")
     _note_constraints(source, request.constraints)
     if what == "derivation":
         content = derivation_document(
@@ -143,6 +151,11 @@ def _check(source: str | os.PathLike, what: str, request: Request) -> None:
         raise InputError("model", f"{LECTURE_ROBOT} for the lecture (the lecture's arm)", repr(printable(str(source))))
     if what == "kinematics" and not request.frame:
         raise InputError("frame", "a link of the robot for its kinematics", repr(request.frame))
+
+
+def _constraints(source: str | os.PathLike, given: object) -> tuple:
+    """The robot's constraints: its file's ``<equality>``, then ``given``."""
+    return (*from_equalities(resolve_source(source).equalities), *as_constraints(given))
 
 
 def _note_constraints(source: str | os.PathLike, given: object) -> None:
