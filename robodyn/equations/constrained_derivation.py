@@ -166,6 +166,19 @@ def _rows(constraint: Constraint, first: sp.Matrix, second: sp.Matrix) -> sp.Mat
     return sp.expand(first - second)
 
 
+def _refuse_constant_rows(rows: sp.Matrix, q: Sequence[sp.Symbol], constraints: Sequence[Constraint]) -> None:
+    """Refuse a row that is a non-zero constant: a constraint no configuration satisfies."""
+    labels = row_labels(constraints)
+    for index in range(rows.rows):
+        if rows[index] != 0 and not rows[index].free_symbols & set(q):
+            name, component, _ = labels[index]
+            raise InputError(
+                "constraints",
+                "constraints some configuration satisfies",
+                f"row {printable(name)}.{component} of Φ is the constant {float(rows[index]):.6g} m for every q",
+            )
+
+
 def derive_constrained(
     source: str | os.PathLike, constraints: object, *, gravity: Sequence[float] | None = None
 ) -> ConstrainedDerivation:
@@ -195,6 +208,7 @@ def derive_constrained(
     every = sp.Matrix.vstack(*(_rows(c, *pair) for c, pair in zip(given, points, strict=True)))
     q, qd = sp.Matrix(steps.q), sp.Matrix(steps.qd)
     kept = tuple(i for i in range(every.rows) if every[i] != 0)
+    _refuse_constant_rows(every, steps.q, given)
     phi = every.extract(list(kept), [0])
     jacobian = sp.simplify(phi.jacobian(q))
     drift = sp.expand((jacobian * qd).jacobian(q) * qd).applyfunc(lambda row: sp.trigsimp(sp.collect(row, list(qd))))
@@ -208,9 +222,20 @@ def derive_constrained(
     return ConstrainedDerivation(steps, given, points, tuple(row_labels(given)), kept, phi, jacobian, drift, tau, lam)
 
 
-def _readable(matrix: sp.Matrix, precision: int) -> sp.Matrix:
-    """Exact numbers as floats of ``precision`` digits, products of constants multiplied out."""
-    return matrix.evalf(17).applyfunc(sp.expand).evalf(precision)
+def readable(matrix: sp.Matrix, precision: int) -> sp.Matrix:
+    """Exact numbers as floats of ``precision`` digits, products of constants multiplied out
+    (in a fraction's numerator and denominator apart).
+
+    Args:
+        matrix: A matrix of the derivation.
+        precision: Significant digits of its numbers.
+    """
+
+    def expanded(entry: sp.Expr) -> sp.Expr:
+        numerator, denominator = sp.fraction(sp.together(entry))
+        return sp.expand(numerator) / sp.expand(denominator)
+
+    return matrix.evalf(17).applyfunc(expanded).evalf(precision)
 
 
 def _row_names(derivation: ConstrainedDerivation, indices: Sequence[int]) -> str:
@@ -226,7 +251,7 @@ def to_text(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
     """
 
     def show(matrix: sp.Matrix) -> list[str]:
-        matrix = _readable(matrix, precision)
+        matrix = readable(matrix, precision)
         rows = (matrix.row(i) for i in range(matrix.rows))
         return [f"    {printable(sp.sstr(row[0] if row.cols == 1 else list(row)))}" for row in rows]
 
@@ -242,9 +267,11 @@ def to_text(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
     lines += ["step 8: J = ∂Φ/∂q =", *show(derivation.J), "  J̇ q̇ =", *show(derivation.Jdot_qd)]
     lines.append("step 9: M q̈ + C q̇ + G = τ + Jᵀ λ, with J q̈ + J̇ q̇ = 0: [[M, −Jᵀ], [J, 0]] (q̈, λ) = (τ − C q̇ − G, −J̇ q̇)")
     if derivation.lam is None:
+        joints, rows = len(derivation.steps.q), len(derivation.kept)
         lines.append(
-            f"step 10: λ ({len(derivation.kept)} rows) and q̈ solve that system: λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇) "
-            f"(with {len(derivation.steps.q)} joints its closed form is too long to read; least-norm λ for redundant rows)"
+            f"step 10: λ ({rows} rows) and q̈ solve that system: λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇) "
+            f"(put in closed form up to {CLOSED_FORM_JOINTS} joints and {CLOSED_FORM_ROWS} rows, here {joints} and {rows}; "
+            "when rows are redundant, J M⁻¹ Jᵀ is singular and λ is the least-norm solution)"
         )
     else:
         lines += ["step 10: λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇) =", *show(derivation.lam)]
@@ -262,7 +289,7 @@ def to_latex(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
     names = {**_latex_names(derivation.steps), **{t: rf"\tau_{{{k}}}" for k, t in enumerate(derivation.tau, 1)}}
 
     def latex(matrix: sp.Matrix) -> str:
-        return sp.latex(_readable(matrix, precision), symbol_names=names)
+        return sp.latex(readable(matrix, precision), symbol_names=names)
 
     points = [rf"p_{{{k + 1}}}(q) &= {latex(a)}, \quad {latex(b)} \\" for k, (a, b) in enumerate(derivation.points)]
     kkt = r"\begin{pmatrix} M & -J^\top \\ J & 0 \end{pmatrix} \begin{pmatrix} \ddot q \\ \lambda \end{pmatrix}"
@@ -283,4 +310,12 @@ def to_latex(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
     )
 
 
-__all__ = ["CLOSED_FORM_JOINTS", "CLOSED_FORM_ROWS", "ConstrainedDerivation", "derive_constrained", "to_latex", "to_text"]
+__all__ = [
+    "CLOSED_FORM_JOINTS",
+    "CLOSED_FORM_ROWS",
+    "ConstrainedDerivation",
+    "derive_constrained",
+    "readable",
+    "to_latex",
+    "to_text",
+]

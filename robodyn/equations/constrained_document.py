@@ -15,7 +15,7 @@ from typing import Any
 import sympy as sp
 
 from robodyn.common.text import json_text, latex_text, printable
-from robodyn.equations.constrained_derivation import ConstrainedDerivation, derive_constrained, to_latex, to_text
+from robodyn.equations.constrained_derivation import ConstrainedDerivation, derive_constrained, readable, to_latex, to_text
 from robodyn.equations.printing import DEFAULT_PRECISION, check_precision
 from robodyn.equations.render_derivation import render_derivation, to_dict
 from robodyn.exceptions import InputError
@@ -25,10 +25,13 @@ FORMATS = ("text", "latex", "json")
 
 
 def _strings(matrix: sp.Matrix | None) -> list[Any] | None:
-    """A matrix as nested lists of strings sympy reads back (17-digit floats)."""
+    """A matrix as strings sympy reads back (17-digit floats): a column as a list (as the
+    steps' ``Cv`` and ``G``), else a list of rows."""
     if matrix is None:
         return None
-    values = matrix.evalf(17).tolist()
+    values = readable(matrix, 17).tolist()
+    if matrix.cols == 1:
+        return [sp.sstr(row[0]) for row in values]
     return [[sp.sstr(value) for value in row] for row in values]
 
 

@@ -26,14 +26,19 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
+from robodyn.common.text import quoted
+from robodyn.constraints.algebra import row_labels
 from robodyn.dynamics import constrained
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.trajectory import Trajectory
+from robodyn.trajectory.columns import constraint_header
+from robodyn.trajectory.io import write_csv
 
 #: Largest ``|Φ|`` left by the position projection, in [m] / [rad].
 POSITION_TOLERANCE = 1e-12
@@ -57,12 +62,77 @@ class ConstrainedSimulation:
             axes (:mod:`robodyn.constraints.algebra`).
         residual: ``max |Φ(q)|`` at each sample, shape (N,), in [m] / [rad].
         initial_correction: How far the projection moved the initial ``q``: ``max |δq|``.
+        labels: ``(constraint, component, unit)`` of each column of ``multipliers``
+            (:func:`robodyn.constraints.algebra.row_labels`).
     """
 
     trajectory: Trajectory
     multipliers: np.ndarray
     residual: np.ndarray
     initial_correction: float
+    labels: tuple[tuple[str, str, str], ...] = ()
+
+    def peak_forces(self) -> list[tuple[str, float, float | None]]:
+        """Each constraint's peak force over the run: ``(name, max |f| in [N], max |m| in
+        [N m] or None)`` (``f``: the force rows of ``λ``, a sliding contact's normal force;
+        ``m``: a weld's torque rows)."""
+        peaks: dict[str, tuple[list[int], list[int]]] = {}
+        for column, (name, component, _) in enumerate(self.labels):
+            forces, torques = peaks.setdefault(name, ([], []))
+            (torques if component.startswith("m") else forces).append(column)
+        lam = self.multipliers.reshape(len(self.trajectory.t), -1)
+        return [
+            (
+                name,
+                float(np.linalg.norm(lam[:, forces], axis=1).max(initial=0.0)),
+                float(np.linalg.norm(lam[:, torques], axis=1).max(initial=0.0)) if torques else None,
+            )
+            for name, (forces, torques) in peaks.items()
+        ]
+
+    def summary_lines(self) -> list[str]:
+        """The run's constraint summary: the largest residual ``max |Φ|`` over the run, and
+        each constraint's peak force (names as given: escape them to print)."""
+        unit = "m / rad" if any(component.startswith("m") for _, component, _ in self.labels) else "m"
+        lines = [
+            f"constraints: max |Φ| over the run {float(self.residual.max(initial=0.0)):.3g} {unit} "
+            f"(RK4, projected after every step; the initial q moved {self.initial_correction:.3g})"
+        ]
+        for name, force, torque in self.peak_forces():
+            torque_text = "" if torque is None else f", |m| {torque:.6g} N m"
+            lines.append(f"peak constraint force {quoted(name)}: |λ| {force:.6g} N{torque_text}")
+        return lines
+
+    def to_dict(self) -> dict[str, object]:
+        """The summary's numbers, units in the keys."""
+        return {
+            "constraint_residual_max_m": float(self.residual.max(initial=0.0)),
+            "constraint_peak_force_N": {name: force for name, force, _ in self.peak_forces()},
+            "constraint_peak_torque_Nm": {name: torque for name, _, torque in self.peak_forces() if torque is not None},
+        }
+
+    def save(self, path: str | Path, extras: dict[str, np.ndarray] | None = None) -> Path:
+        """Write the motion and its multipliers as a CSV trajectory: the trajectory's
+        columns, ``extras`` (kind -> (N, nv), named like ``v``), then one column a row of
+        ``λ``, ``lambda[<constraint>].<component>`` in [N] / [N m]
+        (:func:`robodyn.trajectory.columns.constraint_header`), which trajectory readers skip.
+
+        Args:
+            path: The ``.csv`` file.
+            extras: Extra columns by kind (e.g. ``tau_env``), each (N, nv).
+
+        Raises:
+            InputError: For a file name that does not end in ``.csv``.
+        """
+        path = Path(path)
+        if path.suffix != ".csv":
+            raise InputError("out", "a .csv file for a run with constraints (its multipliers are columns)", repr(str(path)))
+        extras = extras or {}
+        _, v_names = self.trajectory.coordinate_names
+        header = self.trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names]
+        table = np.column_stack([self.trajectory.table(), *extras.values(), self.multipliers.reshape(len(self.trajectory.t), -1)])
+        write_csv(path, self.trajectory.robot, header + constraint_header(self.labels), table)
+        return path
 
 
 def _correction(robot: Robot, bounds, q: np.ndarray, rows: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -195,7 +265,9 @@ def simulate_constrained(
     times = np.arange(steps + 1) * dt
     samples = _run(robot, bounds, q, v, tau, times, constraints)
     trajectory = Trajectory(times, samples["q"], samples["v"], samples["a"], samples["tau"], list(robot.joint_names), robot.name)
-    return ConstrainedSimulation(trajectory, samples["lambda"], samples["residual"], float(np.abs(q - start).max()))
+    labels = tuple(row_labels([b.constraint for b in bounds]))
+    lam = samples["lambda"].reshape(len(times), len(labels))
+    return ConstrainedSimulation(trajectory, lam, samples["residual"], float(np.abs(q - start).max()), labels)
 
 
 def _run(robot: Robot, bounds, q: np.ndarray, v: np.ndarray, tau: Torques, times: np.ndarray, constraints: object) -> dict:

@@ -5,8 +5,9 @@ RK4 on the constrained accelerations, then the state projected back onto ``Φ(q)
 ``J v = 0`` after each step (the module's stated stabilisation); the initial state is
 projected first. The plan's controller (evaluated at every stage) and external wrenches give
 the torques, and the joints' viscous damping acts (``−b v``) when the plan's ``friction``
-does. The run's arrays go back to the engine like any run's
-(its multipliers and residual: :func:`robodyn.sim.constrained.simulate_constrained`).
+does. The run's arrays go back to the engine like any run's, with
+its multipliers and residual (:class:`robodyn.sim.constrained.ConstrainedSimulation`: the
+summary's lines, the CSV's ``lambda[...]`` columns).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def run(plan: RunPlan) -> Outcome:
     trajectory = result.trajectory
     assert trajectory.tau is not None  # a constrained run records its torques
     arrays = SimulationArrays(trajectory.t, trajectory.q, trajectory.v, trajectory.a, trajectory.tau)
-    return Outcome(arrays, loop_time)
+    return Outcome(arrays, loop_time, constrained=result)
 
 
 __all__ = ["run"]

@@ -38,6 +38,8 @@ class EngineRun:
         controller_in_c: Whether the controller ran in C (passive runs: ``False``).
         contact: A run on the ground: its contact forces, gaps and summary
             (:class:`robodyn.sim.contact_run.ContactSimulation`); ``None`` without a ground.
+        constrained: A run with constraints: its multipliers and residual
+            (:class:`robodyn.sim.constrained.ConstrainedSimulation`); else ``None``.
     """
 
     engine: Literal["pinocchio", "compiled"]
@@ -47,6 +49,7 @@ class EngineRun:
     control_period: float | None = None
     controller_in_c: bool = False
     contact: Any = None
+    constrained: Any = None
 
 
 def choose(plan: RunPlan) -> tuple[Literal["pinocchio", "compiled"], str]:
@@ -112,5 +115,6 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
     if violations:  # stack level 4: the caller of simulate / simulate_run
         warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=4)
     return trajectory, EngineRun(
-        engine, reason, outcome.loop_time, compile_time, plan.control_period, outcome.controller_in_c, outcome.contact
-    )
+        engine, reason, outcome.loop_time, compile_time, plan.control_period, outcome.controller_in_c, outcome.contact,
+        outcome.constrained,
+    )  # fmt: skip

@@ -186,6 +186,7 @@ def run_simulation(
         _summary(robot, trajectory, settings, run.loop_time), pushes=pushes, engine_reason=run.reason,
         control_period=run.control_period, controller_in_c=run.controller_in_c, loop_time=run.loop_time,
         compile_time=run.compile_time, ground=lifted + ground_lines(robot, run.contact), contact=run.contact,
+        constrained=run.constrained,
     )  # fmt: skip
     if observer is not None:
         summary = replace(summary, observer=observer_outcome(robot, trajectory, observer, external))

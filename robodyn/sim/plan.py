@@ -140,6 +140,7 @@ class Outcome(NamedTuple):
     loop_time: float
     controller_in_c: bool = False
     contact: Any = None  # a contact run's robodyn.sim.contact_run.ContactSimulation
+    constrained: Any = None  # a constrained run's robodyn.sim.constrained.ConstrainedSimulation
 
 
 def plan(

@@ -175,6 +175,9 @@ class SimulationSummary:
             ``"no ground: the base falls freely"``.
         contact: A run on the ground: its :class:`~robodyn.sim.contact_run.ContactSimulation`
             (forces, gaps; not in :meth:`to_dict`), else ``None``.
+        constrained: A run with constraints: its
+            :class:`~robodyn.sim.constrained.ConstrainedSimulation` (the residual, each
+            constraint's peak force; its multipliers for the files), else ``None``.
         com_error: stand: the final centre of mass's distance to its target in [m].
         force_difference: stand: the largest ``|f_QP − f_simulated|`` of a contact over the run, in [N].
         support_margin: stand: how far the final centre of mass lies inside the support polygon, in [m].
@@ -209,6 +212,7 @@ class SimulationSummary:
     startup_time: float | None = None
     ground: tuple[str, ...] = ()
     contact: Any = field(default=None, repr=False, compare=False)  # the ContactSimulation, for the files
+    constrained: Any = field(default=None, repr=False, compare=False)  # the ConstrainedSimulation
     com_error: float | None = None
     force_difference: float | None = None
     support_margin: float | None = None
@@ -252,6 +256,8 @@ class SimulationSummary:
         data["limit_violations"] = [violation.as_dict() for violation in self.violations]
         if self.ground:
             data["ground"] = list(self.ground)
+        if self.constrained is not None:
+            data |= self.constrained.to_dict()
         for key, unit in (("com_error", "m"), ("force_difference", "N"), ("support_margin", "m")):
             if getattr(self, key) is not None:
                 data[f"{key}_{unit}"] = getattr(self, key)
@@ -330,6 +336,7 @@ class SimulationSummary:
         lines.append(f"peak |torque|: {', '.join(peaks)}")
         lines.append(f"energy change: {_number(self.energy_change, 4)} J")
         lines += [printable(line) for line in self.ground]
+        lines += [printable(line) for line in (self.constrained.summary_lines() if self.constrained is not None else ())]
         if self.com_error is not None:
             lines.append(f"centre of mass: final error {_number(self.com_error, 3)} m")
         if self.force_difference is not None:

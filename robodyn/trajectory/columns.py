@@ -10,6 +10,7 @@ and non-increasing time with the row.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +36,10 @@ _EXTRA = re.compile(r"^(G|M|tau_ext|tau_env)\[(.*)\]$", re.DOTALL)
 #: each contact's force on the robot in world axes ``f[<contact>].x/.y/.z`` [N] and whether
 #: it pushes, ``contact[<contact>]`` (1 or 0).
 _CONTACT = re.compile(r"^(f\[(.*)\]\.[xyz]|contact\[(.*)\])$", re.DOTALL)
+#: A constrained simulation's multipliers (:func:`constraint_header`), skipped on reading as a
+#: trajectory: ``lambda[<constraint>].x/.y/.z`` [N] (and a weld's ``.mx/.my/.mz`` [N m], a
+#: sliding contact's ``.n`` [N]), world axes.
+_CONSTRAINT = re.compile(r"^lambda\[(.*)\]\.(x|y|z|mx|my|mz|n)$", re.DOTALL)
 _LEGACY_Q = re.compile(r"^q(\d+)$")
 
 
@@ -84,6 +89,34 @@ def contact_columns(header: list[str], table: np.ndarray, contacts: list[str]) -
     values = np.asarray(table, dtype=float)[:, [header.index(name) for name in names]]
     count = len(contacts)
     return values[:, : 3 * count].reshape(len(values), count, 3), values[:, 3 * count :] > 0.5
+
+
+def constraint_header(labels: Sequence[tuple[str, str, str]]) -> list[str]:
+    """The columns of a constrained simulation's multipliers: ``lambda[<constraint>].<component>``
+    for each ``(constraint, component, unit)`` row (:func:`robodyn.constraints.algebra.row_labels`).
+
+    Args:
+        labels: The rows of ``λ``.
+    """
+    return [f"lambda[{name}].{component}" for name, component, _ in labels]
+
+
+def constraint_columns(header: list[str], table: np.ndarray, labels: Sequence[tuple[str, str, str]]) -> np.ndarray:
+    """A table's multipliers (N, m) in [N] / [N m] (:func:`constraint_header`).
+
+    Args:
+        header: The table's column names.
+        table: Its rows, shape (N, len(header)).
+        labels: The rows of ``λ`` to read.
+
+    Raises:
+        TrajectoryError: When a column of those rows is missing.
+    """
+    names = constraint_header(labels)
+    missing = [name for name in names if name not in header]
+    if missing:
+        raise TrajectoryError("the table", f"missing columns {short_list(missing)}")
+    return np.asarray(table, dtype=float)[:, [header.index(name) for name in names]]
 
 
 def short_list(names: list[str], limit: int = 4) -> str:
@@ -150,7 +183,7 @@ def parse_header(header: list[str], source: str, *, width: int | None = None) ->
         match = _COLUMN.match(name)
         if match:
             found[match.group(1)][match.group(2)] = index
-        elif name != "t" and not _EXTRA.match(name) and not _CONTACT.match(name):
+        elif name != "t" and not _EXTRA.match(name) and not _CONTACT.match(name) and not _CONSTRAINT.match(name):
             unknown.append(name)
     if unknown:
         raise TrajectoryError(

@@ -71,7 +71,8 @@ def run_experiment(
             extras = {} if summary.observer is None else {"tau_ext": summary.observer.residual}
             if summary.pushes:
                 extras["tau_env"] = applied_torques(robot, trajectory, push_wrenches(robot, summary.pushes)[1])
-            written = summary.contact.save(out, extras) if summary.contact else write_with_extras(Path(out), trajectory, extras)
+            run = summary.contact or summary.constrained  # a run with forces as columns writes them
+            written = run.save(out, extras) if run else write_with_extras(Path(out), trajectory, extras)
             summary = summary.with_file("trajectory", str(written))
         if plot:
             from robodyn.viz.plots import plot_simulation  # matplotlib: only when a figure is asked for

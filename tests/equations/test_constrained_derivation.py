@@ -5,12 +5,13 @@ closed-form wall force against robodyn's numeric λ (moving), against the free-b
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import robodyn
-from robodyn.constraints import FrameAnchor, PointContact
+from robodyn.constraints import FrameAnchor, PointAnchor, PointContact
 from robodyn.equations.constrained_derivation import derive_constrained, to_latex, to_text
 from robodyn.exceptions import InputError
 from robodyn.urdf.models import RPArmParameters
@@ -53,3 +54,51 @@ def test_a_constraint_whose_jacobian_is_not_the_derivative_of_its_rows_is_refuse
         derive_constrained("rp_arm", FrameAnchor("link2"))
     with pytest.raises(InputError, match="constraints"):
         derive_constrained("rp_arm", PointContact("nowhere", friction=0.0))
+
+
+# A loop between two bodies: an arm's tip held on a carriage's pin (oblique slider), gravity
+# not the default. Its z row is 0 = 0 (planar), so 2 rows on 2 joints: λ in closed form.
+TWO_BODIES = Path(__file__).resolve().parents[1] / "data" / "constraints" / "two_body_loop.urdf"
+PIN = PointAnchor("arm", (0.4, 0.0, 0.0), "carriage", (0.0, 0.05, 0.0), name="pin")
+GRAVITY = (0.7, -9.6, 1.1)
+
+
+@pytest.fixture(scope="module")
+def loop_derivation():
+    return derive_constrained(TWO_BODIES, PIN, gravity=GRAVITY)
+
+
+def numeric_terms(robot, derivation, q, v, tau):
+    """The derivation's Φ, J, J̇ q̇, q̈ and λ against robodyn's numeric ones (largest relative gaps)."""
+    order = [robot.joint_names.index(name) for name in derivation.steps.joint_names]
+    kept = list(derivation.kept)
+    a, lam = robot.constrained_forward_dynamics(q, v, tau)
+    values = (q[order], v[order], tau[order])
+    qdd, lam_derived = derivation.solve(*values)
+    pairs = {
+        "phi": (derivation._numbers(derivation.phi, *values).ravel(), robot.constraint_residual(q)[kept]),
+        "J": (derivation._numbers(derivation.J, *values), robot.constraint_jacobian(q)[kept][:, order]),
+        "Jdot_qd": (derivation._numbers(derivation.Jdot_qd, *values).ravel(), robot.constraint_drift(q, v)[kept]),
+        "qdd": (qdd, a[order]),
+        "lambda": (lam_derived, lam),
+        "lambda closed form": (derivation.multipliers(*values), lam),
+    }
+    return {key: np.abs(x - y).max() / max(1.0, np.abs(y).max()) for key, (x, y) in pairs.items()}
+
+
+@pytest.mark.slow
+def test_a_loop_between_two_bodies_is_the_numeric_dynamics_and_a_wrong_sign_is_caught(loop_derivation, rng):
+    from dataclasses import replace
+
+    robot = robodyn.load(str(TWO_BODIES), constraints=[PIN], gravity=GRAVITY)
+    assert loop_derivation.lam is not None and loop_derivation.dropped == (("pin", "z", "N"),)
+    wrong_sign = replace(loop_derivation, J=-loop_derivation.J, lam=None)  # M q̈ + … = τ − Jᵀ λ
+    no_drift = replace(loop_derivation, Jdot_qd=0 * loop_derivation.Jdot_qd, lam=None)
+    for _ in range(4):
+        q, v, tau = rng.uniform(-1.0, 1.0, 2), rng.normal(size=2), rng.normal(scale=3.0, size=2)
+        assert max(numeric_terms(robot, loop_derivation, q, v, tau).values()) <= 1e-9
+        assert numeric_terms(robot, wrong_sign, q, v, tau)["lambda"] > 1e-3  # the checks can fail
+        assert numeric_terms(robot, no_drift, q, v, tau)["qdd"] > 1e-3
+    text, latex = to_text(loop_derivation), to_latex(loop_derivation)
+    assert "rows pin.z: 0 = 0 for every q" in text and "step 10: λ = " in text
+    assert r"\lambda &=" in latex and r"\begin{pmatrix} M & -J^\top" in latex and "q_{1}" in latex

@@ -121,3 +121,33 @@ def test_solo12_held_by_its_feet_and_the_contact_torques_stands_still():
     run = simulate_constrained(robot, q, constraints=feet, duration=0.03, dt=1e-3, tau=tau)
     assert np.abs(run.trajectory.q - q).max() < 1e-9 and np.abs(run.trajectory.v).max() < 1e-9
     assert abs(np.linalg.norm(run.trajectory.q[-1, 3:7]) - 1.0) < 1e-12
+
+
+def test_the_csv_has_a_column_a_multiplier_row_and_they_are_the_dynamics_lambda_at_the_recorded_states(tmp_path, rng):
+    from pathlib import Path
+
+    import robodyn
+    from robodyn.constraints.files import read_constraints
+    from robodyn.trajectory import Trajectory
+    from robodyn.trajectory.columns import constraint_columns
+    from robodyn.trajectory.io import read_table
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    robot = robodyn.load(str(examples / "four_bar.urdf"), constraints=read_constraints(examples / "four_bar_constraints.yaml"))
+    tau = rng.normal(size=robot.nv)
+    run = simulate_constrained(robot, robot.neutral_configuration(), rng.normal(size=robot.nv), duration=0.03, tau=tau)
+    written = run.save(tmp_path / "four_bar.csv")
+    table, layout, _ = read_table(written)
+    assert [name for name in layout.header if name.startswith("lambda")] == [f"lambda[loop].{a}" for a in "xyz"]
+    back = Trajectory.load(written)  # a trajectory reader skips the multipliers
+    assert np.array_equal(back.q, run.trajectory.q)
+    lam = constraint_columns(list(layout.header), table, run.labels)
+    expected = robot.constrained_forward_dynamics(back.q, back.v, back.tau)[1]
+    assert np.abs(lam - expected).max() <= 1e-9 * np.abs(expected).max()
+    assert np.abs(lam[1:] - expected[:-1]).max() > 1e-3  # one row late: the check can fail
+    (name, peak, torque), *_ = run.peak_forces()
+    assert (name, torque) == ("loop", None) and peak == pytest.approx(np.linalg.norm(lam, axis=1).max(), rel=1e-12)
+    lines = run.summary_lines()
+    assert float(lines[0].split("run ")[1].split(" m")[0]) <= 1e-9 and "'loop': |λ|" in lines[1]
+    with pytest.raises(InputError, match="csv"):
+        run.save(tmp_path / "four_bar.npz")
