@@ -44,6 +44,11 @@ def test_a_hostile_constraints_file_is_one_stderr_line_and_exit_2(capsys, tmp_pa
     assert len(err.strip().splitlines()) == 1 and said in err
 
 
+def test_constraints_on_equations_outputs_that_are_the_open_trees_are_refused(capsys):
+    status, out, err = run(capsys, "equations", URDF, "--constraints", LOOP, "--q", "0.1,0.2,0.3")
+    assert (status, out) == (2, "") and "--constraints must be given only with --derivation or --symbolic" in err
+
+
 def kkt_from_json(document: dict, q: np.ndarray, v: np.ndarray, tau: np.ndarray, *, sign: float = 1.0, drift: bool = True):
     """q̈ and λ (kept rows) of the printed derivation's matrices at a state: M, C q̇, G of
     steps 1–6, J and J̇ q̇ of steps 7–8 read back with sympy (``sign``: of Jᵀλ, ``drift``:

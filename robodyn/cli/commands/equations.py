@@ -151,6 +151,12 @@ def _export(arguments: argparse.Namespace) -> int:
 
 def run(arguments: argparse.Namespace) -> int:
     """Run ``robodyn equations`` with the parsed ``arguments``; return the exit status."""
+    if arguments.constraints and not (arguments.derivation or arguments.symbolic or arguments.lecture):
+        raise InputError(
+            "--constraints",
+            "given only with --derivation or --symbolic (the other outputs are the open tree's)",
+            "it without them",
+        )
     if arguments.base_parameters:
         return _base_parameters(arguments)
     if arguments.format in ("casadi", "jax"):
