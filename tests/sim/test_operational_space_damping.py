@@ -101,6 +101,7 @@ def test_a_stretched_ur5_start_keeps_bounded_torques_by_default_and_overflows_wi
         robodyn.simulate(robot, UR5_STRETCHED, np.zeros(6), 0.3, 1e-3, controller=undamped, limits="ignore", engine="pinocchio")
 
 
+@pytest.mark.slow  # compiles the RP arm (5 s in a fresh cache)
 def test_the_compiled_twin_damps_as_the_python_law_inside_the_damped_region():
     """The RP arm with its slider pulled back to the first joint's axis (r = −0.86 m: σ is
     below the threshold): the twin's run within 1e-9 of the Python law's; negative control:
@@ -127,3 +128,34 @@ def test_the_compiled_twin_damps_as_the_python_law_inside_the_damped_region():
     scale = max(1.0, float(np.abs(python.tau).max()))
     assert np.abs(compiled.q - python.q).max() <= 1e-9 and np.abs(compiled.tau - python.tau).max() <= 1e-9 * scale
     assert np.abs(plain.tau - python.tau).max() > 1e-3 * scale
+
+
+#: dm_control's reacher as its suite writes it (two capsules in the horizontal plane, light
+#: damping): stretched at q = 0, the task's second direction vanishes.
+REACHER = """<mujoco><default><joint type="hinge" axis="0 0 1" damping="0.01"/></default><worldbody>
+<body name="arm" pos="0 0 .01"><geom type="capsule" fromto="0 0 0 0.12 0 0" size=".01"/><joint name="shoulder"/>
+  <body name="hand" pos=".12 0 0"><geom type="capsule" fromto="0 0 0 0.1 0 0" size=".01"/>
+    <joint name="wrist" limited="true" range="-160 160"/>
+    <body name="finger" pos=".12 0 0"><geom type="sphere" size=".01"/></body>
+  </body>
+</body></worldbody></mujoco>"""
+
+
+def test_a_stretched_planar_reacher_moves_to_its_target_with_bounded_torques_and_overflows_without_the_variable_damping(tmp_path):
+    """The reacher's planar task (rank 2: its normal is no singularity) from q = 0: peak
+    torque 0.15 N m, the finger within 1 cm of the target after 0.5 s (0.13 m away at the start);
+    with the variable damping off,
+    the run overflows within 10 ms (the issue's "C v + G overflowed")."""
+    path = tmp_path / "reacher.xml"
+    path.write_text(REACHER)
+    robot = robodyn.load(path)
+    target = [0.1, 0.1, 0.01]
+    law = OperationalSpace(robot, "finger", target, compensate_damping=True)
+    assert law.singular_value(np.zeros(2)) < 1e-9 and law.singular_value(np.array([0.3, 1.0])) > law.singular_threshold
+    with pytest.warns(robodyn.RobodynWarning, match="damped there"):
+        run = robodyn.simulate(robot, np.zeros(2), np.zeros(2), 0.5, 1e-3, controller=law, limits="ignore", engine="pinocchio")
+    assert np.isfinite(run.tau).all() and np.abs(run.tau).max() < 0.5
+    assert np.linalg.norm(robot.frame_position(run.q[-1], "finger") - target) < 0.01
+    undamped = OperationalSpace(robot, "finger", target, compensate_damping=True, singular_damping=0.0)
+    with pytest.warns(robodyn.RobodynWarning, match="without bound"), pytest.raises(SimulationError, match="overflow"):
+        robodyn.simulate(robot, np.zeros(2), np.zeros(2), 0.05, 1e-3, controller=undamped, limits="ignore", engine="pinocchio")
