@@ -71,7 +71,15 @@ def write_link(robot: MjcfRobot, body: ET.Element, name: str, link: ET.Element, 
 def write_sites(robot: MjcfRobot, body: ET.Element, name: str, shift: np.ndarray, childclass: str) -> None:
     """The body's sites as frames: massless links on fixed joints, named as the site, or
     ``site:NAME`` where a body has the name (MuJoCo's bodies and sites are separate
-    namespaces; robodyn's links are one)."""
+    namespaces; robodyn's links are one).
+
+    Args:
+        robot: The reading's state.
+        body: The ``<body>`` (or ``<worldbody>``) holding the sites.
+        name: The link the sites hang from.
+        shift: The body's frame in its link's, 4×4.
+        childclass: The default class in force.
+    """
     for index, site in enumerate(body.findall("site")):
         values = attributes(robot, site, childclass)
         given = site.get("name") or f"{name}_site{index}"
