@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint docs bench mutants clean chromium tex
+.PHONY: demo test test-fast lint docs bench mutants corpus clean chromium tex
 
 $(STAMP): pyproject.toml requirements.lock
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -70,6 +70,14 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -r requirements-bench.lock || echo "note: MuJoCo not installed; its rows are skipped"
 	$(BIN)/python scripts/bench.py
+
+# The MJCF reader on the two public model collections as shipped (dm_control's suite, Gymnasium's
+# MuJoCo assets), against MuJoCo: needs the network once (pip download into CORPUS_DIR) and
+# MuJoCo (requirements-bench.lock); not part of `make test`. Exit status 1 on any mismatch.
+CORPUS_DIR ?= $(HOME)/.cache/robodyn-corpus
+corpus: $(STAMP)
+	$(BIN)/python -m pip install --quiet -r requirements-bench.lock
+	$(BIN)/python scripts/corpus_check.py --dir $(CORPUS_DIR)
 
 # Mutation testing of the core modules with the fast tier (slow: not part of `make test` or CI).
 # The modules are [tool.mutmut] only_mutate in pyproject.toml; MUTANTS="robodyn.sim.control*"

@@ -197,6 +197,9 @@ class CompiledOperationalSpace(CompiledFrameController):
         rotation: Target attitude as a rotation matrix (3, 3); ``None``: position only.
         kp, kd, posture, posture_kp, posture_kd, damping: As the Python controller's.
         viscous: The compensated joint damping ``b``, shape (n,) (as for :class:`CompiledComputedTorque`).
+        singular_damping, singular_threshold: As the Python controller's.
+        length: The chain's characteristic length ``ℓ`` in [m]. rank: The task's generic rank
+            (:mod:`robodyn.sim.task_damping`).
     """
 
     position: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -208,19 +211,25 @@ class CompiledOperationalSpace(CompiledFrameController):
     posture_kd: float = 10.0
     damping: float = 1e-8
     viscous: np.ndarray | None = None
+    singular_damping: float = 0.0
+    singular_threshold: float = 0.0
+    length: float = 1.0
+    rank: int = 0
     law: ClassVar[str] = "OSC"
     layout: ClassVar[tuple[Field, ...]] = (
         ("rows", (1, 0, 0)), ("position", (3, 0, 0)), ("rotation", (9, 0, 0)), ("kp", (1, 0, 0)), ("kd", (1, 0, 0)), ("damping", (1, 0, 0)),
         ("posture_kp", (1, 0, 0)), ("posture_kd", (1, 0, 0)), ("has_posture", (1, 0, 0)), ("posture", (0, 1, 0)), ("viscous", (0, 1, 0)),
+        ("singular_damping", (1, 0, 0)), ("singular_threshold", (1, 0, 0)), ("length", (1, 0, 0)), ("rank", (1, 0, 0)),
     )  # fmt: skip
 
     def params(self, n: int) -> np.ndarray:
         rows, rotation = _rotation(self.rotation)
         gains = [_scalar(getattr(self, name), name) for name in ("kp", "kd", "damping", "posture_kp", "posture_kd")]
         posture = np.zeros(n) if self.posture is None else as_state(self.posture, "posture", n)
+        singular = [_scalar(getattr(self, name), name) for name in ("singular_damping", "singular_threshold", "length")]
         return np.concatenate(
             [[rows], _vector(self.position, "position", 3), rotation, gains, [float(self.posture is not None)], posture,
-             _viscous(self.viscous, n)]
+             _viscous(self.viscous, n), singular, [float(self.rank)]]
         )  # fmt: skip
 
 

@@ -417,6 +417,30 @@ static void rdc_task_inertia(double *A, double damping, int m, double *L) {
         }
 }
 
+/* λ_v of sim.task_damping: λ_max √(1 − (σ/ε)²) below ε, else 0, with σ = σ_r(S J) / ℓ from the
+ * eigenvalues of (S J)(S J)ᵀ / ℓ² (J: m rows of n columns, the rotation rows scaled by ℓ). */
+static double rdc_variable_damping(const double *J, int n, int m, double length, int rank, double threshold, double maximum) {
+    if (maximum == 0.0 || rank < 1) return rank < 1 ? maximum : 0.0;
+    double G[36], d[6], e[6];
+    for (int i = 0; i < m; ++i)
+        for (int k = 0; k <= i; ++k) {
+            const double scale = (i >= 3 ? length : 1.0) * (k >= 3 ? length : 1.0) / (length * length);
+            double s = 0.0;
+            for (int j = 0; j < n; ++j) s += J[i * n + j] * J[k * n + j];
+            G[i * m + k] = G[k * m + i] = s * scale;
+        }
+    rdc_tred2(G, m, d, e);
+    rdc_tqli(d, e, m, G);
+    for (int i = 1; i < m; ++i) /* descending */
+        for (int k = i; k > 0 && d[k] > d[k - 1]; --k) {
+            const double t = d[k];
+            d[k] = d[k - 1];
+            d[k - 1] = t;
+        }
+    const double sigma = sqrt(d[rank - 1] > 0.0 ? d[rank - 1] : 0.0);
+    return sigma >= threshold ? 0.0 : maximum * sqrt(1.0 - (sigma / threshold) * (sigma / threshold));
+}
+
 /* pin.log3 (Pinocchio's formulas: renormalised matrix, series near 0, axis near π). */
 static void rdc_log3_axis(int i0, const double *R, double val, double *angle, double *axis) {
     const double eps = 2.220446049250313e-16;
@@ -468,7 +492,7 @@ static void rdc_mat3(const double *A, const double *B, double *C) {
         for (int j = 0; j < 3; ++j) C[i * 3 + j] = A[i * 3] * B[j] + A[i * 3 + 1] * B[3 + j] + A[i * 3 + 2] * B[6 + j];
 }
 
-/* operational_space._log_coefficients: c(θ) and c'(θ)/θ */
+/* so3_log.log_coefficients: c(θ) and c'(θ)/θ */
 static void rdc_log_coefficients(double theta, double *c, double *cp) {
     if (theta < 0.05) {
         *c = 1.0 / 12 + theta * theta / 720 + pow(theta, 4) / 30240;
@@ -579,7 +603,10 @@ static void rdc_operational_space(const rd_kernels *model, const rd_frame_kernel
             for (int j = 0; j < n; ++j) s += J[i * n + j] * MiJt[k * n + j];
             A[i * m + k] = A[k * m + i] = s;
         }
-    rdc_task_inertia(A, p[RD_OSC_DAMPING(n)], m, Lam);
+    const double extra = rdc_variable_damping(J, n, m, p[RD_OSC_LENGTH(n)], (int)p[RD_OSC_RANK(n)], p[RD_OSC_SINGULAR_THRESHOLD(n)],
+                                              p[RD_OSC_SINGULAR_DAMPING(n)]);
+    const double floor_damping = p[RD_OSC_DAMPING(n)];
+    rdc_task_inertia(A, extra == 0.0 ? floor_damping : hypot(floor_damping, extra), m, Lam);
     for (int i = 0; i < m; ++i) y[i] = command[i] - bias[i];
     for (int i = 0; i < m; ++i) {
         f[i] = 0.0;

@@ -20,11 +20,12 @@ their **own** model of the robot like those of :mod:`robodyn.sim.control`.
   so a steady external wrench ``F`` at the frame moves it by ``K⁻¹ F``. The last term
   damps the joint motion the task leaves free (``N_J = I − J⁺ J``); it is zero at rest.
 
-Near singularities ``Λ`` is damped: with the eigen-decomposition ``J M⁻¹ Jᵀ = U S Uᵀ``,
-``Λ = U diag(s / (s² + λ²)) Uᵀ`` with ``λ = damping · max(s)`` (default
-:data:`TASK_DAMPING`). A direction the frame cannot move in (``s = 0``: out of a planar
-arm's plane, a stretched elbow) gets no force instead of an infinite one; elsewhere the
-relative change of ``Λ`` is ``(λ / s)²``.
+Near singularities ``Λ`` is damped (:mod:`robodyn.sim.task_damping`): ``Λ = U diag(s / (s² +
+λ²)) Uᵀ`` from ``J M⁻¹ Jᵀ = U S Uᵀ``, with a constant floor of 1e-8 and a variable damping
+that is exactly zero unless the task's smallest singular value (rotation rows scaled by the
+chain's length, so every row is in [m]) falls below 5 % of that length, growing smoothly to
+1e-2 of the largest eigenvalue at the singularity: the plain law away from singularities,
+bounded torques from a stretched start.
 """
 
 from __future__ import annotations
@@ -36,17 +37,29 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 import pinocchio as pin
 
-from robodyn.common.rotations import rpy_matrix, skew
+from robodyn.common.rotations import rpy_matrix
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.reach import check_reach
+from robodyn.sim.so3_log import log_jacobian, log_jacobian_rate
+from robodyn.sim.task_damping import (
+    FLOOR,
+    MAX_DAMPING,
+    THRESHOLD,
+    characteristic_length,
+    damped_task_inertia,
+    generic_rank,
+    relative_singular_value,
+    total_damping,
+    variable_damping,
+)
 from robodyn.sim.twin import compiled_model, law_refusal, viscous_compensation, viscous_params
 
 if TYPE_CHECKING:
     from robodyn.compiled.controllers import CompiledImpedance, CompiledOperationalSpace
 
-#: Damping of the task inertia, relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
-TASK_DAMPING = 1e-8
+#: The constant floor of the task inertia's damping (:data:`robodyn.sim.task_damping.FLOOR`).
+TASK_DAMPING = FLOOR
 #: Damping of the Jacobian's pseudo-inverse in the impedance law's null space, in [m²].
 PSEUDO_INVERSE_DAMPING = 1e-8
 
@@ -97,53 +110,6 @@ def orientation_error(rotation: np.ndarray, target: np.ndarray) -> np.ndarray:
         Shape (3,), in [rad].
     """
     return pin.log3(rotation.T @ target)
-
-
-#: Below this rotation angle in [rad], the log Jacobian's coefficients use their series.
-SMALL_ANGLE = 0.05
-
-
-def _log_jacobian(phi: np.ndarray) -> np.ndarray:
-    """``Jr⁻¹(φ) = I + φ̂/2 + c(θ) φ̂²``: ``d/dt log(R) = Jr⁻¹ ω_b`` (θ = |φ|, shape (3, 3))."""
-    cross = skew(phi)
-    return np.eye(3) + 0.5 * cross + _log_coefficients(float(np.linalg.norm(phi)))[0] * cross @ cross
-
-
-def _log_jacobian_rate(phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
-    """``d/dt Jr⁻¹(φ)`` along ``φ̇``, shape (3, 3)."""
-    cross, cross_dot = skew(phi), skew(phi_dot)
-    c, c_prime_over_theta = _log_coefficients(float(np.linalg.norm(phi)))
-    return (
-        0.5 * cross_dot + c * (cross_dot @ cross + cross @ cross_dot) + c_prime_over_theta * float(phi @ phi_dot) * cross @ cross
-    )
-
-
-def _log_coefficients(theta: float) -> tuple[float, float]:
-    """``c(θ) = 1/θ² − cot(θ/2)/(2θ)`` and ``c'(θ)/θ`` (series below :data:`SMALL_ANGLE`)."""
-    if theta < SMALL_ANGLE:
-        return 1 / 12 + theta**2 / 720 + theta**4 / 30240, 1 / 360 + theta**2 / 7560
-    cot = 1 / np.tan(theta / 2)
-    c = 1 / theta**2 - cot / (2 * theta)
-    c_prime = -2 / theta**3 + cot / (2 * theta**2) + 1 / (4 * theta * np.sin(theta / 2) ** 2)
-    return float(c), float(c_prime / theta)
-
-
-def damped_task_inertia(inverse: np.ndarray, damping: float) -> np.ndarray:
-    """``Λ`` from ``Λ⁻¹ = J M⁻¹ Jᵀ``, damped near singularities (see the module's note).
-
-    Args:
-        inverse: ``J M⁻¹ Jᵀ``, shape (m, m), symmetric positive semi-definite.
-        damping: ``λ`` relative to its largest eigenvalue (0: the plain inverse).
-
-    Returns:
-        Shape (m, m).
-    """
-    values, vectors = np.linalg.eigh(inverse)
-    values = np.maximum(values, 0.0)
-    floor = (damping * values[-1]) ** 2
-    if floor == 0.0:
-        return vectors @ np.diag(1.0 / values) @ vectors.T
-    return vectors @ np.diag(values / (values**2 + floor)) @ vectors.T
 
 
 @dataclass
@@ -202,7 +168,13 @@ class OperationalSpace:
             ``None`` for damping alone there.
         posture_kp: Posture stiffness in [1/s²]. posture_kd: Posture damping in [1/s]
             (also applied without a posture, so that a redundant arm comes to rest).
-        damping: Damping of ``Λ`` relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
+        damping: The constant floor ``λ₀`` of ``Λ``'s damping, relative to the largest
+            eigenvalue of ``J M⁻¹ Jᵀ`` (:mod:`robodyn.sim.task_damping`).
+        singular_damping: ``λ_max``: the variable damping at a singularity, relative to the
+            same eigenvalue; 0 turns it off (the plain law everywhere: unbounded torques
+            at a singularity).
+        singular_threshold: ``ε``: the variable damping acts where the task's smallest
+            singular value is below this fraction of the chain's length.
         compensate_damping: Add ``b ∘ v``, the model's joint damping (on exactly when the
             run applies it: :mod:`robodyn.sim.control`'s note).
 
@@ -223,9 +195,13 @@ class OperationalSpace:
     posture_kp: float = 25.0
     posture_kd: float = 10.0
     damping: float = TASK_DAMPING
+    singular_damping: float = MAX_DAMPING
+    singular_threshold: float = THRESHOLD
     compensate_damping: bool = False
     _frame_id: int = field(init=False, repr=False)
     _rotation: np.ndarray | None = field(init=False, repr=False)
+    _length: float = field(init=False, repr=False)
+    _rank: int = field(init=False, repr=False)
     #: The compiled twin's frame kinematics model fixed bases.
     twin_fixed_base: ClassVar[bool] = True
 
@@ -234,10 +210,27 @@ class OperationalSpace:
         self._frame_id = self.model.frame_id(self.frame)
         self.position = _checked_position(self.model, self.frame, self.position)
         self._rotation = None if self.orientation is None else target_rotation(self.orientation)
+        for name in ("damping", "singular_damping", "singular_threshold"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise InputError(name, "a finite value >= 0", repr(value))
+        self._length = characteristic_length(self.model, self.frame)
+        self._rank = generic_rank(self.model, self.frame, 3 if self._rotation is None else 6)
         if self.posture is not None:
             (self.posture,), _ = self.model.validate(q=self.posture)
             if self.posture.ndim != 1:
                 raise InputError("posture", f"one configuration ({self.model.nq} values)", f"shape {self.posture.shape}")
+
+    def singular_value(self, q: np.ndarray) -> float:
+        """``σ``: the task's smallest singular value at ``q`` relative to the chain's length
+        (:mod:`robodyn.sim.task_damping`); below ``singular_threshold`` the damping acts.
+
+        Args:
+            q: A configuration, shape (nq,).
+        """
+        rows = 3 if self._rotation is None else 6
+        jacobian = _frame_state(self.model, self._frame_id, q, np.zeros(self.model.nv)).jacobian
+        return relative_singular_value(jacobian[:rows], self._length, self._rank)
 
     def task_error(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The task error ``e`` and its rate ``ė`` ([m], [m/s], then with an attitude [rad], [rad/s]), each (3,) or (6,)."""
@@ -258,10 +251,10 @@ class OperationalSpace:
         # gives ë_o = −Kd ė_o − Kp e_o.
         angle_error = orientation_error(state.rotation, self._rotation)
         body = state.rotation.T @ velocity[3:]
-        inverse_jacobian = _log_jacobian(-angle_error)
+        inverse_jacobian = log_jacobian(-angle_error)
         angle_rate = -inverse_jacobian @ body
         wanted = -self.kd * angle_rate - self.kp * angle_error
-        rate_term = _log_jacobian_rate(-angle_error, -angle_rate) @ body
+        rate_term = log_jacobian_rate(-angle_error, -angle_rate) @ body
         body_acceleration = np.linalg.solve(inverse_jacobian, -wanted - rate_term)
         angular = state.rotation @ body_acceleration
         return np.concatenate([error, angle_error]), np.concatenate([rate, angle_rate]), np.concatenate([command, angular])
@@ -274,7 +267,9 @@ class OperationalSpace:
         _, _, command = self._error(t, state, v)
         mass = model.mass_matrix(q)
         mass_inv_jt = np.linalg.solve(mass, jacobian.T)
-        inertia = damped_task_inertia(jacobian @ mass_inv_jt, self.damping)
+        sigma = relative_singular_value(jacobian, self._length, self._rank)
+        extra = variable_damping(sigma, self.singular_threshold, self.singular_damping)
+        inertia = damped_task_inertia(jacobian @ mass_inv_jt, total_damping(self.damping, extra))
         null_space = np.eye(model.nv) - mass_inv_jt @ inertia @ jacobian  # N = I − J̄ J
         posture_error = np.zeros(model.nv) if self.posture is None else pin.difference(model.model, q, self.posture)
         posture = mass @ (self.posture_kp * posture_error - self.posture_kd * v)
@@ -297,7 +292,7 @@ class OperationalSpace:
         viscous = viscous_params(self.model, self.compensate_damping, self.model.nv)
         return CompiledOperationalSpace(
             model, self.frame, self.position, self._rotation, self.kp, self.kd, self.posture, self.posture_kp,
-            self.posture_kd, self.damping, viscous,
+            self.posture_kd, self.damping, viscous, self.singular_damping, self.singular_threshold, self._length, self._rank,
         )  # fmt: skip
 
 

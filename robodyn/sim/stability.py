@@ -26,8 +26,6 @@ from robodyn.sim.plan import RunPlan
 STABLE_RATE = {"rk4": 2.78, "semi-implicit-euler": 2.0}
 #: Relative step of the central differences of a controller.
 _DIFFERENCE = 1e-6
-#: A task direction whose singular value is below this fraction of the largest is near-singular.
-NEAR_SINGULAR = 1e-3
 
 
 def largest_stable_step(plan: RunPlan) -> tuple[float, str, str] | None:
@@ -95,23 +93,22 @@ def _feedback(plan: RunPlan, tau: np.ndarray) -> np.ndarray:
 
 
 def task_warning(plan: RunPlan) -> str | None:
-    """One sentence when an operational-space task starts at (or near) a singularity: the
-    frame's position Jacobian loses a direction there that it has at other configurations
-    (a stretched or folded arm), where the task inertia grows without bound unless damped."""
+    """One sentence when an operational-space task starts at (or near) a singularity: its
+    smallest singular value (:meth:`OperationalSpace.singular_value`) below the threshold of
+    the law's variable damping (:mod:`robodyn.sim.task_damping`), a stretched or folded arm."""
     law = plan.controller
     if not isinstance(law, OperationalSpace) or law.frame is None:
         return None
-    model = law.model
-    start = np.linalg.svd(model.frame_jacobian(plan.q0, law.frame)[:3], compute_uv=False)
-    elsewhere = np.linalg.svd(
-        model.frame_jacobian(model.random_configuration(np.random.default_rng(0)), law.frame)[:3], compute_uv=False
-    )
-    rank = int((elsewhere > 1e-9 * elsewhere[0]).sum())  # the directions the frame can move in at all
-    if rank == 0 or start[rank - 1] >= NEAR_SINGULAR * start[0]:
+    sigma = law.singular_value(plan.q0)
+    if sigma >= law.singular_threshold:
         return None
-    return (
-        f"{plan.robot.name}: the operational-space task of {law.frame!r} starts near a singularity (a direction "
-        f"{start[rank - 1] / start[0]:.1g} of the others: a stretched or folded arm); its task inertia is damped "
-        f"by only {law.damping:g} of its largest eigenvalue, so torques can grow without bound: start away from it, "
-        "or raise the OperationalSpace damping (1e-3 keeps them bounded)"
+    start = (
+        f"{plan.robot.name}: the operational-space task of {law.frame!r} starts near a singularity (its weakest "
+        f"direction {sigma:.2g} of the chain's length, below {law.singular_threshold:g}: a stretched or folded arm)"
+    )
+    if law.singular_damping == 0:
+        return start + "; with singular_damping=0 its torques can grow without bound: start away from it, or keep the default"
+    return start + (
+        f"; its task inertia is damped there (up to {law.singular_damping:g} of its largest eigenvalue), so torques "
+        "stay bounded but the task is followed loosely until the arm leaves it"
     )

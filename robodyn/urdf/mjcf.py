@@ -22,7 +22,8 @@ The reading, as MuJoCo's compiler does it (docs/robot-files.md states every rule
 - bodies: a body's joints act in order at their ``pos`` (a chain through massless links);
   a body without joints is welded; ``hinge``, ``slide`` and a ``free`` top body; a joint's
   ``ref`` is the offset q = qpos − ref (the body in its modelled pose at q = 0, limits
-  shifted); ``<site>`` s are frames (``site:NAME`` where a body has the name);
+  shifted); ``<site>`` s are frames (``site:NAME`` where a body has the name; a
+  ``fromto`` placed as MuJoCo places it; the world's on the fixed base);
 - ``<inertial>`` or the inertia of the body's solid geoms (:mod:`robodyn.urdf.geom_inertia`);
 - geoms that collide with the world's plane (``contype`` / ``conaffinity``) as
   ``<collision>`` s, the first ``<worldbody>`` plane as the robot's ground
@@ -54,7 +55,7 @@ import numpy as np
 from robodyn.common.text import printable
 from robodyn.exceptions import RobodynWarning, URDFError
 from robodyn.urdf.mjcf_bodies import free_joint, read_body
-from robodyn.urdf.mjcf_geoms import plane_ground, read_plane, set_total_mass
+from robodyn.urdf.mjcf_geoms import plane_ground, read_plane, set_total_mass, write_sites
 from robodyn.urdf.mjcf_includes import expand_includes
 from robodyn.urdf.mjcf_physics import read_actuators, read_equalities, read_option
 from robodyn.urdf.mjcf_settings import read_compiler, read_defaults
@@ -172,12 +173,25 @@ def _read_world(root: ET.Element, robot: MjcfRobot) -> None:
         raise URDFError(robot.label, "the MJCF <worldbody> has no <body>: there is no robot to read")
     free = [body for body in bodies if free_joint(robot, body) is not None]
     if free and len(bodies) > 1:
-        raise URDFError(robot.label, "a free-floating MJCF body must be the only body in <worldbody> (robodyn reads one robot)")
+        others = ", ".join(
+            repr(printable(body.get("name") or f"body #{index + 1}")) for index, body in enumerate(bodies) if body is not free[0]
+        )
+        raise URDFError(
+            robot.label,
+            f"the free-floating MJCF body {printable(free[0].get('name') or 'body #1')!r} has other bodies beside it in "
+            f"<worldbody> ({others}): a second robot or object is not modelled (robodyn reads one robot)",
+        )
+    assert world is not None  # it has bodies
     if free:
         robot.floating = True
         read_body(robot, bodies[0], None, np.eye(4), "main")
+        for index, site in enumerate(world.findall("site")):
+            robot.note(
+                "<worldbody> sites beside a floating robot (no world link holds them)", site.get("name") or f"#{index + 1}"
+            )
         return
     robot.unique("world", "the MJCF worldbody")
     ET.SubElement(robot.urdf, "link", name="world")
+    write_sites(robot, world, "world", np.eye(4), "main")
     for body in bodies:
         read_body(robot, body, "world", np.eye(4), "main")

@@ -64,23 +64,46 @@ def write_link(robot: MjcfRobot, body: ET.Element, name: str, link: ET.Element, 
     for index, (_, values) in enumerate(geoms):
         if collides(robot, values, f'geom #{index + 1} of body "{name}"'):
             _write_collision(robot, values, f'geom #{index + 1} of body "{name}"', link, shift)
-    _write_sites(robot, body, name, shift, childclass)
+    write_sites(robot, body, name, shift, childclass)
     return mass
 
 
-def _write_sites(robot: MjcfRobot, body: ET.Element, name: str, shift: np.ndarray, childclass: str) -> None:
+def write_sites(robot: MjcfRobot, body: ET.Element, name: str, shift: np.ndarray, childclass: str) -> None:
     """The body's sites as frames: massless links on fixed joints, named as the site, or
     ``site:NAME`` where a body has the name (MuJoCo's bodies and sites are separate
-    namespaces; robodyn's links are one)."""
+    namespaces; robodyn's links are one).
+
+    Args:
+        robot: The reading's state.
+        body: The ``<body>`` (or ``<worldbody>``) holding the sites.
+        name: The link the sites hang from.
+        shift: The body's frame in its link's, 4×4.
+        childclass: The default class in force.
+    """
     for index, site in enumerate(body.findall("site")):
         values = attributes(robot, site, childclass)
         given = site.get("name") or f"{name}_site{index}"
         site_name = robot.unique(f"site:{given}" if given in robot.bodies else given, "an MJCF site")
         joint = ET.SubElement(robot.urdf, "joint", name=robot.unique(f"{site_name}_site", "a site's joint"), type="fixed")
-        write_origin(joint, shift @ pose(robot, f'site "{given}"', values))
+        write_origin(joint, shift @ _site_pose(robot, f'site "{given}"', values))
         ET.SubElement(joint, "parent", link=name)
         ET.SubElement(joint, "child", link=site_name)
         ET.SubElement(robot.urdf, "link", name=site_name)
+
+
+def _site_pose(robot: MjcfRobot, where: str, values: dict[str, str]) -> np.ndarray:
+    """A site's pose in its body's frame: its ``fromto`` (centre, z along the segment: it
+    overrides ``pos`` and the orientation, as in MuJoCo) where given, else ``pos`` and orientation.
+
+    Raises:
+        URDFError: ``fromto`` on a site type MuJoCo refuses it for (a sphere).
+    """
+    if "fromto" not in values:
+        return pose(robot, where, values)
+    kind = keyword(robot.label, where, "type", values.get("type", "sphere"), GEOM_TYPES)
+    if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
+        raise URDFError(robot.label, f"{where}: fromto requires a capsule, cylinder, box or ellipsoid site, not a {kind}")
+    return fromto_pose(robot, where, values["fromto"])[0]
 
 
 def _geom_values(robot: MjcfRobot, geom: ET.Element, where: str, childclass: str) -> dict[str, str]:

@@ -152,13 +152,14 @@ def translation(vector: np.ndarray) -> np.ndarray:
 
 
 def fromto_pose(robot: MjcfRobot, where: str, text: str) -> tuple[np.ndarray, float]:
-    """A capsule's or cylinder's ``fromto``: its pose (centre, z along the segment) and half-length."""
+    """A ``fromto``'s pose (centre; z along the segment, from its second point to its first,
+    as MuJoCo turns it) and half-length."""
     ends = floats(robot.label, where, text, 6)
     result = np.eye(4)
     result[:3, 3] = (ends[:3] + ends[3:]) / 2
     length = float(np.linalg.norm(ends[3:] - ends[:3]))
     if length > 1e-12:
-        result[:3, :3] = zaxis((ends[3:] - ends[:3]) / length)
+        result[:3, :3] = zaxis((ends[:3] - ends[3:]) / length)
     return result, length / 2
 
 

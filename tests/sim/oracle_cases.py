@@ -79,9 +79,12 @@ def _controller(name: str, robot: robodyn.Robot, q0: np.ndarray) -> object | Non
     if name == "osc":
         orientation = None if robot.name == "rp_arm" else _rotation(robot, q0 + _nudge(robot), frame)
         posture = q0 if robot.name == "panda" else None
+        # singular_damping=0: the law as recorded (the ur5 and panda starts are near-stretched,
+        # where today's default adds the variable damping of robodyn.sim.task_damping)
         return OperationalSpace(
-            model, frame, reach, orientation=orientation, kp=90.0, kd=18.0, posture=posture, posture_kp=20.0, posture_kd=8.0
-        )
+            model, frame, reach, orientation=orientation, kp=90.0, kd=18.0, posture=posture, posture_kp=20.0, posture_kd=8.0,
+            singular_damping=0.0,
+        )  # fmt: skip
     if name == "impedance":
         orientation = None if robot.name == "rp_arm" else _rotation(robot, q0 + _nudge(robot), frame)
         rows = 3 if orientation is None else 6

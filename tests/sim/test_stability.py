@@ -95,9 +95,10 @@ def test_the_limit_follows_the_integrators_stability_region(integrator):
 
 
 def test_an_operational_space_task_starting_at_a_singularity_is_warned_about():
-    """ur5 stretched (elbow straight): the default damping lets the task inertia blow up (the
-    run stops within 10 ms); the damping the warning suggests keeps the torques under 100 N m.
-    A bent start, and the planar RP arm's direction it never moves in, are not warned about."""
+    """ur5 stretched (elbow straight): the warning says the task inertia is damped there (the
+    default variable damping keeps the torques under 100 N m); with it off the run stops
+    within 10 ms and the warning says the torques are unbounded. A bent start, and the planar
+    RP arm's direction it never moves in, are not warned about."""
     from robodyn.sim.operational_space import OperationalSpace
     from robodyn.sim.stability import task_warning
 
@@ -105,12 +106,14 @@ def test_an_operational_space_task_starting_at_a_singularity_is_warned_about():
     stretched = np.array([0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0])
     law = OperationalSpace(robot, None, [0.3, 0.2, 0.4], orientation=[0.0, 0.0, 0.0])
     said = task_warning(plan(robot, stretched, np.zeros(6), 0.01, 1e-3, controller=law))
-    assert said is not None and "singularity" in said and "OperationalSpace damping (1e-3" in said
-    stopped, _ = _run(robot, 1e-3, 200, q0=stretched, controller=law)
-    assert isinstance(stopped, SimulationError)
-    damped = OperationalSpace(robot, None, [0.3, 0.2, 0.4], orientation=[0.0, 0.0, 0.0], damping=1e-3)
-    calm, _ = _run(robot, 1e-3, 200, q0=stretched, controller=damped)
+    assert said is not None and "singularity" in said and "damped there" in said
+    calm, _ = _run(robot, 1e-3, 200, q0=stretched, controller=law)
     assert np.abs(calm.tau).max() < 100.0
+    undamped = OperationalSpace(robot, None, [0.3, 0.2, 0.4], orientation=[0.0, 0.0, 0.0], singular_damping=0.0)
+    said = task_warning(plan(robot, stretched, np.zeros(6), 0.01, 1e-3, controller=undamped))
+    assert said is not None and "without bound" in said
+    stopped, _ = _run(robot, 1e-3, 200, q0=stretched, controller=undamped)
+    assert isinstance(stopped, SimulationError)
     assert task_warning(plan(robot, stretched + 0.4, np.zeros(6), 0.01, 1e-3, controller=law)) is None
     rp_arm = robodyn.load("rp_arm")
     planar = OperationalSpace(rp_arm, None, [0.7, 0.0, 0.7])

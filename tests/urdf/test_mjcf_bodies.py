@@ -72,3 +72,67 @@ def test_a_ref_ignored_is_caught():
     model = rigid_model(DATA / "floating_ref.xml")
     assert max(largest_differences(robot, model)) < 1e-12
     assert max(largest_differences(robot, model, refs=False)) > 1e-3
+
+
+def test_a_floating_robot_beside_a_free_ball_is_refused_naming_the_ball(tmp_path):
+    """dm_control's quadruped and dog carry a free ball beside the free torso: MuJoCo loads
+    it as two bodies; robodyn reads one robot and says which bodies are the second one."""
+    path = tmp_path / "robot_and_ball.xml"
+    path.write_text(
+        """<mujoco><worldbody>
+        <body name="torso" pos="0 0 1"><freejoint name="root"/><geom type="sphere" size="0.2" mass="3"/></body>
+        <body name="ball" pos="1 0 0.1"><freejoint name="ball_root"/><geom type="sphere" size="0.1" mass="0.2"/></body>
+        </worldbody></mujoco>"""
+    )
+    assert mujoco.MjModel.from_xml_path(str(path)).nv == 12
+    with pytest.raises(robodyn.URDFError, match=r"'torso' has other bodies beside it .*\('ball'\).*one robot") as refused:
+        robodyn.load(path)
+    assert "\n" not in str(refused.value)
+
+
+SITES = """<mujoco><compiler angle="radian"/><worldbody>
+<site name="target" pos="0.3 -0.2 0.4" euler="0.3 0.2 0.1"/>
+<body name="upper" pos="0 0 0.5"><joint name="shoulder" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.04"/>
+  <site name="ray" type="capsule" size="0.005" fromto="0.41 -0.02 0.11 0.34 0 0.115"/>
+  <site name="down" type="box" size="0.01 0.01 0.01" fromto="0.1 0 0.3 0.1 0 0.1"/>
+  <body name="lower" pos="0.4 0 0"><joint name="elbow" axis="0.2 1 0.1"/><geom type="cylinder" fromto="0 0 0 0 0.1 -0.3" size="0.03"/>
+    <site name="upper" pos="0 0.1 -0.3" zaxis="1 1 0"/>
+  </body>
+</body></worldbody></mujoco>"""
+
+
+def test_sites_given_by_fromto_and_the_worlds_sites_are_frames_where_mujoco_puts_them(tmp_path):
+    """A site's ``fromto`` is its pose (centre, z from its second point to its first, as
+    MuJoCo turns it; dm_control's quadruped has twenty such rangefinder sites), and a fixed
+    base's world sites are frames on the world (acrobot's and finger's ``target``); both were
+    read at the body's origin, or not at all. Checked against MuJoCo at random states."""
+    path = tmp_path / "sites.xml"
+    path.write_text(SITES)
+    robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    for q in robot.random_configuration(np.random.default_rng(8), 3):
+        data.qpos[:] = robot.to_mujoco(q)[0]
+        mujoco.mj_kinematics(model, data)
+        ours = placements(robot, q)
+        for site, frame in (("target", "target"), ("ray", "ray"), ("down", "down"), ("upper", "site:upper")):
+            index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, site)
+            pose = ours.oMf[robot.frame_id(frame)]
+            assert np.abs(pose.translation - data.site_xpos[index]).max() < 1e-12, site
+            assert np.abs(pose.rotation - data.site_xmat[index].reshape(3, 3)).max() < 1e-12, site
+
+
+def test_a_sphere_site_with_fromto_is_refused_as_mujoco_refuses_it_and_a_floating_robots_world_site_is_reported(tmp_path):
+    sphere = tmp_path / "sphere.xml"
+    sphere.write_text(SITES.replace('type="capsule" size="0.005"', 'type="sphere" size="0.005"'))
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_path(str(sphere))
+    with pytest.raises(robodyn.URDFError, match="fromto requires a capsule, cylinder, box or ellipsoid site, not a sphere"):
+        robodyn.load(sphere)
+    floating = tmp_path / "floating.xml"
+    floating.write_text(
+        """<mujoco><worldbody><site name="goal" pos="1 0 0"/>
+        <body name="box"><freejoint/><geom type="box" size="0.1 0.1 0.1"/></body></worldbody></mujoco>"""
+    )
+    with pytest.warns(robodyn.RobodynWarning, match=r"<worldbody> sites beside a floating robot .*\(goal\)"):
+        robodyn.load(floating)
