@@ -116,7 +116,7 @@ class ContactSimulation:
         peak = int(np.argmax(normal.max(axis=1))) if len(normal) else 0
         active_slip = np.where(self.active, self.slip, 0.0)
         lines = [
-            f"ground: height {self.ground.height:.6g} m, normal {tuple(round(x, 6) for x in self.ground.normal)}, "
+            f"ground{f' ({self.ground.origin})' if self.ground.origin else ''}: height {self.ground.height:.6g} m, normal {tuple(round(x, 6) for x in self.ground.normal)}, "
             f"μ {self.ground.friction:.6g}; {len(self.contacts)} contact points",
             f"peak normal force: {normal.max(initial=0.0):.6g} N (total {normal.sum(axis=1).max(initial=0.0):.6g} N "
             f"at t = {self.trajectory.t[peak]:.6g} s); final total {normal[-1].sum():.6g} N",

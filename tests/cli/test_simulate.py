@@ -10,6 +10,7 @@ import pytest
 from robodyn.cli.app import main
 
 BOX = str(Path(__file__).parents[1] / "data" / "contact" / "box.urdf")
+MJCF_BOX = str(Path(__file__).parents[1] / "data" / "mjcf" / "contact_box.xml")
 FEET = "FL_FOOT,FR_FOOT,HL_FOOT,HR_FOOT"
 
 
@@ -41,9 +42,28 @@ def test_a_floating_robot_without_a_ground_says_its_base_falls_freely(capsys):
 
 
 @pytest.mark.parametrize(
+    ("model", "flags", "said"),
+    [
+        (MJCF_BOX, [], "ground (the file's plane): height 0.1 m, normal (0.0, 0.0, 1.0), μ 0.7;"),
+        (MJCF_BOX, ["--friction", "0.25"], "ground (the file's plane, μ given): height 0.1 m, normal (0.0, 0.0, 1.0), μ 0.25;"),
+        (MJCF_BOX, ["0.05"], "ground: height 0.05 m, normal (0.0, 0.0, 1.0), μ 1;"),
+        (
+            BOX,
+            ["--floating-base"],
+            "ground (flat at height 0: the file states no plane): height 0 m, normal (0.0, 0.0, 1.0), μ 1;",
+        ),
+    ],
+)
+def test_ground_without_a_height_is_the_files_plane_else_flat_at_zero(capsys, model, flags, said):
+    status, text, _ = run(capsys, "simulate", model, "--duration", "0.002", "--ground", *flags)
+    assert status == 0 and said in text
+
+
+@pytest.mark.parametrize(
     ("flags", "said"),
     [
         (["--contact", "box"], "--contact must be given only with --ground"),
+        (["--friction", "0.5"], "--friction must be given only with --ground"),
         (["--ground", "--friction", "-1"], "--friction must be"),
         (["--ground", "--integrator", "rk4"], "--integrator must be 'semi-implicit-euler' with a ground"),
         (["--ground", "--compiled"], "--ground must be left out for --engine compiled"),
