@@ -1,8 +1,9 @@
 """What a simulation run on the ground may ask, checked when its plan is made.
 
 The contact step (:mod:`robodyn.sim.contact`) is semi-implicit Euler at the velocity level
-with the controller sampled once a step; it has no momentum observer and does not enforce
-joint limits. A plan asking for those with a ground is refused, naming the parameter, as
+with the controller sampled once a step; it has no momentum observer. Enforced joint limits
+are rows of its contact problem (:mod:`robodyn.sim.contact_limits`). A plan asking for
+another integrator, a control period or an observer with a ground is refused, naming the parameter, as
 is a start with a contact point deeper than :data:`START_PENETRATION` below the ground.
 """
 
@@ -30,7 +31,7 @@ def check_contact_run(
     q0: np.ndarray,
     integrator: str,
     every: int | None,
-    limits: str,
+    limits: str,  # every mode: "enforce" puts the limits in the contact problem
     observer: object,
 ) -> Contacts | None:
     """The contact points of a run on ``ground`` (``None`` without one), or an
@@ -44,7 +45,6 @@ def check_contact_run(
     refusals = [
         (integrator != "semi-implicit-euler", "integrator", "'semi-implicit-euler' with a ground (the contact step's scheme)", repr(integrator)),
         (every not in (None, 1), "control_period", "the step dt with a ground (the contact step samples the controller each step)", f"{every} steps"),
-        (limits == "enforce", "limits", "'warn' or 'ignore' with a ground (the contact step does not enforce limits)", repr(limits)),
         (observer is not None, "observer", "none with a ground (the contact step runs no observer)", "an observer"),
     ]  # fmt: skip
     for refused, name, expected, received in refusals:
