@@ -3,8 +3,9 @@
 The contact step (:mod:`robodyn.sim.contact`) is semi-implicit Euler at the velocity level
 with the controller sampled once a step; it has no momentum observer. Enforced joint limits
 are rows of its contact problem (:mod:`robodyn.sim.contact_limits`). A plan asking for
-another integrator, a control period or an observer with a ground is refused, naming the parameter, as
-is a start with a contact point deeper than :data:`START_PENETRATION` below the ground.
+another integrator, a control period or an observer with a ground is refused, naming the
+parameter, as is a start with a contact point deeper than :data:`START_PENETRATION` below
+the ground or a joint further than that past an enforced limit.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.contact import contact_kinematics
+from robodyn.sim.contact_limits import LimitRows
 from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
 
 #: Deepest a contact point may start below the ground, in [m] (deeper: refused; the
@@ -50,6 +52,8 @@ def check_contact_run(
     for refused, name, expected, received in refusals:
         if refused:
             raise InputError(name, expected, received)
+    if limits == "enforce":
+        _check_inside_limits(robot, q0)
     found = contact_points(robot, contacts)
     gaps = contact_kinematics(robot, q0, ground, found.points)[0]
     if gaps.min() < -START_PENETRATION:
@@ -60,6 +64,20 @@ def check_contact_run(
             f"{found.names[deepest]!r} {-gaps[deepest]:.3g} m below",
         )
     return found
+
+
+def _check_inside_limits(robot: Robot, q0: np.ndarray) -> None:
+    """Refuse a start further than :data:`START_PENETRATION` past a joint's position limit
+    (enforced, the row's push-back would fling the joint out at ``β`` of it a step)."""
+    rows = LimitRows(robot)
+    gaps = rows.gaps(q0)
+    if len(gaps) and gaps.min() < -START_PENETRATION:
+        worst = int(gaps.argmin())
+        raise InputError(
+            "q0",
+            f"a configuration within the joint limits (at most {START_PENETRATION} past one) when they are enforced",
+            f"{rows.names[worst]!r} {-gaps[worst]:.3g} past",
+        )
 
 
 def start_above(

@@ -68,6 +68,12 @@ def test_limit_rows_are_the_finite_limits_signed_lower_up_upper_down():
     assert np.allclose(rows.torques(np.array([0.0, 2e-3]), 1e-3, 1), [-2.0])
 
 
+def test_a_start_past_an_enforced_limit_is_refused_naming_q0_and_the_joint():
+    robot = robodyn.load(PENDULUM, gravity=GRAVITY)
+    with pytest.raises(robodyn.exceptions.InputError, match="q0.*'swing upper' 0.1 past"):
+        simulate_run(robot, np.array([UPPER + 0.1]), np.zeros(1), 0.1, 1e-3, limits="enforce", ground=FAR, contacts=TIP)
+
+
 def test_a_contact_run_refuses_an_unknown_limits_mode():
     with pytest.raises(robodyn.exceptions.InputError, match="limits"):
         _drop("clamp")
