@@ -70,7 +70,7 @@ def test_limit_rows_are_the_finite_limits_signed_lower_up_upper_down():
 
 def test_a_start_past_an_enforced_limit_is_refused_naming_q0_and_the_joint():
     robot = robodyn.load(PENDULUM, gravity=GRAVITY)
-    with pytest.raises(robodyn.exceptions.InputError, match="q0.*'swing upper' 0.1 past"):
+    with pytest.raises(robodyn.exceptions.InputError, match=r"q0.*'swing upper' 0.1 past"):
         simulate_run(robot, np.array([UPPER + 0.1]), np.zeros(1), 0.1, 1e-3, limits="enforce", ground=FAR, contacts=TIP)
 
 
