@@ -13,12 +13,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import pinocchio as pin
 
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.contact import contact_kinematics
 from robodyn.sim.contact_limits import LimitRows
-from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
+from robodyn.sim.ground import ContactPoint, Contacts, Ground, collision_points, contact_points
 
 #: Deepest a contact point may start below the ground, in [m] (deeper: refused; the
 #: push-out of a deep penetration would launch the robot).
@@ -80,6 +82,45 @@ def _check_inside_limits(robot: Robot, q0: np.ndarray) -> None:
         )
 
 
+#: How many samples of a run :func:`buried_line` looks at (evenly spread, the last included).
+BURIED_SAMPLES = 200
+#: Depth below the ground [m] a link's origin or collision point may reach unreported
+#: (a penetration the contact step tolerates).
+BURIED_DEPTH = 1e-3
+
+
+def buried_line(robot: Robot, q: np.ndarray, t: np.ndarray, ground: Ground, contacts: Contacts) -> str | None:
+    """One warning line naming the links that are not contact points and went under the
+    ground in a run (``q`` (N, nq) at times ``t`` (N,) [s]): their origins and collision
+    spheres, boxes and capsules checked at :data:`BURIED_SAMPLES` samples, each link with
+    its deepest point in [m]; ``None`` when none went deeper than :data:`BURIED_DEPTH`."""
+    model, data, frames = robot.model, robot.handle.data, robot.handle.frames
+    moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
+    links = sorted(moving - {point.link for point in contacts.points})
+    shapes = [point for point in collision_points(robot).points if point.link in links]
+    depth: dict[str, float] = {}
+    first = np.inf
+    for index in np.unique(np.linspace(0, len(q) - 1, min(len(q), BURIED_SAMPLES)).round().astype(int)):
+        pin.framesForwardKinematics(model, data, q[index])
+        points = [(link, data.oMf[frames[link]].translation) for link in links]
+        points += [
+            (p.link, data.oMf[frames[p.link]].act(np.array(p.position)) - p.radius * np.array(ground.normal)) for p in shapes
+        ]
+        for link, where in points:
+            below = -float(ground.gap(where))
+            if below > BURIED_DEPTH:
+                depth[link] = max(depth.get(link, 0.0), below)
+                first = min(first, float(t[index]))
+    if not depth:
+        return None
+    deepest = sorted(depth.items(), key=lambda item: -item[1])
+    shown = ", ".join(f"{printable(link)!r} {value:.3g} m" for link, value in deepest[:4]) + (", …" if len(deepest) > 4 else "")
+    return (
+        f"warning: {len(deepest)} link{'s' if len(deepest) > 1 else ''} that are no contact points went under the ground "
+        f"(from t = {first:.6g} s; deepest): {shown}: name them as contacts or hold the robot up"
+    )
+
+
 def start_above(
     robot: Robot, q0: np.ndarray, ground: Ground, contacts: str | Sequence[str | ContactPoint], clearance: float = 0.05
 ) -> tuple[np.ndarray, float]:
@@ -92,4 +133,4 @@ def start_above(
     return moved, lift
 
 
-__all__ = ["START_PENETRATION", "check_contact_run", "start_above"]
+__all__ = ["BURIED_DEPTH", "BURIED_SAMPLES", "START_PENETRATION", "buried_line", "check_contact_run", "start_above"]

@@ -20,6 +20,7 @@ from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.contact import ACTIVE_FORCE, ContactSettings, contact_step
+from robodyn.sim.contact_checks import buried_line
 from robodyn.sim.contact_limits import LimitRows, limited_step
 from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
 from robodyn.sim.limits import check_mode
@@ -218,7 +219,8 @@ def run_contacts(
     trajectory = Trajectory(
         samples["t"], samples["q"], samples["v"], samples["a"], samples["tau"], list(robot.joint_names), robot.name
     )
-    notes = list(found.skipped)
+    buried = buried_line(robot, samples["q"], samples["t"], ground, found)
+    notes = ([buried] if buried else []) + list(found.skipped)
     if joint_friction and np.any(robot.joint_friction):
         notes.append("joint Coulomb friction of the file is not applied in contact runs")
     return ContactSimulation(
