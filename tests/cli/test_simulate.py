@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import csv
+import shlex
 from pathlib import Path
 
 import pytest
 
 from robodyn.cli.app import main
+from tests.conftest import ROOT
 
 BOX = str(Path(__file__).parents[1] / "data" / "contact" / "box.urdf")
 MJCF_BOX = str(Path(__file__).parents[1] / "data" / "mjcf" / "contact_box.xml")
@@ -34,6 +36,13 @@ def test_solo12_lands_on_its_feet_and_stands_under_a_pd_hold(capsys, tmp_path):
         next(stream)
         header = next(csv.reader([next(stream)]))
     assert "f[FL_FOOT].z" in header and "contact[HR_FOOT]" in header
+
+
+def test_the_readmes_box_drops_flat_onto_its_files_floor_and_carries_its_weight(capsys):
+    example = str(Path(__file__).parents[2] / "examples" / "ground_box.xml")
+    status, text, _ = run(capsys, "simulate", example, "--ground", "--q0", "0,0,0.25,0,0,0,1", "--duration", "1")
+    assert status == 0 and "ground (the file's plane): height 0 m, normal (0.0, 0.0, 1.0), μ 0.5; 8 contact points" in text
+    assert "final total 24.525 N" in text and "deepest penetration: 0 m" in text  # m g of 2.5 kg
 
 
 def test_a_floating_robot_without_a_ground_says_its_base_falls_freely(capsys):
@@ -74,3 +83,22 @@ def test_ground_without_a_height_is_the_files_plane_else_flat_at_zero(capsys, mo
 def test_impossible_ground_runs_are_one_stderr_line_and_exit_2(capsys, flags, said):
     status, _, err = run(capsys, "simulate", BOX, "--floating-base", "--duration", "0.01", *flags)
     assert status == 2 and said in err and len(err.strip().splitlines()) == 1
+
+
+def _readme_ground_commands() -> list[list[str]]:
+    """The ``robodyn`` commands of the README's ground section run from the repository's root."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text[text.index("## Robots on the ground") :]
+    block = section[section.index("```shell") + len("```shell") : section.index("```", section.index("```shell") + 3)]
+    return [shlex.split(line)[1:] for line in block.splitlines() if line.startswith("robodyn ")]
+
+
+@pytest.mark.slow
+def test_the_readmes_ground_commands_run_from_the_repositorys_root(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    commands = _readme_ground_commands()
+    assert [command[1] for command in commands][:2] == ["examples/ground_box.xml", "tests/data/mjcf/contact_quadruped.xml"]
+    assert commands[2][1].startswith("~/.cache/robodyn/gymnasium/")  # the ant: run by tests/sim/test_gymnasium_ground.py
+    for command in commands[:2]:
+        status, text, err = run(capsys, *command)
+        assert status == 0 and "contacts active at the end" in text, err

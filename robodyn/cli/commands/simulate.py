@@ -28,7 +28,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--target",
         type=vector,
         help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
-        "pd / computed-torque: joint target; lqr: the equilibrium (joint values) to balance at; "
+        "pd / computed-torque: joint target (pd's default: the start's); lqr: the equilibrium (joint values) to balance at; "
         "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it)",
     )
     parser.add_argument(
@@ -169,7 +169,8 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         "--kp",
         type=vector,
         help="pd: stiffness, one value or one a joint, in [N m/rad] / [N/m] (default: 100 x each joint's inertia, a "
-        "critically damped 10 rad/s); computed-torque: in [1/s^2] (default 400)",
+        "critically damped 10 rad/s; a floating robot on --ground adds each joint's load at the target over 0.05 rad); "
+        "computed-torque: in [1/s^2] (default 400)",
     )
     parser.add_argument(
         "--kd",
