@@ -41,5 +41,5 @@ def test_ants_ankles_rest_on_their_stops_where_mujoco_holds_them(assets):
     assert figures["height apart [m]"] < 1e-4 and figures["attitude apart [rad]"] < 1e-3
     assert figures["joints apart [rad]"] < 1e-3
     assert figures["same contact set"] == 1.0
-    assert figures["mean normal error"] < 2e-2  # ADMM stops short on the feet and stops together (the summary says so)
+    assert figures["mean normal error"] < 2e-2  # 4e-16 measured; 7e-3 where the polish fails on the redundant feet and stops
     assert figures["deepest past a limit [rad]"] < 1e-4
