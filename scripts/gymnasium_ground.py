@@ -102,8 +102,9 @@ def _mujoco_body(robot: robodyn.Robot, q: np.ndarray, link: str, data) -> int:
     return int(np.argmin(np.linalg.norm(data.xpos - robot.frame_position(q, link), axis=1)))
 
 
-def compare(path: Path) -> dict[str, float | str]:
-    """Drop the robot of ``path`` in both engines (module docstring); the figures compared."""
+def compare(path: Path, limits: str = "enforce") -> dict[str, float | str]:
+    """Drop the robot of ``path`` in both engines (module docstring); the figures compared
+    (``limits="warn"``: robodyn's joints move through their limits, a negative control)."""
     import mujoco
 
     model, robot = stiffened(mujoco, path), robodyn.load(path)
@@ -122,7 +123,7 @@ def compare(path: Path) -> dict[str, float | str]:
             mujoco.mj_contactForce(model, data, index, force)
             total += force[0]
         totals.append(total)
-    run = simulate_contact(robot, ground=ground, duration=DURATION, dt=DT, q0=q0, limits="enforce")
+    run = simulate_contact(robot, ground=ground, duration=DURATION, dt=DT, q0=q0, limits=limits)
     ours, theirs = run.trajectory.q[-1], _robodyn_q(robot, model, data.qpos)
     their_links = sorted({int(model.geom_bodyid[data.contact[i].geom[1]]) for i in range(data.ncon)})
     our_links = sorted({run.frames[i] for i in np.flatnonzero(run.active[-1])})

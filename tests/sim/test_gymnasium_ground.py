@@ -43,3 +43,10 @@ def test_ants_ankles_rest_on_their_stops_where_mujoco_holds_them(assets):
     assert figures["same contact set"] == 1.0
     assert figures["mean normal error"] < 2e-2  # 4e-16 measured; 7e-3 where the polish fails on the redundant feet and stops
     assert figures["deepest past a limit [rad]"] < 1e-4
+
+
+@pytest.mark.slow
+def test_without_enforced_limits_the_ants_ankles_fold_through_their_stops(assets):
+    figures = drops.compare(assets / "ant.xml", limits="warn")
+    assert figures["deepest past a limit [rad]"] > 0.1 and figures["height apart [m]"] > 0.05  # 0.29 rad, 0.11 m
+    assert figures["same contact set"] == 0.0  # the torso lies on the floor
