@@ -27,7 +27,16 @@ def run(plan: RunPlan) -> Outcome:
 
     began = perf_counter()
     contact = run_contacts(
-        robot, plan.ground, plan.contacts, torques, plan.q0, plan.v0, plan.steps, plan.dt, joint_friction=plan.friction
+        robot,
+        plan.ground,
+        plan.contacts,
+        torques,
+        plan.q0,
+        plan.v0,
+        plan.steps,
+        plan.dt,
+        joint_friction=plan.friction,
+        limits=plan.limits == "enforce",
     )
     loop_time = perf_counter() - began
     trajectory = contact.trajectory

@@ -1,9 +1,11 @@
 """What a simulation run on the ground may ask, checked when its plan is made.
 
 The contact step (:mod:`robodyn.sim.contact`) is semi-implicit Euler at the velocity level
-with the controller sampled once a step; it has no momentum observer and does not enforce
-joint limits. A plan asking for those with a ground is refused, naming the parameter, as
-is a start with a contact point deeper than :data:`START_PENETRATION` below the ground.
+with the controller sampled once a step; it has no momentum observer. Enforced joint limits
+are rows of its contact problem (:mod:`robodyn.sim.contact_limits`). A plan asking for
+another integrator, a control period or an observer with a ground is refused, naming the
+parameter, as is a start with a contact point deeper than :data:`START_PENETRATION` below
+the ground or a joint further than that past an enforced limit.
 """
 
 from __future__ import annotations
@@ -11,11 +13,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import pinocchio as pin
 
+from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.contact import contact_kinematics
-from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
+from robodyn.sim.contact_limits import LimitRows
+from robodyn.sim.ground import ContactPoint, Contacts, Ground, collision_points, contact_points
 
 #: Deepest a contact point may start below the ground, in [m] (deeper: refused; the
 #: push-out of a deep penetration would launch the robot).
@@ -30,7 +35,7 @@ def check_contact_run(
     q0: np.ndarray,
     integrator: str,
     every: int | None,
-    limits: str,
+    limits: str,  # every mode: "enforce" puts the limits in the contact problem
     observer: object,
 ) -> Contacts | None:
     """The contact points of a run on ``ground`` (``None`` without one), or an
@@ -44,12 +49,13 @@ def check_contact_run(
     refusals = [
         (integrator != "semi-implicit-euler", "integrator", "'semi-implicit-euler' with a ground (the contact step's scheme)", repr(integrator)),
         (every not in (None, 1), "control_period", "the step dt with a ground (the contact step samples the controller each step)", f"{every} steps"),
-        (limits == "enforce", "limits", "'warn' or 'ignore' with a ground (the contact step does not enforce limits)", repr(limits)),
         (observer is not None, "observer", "none with a ground (the contact step runs no observer)", "an observer"),
     ]  # fmt: skip
     for refused, name, expected, received in refusals:
         if refused:
             raise InputError(name, expected, received)
+    if limits == "enforce":
+        _check_inside_limits(robot, q0)
     found = contact_points(robot, contacts)
     gaps = contact_kinematics(robot, q0, ground, found.points)[0]
     if gaps.min() < -START_PENETRATION:
@@ -60,6 +66,59 @@ def check_contact_run(
             f"{found.names[deepest]!r} {-gaps[deepest]:.3g} m below",
         )
     return found
+
+
+def _check_inside_limits(robot: Robot, q0: np.ndarray) -> None:
+    """Refuse a start further than :data:`START_PENETRATION` past a joint's position limit
+    (enforced, the row's push-back would fling the joint out at ``β`` of it a step)."""
+    rows = LimitRows(robot)
+    gaps = rows.gaps(q0)
+    if len(gaps) and gaps.min() < -START_PENETRATION:
+        worst = int(gaps.argmin())
+        raise InputError(
+            "q0",
+            f"a configuration within the joint limits (at most {START_PENETRATION} past one) when they are enforced",
+            f"{rows.names[worst]!r} {-gaps[worst]:.3g} past",
+        )
+
+
+#: How many samples of a run :func:`buried_line` looks at (evenly spread, the last included).
+BURIED_SAMPLES = 200
+#: Depth below the ground [m] a link's origin or collision point may reach unreported
+#: (a penetration the contact step tolerates).
+BURIED_DEPTH = 1e-3
+
+
+def buried_line(robot: Robot, q: np.ndarray, t: np.ndarray, ground: Ground, contacts: Contacts) -> str | None:
+    """One warning line naming the links that are not contact points and went under the
+    ground in a run (``q`` (N, nq) at times ``t`` (N,) [s]): their origins and collision
+    spheres, boxes and capsules checked at :data:`BURIED_SAMPLES` samples, each link with
+    its deepest point in [m]; ``None`` when none went deeper than :data:`BURIED_DEPTH`."""
+    model, data, frames = robot.model, robot.handle.data, robot.handle.frames
+    moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
+    links = sorted(moving - {point.link for point in contacts.points})
+    shapes = [point for point in collision_points(robot).points if point.link in links]
+    depth: dict[str, float] = {}
+    first = np.inf
+    for index in np.unique(np.linspace(0, len(q) - 1, min(len(q), BURIED_SAMPLES)).round().astype(int)):
+        pin.framesForwardKinematics(model, data, q[index])
+        points = [(link, data.oMf[frames[link]].translation) for link in links]
+        points += [
+            (p.link, data.oMf[frames[p.link]].act(np.array(p.position)) - p.radius * np.array(ground.normal)) for p in shapes
+        ]
+        for link, where in points:
+            below = -float(ground.gap(where))
+            if below > BURIED_DEPTH:
+                depth[link] = max(depth.get(link, 0.0), below)
+                first = min(first, float(t[index]))
+    if not depth:
+        return None
+    deepest = sorted(depth.items(), key=lambda item: -item[1])
+    shown = ", ".join(f"{printable(link)!r} {value:.3g} m" for link, value in deepest[:4]) + (", …" if len(deepest) > 4 else "")
+    return (
+        f"warning: {len(deepest)} link{'s' if len(deepest) > 1 else ''} that are no contact points went under the ground "
+        f"(from t = {first:.6g} s; deepest): {shown}: name them as contacts or hold the robot up"
+    )
 
 
 def start_above(
@@ -74,4 +133,4 @@ def start_above(
     return moved, lift
 
 
-__all__ = ["START_PENETRATION", "check_contact_run", "start_above"]
+__all__ = ["BURIED_DEPTH", "BURIED_SAMPLES", "START_PENETRATION", "buried_line", "check_contact_run", "start_above"]

@@ -20,7 +20,10 @@ from robodyn.common.text import printable
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.contact import ACTIVE_FORCE, ContactSettings, contact_step
+from robodyn.sim.contact_checks import buried_line
+from robodyn.sim.contact_limits import LimitRows, limited_step
 from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
+from robodyn.sim.limits import check_mode
 from robodyn.sim.plan import ExternalWrench
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import contact_header
@@ -49,6 +52,9 @@ class ContactSimulation:
             tolerance (polished, or ADMM converged), shape (N,).
         notes: What the run does not model, one line each.
         frames: The frame each contact point belongs to, in the order of ``contacts``.
+        limit_torques: With enforced limits, the torques the joints' position limits
+            apply (:mod:`robodyn.sim.contact_limits`), shape (N, nv), in [N m] or [N];
+            ``None``: limits not enforced.
     """
 
     trajectory: Trajectory
@@ -61,6 +67,7 @@ class ContactSimulation:
     converged: np.ndarray
     notes: tuple[str, ...] = ()
     frames: tuple[str, ...] = ()
+    limit_torques: np.ndarray | None = None
 
     @property
     def normal_forces(self) -> np.ndarray:
@@ -116,7 +123,7 @@ class ContactSimulation:
         peak = int(np.argmax(normal.max(axis=1))) if len(normal) else 0
         active_slip = np.where(self.active, self.slip, 0.0)
         lines = [
-            f"ground: height {self.ground.height:.6g} m, normal {tuple(round(x, 6) for x in self.ground.normal)}, "
+            f"ground{f' ({self.ground.origin})' if self.ground.origin else ''}: height {self.ground.height:.6g} m, normal {tuple(round(x, 6) for x in self.ground.normal)}, "
             f"μ {self.ground.friction:.6g}; {len(self.contacts)} contact points",
             f"peak normal force: {normal.max(initial=0.0):.6g} N (total {normal.sum(axis=1).max(initial=0.0):.6g} N "
             f"at t = {self.trajectory.t[peak]:.6g} s); final total {normal[-1].sum():.6g} N",
@@ -129,6 +136,13 @@ class ContactSimulation:
             lines.append(
                 f"contact solver: {unsolved} of {len(self.converged)} steps stopped before ADMM's tolerance "
                 f"(the first at t = {self.trajectory.t[int(np.argmin(self.converged))]:.6g} s): their forces are approximate"
+            )
+        if self.limit_torques is not None:
+            peak = np.abs(self.limit_torques).max(axis=0)
+            joint = self.trajectory.coordinate_names[1][int(np.argmax(peak))] if peak.max() > 0 else ""
+            lines.append(
+                "joint limits: enforced, one-sided rows of the contact problem; peak limit torque "
+                + (f"{peak.max():.6g} N m or N ({joint})" if joint else "0")
             )
         return [printable(line) for line in (*lines, *self.notes)]
 
@@ -144,6 +158,7 @@ def simulate_contact(
     q0: np.ndarray | None = None,
     v0: np.ndarray | None = None,
     settings: ContactSettings | None = None,
+    limits: str = "warn",
 ) -> ContactSimulation:
     """Simulate a robot touching a plane (:mod:`robodyn.sim.contact`'s scheme).
 
@@ -158,6 +173,9 @@ def simulate_contact(
         q0: Initial configuration (nq,), default the neutral one.
         v0: Initial velocity (nv,), default zero.
         settings: Solver settings (:class:`~robodyn.sim.contact.ContactSettings`).
+        limits: ``"enforce"``: the joints' position limits are one-sided rows of the contact
+            problem and their efforts saturate the torques (:mod:`robodyn.sim.contact_limits`);
+            ``"warn"`` / ``"ignore"``: the joints move freely.
 
     Returns:
         The motion with every contact's force, gap and slip at each sample.
@@ -183,25 +201,32 @@ def simulate_contact(
     (q, v), _ = robot.validate(q=q, v=np.zeros(robot.nv) if v0 is None else v0)
     if controller is not None and not callable(controller):
         (controller,), _ = robot.validate(tau=controller)
-    return run_contacts(robot, ground, found, controller, q, v, steps, dt, settings=settings)
+    check_mode(limits)
+    return run_contacts(robot, ground, found, controller, q, v, steps, dt, settings=settings, limits=limits == "enforce")
 
 
 def run_contacts(
     robot: Robot, ground: Ground, found: Contacts, controller: Controller, q: np.ndarray, v: np.ndarray,
     steps: int, dt: float, *, settings: ContactSettings | None = None, joint_friction: bool = True,
+    limits: bool = False,
 ) -> ContactSimulation:  # fmt: skip
-    """:func:`simulate_contact` of checked arguments (``joint_friction=False``: no joint damping)."""
+    """:func:`simulate_contact` of checked arguments (``joint_friction=False``: no joint damping;
+    ``limits``: the joints' position limits in the contact problem and their efforts
+    saturating the torques, :mod:`robodyn.sim.contact_limits`)."""
     damping = robot.joint_damping if joint_friction else np.zeros(robot.nv)
-    samples = _run(robot, ground, found.points, controller, q, v, steps, dt, settings or ContactSettings(), damping)
+    rows = LimitRows(robot) if limits else None
+    samples = _run(robot, ground, found.points, controller, (q, v), steps, dt, settings or ContactSettings(), damping, rows)
     trajectory = Trajectory(
         samples["t"], samples["q"], samples["v"], samples["a"], samples["tau"], list(robot.joint_names), robot.name
     )
-    notes = list(found.skipped)
+    buried = buried_line(robot, samples["q"], samples["t"], ground, found)
+    notes = ([buried] if buried else []) + list(found.skipped)
     if joint_friction and np.any(robot.joint_friction):
         notes.append("joint Coulomb friction of the file is not applied in contact runs")
     return ContactSimulation(
         trajectory, found.names, samples["forces"], samples["gaps"], samples["slip"], ground, samples["iterations"],
         samples["converged"], tuple(notes), tuple(point.link for point in found.points),
+        samples["limit_torques"] if limits else None,
     )  # fmt: skip
 
 
@@ -218,17 +243,27 @@ def _torque(controller: Controller, t: float, q: np.ndarray, v: np.ndarray, nv: 
 
 def _run(
     robot: Robot, ground: Ground, points: tuple[ContactPoint, ...], controller: Controller,
-    q: np.ndarray, v: np.ndarray, steps: int, dt: float, settings: ContactSettings, damping: np.ndarray,
+    state: tuple[np.ndarray, np.ndarray], steps: int, dt: float, settings: ContactSettings, damping: np.ndarray,
+    rows: LimitRows | None,
 ) -> dict[str, np.ndarray]:  # fmt: skip
-    """Samples ``t, q, v, a, tau, forces, gaps, slip, iterations, converged`` of ``steps`` steps."""
-    keys = ("q", "v", "a", "tau", "forces", "gaps", "slip", "iterations", "converged")
+    """Samples ``t, q, v, a, tau, forces, gaps, slip, iterations, converged, limit_torques``
+    of ``steps`` steps (the limit torques zero without ``rows``)."""
+    keys = ("q", "v", "a", "tau", "forces", "gaps", "slip", "iterations", "converged", "limit_torques")
     samples: dict[str, list] = {key: [] for key in keys}
-    guess = None
+    (q, v), guess, held, limit_torques = state, None, None, np.zeros(robot.nv)
     for step in range(steps + 1):
         t = step * dt
         tau = _torque(controller, t, q, v, robot.nv)
-        result = contact_step(robot, q, v, tau - damping * v, dt, ground, points, settings=settings, guess=guess)
-        values = (q, v, (result.v - v) / dt, tau, result.forces, result.gaps, result.slip, result.iterations, result.converged)
+        if rows is None:
+            result = contact_step(robot, q, v, tau - damping * v, dt, ground, points, settings=settings, guess=guess)
+        else:
+            tau = rows.limits.saturate(tau)
+            result, held = limited_step(
+                robot, q, v, tau - damping * v, dt, ground, points, rows, settings=settings, guess=guess, held=held
+            )
+            limit_torques = rows.torques(held, dt, robot.nv)
+        values = (q, v, (result.v - v) / dt, tau, result.forces, result.gaps, result.slip, result.iterations,
+                  result.converged, limit_torques)  # fmt: skip
         for key, value in zip(keys, values, strict=True):
             samples[key].append(value)
         q, v, guess = result.q, result.v, result.impulses

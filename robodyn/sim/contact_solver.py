@@ -137,8 +137,9 @@ def polish(delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses
 
 def _least_norm(matrix: np.ndarray, target: np.ndarray, impulses: np.ndarray) -> np.ndarray:
     """``matrix⁻¹ target`` by one LU solve when ``matrix`` is regular (the answer no larger
-    than 10⁶ times the impulses' scale), else the least-norm solution (redundant rows)."""
-    bound = 1e6 * max(float(np.abs(impulses).max()), float(np.abs(target).max()), 1e-300)
+    than 10³ times the impulses' scale: the target's free velocities, up to ``g / dt`` of far
+    points, are no scale of impulses), else the least-norm solution (redundant rows)."""
+    bound = 1e3 * max(float(np.abs(impulses).max()), 1e-300)
     try:
         with np.errstate(all="ignore"):
             solution = np.linalg.solve(matrix, target)

@@ -34,7 +34,7 @@ from robodyn.sim.contact_checks import start_above
 from robodyn.sim.contact_run import ground_lines
 from robodyn.sim.control import LQR, ComputedTorque, PDGravity, TaskSpace, joint_target, quintic_reference
 from robodyn.sim.gains import LQR_ACCELERATION as LQR_ACCELERATION
-from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_gains
+from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_defaults, pd_gains
 from robodyn.sim.ground import Ground, resolve_ground
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
@@ -107,7 +107,7 @@ def run_simulation(
             (a floating robot on ``ground`` held by the whole-body QP, started on its feet;
             ``target``: its centre of mass's shift DX,DY,DZ, :mod:`robodyn.sim.stand_run`).
         target: Joint target (nq values; a floating base's joints only, nq − 7: the base
-            stays free and gets no torque), task target (X,Z or X,Y,Z in [m]) or, for osc
+            stays free and gets no torque; pd: default the start's), task target (X,Z or X,Y,Z in [m]) or, for osc
             and impedance, X,Y,Z in [m] with optionally ROLL,PITCH,YAW in [rad].
         frame: Controlled frame for task-space, osc and impedance control (default the
             robot's end effector; it must be a frame some joint moves); under the other
@@ -156,6 +156,7 @@ def run_simulation(
     options = _options(robot, controller, posture, stiffness, damping, actuated, kp, kd)
     ground = resolve_ground(robot, ground)  # "file": the plane the robot's file states
     start, lifted = _start(robot, controller, q0, ground, contacts)
+    target, options["gains"] = pd_defaults(robot, controller, target, start, options["gains"], ground, contacts)
     law: Any
     if controller == "stand":  # started on its feet (gap 0), stand_run's docstring
         law, start, placed = stand_law(robot, controller_model(robot), start, target, ground, contacts)
@@ -243,7 +244,7 @@ def _check_request(robot: Robot, controller: str, target: list[float] | None, fr
     if controller not in CONTROLLERS:
         raise InputError("controller", f"one of {', '.join(CONTROLLERS)}", repr(controller))
     check_mode(limits)
-    if controller not in ("passive", "stand") and target is None:
+    if controller not in ("passive", "stand", "pd") and target is None:  # pd: holds the start
         raise InputError("target", f"given for the {controller} controller", "nothing")
     if controller == "passive" and target is not None:
         raise InputError(

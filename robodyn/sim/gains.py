@@ -4,15 +4,26 @@ Fixed gains (``kp = 100 N m/rad``, ``kd = 20 N m s/rad``) put a light joint's cl
 poles far out: a wrist with ``M_jj = 0.0046 kg m²`` gets ``kd / M_jj ≈ 4 300 /s``, beyond
 what RK4 holds at a 1 ms step (``|λ| dt ≤ 2.8``). Scaled to the joint's inertia, every
 joint gets the same critically damped response, ``ω = 10 rad/s``, whatever its mass.
+
+A floating robot on the ground carries its weight through its joints: the inertia rule
+alone (its legs' inertias with the base free, grams times centimetres squared) lets solo12
+fold flat. :func:`load_gains` adds the load each joint carries at the target pose
+(:func:`joint_loads`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
 from robodyn.common.text import counted
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.contact import contact_kinematics
+from robodyn.sim.contact_checks import start_above
+from robodyn.sim.control import joint_target
+from robodyn.sim.ground import ContactPoint, Ground, contact_points
 
 #: The natural frequency [rad/s] of the default PD gains (critically damped).
 PD_FREQUENCY = 10.0
@@ -134,3 +145,68 @@ def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = Non
         if dof.joint in chosen
     ]
     return np.diag(positions + velocities), np.diag(1.0 / np.square(scales))
+
+
+#: The joint angle [rad] (or travel [m]) a joint gives under its full load moment
+#: (:func:`load_gains`).
+LOAD_GIVE = 0.05
+
+
+def joint_loads(robot: Robot, q: np.ndarray, jacobian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The load moment and the carried inertia of each joint of a floating robot standing
+    at ``q`` on the contact points of ``jacobian`` (3k, nv, rows of a contact in any
+    orthonormal axes), shapes (n,) each (the joints).
+
+    The contact forces ``f`` that hold the robot still are the minimum-norm solution of
+    the base's rows of ``G(q) = Jᵀ f``; joint ``j`` carries the load moment
+    ``L_j = Σ_c ‖f_c‖ ‖∂p_c/∂q_j‖`` (each force times its lever about the joint, ``‖J_c,j‖``
+    the distance of the contact from the joint's axis) in [N m] ([N]) and the inertia
+    ``Σ_c ‖f_c‖ / g ‖∂p_c/∂q_j‖²`` in [kg m²] ([kg]) of the weight it lifts.
+    """
+    gravity = robot.gravity(q)
+    forces = np.linalg.lstsq(jacobian[:, :6].T, gravity[:6], rcond=None)[0].reshape(-1, 3)
+    magnitude = np.linalg.norm(forces, axis=1)
+    levers = np.linalg.norm(jacobian[:, 6:].reshape(len(magnitude), 3, -1), axis=1)  # (k, n)
+    g = max(float(np.linalg.norm(robot.model.gravity.linear)), 1e-300)
+    return magnitude @ levers, (magnitude / g) @ levers**2
+
+
+def load_gains(
+    robot: Robot, q: np.ndarray, jacobian: np.ndarray, driven: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Default PD gains of a floating robot standing at ``q`` on the contacts of
+    ``jacobian`` (3k, nv), shape (n,) each (the joints).
+
+    ``kp = ω² m + L / θ``: the inertia rule (:func:`pd_gains`, ``m`` the joint's inertia
+    with the base free) plus the load moment ``L`` (:func:`joint_loads`) over
+    :data:`LOAD_GIVE` ``θ``: a joint gives ``θ`` under its full load moment, and the torque
+    it must hold is at most ``L``, so it sags at most ``θ``. ``kd = 2 √(kp m)``: critical
+    on the joint's own inertia, so a leg in the air stays stable at a millisecond step
+    (damped for the carried weight, a leg's ``kd / m`` would exceed ``2 / dt``).
+    """
+    inertia = joint_inertia(robot, q, driven)
+    stiffness = PD_FREQUENCY**2 * inertia + joint_loads(robot, q, jacobian)[0] / LOAD_GIVE
+    return stiffness, 2.0 * np.sqrt(stiffness * inertia)
+
+
+def pd_defaults(
+    robot: Robot, controller: str, target: list[float] | None, start: np.ndarray, gains: dict,
+    ground: Ground | None, contacts: str | Sequence[str | ContactPoint],
+) -> tuple[list[float] | None, dict]:  # fmt: skip
+    """The pd controller's defaults: without a ``target``, the start's joints (held); a
+    floating robot on a ``ground`` with neither ``kp`` nor ``kd`` in ``gains``: the gains
+    of :func:`load_gains` at the target pose set on the ground, on its contact points that
+    touch it (those within 1 mm of the lowest). Other controllers: unchanged."""
+    if controller != "pd":
+        return target, gains
+    if target is None:
+        target = list(start[7:] if robot.floating_base else start)
+    if ground is None or not robot.floating_base or gains.get("kp") is not None or gains.get("kd") is not None:
+        return target, gains
+    goal = np.array(start, dtype=float)
+    goal[7:] = joint_target(robot, target, "pd")
+    standing = start_above(robot, goal, ground, contacts, clearance=0.0)[0]
+    gaps, jacobian = contact_kinematics(robot, standing, ground, contact_points(robot, contacts).points)
+    support = np.repeat(gaps <= gaps.min() + 1e-3, 3)
+    kp, kd = load_gains(robot, standing, jacobian[support])
+    return target, {**gains, "kp": kp, "kd": kd}

@@ -42,11 +42,13 @@ class Ground:
         height: Height of the plane along world ``z`` at ``x = y = 0``, in [m].
         normal: Its unit normal, pointing out of the ground (normalised on construction).
         friction: Coulomb coefficient ``μ ≥ 0`` (``0``: frictionless).
+        origin: Where it comes from, for a run's summary (``""``: given as is).
     """
 
     height: float = 0.0
     normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     friction: float = 1.0
+    origin: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
         if not math.isfinite(self.height):
@@ -246,7 +248,28 @@ def resolve_ground(robot: Robot, ground: Ground | str | None) -> Ground | None:
     if stated is None:
         raise InputError("ground", "a Ground: the robot's file states no ground plane", '"file"')
     height, normal, friction = stated
-    return Ground(height, normal, friction)
+    return Ground(height, normal, friction, "the file's plane")
+
+
+def asked_ground(robot: Robot, *, height: float | None = None, friction: float | None = None) -> Ground:
+    """The ground asked by a height and a friction coefficient (``robodyn simulate --ground``).
+
+    Args:
+        robot: The robot.
+        height: A flat plane's height in [m]; ``None``: the plane the robot's file states
+            (:func:`resolve_ground` of ``"file"``), or a flat plane at height 0 when it
+            states none (the ground's ``origin`` says which).
+        friction: The coefficient ``μ``, overriding the file's; ``None``: the file's, else 1.
+
+    Raises:
+        InputError: For a height or friction that is not finite (a negative friction).
+    """
+    stated = robot.source.ground
+    if height is None and stated is not None:
+        found = Ground(*stated, "the file's plane")
+        return found if friction is None else Ground(found.height, found.normal, friction, "the file's plane, μ given")
+    origin = "flat at height 0: the file states no plane" if height is None else ""
+    return Ground(0.0 if height is None else height, friction=1.0 if friction is None else friction, origin=origin)
 
 
 def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -> Contacts:
@@ -282,4 +305,4 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
     return found
 
 
-__all__ = ["ContactPoint", "Contacts", "Ground", "collision_points", "contact_points", "resolve_ground"]
+__all__ = ["ContactPoint", "Contacts", "Ground", "asked_ground", "collision_points", "contact_points", "resolve_ground"]

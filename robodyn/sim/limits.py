@@ -12,6 +12,9 @@ Three modes (``simulate(..., limits=...)``, ``robodyn simulate --limits``):
   after every step a joint beyond a position limit is put back on it and its velocity
   into the limit is set to zero (a perfectly plastic stop: no bounce, no penetration;
   the velocity away from the limit is kept). Velocity limits are reported, not enforced.
+  On a ground the position limits are instead one-sided rows of the contact problem
+  (:mod:`robodyn.sim.contact_limits`: stops solved with the contacts, their torques
+  reported).
 - ``"ignore"``: neither enforced nor reported.
 
 Limits that a URDF leaves unspecified do not count: infinite ones, placeholder position

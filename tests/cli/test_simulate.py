@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import csv
+import shlex
 from pathlib import Path
 
 import pytest
 
 from robodyn.cli.app import main
+from tests.conftest import ROOT
 
 BOX = str(Path(__file__).parents[1] / "data" / "contact" / "box.urdf")
+MJCF_BOX = str(Path(__file__).parents[1] / "data" / "mjcf" / "contact_box.xml")
 FEET = "FL_FOOT,FR_FOOT,HL_FOOT,HR_FOOT"
 
 
@@ -35,15 +38,41 @@ def test_solo12_lands_on_its_feet_and_stands_under_a_pd_hold(capsys, tmp_path):
     assert "f[FL_FOOT].z" in header and "contact[HR_FOOT]" in header
 
 
+def test_the_readmes_box_drops_flat_onto_its_files_floor_and_carries_its_weight(capsys):
+    example = str(Path(__file__).parents[2] / "examples" / "ground_box.xml")
+    status, text, _ = run(capsys, "simulate", example, "--ground", "--q0", "0,0,0.25,0,0,0,1", "--duration", "1")
+    assert status == 0 and "ground (the file's plane): height 0 m, normal (0.0, 0.0, 1.0), μ 0.5; 8 contact points" in text
+    assert "final total 24.525 N" in text and "deepest penetration: 0 m" in text  # m g of 2.5 kg
+
+
 def test_a_floating_robot_without_a_ground_says_its_base_falls_freely(capsys):
     status, text, _ = run(capsys, "simulate", BOX, "--floating-base", "--duration", "0.01", "--engine", "pinocchio")
     assert status == 0 and "no ground: the base falls freely" in text
 
 
 @pytest.mark.parametrize(
+    ("model", "flags", "said"),
+    [
+        (MJCF_BOX, [], "ground (the file's plane): height 0.1 m, normal (0.0, 0.0, 1.0), μ 0.7;"),
+        (MJCF_BOX, ["--friction", "0.25"], "ground (the file's plane, μ given): height 0.1 m, normal (0.0, 0.0, 1.0), μ 0.25;"),
+        (MJCF_BOX, ["0.05"], "ground: height 0.05 m, normal (0.0, 0.0, 1.0), μ 1;"),
+        (
+            BOX,
+            ["--floating-base"],
+            "ground (flat at height 0: the file states no plane): height 0 m, normal (0.0, 0.0, 1.0), μ 1;",
+        ),
+    ],
+)
+def test_ground_without_a_height_is_the_files_plane_else_flat_at_zero(capsys, model, flags, said):
+    status, text, _ = run(capsys, "simulate", model, "--duration", "0.002", "--ground", *flags)
+    assert status == 0 and said in text
+
+
+@pytest.mark.parametrize(
     ("flags", "said"),
     [
         (["--contact", "box"], "--contact must be given only with --ground"),
+        (["--friction", "0.5"], "--friction must be given only with --ground"),
         (["--ground", "--friction", "-1"], "--friction must be"),
         (["--ground", "--integrator", "rk4"], "--integrator must be 'semi-implicit-euler' with a ground"),
         (["--ground", "--compiled"], "--ground must be left out for --engine compiled"),
@@ -54,3 +83,22 @@ def test_a_floating_robot_without_a_ground_says_its_base_falls_freely(capsys):
 def test_impossible_ground_runs_are_one_stderr_line_and_exit_2(capsys, flags, said):
     status, _, err = run(capsys, "simulate", BOX, "--floating-base", "--duration", "0.01", *flags)
     assert status == 2 and said in err and len(err.strip().splitlines()) == 1
+
+
+def _readme_ground_commands() -> list[list[str]]:
+    """The ``robodyn`` commands of the README's ground section run from the repository's root."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text[text.index("## Robots on the ground") :]
+    block = section[section.index("```shell") + len("```shell") : section.index("```", section.index("```shell") + 3)]
+    return [shlex.split(line)[1:] for line in block.splitlines() if line.startswith("robodyn ")]
+
+
+@pytest.mark.slow
+def test_the_readmes_ground_commands_run_from_the_repositorys_root(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    commands = _readme_ground_commands()
+    assert [command[1] for command in commands][:2] == ["examples/ground_box.xml", "tests/data/mjcf/contact_quadruped.xml"]
+    assert commands[2][1].startswith("~/.cache/robodyn/gymnasium/")  # the ant: run by tests/sim/test_gymnasium_ground.py
+    for command in commands[:2]:
+        status, text, err = run(capsys, *command)
+        assert status == 0 and "contacts active at the end" in text, err

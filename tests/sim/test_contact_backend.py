@@ -51,7 +51,6 @@ def test_an_external_push_acts_on_a_box_on_the_ground(box):
     [
         ({"engine": "compiled"}, "ground"),
         ({"integrator": "rk4"}, "integrator"),
-        ({"limits": "enforce"}, "limits"),
         ({"ground": "floor"}, "ground"),
     ],
 )

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from robodyn.cli.common import RANGES, add_constraints_argument, add_model_arguments, load_robot, vector, warn
 from robodyn.cli.flags import command_line_text
 from robodyn.common.text import json_text, printable
 from robodyn.exceptions import InputError
+
+if TYPE_CHECKING:
+    from robodyn.dynamics.robot import Robot
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -25,7 +29,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--target",
         type=vector,
         help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
-        "pd / computed-torque: joint target; lqr: the equilibrium (joint values) to balance at; "
+        "pd / computed-torque: joint target (pd's default: the start's); lqr: the equilibrium (joint values) to balance at; "
         "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it)",
     )
     parser.add_argument(
@@ -117,7 +121,7 @@ def run(arguments: argparse.Namespace) -> int:
         record=arguments.record,
         png=arguments.png,
         **_reference(arguments),
-        **_ground(arguments),
+        **_ground(arguments, robot),
     )
     # the library's summary names its parameters (engine='compiled'); the command line, its flags
     summary = replace(summary.with_startup(startup), engine_reason=command_line_text(summary.engine_reason))
@@ -166,7 +170,8 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         "--kp",
         type=vector,
         help="pd: stiffness, one value or one a joint, in [N m/rad] / [N/m] (default: 100 x each joint's inertia, a "
-        "critically damped 10 rad/s); computed-torque: in [1/s^2] (default 400)",
+        "critically damped 10 rad/s; a floating robot on --ground adds each joint's load at the target over 0.05 rad); "
+        "computed-torque: in [1/s^2] (default 400)",
     )
     parser.add_argument(
         "--kd",
@@ -187,12 +192,15 @@ def _add_ground_arguments(parser: argparse.ArgumentParser) -> None:
         "--ground",
         type=float,
         nargs="?",
-        const=0.0,
+        const=...,  # given without a value: the file's plane
         metavar="HEIGHT",
-        help="stand the robot on a flat ground at this height in [m] (default 0 when given without a value): "
-        "point contacts with Coulomb friction; the summary gives peak normal force, slip and penetration",
+        help="stand the robot on a flat ground at this height in [m] (without a value: the MJCF file's plane, "
+        "else height 0; the summary says which): point contacts with Coulomb friction; the summary gives peak "
+        "normal force, slip and penetration",
     )
-    parser.add_argument("--friction", type=float, default=1.0, help="with --ground: the friction coefficient mu (default 1)")
+    parser.add_argument(
+        "--friction", type=float, help="with --ground: the friction coefficient mu (default: the file's plane's, else 1)"
+    )
     parser.add_argument(
         "--contact",
         metavar="FRAME[,...]",
@@ -200,16 +208,19 @@ def _add_ground_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _ground(arguments: argparse.Namespace) -> dict:
+def _ground(arguments: argparse.Namespace, robot: Robot) -> dict:
     """``ground=`` and ``contacts=`` of ``--ground``, ``--friction`` and ``--contact``."""
     if arguments.ground is None:
-        if arguments.contact is not None:
-            raise InputError("--contact", "given only with --ground", repr(arguments.contact))
+        for flag, value in (("--contact", arguments.contact), ("--friction", arguments.friction)):
+            if value is not None:
+                raise InputError(flag, "given only with --ground", repr(value))
         return {}
-    from robodyn.sim.ground import Ground
+    from robodyn.sim.ground import asked_ground
 
+    height = None if arguments.ground is ... else arguments.ground
+    ground = asked_ground(robot, height=height, friction=arguments.friction)
     contacts = "collision" if arguments.contact is None else [name.strip() for name in arguments.contact.split(",")]
-    return {"ground": Ground(height=arguments.ground, friction=arguments.friction), "contacts": contacts}
+    return {"ground": ground, "contacts": contacts}
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,0 +1,131 @@
+"""Joint limits in a contact run: each position limit a one-sided contact on its joint.
+
+A run on the ground with ``limits="enforce"`` solves its joints' position limits in the
+**same complementarity problem** as its ground contacts (what MuJoCo does: a limit is one
+more constraint row of its solver). The lower limit of joint coordinate ``j`` is the row
+
+    λ ≥ 0,     u = v⁺_j + b ≥ 0,     λ u = 0
+
+with the impulse ``λ`` [N m s] / [N s] acting on ``v_j`` alone (the upper limit: ``−v⁺_j``,
+a negative torque); the bias ``b`` is the contact normal rows' (:mod:`robodyn.sim.contact`):
+with the gap ``g = q_j − lower ≥ 0`` the joint may reach its limit within the step but not
+cross it (``b = g / dt``, speculative), a joint past it is pushed back by ``β`` of the
+overshoot a step (``b = β g / dt``). Stops are inelastic and frictionless.
+
+**How it enters the solver**: a row is a cone of three rows whose normal row is the
+limit's and whose two tangent rows are decoupled from everything (a Delassus diagonal equal
+to the normal row's, no free velocity). Their impulses are zero at every solution (sticking
+needs ``u_t = d p_t = 0``; slipping would need ``p_t`` against ``u_t = d p_t``), so the
+cone reduces to ``λ ≥ 0`` and De Saxcé's term ``μ ‖u_t‖`` vanishes: the contact solver
+(:func:`robodyn.sim.contact_solver.solve_impulses`, Pinocchio's ADMM and the exact polish)
+solves the combined problem unchanged. A limit enters a step when its joint is within
+reach of it, ``g < 2 dt (|v_j| + |v_free,j|) +`` :data:`REACH` (else its impulse is 0).
+Effort limits saturate the applied torque, as ``limits="enforce"`` does without a ground.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import SingularMassMatrixError
+from robodyn.sim.contact import ContactStep, contact_kinematics, integrate
+from robodyn.sim.contact_solver import ContactSettings, solve_impulses
+from robodyn.sim.ground import ContactPoint, Ground
+from robodyn.sim.limits import JointLimits
+
+#: A limit row enters a step when its joint is this close to it (beyond the step's reach),
+#: in [rad] or [m].
+REACH = 1e-3
+
+
+class LimitRows:
+    """A robot's finite position limits as rows ``s (q_j − bound) ≥ 0`` (``s = +1`` lower,
+    ``−1`` upper).
+
+    Attributes:
+        limits: The robot's :class:`~robodyn.sim.limits.JointLimits` (its efforts saturate).
+        q_index, v_index: Each row's coordinate in ``q`` and in ``v``, shape (r,).
+        bound: Each row's limit, (r,); sign: ``+1`` lower, ``−1`` upper, (r,).
+        names: Each row's ``"<joint> lower"`` / ``"<joint> upper"``.
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        self.limits = limits = JointLimits(robot)
+        count = len(limits.lower)
+        q_start, v_start = robot.nq - count, robot.nv - count
+        rows = [(i, bound, 1.0) for i, bound in enumerate(limits.lower) if np.isfinite(bound)]
+        rows += [(i, bound, -1.0) for i, bound in enumerate(limits.upper) if np.isfinite(bound)]
+        index = np.array([row[0] for row in rows], dtype=int)
+        self.q_index, self.v_index = q_start + index, v_start + index
+        self.bound = np.array([row[1] for row in rows], dtype=float)
+        self.sign = np.array([row[2] for row in rows], dtype=float)
+        dofs = robot.dofs[v_start:]
+        self.names = [f"{dofs[i].joint} {'lower' if s > 0 else 'upper'}" for i, s in zip(index, self.sign, strict=True)]
+
+    def gaps(self, q: np.ndarray) -> np.ndarray:
+        """Each row's distance inside its limit, shape (r,), in [rad] or [m] (< 0: past it)."""
+        return self.sign * (q[self.q_index] - self.bound)
+
+    def torques(self, impulses: np.ndarray, dt: float, nv: int) -> np.ndarray:
+        """The generalized torques of the rows' impulses (r,) [N m s] over ``dt``, shape (nv,)."""
+        out = np.zeros(nv)
+        np.add.at(out, self.v_index, self.sign * impulses / dt)
+        return out
+
+
+def limited_step(
+    robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, ground: Ground,
+    points: tuple[ContactPoint, ...], rows: LimitRows, *, settings: ContactSettings,
+    guess: np.ndarray | None = None, held: np.ndarray | None = None,
+) -> tuple[ContactStep, np.ndarray]:  # fmt: skip
+    """One contact step (:func:`robodyn.sim.contact.contact_step`'s scheme) with the limit
+    rows in its problem (module docstring).
+
+    Args:
+        robot, q, v, tau, dt, ground, points, settings, guess: As for ``contact_step``.
+        rows: The limits.
+        held: Warm start of the rows: the previous step's limit impulses (r,), or ``None``.
+
+    Returns:
+        The step, and each row's impulse (r,) in [N m s] / [N s] (0 for a row out of reach).
+    """
+    mass, bias = robot.mass_matrix(q), robot.nonlinear_effects(q, v)
+    gaps, contacts = contact_kinematics(robot, q, ground, points)
+    count = len(points)
+    try:
+        inverse = np.linalg.solve(mass, np.column_stack([tau - bias, np.eye(robot.nv)]))
+    except np.linalg.LinAlgError:
+        raise SingularMassMatrixError(robot.name, []) from None
+    free = v + dt * inverse[:, 0]
+    limit_gaps = rows.gaps(q)
+    near = np.flatnonzero(limit_gaps < 2 * dt * (np.abs(v) + np.abs(free))[rows.v_index] + REACH)
+    jacobian = np.zeros((3 * (count + len(near)), robot.nv))
+    jacobian[: 3 * count] = contacts
+    jacobian[3 * (count + np.arange(len(near))) + 2, rows.v_index[near]] = rows.sign[near]
+    response = inverse[:, 1:] @ jacobian.T
+    delassus = jacobian @ response
+    tangents = 3 * count + np.concatenate([3 * np.arange(len(near)), 3 * np.arange(len(near)) + 1])
+    delassus[tangents, tangents] = np.tile(np.diag(delassus)[3 * count + 2 :: 3], 2)
+    velocity = jacobian @ free
+    all_gaps = np.concatenate([gaps, limit_gaps[near]])
+    velocity[2::3] += np.where(all_gaps >= 0.0, all_gaps, settings.baumgarte * all_gaps) / dt
+    start = None
+    if guess is not None:
+        start = np.zeros((count + len(near), 3))
+        start[:count] = guess
+        start[count:, 2] = 0.0 if held is None else held[near]
+    impulses, iterations, converged = solve_impulses(delassus, velocity, ground.friction, settings, start)
+    v_next = free + response @ impulses
+    local = impulses.reshape(-1, 3)
+    after = (contacts @ v_next).reshape(-1, 3)
+    limit_impulses = np.zeros(len(rows.bound))
+    limit_impulses[near] = local[count:, 2]
+    step = ContactStep(
+        integrate(robot, q, dt * v_next), v_next, local[:count], local[:count] @ ground.frame() / dt, gaps,
+        np.linalg.norm(after[:, :2], axis=1), iterations, converged,
+    )  # fmt: skip
+    return step, limit_impulses
+
+
+__all__ = ["REACH", "LimitRows", "limited_step"]

@@ -1,0 +1,31 @@
+"""The checks around a run on the ground: links that are no contact points going under it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import robodyn
+from robodyn.sim.contact_checks import buried_line
+from robodyn.sim.ground import Ground, contact_points
+
+FEET = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+
+
+def test_a_link_that_is_no_contact_point_under_the_ground_is_named_with_its_depth():
+    solo = robodyn.load("solo12")
+    high, sunk = solo.neutral_configuration(), solo.neutral_configuration()
+    high[2], sunk[2] = 0.6, -0.1  # the base's origin 0.1 m below the floor, the feet further down
+    line = buried_line(solo, np.array([high, sunk]), np.array([0.0, 1.0]), Ground(), contact_points(solo, FEET))
+    assert line is not None and line.startswith("warning: 13 links that are no contact points went under the ground")
+    assert "(from t = 1 s; deepest): 'FL_LOWER_LEG' 0.26 m" in line  # the knees, 0.16 m below the base
+    assert not any(foot in line for foot in FEET)  # contact points are the ground's business
+    lower = Ground(height=-0.2)  # only the knees under it now
+    line = buried_line(solo, np.array([sunk]), np.array([0.0]), lower, contact_points(solo, FEET))
+    assert line is not None and line.startswith("warning: 4 links") and "'HR_LOWER_LEG' 0.06 m" in line
+
+
+def test_a_run_that_stays_above_the_ground_has_no_buried_line():
+    solo = robodyn.load("solo12")
+    high = solo.neutral_configuration()
+    high[2] = 0.6
+    assert buried_line(solo, np.array([high]), np.array([0.0]), Ground(), contact_points(solo, FEET)) is None
