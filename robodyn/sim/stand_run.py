@@ -23,8 +23,10 @@ from robodyn.constraints import PointContact
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.contact_checks import start_above
+from robodyn.sim.drawings import MovingPoint, PlotPanel, Polygon
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.sim.whole_body import Stand, support_margin
+from robodyn.trajectory import Trajectory
 
 
 class RecordedStand:
@@ -118,8 +120,9 @@ def stand_law(
 
 def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, Any]:
     """The summary's stand fields: ``com_error`` (final centre of mass to its target, in [m]),
-    ``force_difference`` (largest ``|f_QP − f_simulated|`` of a contact over the run, in [N])
-    and ``support_margin`` (of the final centre of mass, in [m]).
+    ``force_difference`` (largest ``|f_QP − f_simulated|`` of a contact over the run, in [N]),
+    ``support_margin`` (of the final centre of mass, in [m]), and the figure's ``panels`` and
+    the recording's ``drawings`` (:func:`stand_panels`, :func:`stand_drawings`).
 
     Args:
         robot: The plant.
@@ -134,7 +137,72 @@ def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, A
         "com_error": float(np.linalg.norm(robot.center_of_mass(final) - law.law.com)),
         "force_difference": float(np.abs(commanded[:count] - contact.forces[:count]).max()),
         "support_margin": support_margin(robot, final, feet, robot.center_of_mass(final)),
+        "panels": stand_panels(robot, contact.trajectory, feet, law.law.com),
+        "drawings": stand_drawings(robot, contact.trajectory, feet, law.law.com),
     }
 
 
-__all__ = ["RecordedStand", "stand_law", "stand_outcome"]
+def feet_outline(robot: Robot, q: np.ndarray, feet: Sequence[PointContact]) -> np.ndarray:
+    """The feet's points at ``q`` on the support polygon's boundary (its corners), in order
+    counter-clockwise seen from above, world frame, shape (k, 3), in [m].
+
+    Args:
+        robot: The robot.
+        q: Its configuration (nq,).
+        feet: The contacts.
+    """
+    pin.framesForwardKinematics(robot.model, robot.data, q)
+    world = np.array([robot.data.oMf[robot.frame_id(foot.frame)].act(np.asarray(foot.point, float)) for foot in feet])
+    boundary = world[[abs(support_margin(robot, q, feet, point)) <= 1e-9 for point in world]]
+    up = -robot.gravity_vector / np.linalg.norm(robot.gravity_vector)
+    arms = boundary - boundary.mean(axis=0)
+    angles = np.arctan2(np.cross(arms[0], arms) @ up, arms @ arms[0])
+    return boundary[np.argsort(angles)]
+
+
+def stand_drawings(
+    robot: Robot, trajectory: Trajectory, feet: Sequence[PointContact], com: np.ndarray
+) -> tuple[Polygon | MovingPoint, ...]:
+    """The recording's support polygon (the feet at the start), the centre of mass over the
+    motion, its shadow along gravity on the feet's plane, and its target.
+
+    Args:
+        robot: The plant.
+        trajectory: The motion.
+        feet: The contacts.
+        com: The centre of mass's target in [m] (3,).
+    """
+    outline = feet_outline(robot, trajectory.q[0], feet)
+    step = max(1, len(trajectory) // 2000)
+    t, centre = trajectory.t[::step], np.atleast_2d(robot.center_of_mass(trajectory.q[::step]))
+    up = -robot.gravity_vector / np.linalg.norm(robot.gravity_vector)
+    shadow = centre - np.outer((centre - outline[0]) @ up, up)
+    return (
+        Polygon("support_polygon", outline),
+        MovingPoint("com", t, centre, 0.015, 0x20A040),
+        MovingPoint("com_shadow", t, shadow, 0.008, 0x20A040),
+        MovingPoint("com_target", t[:1], np.asarray(com, float)[None], 0.01, 0xE02020),
+    )
+
+
+def stand_panels(robot: Robot, trajectory: Trajectory, feet: Sequence[PointContact], com: np.ndarray) -> tuple[PlotPanel, ...]:
+    """The figure's panels: the centre of mass minus its target (x, y, z) and the support
+    margin over time (at most 100 samples), both in [m].
+
+    Args:
+        robot: The plant.
+        trajectory: The motion.
+        feet: The contacts.
+        com: The centre of mass's target in [m] (3,).
+    """
+    centre = np.atleast_2d(robot.center_of_mass(trajectory.q)) - np.asarray(com, float)
+    step = max(1, len(trajectory) // 100)
+    t = trajectory.t[::step]
+    margin = np.array([support_margin(robot, q, feet, robot.center_of_mass(q)) for q in trajectory.q[::step]])
+    errors = tuple((f"com {axis} − target", trajectory.t, centre[:, k], "solid") for k, axis in enumerate("xyz"))
+    return PlotPanel("centre of mass − target [m]", errors), PlotPanel(
+        "support margin [m]", (("support margin", t, margin, "solid"),)
+    )
+
+
+__all__ = ["RecordedStand", "feet_outline", "stand_drawings", "stand_law", "stand_outcome", "stand_panels"]

@@ -17,7 +17,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     add_model_arguments(parser)
     parser.add_argument(
         "--controller",
-        choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand"],
+        choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand", "hybrid"],
         default="passive",
     )
     parser.add_argument(
@@ -25,7 +25,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         type=vector,
         help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
         "pd / computed-torque: joint target; lqr: the equilibrium (joint values) to balance at; "
-        "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it)",
+        "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it); hybrid: the motion's middle X,Y,Z",
     )
     parser.add_argument(
         "--frame",
@@ -117,6 +117,7 @@ def run(arguments: argparse.Namespace) -> int:
         png=arguments.png,
         **_reference(arguments),
         **_ground(arguments),
+        **_hybrid(arguments),
     )
     # the library's summary names its parameters (engine='compiled'); the command line, its flags
     summary = replace(summary.with_startup(startup), engine_reason=command_line_text(summary.engine_reason))
@@ -165,19 +166,20 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         "--kp",
         type=vector,
         help="pd: stiffness, one value or one a joint, in [N m/rad] / [N/m] (default: 100 x each joint's inertia, a "
-        "critically damped 10 rad/s); computed-torque: in [1/s^2] (default 400)",
+        "critically damped 10 rad/s); computed-torque, hybrid (the motion along the surface): in [1/s^2] (default 400)",
     )
     parser.add_argument(
         "--kd",
         type=vector,
         help="pd: damping in [N m s/rad] / [N s/m] (default: 20 x each joint's inertia, or critical for a given --kp); "
-        "computed-torque: in [1/s] (default 40)",
+        "computed-torque, hybrid: in [1/s] (default 40)",
     )
     parser.add_argument(
         "--actuated",
         help="pd, computed-torque, lqr: the actuated joints, comma-separated (default: the file's actuated joints, else "
         "all); the others get no torque",
     )
+    _add_hybrid_arguments(parser)
 
 
 def _add_ground_arguments(parser: argparse.ArgumentParser) -> None:
@@ -209,6 +211,37 @@ def _ground(arguments: argparse.Namespace) -> dict:
 
     contacts = "collision" if arguments.contact is None else [name.strip() for name in arguments.contact.split(",")]
     return {"ground": Ground(height=arguments.ground, friction=arguments.friction), "contacts": contacts}
+
+
+def _add_hybrid_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--force``, ``--surface``, ``--along``, ``--frequency`` of ``--controller hybrid``."""
+    parser.add_argument("--force", dest="normal_force", type=float, help="hybrid: the normal force pressing the surface, in [N]")
+    parser.add_argument(
+        "--surface",
+        metavar="X,Y,Z:NX,NY,NZ",
+        help="hybrid: the surface, a point of it in [m] and its normal toward the robot (world axes); the frame "
+        "(--frame, default the end effector) slides on it without friction and starts on it",
+    )
+    parser.add_argument(
+        "--along",
+        type=vector,
+        metavar="DX,DY,DZ",
+        help="hybrid: the motion along the surface, X(t) = middle + along sin(2 pi f t), in [m] (default: hold the middle)",
+    )
+    parser.add_argument("--frequency", type=float, help="hybrid: f of --along, in [Hz] (default 0.5)")
+
+
+def _hybrid(arguments: argparse.Namespace) -> dict:
+    """``force=``, ``surface=``, ``along=``, ``frequency=`` of the flags given."""
+    given = {name: getattr(arguments, name) for name in ("along", "frequency") if getattr(arguments, name) is not None}
+    if arguments.normal_force is not None:
+        given["force"] = arguments.normal_force
+    if arguments.surface is not None:
+        point, colon, normal = arguments.surface.partition(":")
+        if not colon:
+            raise InputError("--surface", "X,Y,Z:NX,NY,NZ (a point in [m], a colon, the normal)", repr(arguments.surface))
+        given["surface"] = (vector(point), vector(normal))
+    return given
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:

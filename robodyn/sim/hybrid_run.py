@@ -1,0 +1,245 @@
+"""``controller="hybrid"``: hybrid force/motion control on a surface, as a named run.
+
+:func:`run_hybrid` is what ``robodyn simulate --controller hybrid`` calls. The plant is the
+robot with the surface as a frictionless :class:`~robodyn.constraints.PointContact` (its
+multiplier ``λ`` is the **measured** normal force, :mod:`robodyn.sim.constrained`); the
+controller is :class:`~robodyn.sim.force_control.HybridForceMotion` on its own copy of the
+model, pressing with ``force`` along the surface's normal while its frame follows
+``x_d(t) = c + a sin(2π f t)`` along the surface (``c``: ``target``, default the frame's
+start; ``a``: ``along``; ``f``: ``frequency``).
+
+The run starts with the frame **on** the surface: without ``q0`` the default configuration
+is projected onto it (:func:`robodyn.sim.constrained.project`); a ``q0`` whose frame lies
+more than :data:`ON_SURFACE` off it is refused. The summary's ``forces``
+(:class:`ForceOutcome`) compares the commanded and measured normal force and gives the
+motion's final error along the surface; ``contact`` (:class:`SurfaceRun`) writes the CSV's
+``f[surface]`` (measured) and ``f_cmd[surface]`` (commanded) columns and the recording's
+force arrow.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from robodyn.constraints import PointContact
+from robodyn.dynamics import constrained
+from robodyn.dynamics.loading import rebuild
+from robodyn.dynamics.robot import Robot
+from robodyn.exceptions import InputError
+from robodyn.sim.constrained import project, simulate_constrained
+from robodyn.sim.experiment import run_simulation
+from robodyn.sim.force_control import HybridForceMotion, scalar, unit_normal, vector
+from robodyn.sim.surface_run import ForceOutcome, SurfaceRun, refuse_options, summary_of, timed
+from robodyn.trajectory import Trajectory
+
+#: Largest distance in [m] a given ``q0`` may leave the frame off the surface.
+ON_SURFACE = 1e-6
+#: The contact's name in files and reports.
+SURFACE = "surface"
+
+
+@dataclass(frozen=True)
+class SlidingReference:
+    """``x_d(t) = center + along · sin(2π frequency t)`` with its first two derivatives.
+
+    Attributes:
+        center: The middle of the motion in [m], world axes (3,).
+        along: The amplitude vector in [m] (3,), in the surface.
+        frequency: In [Hz].
+    """
+
+    center: np.ndarray
+    along: np.ndarray
+    frequency: float
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        rate = 2 * np.pi * self.frequency
+        s, c = np.sin(rate * t), np.cos(rate * t)
+        return self.center + self.along * s, self.along * rate * c, -self.along * rate**2 * s
+
+
+def _surface(value: object) -> tuple[np.ndarray, np.ndarray]:
+    """``(point, unit normal)`` of ``surface`` (a point and a normal, each 3 values)."""
+    try:
+        parts: list[Any] = list(value)  # type: ignore[call-overload]
+    except TypeError:
+        parts = []
+    if len(parts) != 2:
+        raise InputError("surface", "a point X,Y,Z in [m] and an outward normal NX,NY,NZ", repr(value)[:80])
+    return vector(parts[0], "surface"), unit_normal(parts[1], "surface")
+
+
+def _start(robot: Robot, contact: PointContact, q0: Sequence[float] | None) -> tuple[np.ndarray, float]:
+    """The start configuration, its frame on the surface, and how far the projection moved it."""
+    start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
+    (start,), batch = robot.validate(q=start)
+    if batch:
+        raise InputError("q0", f"one configuration ({robot.nq} values)", f"shape {start.shape}")
+    normal, point = np.array(contact.normal), np.array(contact.plane_point)
+    gap = float(normal @ (robot.frame_position(start, contact.frame) - point))
+    if q0 is not None and abs(gap) > ON_SURFACE:
+        raise InputError(
+            "q0", f"a configuration with {contact.frame} on the surface (within {ON_SURFACE:g} m)", f"{gap:.3g} m off it"
+        )
+    try:
+        placed, _ = project(robot, start, np.zeros(robot.nv), constrained.bound(robot, [contact]))
+    except InputError:
+        raise InputError(
+            "surface", f"a plane {contact.frame} can reach from the default configuration", f"{gap:.3g} m away"
+        ) from None
+    return placed, float(np.abs(placed - start).max())
+
+
+def _reference(
+    robot: Robot, frame: str, start: np.ndarray, surface: tuple[np.ndarray, np.ndarray], motion: tuple[Any, Any, float]
+) -> SlidingReference:
+    """The sliding reference, refused when it leaves the surface (``target``, ``along``)."""
+    point, normal = surface
+    target, along, frequency = motion
+    center = robot.frame_position(start, frame) if target is None else vector(target, "target")
+    if abs(normal @ (center - point)) > ON_SURFACE:
+        raise InputError(
+            "target", f"a point on the surface (within {ON_SURFACE:g} m)", f"{normal @ (center - point):.3g} m off it"
+        )
+    amplitude = np.zeros(3) if along is None else vector(along, "along")
+    if abs(normal @ amplitude) > 1e-9 * max(1.0, float(np.linalg.norm(amplitude))):
+        raise InputError(
+            "along", "an amplitude DX,DY,DZ in [m] along the surface (normal part 0)", f"normal part {normal @ amplitude:.3g} m"
+        )
+    rate = scalar(frequency, "frequency", "a finite frequency >= 0 in [Hz]")
+    return SlidingReference(center, amplitude, rate)
+
+
+def _fixed_base(robot: Robot) -> None:
+    """Refuse a floating robot: its base has no actuator to press or slide with."""
+    if robot.floating_base:
+        raise InputError(
+            "controller", "a fixed-base robot for the hybrid controller (a floating base has no actuator)", repr(robot.name)
+        )
+
+
+def run_hybrid(
+    robot: Robot,
+    *,
+    force: float | None = None,
+    surface: tuple[Sequence[float], Sequence[float]] | None = None,
+    along: Sequence[float] | None = None,
+    frequency: float = 0.5,
+    target: Sequence[float] | None = None,
+    frame: str | None = None,
+    q0: Sequence[float] | None = None,
+    duration: float = 3.0,
+    dt: float = 1e-3,
+    kp: float | Sequence[float] | None = None,
+    kd: float | Sequence[float] | None = None,
+    posture: Sequence[float] | None = None,
+    limits: str = "warn",
+    joint_friction: bool = True,
+    **others: Any,
+) -> tuple[Trajectory, Any]:
+    """Hybrid force/motion control of a frame on a surface (module docstring).
+
+    Args:
+        robot: The plant (its frame slides on the surface without friction).
+        force: The commanded normal force in [N] (≥ 0: pressing); required.
+        surface: Required: A point of the plane in [m] and its normal toward the robot, each (3,), world axes.
+        along: The motion's amplitude vector in [m], in the surface (``None``: hold ``target``).
+        frequency: Of the motion, in [Hz].
+        target: The middle of the motion in [m] (3,), on the surface; default the frame's start.
+        frame: The frame whose origin touches the surface (default the end effector).
+        q0: The start (nq,), its frame on the surface; default: the default configuration
+            projected onto it.
+        duration, dt: Simulated time and step in [s] (RK4 and projection).
+        kp, kd: The motion's gains in [1/s²] and [1/s] (default 400 and 40).
+        posture: A configuration (nq,) held in the task's null space (default the start).
+        limits: ``"warn"`` (report every broken limit) or ``"ignore"``.
+        joint_friction: Apply the joints' viscous damping (the controller compensates it).
+        **others: The other controllers' options, refused when set (``engine``, ``ground``, ...).
+
+    Returns:
+        The trajectory and its :class:`~robodyn.sim.report.SimulationSummary`, whose
+        ``forces`` is a :class:`ForceOutcome` and ``contact`` a :class:`SurfaceRun`.
+
+    Raises:
+        InputError: Naming the parameter (``force``, ``surface``, ``along``, ``q0``, ...).
+    """
+    refuse_options(others, limits)
+    for name, value in (("force", force), ("surface", surface)):
+        if value is None:
+            raise InputError(name, "given for the hybrid controller", "nothing")
+    _fixed_base(robot)
+    point, normal = _surface(surface)
+    frame = robot.task_frame(frame, "hybrid force/motion control")
+    contact = PointContact(frame, normal=tuple(normal), friction=0.0, plane_point=tuple(point), name=SURFACE)
+    start, moved = _start(robot, contact, q0)
+    reference = _reference(robot, frame, start, (point, normal), (target, along, frequency))
+    gains: dict[str, Any] = {
+        name: scalar(np.squeeze(value), name, "one finite gain >= 0")
+        for name, value in (("kp", kp), ("kd", kd))
+        if value is not None
+    }
+    model = rebuild(robot)
+    held = start if posture is None else np.asarray(posture, dtype=float)
+    law = HybridForceMotion(
+        model,
+        frame,
+        normal,
+        scalar(force, "force", "a finite normal force >= 0 in [N] (pressing)"),
+        reference,
+        posture=held,
+        **gains,
+    )
+    plant = _plant(robot, model, law, joint_friction)
+    run, loop_time = timed(lambda: simulate_constrained(robot, start, constraints=[contact], duration=duration, dt=dt, tau=plant))
+    surface_run = SurfaceRun(
+        run.trajectory, SURFACE, frame, normal, run.multipliers[:, 0], np.full(len(run.trajectory), law.force)
+    )
+    errors = np.array(
+        [law.motion_error(t, q, v)[0] for t, q, v in zip(run.trajectory.t, run.trajectory.q, run.trajectory.v, strict=True)]
+    )
+    outcome = ForceOutcome.of(surface_run, errors, moved, _notes(robot, joint_friction))
+    summary = summary_of(robot, run.trajectory, outcome, surface_run, limits=limits, loop_time=loop_time, dt=dt)
+    return run.trajectory, replace(summary, panels=surface_run.panels())
+
+
+def _plant(robot: Robot, model: Robot, law: HybridForceMotion, joint_friction: bool) -> Callable:
+    """The torques the plant feels: the law, plus its compensation of the joints' viscous
+    damping (its own model's), minus that damping (the plant's) when ``joint_friction``."""
+    if not joint_friction or not np.any(robot.joint_damping):
+        return law
+    return lambda t, q, v: law(t, q, v) + model.joint_damping * v - robot.joint_damping * v
+
+
+def _notes(robot: Robot, joint_friction: bool) -> tuple[str, ...]:
+    """What the run does not model, one line each."""
+    if joint_friction and np.any(robot.joint_friction):
+        return ("joint Coulomb friction of the file is not applied in hybrid runs (the constrained plant)",)
+    return ()
+
+
+def run_named(robot: Robot, **settings: Any) -> tuple[Trajectory, Any]:
+    """:func:`run_hybrid` for ``controller="hybrid"``, else
+    :func:`robodyn.sim.experiment.run_simulation` (which takes no ``force``, ``surface``,
+    ``along`` or ``frequency``: refused naming them).
+
+    Args:
+        robot: The plant.
+        **settings: As for either function.
+
+    Raises:
+        InputError: A hybrid option with another controller.
+    """
+    if settings.get("controller") == "hybrid":
+        return run_hybrid(robot, **settings)
+    for name in ("force", "surface", "along", "frequency"):
+        if settings.get(name) is not None:
+            raise InputError(name, "given only with the hybrid controller", repr(settings[name])[:80])
+        settings.pop(name, None)
+    return run_simulation(robot, **settings)
+
+
+__all__ = ["ON_SURFACE", "SURFACE", "SlidingReference", "run_hybrid", "run_named"]

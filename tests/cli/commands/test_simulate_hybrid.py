@@ -1,0 +1,124 @@
+"""Issue 42, `robodyn simulate --controller hybrid`: the RP arm's tip presses the wall
+``x = 1`` with 10 N while sliding up and down it. Read back from the CSV (the measured force
+is the constraint's, the tip's height the robot's forward kinematics of the written ``q``):
+the normal force is the command within 1e-6 relative, and the error along the wall obeys
+``ë + Kd ė + Kp e = 0`` (its exact solution computed here). What it cannot do is one stderr
+line naming the flag, exit 2."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+import robodyn
+from robodyn.cli.app import main
+
+WALL, FORCE, AMPLITUDE, FREQUENCY, MIDDLE, KP, KD = 1.0, 10.0, 0.1, 0.5, 0.03, 100.0, 20.0
+COMMAND = [
+    "simulate", "rp_arm", "--controller", "hybrid", "--force", str(FORCE), "--surface", f"{WALL},0,0:-1,0,0",
+    "--along", f"0,0,{AMPLITUDE}", "--frequency", str(FREQUENCY), "--target", f"{WALL},0,{MIDDLE}",
+    "--kp", str(KP), "--kd", str(KD), "--duration", "0.4", "--dt", "0.004",
+]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def wall(tmp_path_factory) -> dict[str, np.ndarray]:
+    """The CSV's columns of the run, by name."""
+    out = tmp_path_factory.mktemp("hybrid") / "wall.csv"
+    assert main([*COMMAND, "--out", str(out)]) == 0
+    with out.open() as file:
+        rows = [row for row in csv.reader(file) if row and not row[0].startswith("#")]
+    return {name: np.array([float(row[k]) for row in rows[1:]]) for k, name in enumerate(rows[0])}
+
+
+def law(times: np.ndarray, e0: float, de0: float, kp: float = KP, kd: float = KD) -> np.ndarray:
+    """The solution of ``ë + kd ė + kp e = 0`` from ``e₀``, ``ė₀``."""
+    system = np.array([[0.0, 1.0], [-kp, -kd]])
+    return np.array([(expm(system * t) @ [e0, de0])[0] for t in times])
+
+
+def tangential_error(columns: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Times and ``e = z_d − z`` of the tip, ``z`` from the written ``q`` by forward kinematics."""
+    robot = robodyn.load("rp_arm")
+    t = columns["t"]
+    q = np.column_stack([columns["q[joint1]"], columns["q[joint2]"]])
+    tip = robot.frame_position(q, "end_effector")
+    assert np.abs(tip[:, 0] - WALL).max() <= 1e-9  # on the wall
+    return t, MIDDLE + AMPLITUDE * np.sin(2 * np.pi * FREQUENCY * t) - tip[:, 2]
+
+
+def test_the_wall_force_read_from_the_csv_is_the_command_within_1e_6(wall):
+    measured = -wall["f[surface].x"]  # the wall's force on the robot along its normal (-1, 0, 0)
+    commanded = -wall["f_cmd[surface].x"]
+    assert np.abs(commanded - FORCE).max() == 0.0
+    assert np.abs(measured - FORCE).max() <= 1e-6 * FORCE
+    assert np.abs(wall["f[surface].y"]).max() == 0.0 and np.abs(wall["f[surface].z"]).max() == 0.0  # frictionless
+    assert wall["contact[surface]"].min() == 1.0
+
+
+def test_the_motion_along_the_wall_follows_its_closed_loop_law(wall):
+    t, error = tangential_error(wall)
+    expected = law(t, MIDDLE, 2 * np.pi * FREQUENCY * AMPLITUDE)  # the tip starts at rest at z = 0
+    assert np.abs(error - expected).max() <= 1e-3 * MIDDLE
+
+
+def test_the_law_checker_sees_other_gains(wall):  # negative control
+    t, error = tangential_error(wall)
+    wrong = law(t, MIDDLE, 2 * np.pi * FREQUENCY * AMPLITUDE, kd=0.8 * KD)
+    assert np.abs(error - wrong).max() > 1e-3 * MIDDLE
+
+
+def test_the_summary_says_commanded_and_measured_force(tmp_path, capsys):
+    assert main([*COMMAND[:-4], "--duration", "0.04", "--dt", "0.004"]) == 0
+    text = capsys.readouterr().out
+    assert "contact force (normal, on the robot): commanded 10 N, measured 10 N at the end" in text
+    assert "contact force error: final" in text and "peak" in text
+    assert main([*COMMAND[:-4], "--duration", "0.04", "--dt", "0.004", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["force_commanded_N"] == FORCE and summary["force_peak_error_N"] <= 1e-6 * FORCE
+    assert summary["controller"] == "hybrid" and summary["limit_violations"] == []
+
+
+@pytest.mark.parametrize(
+    ("change", "flag"),
+    [
+        ({"--q0": "0,0.2"}, "--q0"),  # the tip at x = 1.1, off the wall
+        ({"--along": "0.1,0,0"}, "--along"),  # into the wall
+        ({"--target": "0.9,0,0"}, "--target"),  # off the wall
+        ({"--surface": "1,0,0"}, "--surface"),  # no normal
+        ({"--surface": "1,0,0:0,0,0"}, "--surface"),
+        ({"--force": "-1"}, "--force"),
+        ({"--force": None}, "--force"),
+        ({"--engine": "compiled"}, "--engine"),
+        ({"--limits": "enforce"}, "--limits"),
+        ({"--ground": "0"}, "--ground"),
+        ({"--out": "x.npz"}, "--out"),
+        ({"--frame": "nowhere"}, "nowhere"),
+    ],
+)
+def test_a_hybrid_run_it_cannot_do_is_one_line_naming_the_flag(change, flag, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    arguments = list(COMMAND)
+    for key, value in change.items():
+        if key in arguments:
+            index = arguments.index(key)
+            del arguments[index : index + 2]
+        if value is not None:
+            arguments += [key, value]
+    assert main(arguments) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.count("\n") == 0 and flag in error
+    assert not (tmp_path / "x.npz").exists()
+
+
+@pytest.mark.parametrize("arguments", [["rp_arm", "--controller", "pd", "--target", "0,0.1", "--force", "3"], ["solo12"]])
+def test_hybrid_options_elsewhere_and_a_floating_robot_are_refused(arguments, capsys):
+    if arguments == ["solo12"]:
+        arguments = ["solo12", "--controller", "hybrid", "--force", "1", "--surface", "0,0,0:0,0,1"]
+    assert main(["simulate", *arguments, "--duration", "0.01"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.count("\n") == 0 and ("--force" in error or "--controller" in error)
