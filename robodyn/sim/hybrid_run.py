@@ -5,8 +5,9 @@ robot with the surface as a frictionless :class:`~robodyn.constraints.PointConta
 multiplier ``λ`` is the **measured** normal force, :mod:`robodyn.sim.constrained`); the
 controller is :class:`~robodyn.sim.force_control.HybridForceMotion` on its own copy of the
 model, pressing with ``force`` along the surface's normal while its frame follows
-``x_d(t) = c + a sin(2π f t)`` along the surface (``c``: ``target``, default the frame's
-start; ``a``: ``along``; ``f``: ``frequency``).
+``x_d(t) = c + a sin(2π f t) + b cos(2π f t)`` along the surface (``c``: ``target``,
+default the frame's start; ``a`` and optionally ``b``: ``along``; ``f``: ``frequency``): a
+line back and forth, or with ``a ⊥ b`` of equal length a circle about ``c`` (wiping).
 
 The run starts with the frame **on** the surface: without ``q0`` the default configuration
 is projected onto it (:func:`robodyn.sim.constrained.project`); a ``q0`` whose frame lies
@@ -33,22 +34,24 @@ from robodyn.exceptions import InputError
 from robodyn.sim.constrained import project, simulate_constrained
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.force_control import HybridForceMotion, scalar, unit_normal, vector
+from robodyn.sim.limits import limit_violations
 from robodyn.sim.surface_run import ForceOutcome, SurfaceRun, refuse_options, summary_of, timed
 from robodyn.trajectory import Trajectory
 
-#: Largest distance in [m] a given ``q0`` may leave the frame off the surface.
-ON_SURFACE = 1e-6
+#: Largest distance in [m] a given ``q0`` (or ``target``) may leave the frame off the surface
+#: (the start is then projected onto it: the summary says how far it moved).
+ON_SURFACE = 1e-4
 #: The contact's name in files and reports.
 SURFACE = "surface"
 
 
 @dataclass(frozen=True)
 class SlidingReference:
-    """``x_d(t) = center + along · sin(2π frequency t)`` with its first two derivatives.
+    """``x_d(t) = center + a sin(2π frequency t) + b cos(2π frequency t)`` with its first two derivatives.
 
     Attributes:
         center: The middle of the motion in [m], world axes (3,).
-        along: The amplitude vector in [m] (3,), in the surface.
+        along: The amplitude vectors ``a`` and ``b`` in [m], shape (2, 3), in the surface.
         frequency: In [Hz].
     """
 
@@ -58,8 +61,10 @@ class SlidingReference:
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         rate = 2 * np.pi * self.frequency
+        sine, cosine = self.along
         s, c = np.sin(rate * t), np.cos(rate * t)
-        return self.center + self.along * s, self.along * rate * c, -self.along * rate**2 * s
+        offset = sine * s + cosine * c
+        return self.center + offset, rate * (sine * c - cosine * s), -(rate**2) * offset
 
 
 def _surface(value: object) -> tuple[np.ndarray, np.ndarray]:
@@ -91,7 +96,19 @@ def _start(robot: Robot, contact: PointContact, q0: Sequence[float] | None) -> t
         raise InputError(
             "surface", f"a plane {contact.frame} can reach from the default configuration", f"{gap:.3g} m away"
         ) from None
+    if q0 is None:
+        _within_limits(robot, placed)
     return placed, float(np.abs(placed - start).max())
+
+
+def _within_limits(robot: Robot, q: np.ndarray) -> None:
+    """Refuse a solved start that breaks a joint's position limits (naming ``q0``)."""
+    still = Trajectory(np.zeros(1), q[None], np.zeros((1, robot.nv)), None, None, list(robot.joint_names), robot.name)
+    broken = [violation for violation in limit_violations(robot, still) if violation.quantity == "position"]
+    if broken:
+        raise InputError(
+            "q0", "given: the default configuration projected onto the surface breaks a joint limit", broken[0].text()
+        )
 
 
 def _reference(
@@ -105,13 +122,28 @@ def _reference(
         raise InputError(
             "target", f"a point on the surface (within {ON_SURFACE:g} m)", f"{normal @ (center - point):.3g} m off it"
         )
-    amplitude = np.zeros(3) if along is None else vector(along, "along")
-    if abs(normal @ amplitude) > 1e-9 * max(1.0, float(np.linalg.norm(amplitude))):
+    amplitude = np.zeros((2, 3)) if along is None else _amplitudes(along)
+    if np.abs(amplitude @ normal).max() > 1e-9 * max(1.0, float(np.abs(amplitude).max())):
         raise InputError(
-            "along", "an amplitude DX,DY,DZ in [m] along the surface (normal part 0)", f"normal part {normal @ amplitude:.3g} m"
+            "along",
+            "amplitudes DX,DY,DZ[:EX,EY,EZ] in [m] along the surface (normal part 0)",
+            f"normal part {np.abs(amplitude @ normal).max():.3g} m",
         )
     rate = scalar(frequency, "frequency", "a finite frequency >= 0 in [Hz]")
     return SlidingReference(center, amplitude, rate)
+
+
+def _amplitudes(along: object) -> np.ndarray:
+    """``along`` as the (2, 3) amplitudes of the sine and the cosine (3 values: no cosine)."""
+    try:
+        values = np.asarray(along, dtype=float)
+    except (TypeError, ValueError):
+        values = np.zeros(0)
+    if values.shape == (3,):
+        values = np.vstack([values, np.zeros(3)])
+    if values.shape != (2, 3) or not np.isfinite(values).all():
+        raise InputError("along", "3 amplitudes in [m] (or 2 x 3: the sine's and the cosine's)", repr(along)[:80])
+    return values
 
 
 def _fixed_base(robot: Robot) -> None:
@@ -127,7 +159,7 @@ def run_hybrid(
     *,
     force: float | None = None,
     surface: tuple[Sequence[float], Sequence[float]] | None = None,
-    along: Sequence[float] | None = None,
+    along: Sequence[float] | Sequence[Sequence[float]] | None = None,
     frequency: float = 0.5,
     target: Sequence[float] | None = None,
     frame: str | None = None,
@@ -147,7 +179,8 @@ def run_hybrid(
         robot: The plant (its frame slides on the surface without friction).
         force: The commanded normal force in [N] (≥ 0: pressing); required.
         surface: Required: A point of the plane in [m] and its normal toward the robot, each (3,), world axes.
-        along: The motion's amplitude vector in [m], in the surface (``None``: hold ``target``).
+        along: The motion's amplitude ``a`` in [m] (3,), or ``a`` and ``b`` (2, 3), in the
+            surface (``None``: hold ``target``).
         frequency: Of the motion, in [Hz].
         target: The middle of the motion in [m] (3,), on the surface; default the frame's start.
         frame: The frame whose origin touches the surface (default the end effector).

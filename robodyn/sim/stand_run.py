@@ -13,6 +13,8 @@ and the simulated contact forces, and the final centre of mass's support margin.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -27,19 +29,76 @@ from robodyn.sim.drawings import MovingPoint, PlotPanel, Polygon
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.sim.whole_body import Stand, support_margin
 from robodyn.trajectory import Trajectory
+from robodyn.trajectory.columns import commanded_header, contact_header
+from robodyn.trajectory.io import write_csv
 
 
 class RecordedStand:
-    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N]."""
+    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N],
+    and the call's time in [s]."""
 
     def __init__(self, law: Stand) -> None:
         self.law = law
         self.forces: list[np.ndarray] = []
+        self.times: list[float] = []
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         tau = self.law(t, q, v)
         self.forces.append(self.law.last_forces.copy())
+        self.times.append(float(t))
         return tau
+
+    def held(self, times: np.ndarray) -> np.ndarray:
+        """The QP's forces in force at ``times`` (its last call at or before each), (N, k, 3) [N].
+
+        Args:
+            times: In [s], shape (N,).
+        """
+        forces = np.array(self.forces).reshape(len(self.forces), -1, 3)
+        return forces[np.clip(np.searchsorted(self.times, times, side="right") - 1, 0, len(forces) - 1)]
+
+
+@dataclass(frozen=True)
+class CommandedContacts:
+    """A stand run's contacts (:class:`~robodyn.sim.contact_run.ContactSimulation`, every
+    attribute of it) with the QP's forces, which its CSV writes beside the simulated ones.
+
+    Attributes:
+        run: The contact simulation.
+        commanded: The QP's force of each contact at each sample, (N, k, 3), world axes, in [N].
+    """
+
+    run: Any
+    commanded: np.ndarray
+
+    def __getattr__(self, name: str) -> Any:
+        if name == "run":  # not set yet (copying): no recursion
+            raise AttributeError(name)
+        return getattr(self.run, name)
+
+    def save(self, path: str | Path, extras: dict[str, np.ndarray] | None = None) -> Path:
+        """The run's CSV (``ContactSimulation.save``) with ``f_cmd[<contact>].x/.y/.z`` [N]
+        after its ``f[<contact>]`` columns.
+
+        Args:
+            path: The ``.csv`` file.
+            extras: As for ``ContactSimulation.save``.
+
+        Raises:
+            InputError: For a file name that does not end in ``.csv``.
+        """
+        path = Path(path)
+        if path.suffix != ".csv":
+            raise InputError("out", "a .csv file for a run on the ground (its contact forces are columns)", repr(str(path)))
+        extras = extras or {}
+        trajectory, names, count = self.run.trajectory, list(self.run.contacts), len(self.run.contacts)
+        header = trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in trajectory.coordinate_names[1]]
+        flags = contact_header(names)
+        header += flags[: 3 * count] + commanded_header(names) + flags[3 * count :]
+        forces, commanded = (array.reshape(len(array), 3 * count) for array in (self.run.forces, self.commanded))
+        table = np.column_stack([trajectory.table(), *extras.values(), forces, commanded, self.run.active.astype(float)])
+        write_csv(path, trajectory.robot, header, table)
+        return path
 
 
 def _feet(robot: Robot, q: np.ndarray, ground: Ground, points: Sequence[ContactPoint]) -> tuple[PointContact, ...]:
@@ -137,6 +196,7 @@ def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, A
         "com_error": float(np.linalg.norm(robot.center_of_mass(final) - law.law.com)),
         "force_difference": float(np.abs(commanded[:count] - contact.forces[:count]).max()),
         "support_margin": support_margin(robot, final, feet, robot.center_of_mass(final)),
+        "contact": CommandedContacts(contact, law.held(contact.trajectory.t)),
         "panels": stand_panels(robot, contact.trajectory, feet, law.law.com),
         "drawings": stand_drawings(robot, contact.trajectory, feet, law.law.com),
     }
@@ -205,4 +265,4 @@ def stand_panels(robot: Robot, trajectory: Trajectory, feet: Sequence[PointConta
     )
 
 
-__all__ = ["RecordedStand", "feet_outline", "stand_drawings", "stand_law", "stand_outcome", "stand_panels"]
+__all__ = ["CommandedContacts", "RecordedStand", "feet_outline", "stand_drawings", "stand_law", "stand_outcome", "stand_panels"]

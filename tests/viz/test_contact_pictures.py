@@ -5,6 +5,8 @@ feet's positions) and centre of mass (where the robot's centre of mass is at eac
 
 from __future__ import annotations
 
+import csv
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -37,6 +39,22 @@ def stand():
         robot, controller="stand", ground=Ground(), q0=BENT, target=[0, 0.01, 0], duration=0.05, dt=1e-3
     )
     return robot, trajectory, summary
+
+
+def test_the_stand_csv_has_the_qp_forces_beside_the_simulated_ones(stand, tmp_path):
+    robot, trajectory, summary = stand
+    path = summary.contact.save(tmp_path / "stand.csv")
+    with path.open() as file:
+        rows = [row for row in csv.reader(file) if row and not row[0].startswith("#")]
+    columns = {name: np.array([float(row[k]) for row in rows[1:]]) for k, name in enumerate(rows[0])}
+    names = summary.contact.contacts
+    commanded = np.stack([[columns[f"f_cmd[{name}].{axis}"] for axis in "xyz"] for name in names], axis=1).T
+    measured = np.stack([[columns[f"f[{name}].{axis}"] for axis in "xyz"] for name in names], axis=1).T
+    weight = robot.total_mass * 9.81
+    np.testing.assert_allclose(commanded[:, :, 2].sum(axis=1)[-1], weight, rtol=1e-3)  # the QP carries m g at rest
+    assert np.abs(commanded - measured).max() <= 1e-4 * weight
+    assert np.abs(commanded - measured[::-1]).max() > 1e-3 * weight or len(measured) < 3  # negative control
+    assert robodyn.Trajectory.load(path).q.shape == trajectory.q.shape  # a trajectory reader skips them
 
 
 def _arrows(robot, run: SurfaceRun):

@@ -224,24 +224,35 @@ def _add_hybrid_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--along",
-        type=vector,
-        metavar="DX,DY,DZ",
-        help="hybrid: the motion along the surface, X(t) = middle + along sin(2 pi f t), in [m] (default: hold the middle)",
+        metavar="DX,DY,DZ[:EX,EY,EZ]",
+        help="hybrid: the motion along the surface, X(t) = middle + D sin(2 pi f t) + E cos(2 pi f t), in [m] (a circle: "
+        "D, E of one length at right angles; default: hold the middle)",
     )
     parser.add_argument("--frequency", type=float, help="hybrid: f of --along, in [Hz] (default 0.5)")
 
 
 def _hybrid(arguments: argparse.Namespace) -> dict:
     """``force=``, ``surface=``, ``along=``, ``frequency=`` of the flags given."""
-    given = {name: getattr(arguments, name) for name in ("along", "frequency") if getattr(arguments, name) is not None}
+    given = {} if arguments.frequency is None else {"frequency": arguments.frequency}
     if arguments.normal_force is not None:
         given["force"] = arguments.normal_force
+    if arguments.along is not None:
+        parts = _vectors("--along", arguments.along, "DX,DY,DZ[:EX,EY,EZ] in [m]")
+        given["along"] = parts[0] if len(parts) == 1 else parts
     if arguments.surface is not None:
-        point, colon, normal = arguments.surface.partition(":")
-        if not colon:
+        parts = _vectors("--surface", arguments.surface, "X,Y,Z:NX,NY,NZ (a point in [m], a colon, the normal)")
+        if len(parts) != 2:
             raise InputError("--surface", "X,Y,Z:NX,NY,NZ (a point in [m], a colon, the normal)", repr(arguments.surface))
-        given["surface"] = (vector(point), vector(normal))
+        given["surface"] = tuple(parts)
     return given
+
+
+def _vectors(flag: str, text: str, expected: str) -> list[list[float]]:
+    """``text``'s colon-separated lists of numbers (one stderr line, naming ``flag``, if not)."""
+    try:
+        return [vector(part) for part in text.split(":")]
+    except argparse.ArgumentTypeError:
+        raise InputError(flag, expected, repr(text)) from None
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
