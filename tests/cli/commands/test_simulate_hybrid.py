@@ -91,6 +91,10 @@ def test_the_summary_says_commanded_and_measured_force(tmp_path, capsys):
         ({"--target": "0.9,0,0"}, "--target"),  # off the wall
         ({"--surface": "1,0,0"}, "--surface"),  # no normal
         ({"--surface": "1,0,0:0,0,0"}, "--surface"),
+        ({"--surface": "1,0,0:-1,0,x"}, "--surface"),
+        ({"--along": "0,0,0.1:0,0"}, "--along"),
+        ({"--frequency": "-1"}, "--frequency"),
+        ({"--q0": None, "--surface": "5,0,0:-1,0,0"}, "--q0"),  # out of reach within the joint limits
         ({"--force": "-1"}, "--force"),
         ({"--force": None}, "--force"),
         ({"--engine": "compiled"}, "--engine"),
@@ -122,3 +126,32 @@ def test_hybrid_options_elsewhere_and_a_floating_robot_are_refused(arguments, ca
     assert main(["simulate", *arguments, "--duration", "0.01"]) == 2
     error = capsys.readouterr().err.strip()
     assert error.count("\n") == 0 and ("--force" in error or "--controller" in error)
+
+
+PANDA_Q0 = "0,-0.785,0,-2.356,0,1.571,0.785,0.02"
+
+
+@pytest.mark.slow
+def test_the_panda_wipes_a_table_with_five_newtons_along_a_circle(tmp_path):
+    """The issue's wiping case through the command line: after 0.5 s the normal force is
+    within 1 % of 5 N and the hand within 1 mm of the circle (both read from the CSV)."""
+    out = tmp_path / "wipe.csv"
+    start = robodyn.load("panda").frame_position(np.array([float(x) for x in PANDA_Q0.split(",")]), "panda_hand_tcp")
+    table = f"{start[0]},{start[1]},0.4869"  # the hand 3e-5 m above it: projected onto it
+    status = main([
+        "simulate", "panda", "--controller", "hybrid", "--frame", "panda_hand_tcp", "--force", "5", "--surface",
+        f"{table}:0,0,1", "--q0", PANDA_Q0, "--along", "0.05,0,0:0,0.05,0", "--target", f"{start[0]},{start[1] - 0.05},0.4869",
+        "--duration", "1.5", "--dt", "0.002", "--out", str(out),
+    ])  # fmt: skip
+    assert status == 0
+    with out.open() as file:
+        rows = [row for row in csv.reader(file) if row and not row[0].startswith("#")]
+    columns = {name: np.array([float(row[k]) for row in rows[1:]]) for k, name in enumerate(rows[0])}
+    robot = robodyn.load("panda")
+    q = np.column_stack([columns[f"q[{name}]"] for name in robot.configuration_names])
+    hand = robot.frame_position(q, "panda_hand_tcp")
+    late = columns["t"] >= 0.5
+    assert np.abs(columns["f[surface].z"][late] - 5.0).max() <= 0.01 * 5.0
+    centre = np.array([start[0], start[1] - 0.05])
+    assert np.abs(np.linalg.norm(hand[late, :2] - centre, axis=1) - 0.05).max() <= 1e-3
+    assert np.abs(hand[:, 2] - 0.4869).max() <= 1e-9  # on the table
