@@ -32,6 +32,7 @@ from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.constrained import project, simulate_constrained
+from robodyn.sim.drawings import Polygon
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.force_control import HybridForceMotion, scalar, unit_normal, vector
 from robodyn.sim.limits import limit_violations
@@ -103,7 +104,8 @@ def _start(robot: Robot, contact: PointContact, q0: Sequence[float] | None) -> t
 
 def _within_limits(robot: Robot, q: np.ndarray) -> None:
     """Refuse a solved start that breaks a joint's position limits (naming ``q0``)."""
-    still = Trajectory(np.zeros(1), q[None], np.zeros((1, robot.nv)), None, None, list(robot.joint_names), robot.name)
+    zeros = np.zeros((1, robot.nv))
+    still = Trajectory(np.zeros(1), q[None], zeros, zeros, None, list(robot.joint_names), robot.name)
     broken = [violation for violation in limit_violations(robot, still) if violation.quantity == "position"]
     if broken:
         raise InputError(
@@ -236,7 +238,7 @@ def run_hybrid(
     )
     outcome = ForceOutcome.of(surface_run, errors, moved, _notes(robot, joint_friction))
     summary = summary_of(robot, run.trajectory, outcome, surface_run, limits=limits, loop_time=loop_time, dt=dt)
-    return run.trajectory, replace(summary, panels=surface_run.panels())
+    return run.trajectory, replace(summary, panels=surface_run.panels(), drawings=(surface_patch(reference, normal),))
 
 
 def _plant(robot: Robot, model: Robot, law: HybridForceMotion, joint_friction: bool) -> Callable:
@@ -252,6 +254,21 @@ def _notes(robot: Robot, joint_friction: bool) -> tuple[str, ...]:
     if joint_friction and np.any(robot.joint_friction):
         return ("joint Coulomb friction of the file is not applied in hybrid runs (the constrained plant)",)
     return ()
+
+
+def surface_patch(reference: SlidingReference, normal: np.ndarray) -> Polygon:
+    """The surface drawn: a square in it about the motion's middle, 0.1 m beyond its amplitude.
+
+    Args:
+        reference: The motion.
+        normal: The surface's unit normal (3,).
+    """
+    seed = np.eye(3)[int(np.argmin(np.abs(normal)))]
+    u = np.cross(normal, seed) / np.linalg.norm(np.cross(normal, seed))
+    w = np.cross(normal, u)
+    half = float(np.abs(reference.along).sum(axis=0).max()) + 0.1
+    corners = [reference.center + half * (a * u + b * w) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    return Polygon("surface", np.array(corners), 0x808080)
 
 
 def run_named(robot: Robot, **settings: Any) -> tuple[Trajectory, Any]:
@@ -275,4 +292,4 @@ def run_named(robot: Robot, **settings: Any) -> tuple[Trajectory, Any]:
     return run_simulation(robot, **settings)
 
 
-__all__ = ["ON_SURFACE", "SURFACE", "SlidingReference", "run_hybrid", "run_named"]
+__all__ = ["ON_SURFACE", "SURFACE", "SlidingReference", "run_hybrid", "run_named", "surface_patch"]

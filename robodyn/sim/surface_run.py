@@ -172,7 +172,7 @@ class ForceOutcome:
             f"contact force error: final {self.final_error:.3g} N ({self.final_error / max(self.commanded, 1e-300):.3g} "
             f"relative), peak {self.peak_error:.3g} N at t = {self.peak_time:.6g} s",
             f"motion along the surface: final error {self.motion_error:.3g} m, peak {self.motion_peak:.3g} m",
-            f"start: moved {self.start_moved:.3g} onto the surface (max |dq|, rad / m)",
+            f"start: moved by {self.start_moved:.3g} (max |dq|, rad / m) to put the frame on the surface",
         ]
         if self.smallest < 0:
             lines.append(f"the surface pulled (smallest normal force {self.smallest:.3g} N): a real contact would have separated")

@@ -86,6 +86,16 @@ def test_the_wall_force_arrow_is_the_measured_force_scaled_along_the_normal_at_t
     np.testing.assert_allclose(lengths, full * measured / measured.max(), rtol=1e-12)
 
 
+def test_the_surface_is_drawn_in_its_plane_about_the_motions_middle(wall):
+    robot, trajectory, summary = wall
+    (patch,) = summary.drawings
+    np.testing.assert_allclose(patch.vertices[:, 0], 1.0, atol=1e-15)  # the wall x = 1
+    start = robot.frame_position(trajectory.q[0], "end_effector")
+    np.testing.assert_allclose(patch.vertices.mean(axis=0), start, atol=1e-12)  # the middle: the tip's start
+    sides = np.linalg.norm(np.roll(patch.vertices, -1, axis=0) - patch.vertices, axis=1)
+    np.testing.assert_allclose(sides, 2 * (0.1 + 0.1), rtol=1e-12)  # 0.1 m beyond the 0.1 m amplitude
+
+
 def test_the_arrow_check_tells_the_measured_force_from_the_commanded():  # negative control
     robot = robodyn.load("rp_arm")
     trajectory, summary = run_hybrid(robot, force=10.0, surface=((1.0, 0, 0), (-1.0, 0, 0)), duration=0.1, dt=0.01)
