@@ -81,10 +81,7 @@ def _surface(value: object) -> tuple[np.ndarray, np.ndarray]:
 
 def _start(robot: Robot, contact: PointContact, q0: Sequence[float] | None) -> tuple[np.ndarray, float]:
     """The start configuration, its frame on the surface, and how far the projection moved it."""
-    start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
-    (start,), batch = robot.validate(q=start)
-    if batch:
-        raise InputError("q0", f"one configuration ({robot.nq} values)", f"shape {start.shape}")
+    start = robot.default_configuration() if q0 is None else _configuration(robot, q0, "q0")
     normal, point = np.array(contact.normal), np.array(contact.plane_point)
     gap = float(normal @ (robot.frame_position(start, contact.frame) - point))
     if q0 is not None and abs(gap) > ON_SURFACE:
@@ -100,6 +97,29 @@ def _start(robot: Robot, contact: PointContact, q0: Sequence[float] | None) -> t
     if q0 is None:
         _within_limits(robot, placed)
     return placed, float(np.abs(placed - start).max())
+
+
+def _configuration(robot: Robot, value: object, name: str) -> np.ndarray:
+    """``value`` as one configuration (nq,), or an :class:`InputError` naming ``name``."""
+    try:
+        q = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(name, f"one configuration of {robot.nq} finite values", repr(value)[:80]) from None
+    if q.shape != (robot.nq,) or not np.isfinite(q).all():
+        found = f"shape {q.shape}" if q.shape != (robot.nq,) else "non-finite values"
+        raise InputError(name, f"one configuration of {robot.nq} finite values", found)
+    return robot.validate(q=q)[0][0]
+
+
+def _gains(kp: Any, kd: Any) -> dict[str, float]:
+    """The motion's gains given, each one finite value >= 0 (naming ``kp`` or ``kd``)."""
+    gains = {}
+    for name, value in (("kp", kp), ("kd", kd)):
+        if value is not None and np.size(value) != 1:
+            raise InputError(name, "one finite gain >= 0 for the hybrid controller", f"{np.size(value)} values")
+        if value is not None:
+            gains[name] = scalar(np.squeeze(np.asarray(value, dtype=float)), name, "one finite gain >= 0")
+    return gains
 
 
 def _within_limits(robot: Robot, q: np.ndarray) -> None:
@@ -212,13 +232,9 @@ def run_hybrid(
     contact = PointContact(frame, normal=tuple(normal), friction=0.0, plane_point=tuple(point), name=SURFACE)
     start, moved = _start(robot, contact, q0)
     reference = _reference(robot, frame, start, (point, normal), (target, along, frequency))
-    gains: dict[str, Any] = {
-        name: scalar(np.squeeze(value), name, "one finite gain >= 0")
-        for name, value in (("kp", kp), ("kd", kd))
-        if value is not None
-    }
+    gains: dict[str, Any] = _gains(kp, kd)
     model = rebuild(robot)
-    held = start if posture is None else np.asarray(posture, dtype=float)
+    held = start if posture is None else _configuration(robot, posture, "posture")
     law = HybridForceMotion(
         model,
         frame,

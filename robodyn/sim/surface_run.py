@@ -141,6 +141,7 @@ class ForceOutcome:
         smallest: The smallest measured normal force in [N] (< 0: the surface pulled).
         motion_error: The final ``|Ω e|`` along the surface in [m]; ``motion_peak`` its largest.
         start_moved: How far the start was projected onto the surface, ``max |δq|``.
+        surface: What touches what: the frame and the surface's normal, one line.
         notes: What the run does not model, one line each.
     """
 
@@ -153,6 +154,7 @@ class ForceOutcome:
     motion_error: float
     motion_peak: float
     start_moved: float
+    surface: str = ""
     notes: tuple[str, ...] = field(default=())
 
     @classmethod
@@ -162,12 +164,14 @@ class ForceOutcome:
         peak, along = int(np.argmax(difference)), np.linalg.norm(errors, axis=1)
         return cls(
             float(run.commanded[-1]), float(run.measured[-1]), float(difference[-1]), float(difference[peak]),
-            float(run.trajectory.t[peak]), float(run.measured.min()), float(along[-1]), float(along.max()), moved, notes,
+            float(run.trajectory.t[peak]), float(run.measured.min()), float(along[-1]), float(along.max()), moved,
+            f"surface: the origin of {run.frame} slides on it without friction, normal {vector_text(run.normal, 6)}", notes,
         )  # fmt: skip
 
     def lines(self) -> list[str]:
         """The summary's lines."""
         lines = [
+            self.surface,
             f"contact force (normal, on the robot): commanded {self.commanded:.6g} N, measured {self.measured:.6g} N at the end",
             f"contact force error: final {self.final_error:.3g} N ({self.final_error / max(self.commanded, 1e-300):.3g} "
             f"relative), peak {self.peak_error:.3g} N at t = {self.peak_time:.6g} s",
@@ -189,6 +193,7 @@ class ForceOutcome:
             "motion_final_error_m": self.motion_error,
             "motion_peak_error_m": self.motion_peak,
             "start_moved": self.start_moved,
+            "surface": self.surface,
             "surface_notes": list(self.notes),
         }
 
@@ -229,7 +234,6 @@ def summary_of(
         violations=() if limits == "ignore" else tuple(limit_violations(robot, trajectory)),
         engine_reason="the surface is a constraint: RK4 and projection in Python over Pinocchio",
         loop_time=loop_time, contact=run, forces=outcome,
-        ground=(f"surface: the origin of {run.frame} slides on it without friction, normal {vector_text(run.normal, 6)}",),
     )  # fmt: skip
 
 

@@ -145,7 +145,7 @@ def _engine(arguments: argparse.Namespace) -> str:
 
 def _add_controller_options(parser: argparse.ArgumentParser) -> None:
     """The options of particular controllers, pushes and the observer."""
-    parser.add_argument("--posture", type=vector, help="osc: a configuration drawn toward in the task's null space")
+    parser.add_argument("--posture", type=vector, help="osc, hybrid: a configuration drawn toward in the task's null space")
     parser.add_argument("--stiffness", type=vector, help="impedance: K, 3 values in [N/m] (or 6, then [N m/rad])")
     parser.add_argument("--damping", type=vector, help="impedance: D, in [N s/m] (then [N m s/rad])")
     parser.add_argument(

@@ -94,6 +94,9 @@ def test_the_summary_says_commanded_and_measured_force(tmp_path, capsys):
         ({"--surface": "1,0,0:-1,0,x"}, "--surface"),
         ({"--along": "0,0,0.1:0,0"}, "--along"),
         ({"--frequency": "-1"}, "--frequency"),
+        ({"--q0": "0"}, "--q0"),
+        ({"--posture": "0"}, "--posture"),
+        ({"--kp": "1,2"}, "--kp"),
         ({"--q0": None, "--surface": "5,0,0:-1,0,0"}, "--q0"),  # out of reach within the joint limits
         ({"--force": "-1"}, "--force"),
         ({"--force": None}, "--force"),
