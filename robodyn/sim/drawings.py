@@ -8,7 +8,7 @@ recording (``robodyn.viz.drawings``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,7 +23,7 @@ class PlotPanel:
     """
 
     ylabel: str
-    curves: tuple[tuple[str, np.ndarray, np.ndarray, str], ...]
+    curves: tuple[tuple[str, np.ndarray, np.ndarray, str], ...] = field(repr=False)
 
 
 @dataclass(frozen=True)
@@ -37,7 +37,7 @@ class Polygon:
     """
 
     name: str
-    vertices: np.ndarray
+    vertices: np.ndarray = field(repr=False)
     colour: int = 0x2060E0
 
 
@@ -54,8 +54,8 @@ class MovingPoint:
     """
 
     name: str
-    t: np.ndarray
-    positions: np.ndarray
+    t: np.ndarray = field(repr=False)
+    positions: np.ndarray = field(repr=False)
     radius: float = 0.012
     colour: int = 0x2060E0
 

@@ -21,7 +21,7 @@ WALL, FORCE, AMPLITUDE, FREQUENCY, MIDDLE, KP, KD = 1.0, 10.0, 0.1, 0.5, 0.03, 1
 COMMAND = [
     "simulate", "rp_arm", "--controller", "hybrid", "--force", str(FORCE), "--surface", f"{WALL},0,0:-1,0,0",
     "--along", f"0,0,{AMPLITUDE}", "--frequency", str(FREQUENCY), "--target", f"{WALL},0,{MIDDLE}",
-    "--kp", str(KP), "--kd", str(KD), "--duration", "0.4", "--dt", "0.004",
+    "--kp", str(KP), "--kd", str(KD), "--duration", "0.4", "--dt", "0.008",
 ]  # fmt: skip
 
 
