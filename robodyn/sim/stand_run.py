@@ -191,13 +191,13 @@ def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, A
     final = contact.trajectory.q[-1]
     feet = law.law.contacts
     commanded = np.array(law.forces).reshape(len(law.forces), len(feet), 3)
-    count = min(len(commanded), len(contact.forces))
+    count, held = min(len(commanded), len(contact.forces)), law.held(contact.trajectory.t)
     return {
         "com_error": float(np.linalg.norm(robot.center_of_mass(final) - law.law.com)),
         "force_difference": float(np.abs(commanded[:count] - contact.forces[:count]).max()),
         "support_margin": support_margin(robot, final, feet, robot.center_of_mass(final)),
-        "contact": CommandedContacts(contact, law.held(contact.trajectory.t)),
-        "panels": stand_panels(robot, contact.trajectory, feet, law.law.com),
+        "contact": CommandedContacts(contact, held),
+        "panels": (*stand_panels(robot, contact.trajectory, feet, law.law.com), force_panel(contact, held)),
         "drawings": stand_drawings(robot, contact.trajectory, feet, law.law.com),
     }
 
@@ -265,4 +265,29 @@ def stand_panels(robot: Robot, trajectory: Trajectory, feet: Sequence[PointConta
     )
 
 
-__all__ = ["CommandedContacts", "RecordedStand", "feet_outline", "stand_drawings", "stand_law", "stand_outcome", "stand_panels"]
+def force_panel(contact: Any, commanded: np.ndarray) -> PlotPanel:
+    """The figure's force panel: the feet's total normal force, the QP's (commanded) and the
+    simulated (measured), in [N].
+
+    Args:
+        contact: The run's :class:`~robodyn.sim.contact_run.ContactSimulation`.
+        commanded: The QP's forces at each sample, (N, k, 3) [N].
+    """
+    normal, t = np.asarray(contact.ground.normal, dtype=float), contact.trajectory.t
+    curves = (
+        ("commanded force", t, (commanded @ normal).sum(axis=1), "dashed"),
+        ("measured force", t, contact.normal_forces.sum(axis=1), "solid"),
+    )
+    return PlotPanel("total normal force [N]", curves)
+
+
+__all__ = [
+    "CommandedContacts",
+    "RecordedStand",
+    "feet_outline",
+    "force_panel",
+    "stand_drawings",
+    "stand_law",
+    "stand_outcome",
+    "stand_panels",
+]

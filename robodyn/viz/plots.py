@@ -207,6 +207,7 @@ def _curves_panel(axis: Axes, panel: Any) -> None:
         colour = ("darkred", "darkgreen", "navy", "darkorange")[index % 4]
         axis.plot(t, values, color=colour, linestyle=style, label=text_label(label), linewidth=1.3)
     axis.set_ylabel(panel.ylabel)
+    axis.ticklabel_format(axis="y", useOffset=False)  # a force held to 1e-5 N: its values, not an offset
     axis.grid(alpha=0.3)
 
 

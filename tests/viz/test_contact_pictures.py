@@ -144,7 +144,11 @@ def test_the_support_polygon_has_the_feet_as_corners_and_the_centre_of_mass_move
 
 def test_the_stand_panels_are_the_centre_of_mass_error_and_the_support_margin(stand):
     robot, trajectory, summary = stand
-    errors, margin = summary.panels
+    errors, margin, forces = summary.panels
+    (_, t, commanded, _), (_, _, measured, _) = forces.curves
+    np.testing.assert_array_equal(t, trajectory.t)
+    weight = robot.total_mass * 9.81
+    assert abs(commanded[-1] - weight) <= 1e-3 * weight and np.abs(commanded - measured).max() <= 1e-4 * weight
     target = robot.center_of_mass(trajectory.q[0]) + np.array([0, 0.01, 0])
     expected = robot.center_of_mass(trajectory.q) - target
     for k, (_, t, values, _) in enumerate(errors.curves):
