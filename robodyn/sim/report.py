@@ -304,8 +304,9 @@ class SimulationSummary:
         return key in self.to_dict()
 
     def warnings(self) -> list[str]:
-        """Lines worth a warning: the limits broken (one line for all)."""
-        return [warning_text(self.robot, list(self.violations))] if self.violations else []
+        """Lines worth a warning: the limits broken (one line for all); a hybrid run's misses."""
+        limits = [warning_text(self.robot, list(self.violations))] if self.violations else []
+        return limits + (self.forces.warnings(self.robot) if self.forces is not None else [])
 
     def text(self) -> str:
         """Readable text: six significant digits and units; one line a limit violation."""

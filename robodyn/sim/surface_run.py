@@ -29,6 +29,9 @@ from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import commanded_header, contact_header
 from robodyn.trajectory.io import write_csv
 
+#: A final motion error along the surface at or above this is warned about, in [m].
+MISSED = 1e-3
+
 #: Options of the other controllers and their values that mean "not set".
 _UNSET: dict[str, tuple[Any, ...]] = {
     "controller": ("hybrid",),
@@ -181,6 +184,23 @@ class ForceOutcome:
         if self.smallest < 0:
             lines.append(f"the surface pulled (smallest normal force {self.smallest:.3g} N): a real contact would have separated")
         return [printable(line) for line in (*lines, *self.notes)]
+
+    def warnings(self, robot: str) -> list[str]:
+        """Lines worth a warning: the motion missed its path by :data:`MISSED` or more, or the
+        surface pulled.
+
+        Args:
+            robot: The robot's name.
+        """
+        lines = []
+        if self.motion_error >= MISSED:
+            lines.append(
+                f"{robot}: the motion along the surface missed its path by {self.motion_error:.3g} m at the end "
+                "(out of reach, or a longer duration?)"
+            )
+        if self.smallest < 0:
+            lines.append(f"{robot}: the surface pulled the frame ({self.smallest:.3g} N): a real contact would have separated")
+        return [printable(line) for line in lines]
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, units in the keys."""

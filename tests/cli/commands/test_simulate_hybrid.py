@@ -66,6 +66,26 @@ def test_the_motion_along_the_wall_follows_its_closed_loop_law(wall):
     assert np.abs(error - expected).max() <= 1e-3 * MIDDLE
 
 
+def test_the_commanded_force_does_no_work_along_the_motion(wall):
+    robot = robodyn.load("rp_arm")
+    q = np.column_stack([wall["q[joint1]"], wall["q[joint2]"]])
+    v = np.column_stack([wall["v[joint1]"], wall["v[joint2]"]])
+    velocity = np.einsum("nij,nj->ni", robot.frame_jacobian(q, "end_effector")[:, :3], v)
+    commanded = np.column_stack([wall[f"f_cmd[surface].{axis}"] for axis in "xyz"])
+    assert np.abs(velocity[:, 2]).max() > 0.1  # it slides
+    assert np.abs(np.einsum("ni,ni->n", commanded, velocity)).max() <= 1e-9 * FORCE  # [W]
+
+
+def test_a_path_out_of_reach_is_one_warning_line(capsys):
+    arguments = [*COMMAND[:-4], "--duration", "0.1", "--dt", "0.01", "--limits", "ignore"]
+    arguments[arguments.index("--target") + 1] = f"{WALL},0,0.9"
+    assert main(arguments) == 0
+    warnings = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warnings) == 1 and "missed its path" in warnings[0]
+    assert main([*COMMAND[:-4], "--duration", "1", "--dt", "0.02"]) == 0  # e(1 s) = 3e-5 m
+    assert "missed" not in capsys.readouterr().err  # negative control: on its path, no warning
+
+
 def test_the_law_checker_sees_other_gains(wall):  # negative control
     t, error = tangential_error(wall)
     wrong = law(t, MIDDLE, 2 * np.pi * FREQUENCY * AMPLITUDE, kd=0.8 * KD)
