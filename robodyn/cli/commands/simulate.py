@@ -29,8 +29,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--frame",
-        help="controlled frame for task-space, osc, impedance (default: the end effector 'robodyn info' shows; it must move);"
-        " with any controller, the path --record and --plot draw",
+        help="controlled frame for task-space, osc, impedance, hybrid (default: the end effector 'robodyn info' shows; it "
+        "must move); with any controller, the path --record and --plot draw",
     )
     _add_controller_options(parser)
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
