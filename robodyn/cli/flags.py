@@ -60,6 +60,10 @@ FLAGS: dict[str, str] = {
     "control_period": "--control-period",
     "kp": "--kp",
     "kd": "--kd",
+    "force": "--force",
+    "surface": "--surface",
+    "along": "--along",
+    "frequency": "--frequency",
 }
 
 #: Boolean keyword arguments a message suggests -> the switch that sets them.

@@ -93,7 +93,15 @@ def buried_line(robot: Robot, q: np.ndarray, t: np.ndarray, ground: Ground, cont
     """One warning line naming the links that are not contact points and went under the
     ground in a run (``q`` (N, nq) at times ``t`` (N,) [s]): their origins and collision
     spheres, boxes and capsules checked at :data:`BURIED_SAMPLES` samples, each link with
-    its deepest point in [m]; ``None`` when none went deeper than :data:`BURIED_DEPTH`."""
+    its deepest point in [m]; ``None`` when none went deeper than :data:`BURIED_DEPTH`.
+
+    Args:
+        robot: The simulated robot.
+        q: Configurations of the run, shape (N, nq).
+        t: Their times, shape (N,), in [s].
+        ground: The ground plane.
+        contacts: The run's contact points (their links are left out).
+    """
     model, data, frames = robot.model, robot.handle.data, robot.handle.frames
     moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
     links = sorted(moving - {point.link for point in contacts.points})

@@ -64,11 +64,21 @@ class LimitRows:
         self.names = [f"{dofs[i].joint} {'lower' if s > 0 else 'upper'}" for i, s in zip(index, self.sign, strict=True)]
 
     def gaps(self, q: np.ndarray) -> np.ndarray:
-        """Each row's distance inside its limit, shape (r,), in [rad] or [m] (< 0: past it)."""
+        """Each row's distance inside its limit, shape (r,), in [rad] or [m] (< 0: past it).
+
+        Args:
+            q: A configuration, shape (nq,).
+        """
         return self.sign * (q[self.q_index] - self.bound)
 
     def torques(self, impulses: np.ndarray, dt: float, nv: int) -> np.ndarray:
-        """The generalized torques of the rows' impulses (r,) [N m s] over ``dt``, shape (nv,)."""
+        """The generalized torques of the rows' impulses (r,) [N m s] over ``dt``, shape (nv,).
+
+        Args:
+            impulses: The rows' impulses, shape (r,), in [N m s] or [N s].
+            dt: The step they act over, in [s].
+            nv: The robot's number of velocity coordinates.
+        """
         out = np.zeros(nv)
         np.add.at(out, self.v_index, self.sign * impulses / dt)
         return out

@@ -162,6 +162,11 @@ def joint_loads(robot: Robot, q: np.ndarray, jacobian: np.ndarray) -> tuple[np.n
     ``L_j = Σ_c ‖f_c‖ ‖∂p_c/∂q_j‖`` (each force times its lever about the joint, ``‖J_c,j‖``
     the distance of the contact from the joint's axis) in [N m] ([N]) and the inertia
     ``Σ_c ‖f_c‖ / g ‖∂p_c/∂q_j‖²`` in [kg m²] ([kg]) of the weight it lifts.
+
+    Args:
+        robot: A floating robot.
+        q: Its configuration, shape (nq,).
+        jacobian: The contact points' Jacobians, shape (3k, nv).
     """
     gravity = robot.gravity(q)
     forces = np.linalg.lstsq(jacobian[:, :6].T, gravity[:6], rcond=None)[0].reshape(-1, 3)
@@ -183,6 +188,13 @@ def load_gains(
     it must hold is at most ``L``, so it sags at most ``θ``. ``kd = 2 √(kp m)``: critical
     on the joint's own inertia, so a leg in the air stays stable at a millisecond step
     (damped for the carried weight, a leg's ``kd / m`` would exceed ``2 / dt``).
+
+    Args:
+        robot: A floating robot.
+        q: Its configuration, shape (nq,).
+        jacobian: The contact points' Jacobians, shape (3k, nv).
+        driven: Which degrees of freedom an actuator drives, shape (nv,) (as
+            :func:`joint_inertia`); ``None``: every joint.
     """
     inertia = joint_inertia(robot, q, driven)
     stiffness = PD_FREQUENCY**2 * inertia + joint_loads(robot, q, jacobian)[0] / LOAD_GIVE
@@ -196,7 +208,17 @@ def pd_defaults(
     """The pd controller's defaults: without a ``target``, the start's joints (held); a
     floating robot on a ``ground`` with neither ``kp`` nor ``kd`` in ``gains``: the gains
     of :func:`load_gains` at the target pose set on the ground, on its contact points that
-    touch it (those within 1 mm of the lowest). Other controllers: unchanged."""
+    touch it (those within 1 mm of the lowest). Other controllers: unchanged.
+
+    Args:
+        robot: The plant.
+        controller: The controller's name; only ``"pd"`` has these defaults.
+        target: The joint target, one value a joint, or ``None``.
+        start: The start configuration, shape (nq,).
+        gains: The gains given (``kp``, ``kd``; ``None`` values: not given).
+        ground: The ground, or ``None``.
+        contacts: The contact points asked for (as ``simulate``'s ``contacts``).
+    """
     if controller != "pd":
         return target, gains
     if target is None:

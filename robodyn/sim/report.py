@@ -181,6 +181,8 @@ class SimulationSummary:
         com_error: stand: the final centre of mass's distance to its target in [m].
         force_difference: stand: the largest ``|f_QP − f_simulated|`` of a contact over the run, in [N].
         support_margin: stand: how far the final centre of mass lies inside the support polygon, in [m].
+        forces: hybrid: commanded vs measured contact force (:class:`robodyn.sim.surface_run.ForceOutcome`).
+        panels, drawings: Extra figure panels and recording drawings of the run (not in :meth:`to_dict`).
     """
 
     robot: str
@@ -216,6 +218,9 @@ class SimulationSummary:
     com_error: float | None = None
     force_difference: float | None = None
     support_margin: float | None = None
+    forces: Any = None
+    panels: tuple = field(default=(), repr=False, compare=False)
+    drawings: tuple = field(default=(), repr=False, compare=False)
 
     def with_startup(self, seconds: float | None) -> SimulationSummary:
         """The same summary with the start-up time in [s] (process start to the run)."""
@@ -261,7 +266,7 @@ class SimulationSummary:
         for key, unit in (("com_error", "m"), ("force_difference", "N"), ("support_margin", "m")):
             if getattr(self, key) is not None:
                 data[f"{key}_{unit}"] = getattr(self, key)
-        return data | dict(self.files)
+        return data | (self.forces.to_dict() if self.forces is not None else {}) | dict(self.files)
 
     def _timing_dict(self) -> dict[str, Any]:
         """The engine's reason, the controller's sampling and the times, units in the keys."""
@@ -305,8 +310,9 @@ class SimulationSummary:
         return key in self.to_dict()
 
     def warnings(self) -> list[str]:
-        """Lines worth a warning: the limits broken (one line for all)."""
-        return [warning_text(self.robot, list(self.violations))] if self.violations else []
+        """Lines worth a warning: the limits broken (one line for all); a hybrid run's misses."""
+        limits = [warning_text(self.robot, list(self.violations))] if self.violations else []
+        return limits + (self.forces.warnings(self.robot) if self.forces is not None else [])
 
     def text(self) -> str:
         """Readable text: six significant digits and units; one line a limit violation."""
@@ -337,6 +343,7 @@ class SimulationSummary:
         lines.append(f"energy change: {_number(self.energy_change, 4)} J")
         lines += [printable(line) for line in self.ground]
         lines += [printable(line) for line in (self.constrained.summary_lines() if self.constrained is not None else ())]
+        lines += self.forces.lines() if self.forces is not None else []
         if self.com_error is not None:
             lines.append(f"centre of mass: final error {_number(self.com_error, 3)} m")
         if self.force_difference is not None:

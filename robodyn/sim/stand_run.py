@@ -13,6 +13,8 @@ and the simulated contact forces, and the final centre of mass's support margin.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -23,21 +25,80 @@ from robodyn.constraints import PointContact
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.contact_checks import start_above
+from robodyn.sim.drawings import MovingPoint, PlotPanel, Polygon
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.sim.whole_body import Stand, support_margin
+from robodyn.trajectory import Trajectory
+from robodyn.trajectory.columns import commanded_header, contact_header
+from robodyn.trajectory.io import write_csv
 
 
 class RecordedStand:
-    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N]."""
+    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N],
+    and the call's time in [s]."""
 
     def __init__(self, law: Stand) -> None:
         self.law = law
         self.forces: list[np.ndarray] = []
+        self.times: list[float] = []
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         tau = self.law(t, q, v)
         self.forces.append(self.law.last_forces.copy())
+        self.times.append(float(t))
         return tau
+
+    def held(self, times: np.ndarray) -> np.ndarray:
+        """The QP's forces in force at ``times`` (its last call at or before each), (N, k, 3) [N].
+
+        Args:
+            times: In [s], shape (N,).
+        """
+        forces = np.array(self.forces).reshape(len(self.forces), -1, 3)
+        return forces[np.clip(np.searchsorted(self.times, times, side="right") - 1, 0, len(forces) - 1)]
+
+
+@dataclass(frozen=True)
+class CommandedContacts:
+    """A stand run's contacts (:class:`~robodyn.sim.contact_run.ContactSimulation`, every
+    attribute of it) with the QP's forces, which its CSV writes beside the simulated ones.
+
+    Attributes:
+        run: The contact simulation.
+        commanded: The QP's force of each contact at each sample, (N, k, 3), world axes, in [N].
+    """
+
+    run: Any
+    commanded: np.ndarray
+
+    def __getattr__(self, name: str) -> Any:
+        if name == "run":  # not set yet (copying): no recursion
+            raise AttributeError(name)
+        return getattr(self.run, name)
+
+    def save(self, path: str | Path, extras: dict[str, np.ndarray] | None = None) -> Path:
+        """The run's CSV (``ContactSimulation.save``) with ``f_cmd[<contact>].x/.y/.z`` [N]
+        after its ``f[<contact>]`` columns.
+
+        Args:
+            path: The ``.csv`` file.
+            extras: As for ``ContactSimulation.save``.
+
+        Raises:
+            InputError: For a file name that does not end in ``.csv``.
+        """
+        path = Path(path)
+        if path.suffix != ".csv":
+            raise InputError("out", "a .csv file for a run on the ground (its contact forces are columns)", repr(str(path)))
+        extras = extras or {}
+        trajectory, names, count = self.run.trajectory, list(self.run.contacts), len(self.run.contacts)
+        header = trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in trajectory.coordinate_names[1]]
+        flags = contact_header(names)
+        header += flags[: 3 * count] + commanded_header(names) + flags[3 * count :]
+        forces, commanded = (array.reshape(len(array), 3 * count) for array in (self.run.forces, self.commanded))
+        table = np.column_stack([trajectory.table(), *extras.values(), forces, commanded, self.run.active.astype(float)])
+        write_csv(path, trajectory.robot, header, table)
+        return path
 
 
 def _feet(robot: Robot, q: np.ndarray, ground: Ground, points: Sequence[ContactPoint]) -> tuple[PointContact, ...]:
@@ -118,8 +179,9 @@ def stand_law(
 
 def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, Any]:
     """The summary's stand fields: ``com_error`` (final centre of mass to its target, in [m]),
-    ``force_difference`` (largest ``|f_QP − f_simulated|`` of a contact over the run, in [N])
-    and ``support_margin`` (of the final centre of mass, in [m]).
+    ``force_difference`` (largest ``|f_QP − f_simulated|`` of a contact over the run, in [N]),
+    ``support_margin`` (of the final centre of mass, in [m]), and the figure's ``panels`` and
+    the recording's ``drawings`` (:func:`stand_panels`, :func:`stand_drawings`).
 
     Args:
         robot: The plant.
@@ -129,12 +191,103 @@ def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, A
     final = contact.trajectory.q[-1]
     feet = law.law.contacts
     commanded = np.array(law.forces).reshape(len(law.forces), len(feet), 3)
-    count = min(len(commanded), len(contact.forces))
+    count, held = min(len(commanded), len(contact.forces)), law.held(contact.trajectory.t)
     return {
         "com_error": float(np.linalg.norm(robot.center_of_mass(final) - law.law.com)),
         "force_difference": float(np.abs(commanded[:count] - contact.forces[:count]).max()),
         "support_margin": support_margin(robot, final, feet, robot.center_of_mass(final)),
+        "contact": CommandedContacts(contact, held),
+        "panels": (*stand_panels(robot, contact.trajectory, feet, law.law.com), force_panel(contact, held)),
+        "drawings": stand_drawings(robot, contact.trajectory, feet, law.law.com),
     }
 
 
-__all__ = ["RecordedStand", "stand_law", "stand_outcome"]
+def feet_outline(robot: Robot, q: np.ndarray, feet: Sequence[PointContact]) -> np.ndarray:
+    """The feet's points at ``q`` on the support polygon's boundary (its corners), in order
+    counter-clockwise seen from above, world frame, shape (k, 3), in [m].
+
+    Args:
+        robot: The robot.
+        q: Its configuration (nq,).
+        feet: The contacts.
+    """
+    pin.framesForwardKinematics(robot.model, robot.data, q)
+    world = np.array([robot.data.oMf[robot.frame_id(foot.frame)].act(np.asarray(foot.point, float)) for foot in feet])
+    boundary = world[[abs(support_margin(robot, q, feet, point)) <= 1e-9 for point in world]]
+    up = -robot.gravity_vector / np.linalg.norm(robot.gravity_vector)
+    arms = boundary - boundary.mean(axis=0)
+    angles = np.arctan2(np.cross(arms[0], arms) @ up, arms @ arms[0])
+    return boundary[np.argsort(angles)]
+
+
+def stand_drawings(
+    robot: Robot, trajectory: Trajectory, feet: Sequence[PointContact], com: np.ndarray
+) -> tuple[Polygon | MovingPoint, ...]:
+    """The recording's support polygon (the feet at the start), the centre of mass over the
+    motion, its shadow along gravity on the feet's plane, and its target.
+
+    Args:
+        robot: The plant.
+        trajectory: The motion.
+        feet: The contacts.
+        com: The centre of mass's target in [m] (3,).
+    """
+    outline = feet_outline(robot, trajectory.q[0], feet)
+    step = max(1, len(trajectory) // 2000)
+    t, centre = trajectory.t[::step], np.atleast_2d(robot.center_of_mass(trajectory.q[::step]))
+    up = -robot.gravity_vector / np.linalg.norm(robot.gravity_vector)
+    shadow = centre - np.outer((centre - outline[0]) @ up, up)
+    return (
+        Polygon("support_polygon", outline),
+        MovingPoint("com", t, centre, 0.015, 0x20A040),
+        MovingPoint("com_shadow", t, shadow, 0.008, 0x20A040),
+        MovingPoint("com_target", t[:1], np.asarray(com, float)[None], 0.01, 0xE02020),
+    )
+
+
+def stand_panels(robot: Robot, trajectory: Trajectory, feet: Sequence[PointContact], com: np.ndarray) -> tuple[PlotPanel, ...]:
+    """The figure's panels: the centre of mass minus its target (x, y, z) and the support
+    margin over time (at most 100 samples), both in [m].
+
+    Args:
+        robot: The plant.
+        trajectory: The motion.
+        feet: The contacts.
+        com: The centre of mass's target in [m] (3,).
+    """
+    centre = np.atleast_2d(robot.center_of_mass(trajectory.q)) - np.asarray(com, float)
+    step = max(1, len(trajectory) // 100)
+    t = trajectory.t[::step]
+    margin = np.array([support_margin(robot, q, feet, robot.center_of_mass(q)) for q in trajectory.q[::step]])
+    errors = tuple((f"com {axis} − target", trajectory.t, centre[:, k], "solid") for k, axis in enumerate("xyz"))
+    return PlotPanel("centre of mass − target [m]", errors), PlotPanel(
+        "support margin [m]", (("support margin", t, margin, "solid"),)
+    )
+
+
+def force_panel(contact: Any, commanded: np.ndarray) -> PlotPanel:
+    """The figure's force panel: the feet's total normal force, the QP's (commanded) and the
+    simulated (measured), in [N].
+
+    Args:
+        contact: The run's :class:`~robodyn.sim.contact_run.ContactSimulation`.
+        commanded: The QP's forces at each sample, (N, k, 3) [N].
+    """
+    normal, t = np.asarray(contact.ground.normal, dtype=float), contact.trajectory.t
+    curves = (
+        ("commanded force", t, (commanded @ normal).sum(axis=1), "dashed"),
+        ("measured force", t, contact.normal_forces.sum(axis=1), "solid"),
+    )
+    return PlotPanel("total normal force [N]", curves)
+
+
+__all__ = [
+    "CommandedContacts",
+    "RecordedStand",
+    "feet_outline",
+    "force_panel",
+    "stand_drawings",
+    "stand_law",
+    "stand_outcome",
+    "stand_panels",
+]

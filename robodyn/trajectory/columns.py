@@ -34,8 +34,9 @@ _COLUMN = re.compile(r"^(q|v|a|tau)\[(.*)\]$", re.DOTALL)
 _EXTRA = re.compile(r"^(G|M|tau_ext|tau_env)\[(.*)\]$", re.DOTALL)
 #: A contact simulation's columns (:func:`contact_header`), skipped on reading as a trajectory:
 #: each contact's force on the robot in world axes ``f[<contact>].x/.y/.z`` [N] and whether
-#: it pushes, ``contact[<contact>]`` (1 or 0).
-_CONTACT = re.compile(r"^(f\[(.*)\]\.[xyz]|contact\[(.*)\])$", re.DOTALL)
+#: it pushes, ``contact[<contact>]`` (1 or 0); a controlled run adds the force its controller
+#: commanded beside it, ``f_cmd[<contact>].x/.y/.z`` [N] (:func:`commanded_header`).
+_CONTACT = re.compile(r"^(f(_cmd)?\[(.*)\]\.[xyz]|contact\[(.*)\])$", re.DOTALL)
 #: A constrained simulation's multipliers (:func:`constraint_header`), skipped on reading as a
 #: trajectory: ``lambda[<constraint>].x/.y/.z`` [N] (and a weld's ``.mx/.my/.mz`` [N m], a
 #: sliding contact's ``.n`` [N]), world axes.
@@ -74,6 +75,16 @@ def contact_header(contacts: list[str]) -> list[str]:
     ``contacts``: ``f[<c>].x``, ``f[<c>].y``, ``f[<c>].z`` of each, then ``contact[<c>]``."""
     forces = [f"f[{name}].{axis}" for name in contacts for axis in "xyz"]
     return forces + [f"contact[{name}]" for name in contacts]
+
+
+def commanded_header(contacts: list[str]) -> list[str]:
+    """The columns of the contact forces a controller commanded, world axes, in [N]:
+    ``f_cmd[<c>].x``, ``f_cmd[<c>].y``, ``f_cmd[<c>].z`` of each contact.
+
+    Args:
+        contacts: The contacts' names.
+    """
+    return [f"f_cmd[{name}].{axis}" for name in contacts for axis in "xyz"]
 
 
 def contact_columns(header: list[str], table: np.ndarray, contacts: list[str]) -> tuple[np.ndarray, np.ndarray]:

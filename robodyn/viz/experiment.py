@@ -20,7 +20,8 @@ import numpy as np
 from robodyn.common.files import outputs_together
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
-from robodyn.sim.experiment import applied_torques, push_wrenches, run_simulation
+from robodyn.sim.experiment import applied_torques, push_wrenches
+from robodyn.sim.hybrid_run import run_named
 from robodyn.sim.observer import ObservationRun, observe_file
 from robodyn.sim.operational_space import target_rotation
 from robodyn.sim.report import SimulationSummary
@@ -40,8 +41,8 @@ def run_experiment(
     png: PathLike | None = None,
     **settings: Any,
 ) -> SimulationSummary:
-    """Simulate (``settings``: as for :func:`~robodyn.sim.experiment.run_simulation`) and
-    write the files asked for.
+    """Simulate (``settings``: as for :func:`~robodyn.sim.experiment.run_simulation`, or
+    :func:`~robodyn.sim.hybrid_run.run_hybrid` for ``controller="hybrid"``) and write the files asked for.
 
     Args:
         robot: The plant.
@@ -60,9 +61,10 @@ def run_experiment(
         applied, ``tau_env[<joint>]``;
         ``plot``, ``recording`` (the target pose as a triad, pushes as arrows), ``poster``).
     """
-    if out and settings.get("ground") is not None and Path(out).suffix != ".csv":
-        raise InputError("out", "a .csv file for a run on the ground (its contact forces are columns)", repr(str(out)))
-    trajectory, summary = run_simulation(robot, **settings)
+    kind = "on the ground" if settings.get("ground") is not None else "of the hybrid controller"
+    if out and (settings.get("ground") is not None or settings.get("controller") == "hybrid") and Path(out).suffix != ".csv":
+        raise InputError("out", f"a .csv file for a run {kind} (its contact forces are columns)", repr(str(out)))
+    trajectory, summary = run_named(robot, **settings)  # hybrid: robodyn.sim.hybrid_run
     # The controlled frame, else the frame asked for (it names the drawn path), else none.
     frame = summary.task.frame if summary.task is not None else settings.get("frame")
     task = np.asarray(summary.task.target) if summary.task is not None else None
@@ -77,7 +79,8 @@ def run_experiment(
         if plot:
             from robodyn.viz.plots import plot_simulation  # matplotlib: only when a figure is asked for
 
-            summary = summary.with_file("plot", str(plot_simulation(robot, trajectory, plot, frame=frame, target=task)))
+            drawn = plot_simulation(robot, trajectory, plot, frame=frame, target=task, panels=summary.panels)
+            summary = summary.with_file("plot", str(drawn))
         if record:
             from robodyn.viz.recording import record as write_recording  # meshcat: only for an animation
 
@@ -87,6 +90,7 @@ def run_experiment(
             written = write_recording(
                 robot, trajectory, record, png=png, target=task, frame=frame,
                 target_rotation=None if rpy is None else target_rotation(np.asarray(rpy)), forces=tuple(forces),
+                drawings=summary.drawings,
             )  # fmt: skip
             summary = summary.with_file("recording", str(written))
             if png:

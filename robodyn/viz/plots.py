@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import io
 import re
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -105,7 +107,12 @@ def _fit(axis: Axes, data: list[np.ndarray], limits: list[float]) -> None:
 # The simulation figure
 # --------------------------------------------------------------------------------------
 def simulation_figure(
-    robot: Robot, trajectory: Trajectory, *, frame: str | None = None, target: np.ndarray | None = None
+    robot: Robot,
+    trajectory: Trajectory,
+    *,
+    frame: str | None = None,
+    target: np.ndarray | None = None,
+    panels: Sequence[Any] = (),
 ) -> Figure:
     """Joint positions, joint torques / forces, the frame's distance to its target, energy.
 
@@ -114,13 +121,15 @@ def simulation_figure(
         trajectory: ``t`` in [s]; ``q`` shape (N, nq); ``v``, ``tau`` shape (N, nv).
         frame: With ``target``: the frame whose distance to the target is drawn.
         target: Target position in [m], shape (3,).
+        panels: More panels before the energy's, each a
+            :class:`~robodyn.sim.drawings.PlotPanel` (commanded vs measured force, ...).
 
     Returns:
         The figure: one panel a quantity and unit; revolute and prismatic joints apart.
     """
-    panels = _joint_panels(robot)
+    extra, panels = tuple(panels), _joint_panels(robot)
     task = frame is not None and target is not None
-    rows = len(panels) + 1 + int(task)
+    rows = len(panels) + 1 + int(task) + len(extra)
     figure = new_figure(9.0, 1.9 * rows + 0.6)
     axes = figure.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
     joints = [dof for dof in robot.dofs if not dof.is_base]
@@ -134,7 +143,9 @@ def simulation_figure(
         axes[row].set_ylabel("distance [m]")
         axes[row].grid(alpha=0.3, which="both")
         row += 1
-    _energy_panel(axes[row], robot, trajectory)
+    for axis, panel in zip(axes[row:-1], extra, strict=True):
+        _curves_panel(axis, panel)
+    _energy_panel(axes[-1], robot, trajectory)
     axes[-1].set_xlabel("time [s]")
     # One legend for the joints (a colour each, shared by every panel), one for the rest.
     handles, labels = [], []
@@ -190,6 +201,16 @@ def _joint_panel(axis: Axes, robot: Robot, trajectory: Trajectory, ylabel: str, 
     axis.grid(alpha=0.3)
 
 
+def _curves_panel(axis: Axes, panel: Any) -> None:
+    """A :class:`~robodyn.sim.drawings.PlotPanel`: its curves, one colour and style each."""
+    for index, (label, t, values, style) in enumerate(panel.curves):
+        colour = ("darkred", "darkgreen", "navy", "darkorange")[index % 4]
+        axis.plot(t, values, color=colour, linestyle=style, label=text_label(label), linewidth=1.3)
+    axis.set_ylabel(panel.ylabel)
+    axis.ticklabel_format(axis="y", useOffset=False)  # a force held to 1e-5 N: its values, not an offset
+    axis.grid(alpha=0.3)
+
+
 def _energy_panel(axis: Axes, robot: Robot, trajectory: Trajectory) -> None:
     """Kinetic, potential and total energy in [J] over time."""
     kinetic = np.atleast_1d(robot.kinetic_energy(trajectory.q, trajectory.v))
@@ -202,7 +223,13 @@ def _energy_panel(axis: Axes, robot: Robot, trajectory: Trajectory) -> None:
 
 
 def plot_simulation(
-    robot: Robot, trajectory: Trajectory, path: str | Path, *, frame: str | None = None, target: np.ndarray | None = None
+    robot: Robot,
+    trajectory: Trajectory,
+    path: str | Path,
+    *,
+    frame: str | None = None,
+    target: np.ndarray | None = None,
+    panels: Sequence[Any] = (),
 ) -> Path | None:
     """Write :func:`simulation_figure` as a PNG (atomically) and return its path (``None`` for ``-``).
 
@@ -210,7 +237,7 @@ def plot_simulation(
         path: The PNG file, or ``-`` for standard output; the other arguments are
             :func:`simulation_figure`'s.
     """
-    return save_png(simulation_figure(robot, trajectory, frame=frame, target=target), path)
+    return save_png(simulation_figure(robot, trajectory, frame=frame, target=target, panels=panels), path)
 
 
 # --------------------------------------------------------------------------------------

@@ -29,6 +29,7 @@ from robodyn.common.files import atomic_write_text
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, RobodynError, ViewerError
 from robodyn.trajectory import Trajectory
+from robodyn.viz.drawings import drawing_commands
 from robodyn.viz.mesh_files import MAX_MESH_BYTES
 from robodyn.viz.scene import build_scene, camera_commands, lower_animation, motion, pose_commands
 from robodyn.viz.task import axis_commands, force_commands, target_pose_commands, task_commands
@@ -190,6 +191,7 @@ def motion_commands(
     max_mesh_bytes: int = MAX_MESH_BYTES,
     target_rotation: np.ndarray | None = None,
     forces: tuple = (),
+    drawings: tuple = (),
 ) -> tuple[list[dict], float, list[str]]:
     """The meshcat commands of a motion with its task (see :func:`recording`).
 
@@ -220,12 +222,14 @@ def motion_commands(
     if target_m is not None and target_rotation is not None:
         task += target_pose_commands(target_m, np.asarray(target_rotation, dtype=float), points)
     arrows, arrow_clips = force_commands(robot, moved.times, moved.configurations, forces, points, fps)
-    task_clips |= arrow_clips
+    drawn, drawn_clips = drawing_commands(drawings, moved.times, fps)
+    task_clips |= arrow_clips | drawn_clips
     commands = [
         *scene.commands,
         *axis_commands(robot, axes, points),
         *task,
         *arrows,
+        *drawn,
         *pose_commands(robot, moved.configurations[0]),
         *camera_commands(framed),
         lower_animation({**clips, **task_clips}),
@@ -244,6 +248,7 @@ def recording(
     max_mesh_bytes: int = MAX_MESH_BYTES,
     target_rotation: np.ndarray | None = None,
     forces: tuple = (),
+    drawings: tuple = (),
 ) -> Recording:
     """Draw a trajectory: the robot, the ground, the target and the end effector's path.
 
@@ -258,6 +263,7 @@ def recording(
         max_mesh_bytes: Largest mesh file drawn; larger ones become placeholder boxes.
         target_rotation: The target's attitude (3, 3): the target pose drawn as a triad.
         forces: :class:`robodyn.ExternalWrench` es drawn as arrows while they act.
+        drawings: More to draw (a support polygon, a moving point: :mod:`robodyn.viz.drawings`).
 
     Raises:
         RobodynError: If the trajectory is empty, does not fit the robot, or nothing of the
@@ -265,7 +271,7 @@ def recording(
     """
     commands, duration, placeholders = motion_commands(
         robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes,
-        target_rotation=target_rotation, forces=forces,
+        target_rotation=target_rotation, forces=forces, drawings=drawings,
     )  # fmt: skip
     return Recording(page(commands, title=f"robodyn: {robot.name}"), duration, fps, robot.name, placeholders)
 
@@ -284,6 +290,7 @@ def record(
     max_mesh_bytes: int = MAX_MESH_BYTES,
     target_rotation: np.ndarray | None = None,
     forces: tuple = (),
+    drawings: tuple = (),
 ) -> Path | None:
     """Write a self-contained HTML animation of a trajectory (plays on open).
 
@@ -300,7 +307,7 @@ def record(
         frame: Frame whose path is drawn (default ``robot.end_effector``).
         axes: Links that carry an x/y/z triad.
         max_mesh_bytes: Largest mesh file drawn (see :mod:`robodyn.viz.mesh_files`).
-        target_rotation, forces: As for :func:`recording`.
+        target_rotation, forces, drawings: As for :func:`recording`.
 
     Returns:
         The HTML path (``None`` for standard output, ``-``).
@@ -311,7 +318,7 @@ def record(
     """
     made = recording(
         robot, trajectory, fps=fps, target=target, frame=frame, axes=axes, max_mesh_bytes=max_mesh_bytes,
-        target_rotation=target_rotation, forces=forces,
+        target_rotation=target_rotation, forces=forces, drawings=drawings,
     )  # fmt: skip
     if png is not None:
         made.still(png, at=made.duration if at is None else at)

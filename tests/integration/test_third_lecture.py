@@ -22,6 +22,8 @@ def test_the_third_lecture_notebook_runs_and_each_law_holds():
     assert number(r"motion error off ë \+ Kd ė \+ Kp e = 0 by (\S+) of e0") <= 1e-3
     assert number(r"work of the commanded force along the motion: (\S+) J") <= 1e-9
     assert number(r"without decoupling: motion off its law by (\S+) of e0") > 1e-2
+    assert number(r"command line: wall force off the command by (\S+) relative") <= 1e-6
+    assert number(r"command line: motion off its law by (\S+) of e0") <= 1e-3
     assert number(r"normal force off 5 N after 0.5 s: (\S+) ") <= 1e-2
     assert number(r"hand off the circle after 0.5 s: (\S+) m") <= 1e-3
     assert number(r"Ki = 20: settled force off the command by (\S+) ") <= 1e-6

@@ -22,7 +22,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     add_constraints_argument(parser)
     parser.add_argument(
         "--controller",
-        choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand"],
+        choices=["passive", "pd", "computed-torque", "task-space", "osc", "impedance", "lqr", "stand", "hybrid"],
         default="passive",
     )
     parser.add_argument(
@@ -30,12 +30,12 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         type=vector,
         help="task-space: frame position X,Z or X,Y,Z in [m]; osc / impedance: X,Y,Z[,ROLL,PITCH,YAW] in [m] and [rad]; "
         "pd / computed-torque: joint target (pd's default: the start's); lqr: the equilibrium (joint values) to balance at; "
-        "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it)",
+        "stand: the centre of mass's shift DX,DY,DZ in [m] (default none: hold it); hybrid: the motion's middle X,Y,Z",
     )
     parser.add_argument(
         "--frame",
-        help="controlled frame for task-space, osc, impedance (default: the end effector 'robodyn info' shows; it must move);"
-        " with any controller, the path --record and --plot draw",
+        help="controlled frame for task-space, osc, impedance, hybrid (default: the end effector 'robodyn info' shows; it "
+        "must move); with any controller, the path --record and --plot draw",
     )
     _add_controller_options(parser)
     parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
@@ -122,6 +122,7 @@ def run(arguments: argparse.Namespace) -> int:
         png=arguments.png,
         **_reference(arguments),
         **_ground(arguments, robot),
+        **_hybrid(arguments),
     )
     # the library's summary names its parameters (engine='compiled'); the command line, its flags
     summary = replace(summary.with_startup(startup), engine_reason=command_line_text(summary.engine_reason))
@@ -149,7 +150,7 @@ def _engine(arguments: argparse.Namespace) -> str:
 
 def _add_controller_options(parser: argparse.ArgumentParser) -> None:
     """The options of particular controllers, pushes and the observer."""
-    parser.add_argument("--posture", type=vector, help="osc: a configuration drawn toward in the task's null space")
+    parser.add_argument("--posture", type=vector, help="osc, hybrid: a configuration drawn toward in the task's null space")
     parser.add_argument("--stiffness", type=vector, help="impedance: K, 3 values in [N/m] (or 6, then [N m/rad])")
     parser.add_argument("--damping", type=vector, help="impedance: D, in [N s/m] (then [N m s/rad])")
     parser.add_argument(
@@ -171,19 +172,20 @@ def _add_controller_options(parser: argparse.ArgumentParser) -> None:
         type=vector,
         help="pd: stiffness, one value or one a joint, in [N m/rad] / [N/m] (default: 100 x each joint's inertia, a "
         "critically damped 10 rad/s; a floating robot on --ground adds each joint's load at the target over 0.05 rad); "
-        "computed-torque: in [1/s^2] (default 400)",
+        "computed-torque, hybrid (the motion along the surface): in [1/s^2] (default 400)",
     )
     parser.add_argument(
         "--kd",
         type=vector,
         help="pd: damping in [N m s/rad] / [N s/m] (default: 20 x each joint's inertia, or critical for a given --kp); "
-        "computed-torque: in [1/s] (default 40)",
+        "computed-torque, hybrid: in [1/s] (default 40)",
     )
     parser.add_argument(
         "--actuated",
         help="pd, computed-torque, lqr: the actuated joints, comma-separated (default: the file's actuated joints, else "
         "all); the others get no torque",
     )
+    _add_hybrid_arguments(parser)
 
 
 def _add_ground_arguments(parser: argparse.ArgumentParser) -> None:
@@ -221,6 +223,48 @@ def _ground(arguments: argparse.Namespace, robot: Robot) -> dict:
     ground = asked_ground(robot, height=height, friction=arguments.friction)
     contacts = "collision" if arguments.contact is None else [name.strip() for name in arguments.contact.split(",")]
     return {"ground": ground, "contacts": contacts}
+
+
+def _add_hybrid_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--force``, ``--surface``, ``--along``, ``--frequency`` of ``--controller hybrid``."""
+    parser.add_argument("--force", dest="normal_force", type=float, help="hybrid: the normal force pressing the surface, in [N]")
+    parser.add_argument(
+        "--surface",
+        metavar="X,Y,Z:NX,NY,NZ",
+        help="hybrid: the surface, a point of it in [m] and its normal toward the robot (world axes); the frame "
+        "(--frame, default the end effector) slides on it without friction and starts on it",
+    )
+    parser.add_argument(
+        "--along",
+        metavar="DX,DY,DZ[:EX,EY,EZ]",
+        help="hybrid: the motion along the surface, X(t) = middle + D sin(2 pi f t) + E cos(2 pi f t), in [m] (a circle: "
+        "D, E of one length at right angles; default: hold the middle)",
+    )
+    parser.add_argument("--frequency", type=float, help="hybrid: f of --along, in [Hz] (default 0.5)")
+
+
+def _hybrid(arguments: argparse.Namespace) -> dict:
+    """``force=``, ``surface=``, ``along=``, ``frequency=`` of the flags given."""
+    given = {} if arguments.frequency is None else {"frequency": arguments.frequency}
+    if arguments.normal_force is not None:
+        given["force"] = arguments.normal_force
+    if arguments.along is not None:
+        parts = _vectors("--along", arguments.along, "DX,DY,DZ[:EX,EY,EZ] in [m]")
+        given["along"] = parts[0] if len(parts) == 1 else parts
+    if arguments.surface is not None:
+        parts = _vectors("--surface", arguments.surface, "X,Y,Z:NX,NY,NZ (a point in [m], a colon, the normal)")
+        if len(parts) != 2:
+            raise InputError("--surface", "X,Y,Z:NX,NY,NZ (a point in [m], a colon, the normal)", repr(arguments.surface))
+        given["surface"] = tuple(parts)
+    return given
+
+
+def _vectors(flag: str, text: str, expected: str) -> list[list[float]]:
+    """``text``'s colon-separated lists of numbers (one stderr line, naming ``flag``, if not)."""
+    try:
+        return [vector(part) for part in text.split(":")]
+    except argparse.ArgumentTypeError:
+        raise InputError(flag, expected, repr(text)) from None
 
 
 def _add_engine_arguments(parser: argparse.ArgumentParser) -> None:
