@@ -42,6 +42,7 @@ __all__ = [
     "SimulationArrays",
     "compiled_controller",
     "has_twin",
+    "simulate_checked",
     "simulate_compiled",
 ]
 
@@ -105,8 +106,36 @@ def simulate_compiled(
     (q, v), batch = compiled.robot.validate(q=q0, v=v0)
     if batch:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
+    return simulate_checked(
+        compiled, q, v, steps, float(dt), integrator=integrator, controller=controller, control_period=control_period,
+        hold=hold, damping=damping,
+    )  # fmt: skip
+
+
+def simulate_checked(
+    compiled: CompiledRobot,
+    q: np.ndarray,
+    v: np.ndarray,
+    steps: int,
+    dt: float,
+    *,
+    integrator: str,
+    controller: CompiledLaw | PythonController | None,
+    control_period: float | None,
+    hold: bool,
+    damping: np.ndarray | None,
+) -> SimulationArrays:
+    """:func:`simulate_compiled` on arguments already checked (the caller did what it does:
+    ``q``, ``v`` one valid state, ``steps`` of ``dt`` from :func:`step_count`, a known
+    integrator, ``damping`` the joints' ``b`` or ``None``, no Coulomb friction), so a run
+    planned once (:mod:`robodyn.sim.plan`) is not checked twice.
+
+    Raises:
+        InputError: For a bad controller or control period.
+        SimulationError: If the state stops being finite.
+    """
     out = [np.empty((steps + 1, size)) for size in (compiled.nq, compiled.nv, compiled.nv, compiled.nv)]
-    q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
+    q, v = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float)
     if controller is None or isinstance(controller, CompiledLaw):
         if control_period is not None:
             raise InputError("control_period", "used with a Python controller only", repr(control_period))

@@ -24,7 +24,7 @@ from robodyn.common.text import quoted
 from robodyn.compiled.build import is_compiled
 from robodyn.compiled.controllers import CompiledLaw, HasTwin
 from robodyn.compiled.loop_rules import damped
-from robodyn.compiled.simulation import SimulationArrays, simulate_compiled
+from robodyn.compiled.simulation import SimulationArrays, simulate_checked
 from robodyn.dynamics.robot import Robot
 from robodyn.sim.plan import Outcome, RunPlan
 from robodyn.sim.python_loop import Forward, Stepper, integrate
@@ -82,7 +82,12 @@ def twin_runs(plan: RunPlan) -> bool:
     """Whether the plan's controller runs in C: it owns a twin and is evaluated at every
     stage or sampled once a step."""
     controller = plan.controller
-    return isinstance(controller, HasTwin) and plan.every in (None, 1) and controller.twin_refusal() is None
+    return (
+        controller is not None
+        and isinstance(controller, HasTwin)
+        and plan.every in (None, 1)
+        and controller.twin_refusal() is None
+    )
 
 
 def not_ready(plan: RunPlan) -> list[str]:
@@ -140,10 +145,11 @@ def run(plan: RunPlan, prepared: Prepared) -> Outcome:
     else:
         law = prepared.twin if prepared.twin is not None else plan.controller
         sampled = prepared.twin is None and plan.controller is not None
-        arrays = simulate_compiled(
-            prepared.plant, plan.q0, plan.v0, plan.steps * plan.dt, plan.dt, integrator=plan.integrator, controller=law,
+        damping = plan.damping  # Coulomb friction: unsupported, refused before
+        arrays = simulate_checked(
+            prepared.plant, plan.q0, plan.v0, plan.steps, plan.dt, integrator=plan.integrator, controller=law,
             control_period=plan.control_period if sampled else None, hold=plan.every is not None,
-            joint_friction=plan.friction,  # Coulomb friction: unsupported, refused before
+            damping=None if damping is None else np.ascontiguousarray(damping, dtype=float),
         )  # fmt: skip
     return Outcome(arrays, perf_counter() - began, prepared.twin is not None)
 
