@@ -12,6 +12,7 @@ prepared (:func:`prepare`).
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 from dataclasses import dataclass
@@ -21,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robodyn.common.text import quoted
-from robodyn.compiled.build import is_compiled
+from robodyn.compiled.build import is_compiled, loaded
 from robodyn.compiled.controllers import CompiledLaw, HasTwin
 from robodyn.compiled.loop_rules import damped
 from robodyn.compiled.simulation import SimulationArrays, simulate_checked
@@ -96,14 +97,21 @@ def not_ready(plan: RunPlan) -> list[str]:
     the robot not compiled before (a cache lookup: no code generator is loaded)."""
     if plan.controller is not None and not twin_runs(plan):
         return ["a Python controller (called from Python at every stage in either engine)"]
-    candidates = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
-    if not any(shutil.which(candidate) for candidate in candidates):
+    candidates = (os.environ["CC"],) if os.environ.get("CC") else ("cc", "gcc", "clang")
+    if not _compiler_on_path(candidates, os.environ.get("PATH")):
         return [f"no C compiler (none of {', '.join(candidates)} on the PATH)"]
     model = getattr(plan.controller, "model", None)
     models = [plan.robot] if not isinstance(model, Robot) else [plan.robot, model]
-    if not all(is_compiled(each) for each in models):
+    if not all(loaded(each) is not None or is_compiled(each) for each in models):
         return ["not compiled yet (engine='compiled' builds it once, in seconds to minutes; auto uses it from then on)"]
     return []
+
+
+@functools.lru_cache(maxsize=8)
+def _compiler_on_path(candidates: tuple[str, ...], path: str | None) -> bool:
+    """Whether one of the compilers is on the PATH (a search of the folders, remembered for
+    this PATH: every ``engine="auto"`` run asks)."""
+    return any(shutil.which(candidate, path=path) for candidate in candidates)
 
 
 def ready_reason(plan: RunPlan) -> str:

@@ -21,6 +21,8 @@ microseconds instead of hundreds); otherwise the eigenvalues decide, as before.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import pinocchio as pin
 
@@ -43,23 +45,37 @@ SCREEN_MARGIN = 1.25
 _SCALES = 2.0 ** np.arange(-4.0, 5.0)
 
 
+#: What the check catches at the start: it then says nothing (the run reports its own error).
+_FAILURES = (RobodynError, np.linalg.LinAlgError, FloatingPointError, ValueError)
+
+
+class _Start(NamedTuple):
+    """The closed loop at the plan's start: the library controller (``None``: the plant
+    alone), its torque there and its feedback ``[∂τ/∂q, ∂τ/∂v]`` (nv, 2 nv), computed once."""
+
+    controller: HasTwin | None
+    tau: np.ndarray
+    feedback: np.ndarray | None
+
+
 def largest_stable_step(plan: RunPlan) -> tuple[float, str, str] | None:
     """The largest stable step in [s] at the plan's start, the joint its fastest mode moves
     most and that mode's likely cause; ``None`` when the start cannot be linearized (a
     singular mass matrix: the run reports its own error)."""
     try:
-        fastest, joint, cause = _rates(plan)
-    except (RobodynError, np.linalg.LinAlgError, FloatingPointError, ValueError):
+        return _largest(plan, _start(plan))
+    except _FAILURES:
         return None
-    return (STABLE_RATE[plan.integrator] / fastest if fastest > 0 else float("inf")), joint, cause
 
 
 def step_warning(plan: RunPlan) -> str | None:
     """One sentence when ``plan.dt`` exceeds the largest stable step at the start, else ``None``
     (at once when :func:`clearly_stable` says the step fits)."""
-    if clearly_stable(plan):
+    try:
+        start = _start(plan)
+        found = None if clearly_stable(plan, start) else _largest(plan, start)
+    except _FAILURES:
         return None
-    found = largest_stable_step(plan)
     if found is None or plan.dt <= found[0]:
         return None
     limit, joint, cause = found
@@ -71,23 +87,22 @@ def step_warning(plan: RunPlan) -> str | None:
     )
 
 
-def clearly_stable(plan: RunPlan) -> bool:
-    """Whether an upper bound on the fastest rate at the plan's start already fits its step.
+def clearly_stable(plan: RunPlan, start: _Start | None = None) -> bool:
+    """Whether an upper bound on the fastest rate at the plan's start already fits its step:
+    :func:`spectral_bound` of the closed loop ``A + B K`` (``K`` the library controller's
+    feedback; the plant alone for a user's controller, which the check never calls), from one
+    call of the plant's analytical derivatives.
 
-    The bound holds for the plant alone (passive runs, and a user's controller, which the
-    check never calls); a library controller's feedback needs its differences, so those
-    plans go to the eigenvalues. ``False`` also when the derivatives fail (the full check
-    then says what it says).
+    Raises:
+        RobodynError: If the derivatives fail there (a singular mass matrix).
     """
-    if plan.controller is not None and isinstance(plan.controller, HasTwin):
-        return False
-    robot, q, v = plan.robot, plan.q0, plan.v0
-    damping = robot.joint_damping if plan.friction and not plan.coulomb else np.zeros(robot.nv)
-    try:
-        by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, -damping * v)
-    except (RobodynError, FloatingPointError, ValueError):
-        return False
+    start = _start(plan) if start is None else start
+    robot, q, v, nv = plan.robot, plan.q0, plan.v0, plan.robot.nv
+    damping = robot.joint_damping if plan.friction and not plan.coulomb else np.zeros(nv)
+    by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, start.tau - damping * v)
     by_v = by_v - inverse * damping
+    if start.feedback is not None:
+        by_q, by_v = by_q + inverse @ start.feedback[:, :nv], by_v + inverse @ start.feedback[:, nv:]
     top = float(np.abs(pin.Motion(v[:6]).action).sum(axis=1).max()) if robot.floating_base else 0.0
     bound = spectral_bound(top, np.abs(by_q).sum(axis=1), np.abs(by_v).sum(axis=1))
     return bool(plan.dt * bound * SCREEN_MARGIN <= STABLE_RATE[plan.integrator])
@@ -113,14 +128,29 @@ def spectral_bound(top: float, by_q: np.ndarray, by_v: np.ndarray) -> float:
     return best if np.isfinite(best) else float("inf")
 
 
-def _rates(plan: RunPlan) -> tuple[float, str, str]:
+def _start(plan: RunPlan) -> _Start:
+    """The controller, torque and feedback at the plan's start (a user's controller: none)."""
+    law = plan.controller
+    controller = law if law is not None and isinstance(law, HasTwin) else None
+    if controller is None:
+        return _Start(None, np.zeros(plan.robot.nv), None)
+    tau = np.asarray(controller(0.0, plan.q0, plan.v0), dtype=float)
+    return _Start(controller, tau, _feedback(plan, tau))
+
+
+def _largest(plan: RunPlan, start: _Start) -> tuple[float, str, str]:
+    """:func:`largest_stable_step` from the start's closed loop, by its eigenvalues."""
+    fastest, joint, cause = _rates(plan, start)
+    return (STABLE_RATE[plan.integrator] / fastest if fastest > 0 else float("inf")), joint, cause
+
+
+def _rates(plan: RunPlan, start: _Start) -> tuple[float, str, str]:
     """The fastest closed-loop rate in [1/s], the joint its mode moves most, and its cause."""
     robot, q, v = plan.robot, plan.q0, plan.v0
-    controller = plan.controller if isinstance(plan.controller, HasTwin) else None
-    tau = np.zeros(robot.nv) if controller is None else np.asarray(controller(0.0, q, v), dtype=float)
+    controller, tau = start.controller, start.tau
     damped = plan.friction and not plan.coulomb
     A, B = linearize(robot, q, v, tau, joint_friction=damped)
-    closed = A if controller is None else A + B @ _feedback(plan, tau)
+    closed = A if start.feedback is None else A + B @ start.feedback
     values, vectors = np.linalg.eig(closed)
     index = int(np.argmax(np.abs(values)))
     fastest = float(np.abs(values[index]))
@@ -136,19 +166,24 @@ def _rates(plan: RunPlan) -> tuple[float, str, str]:
 
 
 def _feedback(plan: RunPlan, tau: np.ndarray) -> np.ndarray:
-    """``[∂τ/∂q, ∂τ/∂v]`` of the controller at the start (q in the tangent space), shape (nv, 2 nv)."""
+    """``[∂τ/∂q, ∂τ/∂v]`` of the controller at the start (q in the tangent space), shape (nv, 2 nv).
+
+    ``q ⊕ step`` is :meth:`Robot.integrate`'s arithmetic on the plan's checked ``q`` (Pinocchio's
+    ``integrate`` for a floating base, else addition) without its input checks."""
     robot, q, v, controller = plan.robot, plan.q0, plan.v0, plan.controller
     assert controller is not None
+    model = robot.model
+    plus = (lambda step: pin.integrate(model, q, step)) if robot.floating_base else (lambda step: q + step)
     columns = []
     for which in ("q", "v"):
         for i in range(robot.nv):
             step = np.zeros(robot.nv)
             step[i] = h = _DIFFERENCE * max(1.0, abs(float(v[i])) if which == "v" else 1.0)
             if which == "q":
-                plus, minus = controller(0.0, robot.integrate(q, step), v), controller(0.0, robot.integrate(q, -step), v)
+                plus_torque, minus_torque = controller(0.0, plus(step), v), controller(0.0, plus(-step), v)
             else:
-                plus, minus = controller(0.0, q, v + step), controller(0.0, q, v - step)
-            columns.append((np.asarray(plus, dtype=float) - np.asarray(minus, dtype=float)) / (2 * h))
+                plus_torque, minus_torque = controller(0.0, q, v + step), controller(0.0, q, v - step)
+            columns.append((np.asarray(plus_torque, dtype=float) - np.asarray(minus_torque, dtype=float)) / (2 * h))
     return np.array(columns).T
 
 
