@@ -34,3 +34,9 @@ def test_the_screen_reports_what_the_violations_report(floating, factor):
     assert (reported > 0) == (factor > 1.0)
     calm = motion(robot, np.array([0.0, 0.2]), np.array([0.0, 2.9]), np.array([[0.0, 0.0], [29.0, 6.9]]))
     assert _violations(robot, calm) == [] == JointLimits(robot).violations(calm)
+
+
+def test_an_empty_trajectory_breaks_no_limit():
+    robot = arm()
+    empty = motion(robot, np.zeros(0), np.zeros(0), np.zeros((0, 2)))
+    assert _violations(robot, empty) == [] == JointLimits(robot).violations(empty)
