@@ -22,6 +22,7 @@ URDF's "unknown"). A floating base has no limits.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -156,15 +157,19 @@ class JointLimits:
             if beyond is None:
                 beyond, worst = values > limits[:, None] + _slack(limits[:, None]), values.argmax(axis=1)
             hit = beyond.any(axis=1) & np.isfinite(limits)
-            columns.append((quantity, side, values if signed is None else signed, limits, hit, beyond.argmax(axis=1), worst))
+            if hit.any():
+                rows = np.flatnonzero(hit)
+                times = trajectory.t[beyond[rows].argmax(axis=1)].tolist()
+                worsts = values[rows, worst[rows]] if signed is None else signed[rows, worst[rows]]
+                found_here = zip(times, worsts.tolist(), limits[rows].tolist(), strict=True)
+                columns.append((quantity, side, dict(zip(rows.tolist(), found_here, strict=True))))
         found = []
         for index, dof in enumerate(self.robot.dofs[self._v_start :]):
             units = {"position": dof.position_unit, "velocity": dof.velocity_unit, "effort": dof.effort_unit}
-            for quantity, side, values, limits, hit, first, worst_rows in columns:
-                if hit[index]:
-                    worst = float(values[index, worst_rows[index]])
-                    bound = float(limits[index] if side != "magnitude" else np.copysign(limits[index], worst))
-                    time = float(trajectory.t[first[index]])
+            for quantity, side, broken in columns:
+                if index in broken:
+                    time, worst, limit = broken[index]
+                    bound = limit if side != "magnitude" else math.copysign(limit, worst)
                     found.append(LimitViolation(dof.joint, quantity, side, time, worst, bound, units[quantity]))
         return found
 
