@@ -701,18 +701,27 @@ def bench_simulate_fixed_cost(quick: bool) -> list[dict]:
     """``robodyn.simulate``'s cost over its loop (issue 43: <= 1 ms for a compiled robot):
     10 steps of 1 ms, kernels built; per call, the wall time of the whole call minus the
     loop's own (``EngineRun.loop_time``); the median over many calls. Passive (compiled and
-    auto), a PD + gravity law in C, and ur5."""
+    auto), a PD + gravity law in C, ur5, and a robot never compiled (auto: a cache look-up,
+    then the Pinocchio engine)."""
     from robodyn.sim.control import PDGravity
     from robodyn.sim.simulation import simulate_run
 
     rows = []
-    for label, name, options in (("panda arm", "panda", PANDA_ARM), ("ur5", "ur5", {})):
+    never = {**PANDA_ARM, "gravity": [0.0, 0.0, -9.7]}  # a key of its own: auto never compiles it
+    for label, name, options in (
+        ("panda arm", "panda", PANDA_ARM),
+        ("ur5", "ur5", {}),
+        ("panda arm, never compiled", "panda", never),
+    ):
         robot = robodyn.load(name, **options)
-        robodyn.compile(robot)
         q0 = 0.5 * np.add(*robot.physical_limits())  # mid-range: no limit broken, nothing to report
         v0 = np.full(robot.nv, 0.1)
         cases: dict[str, dict] = {"passive, engine='compiled'": {"engine": "compiled"}, "passive, engine='auto'": {}}
-        if name == "panda":
+        if options is never:
+            cases = {"passive, engine='auto' (runs on Pinocchio)": {}}
+        else:
+            robodyn.compile(robot)
+        if options is PANDA_ARM:
             cases["PD + gravity in C, engine='compiled'"] = {
                 "engine": "compiled", "controller": PDGravity(robot, q0 + 0.1, kp=50.0, kd=2.0),
             }  # fmt: skip
