@@ -272,9 +272,8 @@ def _state(robot: Robot, q: Any, v: Any, tau: Any, batch_ok: bool) -> tuple[np.n
     arrays, batch = robot.validate(**named)
     if batch and not batch_ok:
         raise InputError("q", "one state (1-D arrays): a linearisation is about one state", f"shape {arrays[0].shape}")
-    if tau is None:  # a batch row by row: each row its single call's (a batch call may differ in the last bits)
-        rows = [robot.nonlinear_effects(q, v) for q, v in zip(arrays[0], arrays[1], strict=True)] if batch else None
-        arrays.append(np.array(rows).reshape(arrays[1].shape) if batch else robot.nonlinear_effects(arrays[0], arrays[1]))
+    if tau is None:
+        arrays.append(_by_row(robot.nonlinear_effects, arrays[1].shape, arrays[0], arrays[1]))
     return arrays[0], arrays[1], arrays[2]
 
 
@@ -345,9 +344,10 @@ class _Step:
             return q + h * w, self.dq0 + h * dw
         step = h * w
         by_q, by_step = (
-            _d_integrate(robot, q, step, argument) for argument in (pin.ArgumentPosition.ARG0, pin.ArgumentPosition.ARG1)
+            _by_row(lambda x, y, a=argument: pin.dIntegrate(robot.model, x, y, a), (*q.shape[:-1], robot.nv, robot.nv), q, step)
+            for argument in (pin.ArgumentPosition.ARG0, pin.ArgumentPosition.ARG1)
         )
-        return robot.integrate(q, step), by_q @ self.dq0 + h * by_step @ dw
+        return _by_row(robot.integrate, q.shape, q, step), by_q @ self.dq0 + h * by_step @ dw
 
     def acceleration(self, q: np.ndarray, dq: np.ndarray, v: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Forward dynamics at a stage and its Jacobian by the chain rule."""
@@ -355,7 +355,7 @@ class _Step:
         tau = self.tau + friction_torque(*friction, v)
         by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, tau)
         by_v = by_v - inverse * friction[0]
-        return _forward(robot, q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
+        return _by_row(robot.forward_dynamics, v.shape, q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
 
     def jacobians(self, q: np.ndarray, v: np.ndarray, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
         """``(A, B)`` of one step of ``dt`` from ``(q, v)``."""
@@ -379,19 +379,12 @@ class _Step:
         return jacobian[..., : 2 * nv], jacobian[..., 2 * nv :]
 
 
-def _forward(robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-    """Forward dynamics of one state, or of each row of a batch by the single call (a row
-    of a batch call may differ in the last bits, and each row is to be its single call's)."""
-    if q.ndim == 1:
-        return robot.forward_dynamics(q, v, tau)
-    return np.array([robot.forward_dynamics(*row) for row in zip(q, v, tau, strict=True)])
-
-
-def _d_integrate(robot: Robot, q: np.ndarray, step: np.ndarray, argument: Any) -> np.ndarray:
-    """``pin.dIntegrate`` of one state, (nv, nv), or of each row of a batch, (N, nv, nv)."""
-    if q.ndim == 1:
-        return pin.dIntegrate(robot.model, q, step, argument)
-    return np.array([pin.dIntegrate(robot.model, row, by, argument) for row, by in zip(q, step, strict=True)])
+def _by_row(function: Any, shape: tuple[int, ...], *states: np.ndarray) -> np.ndarray:
+    """``function`` of one state, or of each row of a batch stacked to ``shape`` (N may be 0):
+    every row its single call's (a batch call may differ from it in the last bits)."""
+    if states[0].ndim == 1:
+        return function(*states)
+    return np.array([function(*row) for row in zip(*states, strict=True)]).reshape(shape)
 
 
 __all__ = ["STEP_INTEGRATORS", "Linearization", "StepIntegrator", "actuation_matrix", "linearization", "linearize"]

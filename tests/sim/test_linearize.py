@@ -306,3 +306,12 @@ def test_a_bad_batch_is_refused_naming_the_argument(rng):
         assert error.value.argument == name
     with pytest.raises(robodyn.InputError, match="one state"):
         linearization(robot, q, v, tau)
+
+
+@pytest.mark.parametrize("name", ["double_pendulum_continuous", "oblique_floating"])
+def test_an_empty_batch_gives_empty_stacks(name):
+    robot = load_case(name)
+    q, v = np.zeros((0, robot.nq)), np.zeros((0, robot.nv))
+    for options in ({}, {"dt": 1e-3}, {"dt": 1e-3, "integrator": "semi-implicit-euler"}):
+        A, B = linearize(robot, q, v, **options)
+        assert A.shape == (0, 2 * robot.nv, 2 * robot.nv) and B.shape == (0, 2 * robot.nv, robot.nv)
