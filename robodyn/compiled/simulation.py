@@ -130,6 +130,14 @@ def simulate_checked(
     integrator, ``damping`` the joints' ``b`` or ``None``, no Coulomb friction), so a run
     planned once (:mod:`robodyn.sim.plan`) is not checked twice.
 
+    Args:
+        compiled: The plant.
+        q, v: The initial state, checked, shapes (nq,) and (nv,).
+        steps: Steps of ``dt`` (the run has ``steps + 1`` samples).
+        dt: The step in [s].
+        integrator, controller, control_period, hold: As :func:`simulate_compiled`.
+        damping: The joints' damping ``b`` acting in C, shape (nv,), float64; ``None``: none.
+
     Raises:
         InputError: For a bad controller or control period.
         SimulationError: If the state stops being finite.

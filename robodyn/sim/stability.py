@@ -93,6 +93,10 @@ def clearly_stable(plan: RunPlan, start: _Start | None = None) -> bool:
     feedback; the plant alone for a user's controller, which the check never calls), from one
     call of the plant's analytical derivatives.
 
+    Args:
+        plan: The run.
+        start: Its closed loop at the start, when already computed (``None``: computed here).
+
     Raises:
         RobodynError: If the derivatives fail there (a singular mass matrix).
     """
