@@ -704,6 +704,7 @@ def bench_simulate_fixed_cost(quick: bool) -> list[dict]:
     auto), a PD + gravity law in C, ur5, and a robot never compiled (auto: a cache look-up,
     then the Pinocchio engine)."""
     from robodyn.sim.control import PDGravity
+    from robodyn.sim.operational_space import OperationalSpace
     from robodyn.sim.simulation import simulate_run
 
     rows = []
@@ -722,8 +723,12 @@ def bench_simulate_fixed_cost(quick: bool) -> list[dict]:
         else:
             robodyn.compile(robot)
         if options is PANDA_ARM:
+            target = (robot.frame_position(q0, robot.end_effector) + 0.02).tolist()
             cases["PD + gravity in C, engine='compiled'"] = {
                 "engine": "compiled", "controller": PDGravity(robot, q0 + 0.1, kp=50.0, kd=2.0),
+            }  # fmt: skip
+            cases["operational space in C, engine='compiled'"] = {
+                "engine": "compiled", "controller": OperationalSpace(robot, None, target),
             }  # fmt: skip
         for case, arguments in cases.items():
             simulate_run(robot, q0, v0, 0.01, 1e-3, **arguments)  # warm (the kernels' module loaded)

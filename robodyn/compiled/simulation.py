@@ -42,6 +42,7 @@ __all__ = [
     "SimulationArrays",
     "compiled_controller",
     "has_twin",
+    "law_torque",
     "simulate_checked",
     "simulate_compiled",
 ]
@@ -160,6 +161,33 @@ def simulate_checked(
     if steps:  # the last sample's own acceleration, under the torque held at the end (as robodyn.simulate)
         a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], damped(tau_out[-1], damping, v_out[-1]))
     return SimulationArrays(np.arange(steps + 1) * dt, *out)
+
+
+def law_torque(compiled: CompiledRobot, twin: CompiledLaw) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """The twin's torque ``tau(0, q, v)`` evaluated in C: the first sample's torque of one
+    step of the loop (for a check that evaluates a library law many times, such as its
+    feedback by differences).
+
+    Args:
+        compiled: The plant.
+        twin: A controller's compiled twin (:mod:`robodyn.compiled.controllers`).
+
+    Returns:
+        ``torque(q, v)``, shape (nv,), for checked states of the plant.
+
+    Raises:
+        InputError: For a twin that does not fit the plant (as :func:`simulate_compiled`).
+    """
+    kind, params, model, frame = _law(compiled, twin)
+    nq, nv, simulate = compiled.nq, compiled.nv, compiled.module.simulate
+
+    def torque(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = [np.empty((2, nq)), np.empty((2, nv)), np.empty((2, nv)), np.empty((2, nv))]
+        q, v = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float)
+        simulate(q, v, 1e-6, 1, 0.0, 0, kind, 1, params, model, *out, frame, None)
+        return out[3][0].copy()
+
+    return torque
 
 
 def _law(compiled: CompiledRobot, twin: CompiledLaw | None) -> tuple[int, np.ndarray, object | None, object | None]:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 import os
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass
 from time import perf_counter
 from typing import TYPE_CHECKING
@@ -25,7 +26,7 @@ from robodyn.common.text import quoted
 from robodyn.compiled.build import is_compiled, loaded
 from robodyn.compiled.controllers import CompiledLaw, HasTwin
 from robodyn.compiled.loop_rules import damped
-from robodyn.compiled.simulation import SimulationArrays, simulate_checked
+from robodyn.compiled.simulation import SimulationArrays, law_torque, simulate_checked
 from robodyn.dynamics.robot import Robot
 from robodyn.sim.plan import Outcome, RunPlan
 from robodyn.sim.python_loop import Forward, Stepper, integrate
@@ -139,6 +140,16 @@ def prepare(plan: RunPlan) -> Prepared:
     plant = compile(plan.robot)
     twin = plan.controller.compiled() if twin_runs(plan) else None  # type: ignore[union-attr]
     return Prepared(plant, twin)
+
+
+def twin_torque(prepared: Prepared) -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
+    """The prepared controller's torque ``tau(0, q, v)`` by its twin in C (``None``: no twin
+    runs), for the step check's screen (:func:`robodyn.sim.stability.step_warning`).
+
+    Args:
+        prepared: The plant and the twin, from :func:`prepare`.
+    """
+    return None if prepared.twin is None else law_torque(prepared.plant, prepared.twin)
 
 
 def run(plan: RunPlan, prepared: Prepared) -> Outcome:

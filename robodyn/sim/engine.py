@@ -90,12 +90,9 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
             (:mod:`robodyn.sim.stability`).
         JointLimitWarning: With ``limits="warn"``, for the limits the run broke.
     """
-    for sentence in (step_warning(plan), task_warning(plan)):  # stack level 4: the caller of simulate
-        if sentence:
-            warnings.warn(RobodynWarning(sentence), stacklevel=4)
     began = perf_counter()
     engine, reason = choose(plan)
-    outcome: Outcome | None = None
+    prepared: compiled_backend.Prepared | None = None
     if engine == "compiled":
         try:
             prepared = compiled_backend.prepare(plan)
@@ -103,12 +100,12 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
             if plan.engine == "compiled":
                 raise
             engine, reason = "pinocchio", f"the compiled engine does not apply: {error}"
-        else:
-            compile_time = perf_counter() - began
-            outcome = compiled_backend.run(plan, prepared)
-    if outcome is None:
-        compile_time = 0.0 if plan.engine == "pinocchio" else perf_counter() - began
-        outcome = pinocchio_loop.run(plan)
+    compile_time = 0.0 if plan.engine == "pinocchio" else perf_counter() - began
+    law = None if prepared is None else compiled_backend.twin_torque(prepared)  # the screen's feedback in C
+    for sentence in (step_warning(plan, law), task_warning(plan)):  # stack level 4: the caller of simulate
+        if sentence:
+            warnings.warn(RobodynWarning(sentence), stacklevel=4)
+    outcome: Outcome = pinocchio_loop.run(plan) if prepared is None else compiled_backend.run(plan, prepared)
     robot = plan.robot
     trajectory = Trajectory(plan.times(), *outcome.arrays[1:], list(robot.joint_names), robot.name)
     violations = [] if plan.limits == "ignore" else _violations(robot, trajectory)

@@ -21,6 +21,7 @@ microseconds instead of hundreds); otherwise the eigenvalues decide, as before.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -45,6 +46,8 @@ SCREEN_MARGIN = 1.25
 _SCALES = 2.0 ** np.arange(-4.0, 5.0)
 
 
+#: A controller's torque as a function of the state alone, ``tau(q, v)`` at t = 0, in [N m] / [N].
+Torque = Callable[[np.ndarray, np.ndarray], np.ndarray]
 #: What the check catches at the start: it then says nothing (the run reports its own error).
 _FAILURES = (RobodynError, np.linalg.LinAlgError, FloatingPointError, ValueError)
 
@@ -68,12 +71,21 @@ def largest_stable_step(plan: RunPlan) -> tuple[float, str, str] | None:
         return None
 
 
-def step_warning(plan: RunPlan) -> str | None:
+def step_warning(plan: RunPlan, law: Torque | None = None) -> str | None:
     """One sentence when ``plan.dt`` exceeds the largest stable step at the start, else ``None``
-    (at once when :func:`clearly_stable` says the step fits)."""
+    (at once when :func:`clearly_stable` says the step fits).
+
+    Args:
+        plan: The run.
+        law: The plan's library controller as ``tau(q, v)`` at t = 0 evaluated elsewhere (its
+            compiled twin: microseconds a call), for the screen's feedback only; a step it does
+            not clear is judged on the controller itself, as without it.
+    """
     try:
+        if law is not None and clearly_stable(plan, _start(plan, law)):
+            return None
         start = _start(plan)
-        found = None if clearly_stable(plan, start) else _largest(plan, start)
+        found = None if law is None and clearly_stable(plan, start) else _largest(plan, start)
     except _FAILURES:
         return None
     if found is None or plan.dt <= found[0]:
@@ -132,14 +144,16 @@ def spectral_bound(top: float, by_q: np.ndarray, by_v: np.ndarray) -> float:
     return best if np.isfinite(best) else float("inf")
 
 
-def _start(plan: RunPlan) -> _Start:
-    """The controller, torque and feedback at the plan's start (a user's controller: none)."""
-    law = plan.controller
-    controller = law if law is not None and isinstance(law, HasTwin) else None
+def _start(plan: RunPlan, law: Torque | None = None) -> _Start:
+    """The controller, torque and feedback at the plan's start (a user's controller: none),
+    the controller evaluated by ``law`` when given (its twin), else called at t = 0."""
+    given = plan.controller
+    controller = given if given is not None and isinstance(given, HasTwin) else None
     if controller is None:
         return _Start(None, np.zeros(plan.robot.nv), None)
-    tau = np.asarray(controller(0.0, plan.q0, plan.v0), dtype=float)
-    return _Start(controller, tau, _feedback(plan, tau))
+    torque: Torque = law if law is not None else (lambda q, v: controller(0.0, q, v))
+    tau = np.asarray(torque(plan.q0, plan.v0), dtype=float)
+    return _Start(controller, tau, _feedback(plan, torque))
 
 
 def _largest(plan: RunPlan, start: _Start) -> tuple[float, str, str]:
@@ -169,13 +183,12 @@ def _rates(plan: RunPlan, start: _Start) -> tuple[float, str, str]:
     return fastest, joint, "the robot's own dynamics"
 
 
-def _feedback(plan: RunPlan, tau: np.ndarray) -> np.ndarray:
+def _feedback(plan: RunPlan, torque: Torque) -> np.ndarray:
     """``[∂τ/∂q, ∂τ/∂v]`` of the controller at the start (q in the tangent space), shape (nv, 2 nv).
 
     ``q ⊕ step`` is :meth:`Robot.integrate`'s arithmetic on the plan's checked ``q`` (Pinocchio's
     ``integrate`` for a floating base, else addition) without its input checks."""
-    robot, q, v, controller = plan.robot, plan.q0, plan.v0, plan.controller
-    assert controller is not None
+    robot, q, v = plan.robot, plan.q0, plan.v0
     model = robot.model
     plus = (lambda step: pin.integrate(model, q, step)) if robot.floating_base else (lambda step: q + step)
     columns = []
@@ -184,9 +197,9 @@ def _feedback(plan: RunPlan, tau: np.ndarray) -> np.ndarray:
             step = np.zeros(robot.nv)
             step[i] = h = _DIFFERENCE * max(1.0, abs(float(v[i])) if which == "v" else 1.0)
             if which == "q":
-                plus_torque, minus_torque = controller(0.0, plus(step), v), controller(0.0, plus(-step), v)
+                plus_torque, minus_torque = torque(plus(step), v), torque(plus(-step), v)
             else:
-                plus_torque, minus_torque = controller(0.0, q, v + step), controller(0.0, q, v - step)
+                plus_torque, minus_torque = torque(q, v + step), torque(q, v - step)
             columns.append((np.asarray(plus_torque, dtype=float) - np.asarray(minus_torque, dtype=float)) / (2 * h))
     return np.array(columns).T
 

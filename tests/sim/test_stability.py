@@ -3,6 +3,8 @@ with the step that would not; a divergence inside a step is reported as a diverg
 
 from __future__ import annotations
 
+import contextlib
+import shutil
 import warnings
 
 import numpy as np
@@ -217,3 +219,29 @@ def test_the_screen_never_clears_a_step_the_eigenvalues_refuse():
                     assert dt <= limit, (kp, integrator, dt, limit)
                 cleared.append(clearly_stable(start))
     assert any(cleared) and not all(cleared)
+
+
+@pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
+def test_a_controller_in_c_is_screened_by_its_twin_and_warned_about_by_itself(monkeypatch):
+    """rp_arm under PD in C: a soft law is cleared with the twin's feedback (the Python law is
+    not called by the check); a stiff one is warned about with the very sentence the
+    Pinocchio engine gives (the check then runs on the law itself)."""
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+    calls = []
+    original = PDGravity.__call__
+    monkeypatch.setattr(PDGravity, "__call__", lambda self, t, q, v: calls.append(t) or original(self, t, q, v))
+    soft = PDGravity(robot, q0 + 0.1, kp=100.0, kd=5.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robodyn.simulate(robot, q0, np.zeros(2), 0.01, 1e-3, controller=soft, engine="compiled", limits="ignore")
+    assert calls == [] and not [w for w in caught if issubclass(w.category, RobodynWarning)]
+    stiff = PDGravity(robot, q0 + 0.1, kp=1e7, kd=20.0)
+    said = {}
+    for engine in ("compiled", "pinocchio"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with contextlib.suppress(SimulationError):  # it diverges, as warned
+                robodyn.simulate(robot, q0, np.zeros(2), 0.01, 1e-3, controller=stiff, engine=engine, limits="ignore")
+        said[engine] = [str(w.message) for w in caught if issubclass(w.category, RobodynWarning)]
+    assert len(said["compiled"]) == 1 and said["compiled"] == said["pinocchio"] and "PDGravity gains" in said["compiled"][0]
