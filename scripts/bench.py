@@ -19,6 +19,9 @@ Sections:
     compiled-batch-simd  SIMD batches (100 000 and 100 003 states): the instruction set that ran, the
                          scalar kernels' batch, Pinocchio's parallel API; the kernels' operation counts
     compiled-simulation  panda-arm real-time factor: compiled RK4 / Euler vs Python engine vs MuJoCo
+    simulate-fixed-cost  robodyn.simulate's cost over its loop, kernels built (10 steps; target <= 1 ms)
+    simulate-vs-mujoco   2 s panda arm, RK4 / Euler: the C loop and the whole simulate call vs mj_step
+    linearize-batch      linearize of N states in one call vs a loop of single calls
     derivatives  Robot.*_derivatives single calls vs pin.computeRNEADerivatives / computeABADerivatives
     export     CasADi instruction counts of M + C v + G vs adam's (bench-only), forward dynamics
                through CasADi's generated C vs pin.aba
@@ -36,6 +39,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import functools
 import json
 import os
 import platform
@@ -43,6 +47,7 @@ import statistics
 import sys
 import time
 import timeit
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -692,6 +697,159 @@ def bench_compiled_simulation(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_simulate_fixed_cost(quick: bool) -> list[dict]:
+    """``robodyn.simulate``'s cost over its loop (issue 43: <= 1 ms for a compiled robot):
+    10 steps of 1 ms, kernels built; per call, the wall time of the whole call minus the
+    loop's own (``EngineRun.loop_time``); the median over many calls. Passive (compiled and
+    auto), a PD + gravity law in C, ur5, and a robot never compiled (auto: a cache look-up,
+    then the Pinocchio engine)."""
+    from robodyn.sim.control import PDGravity
+    from robodyn.sim.operational_space import OperationalSpace
+    from robodyn.sim.simulation import simulate_run
+
+    rows = []
+    never = {**PANDA_ARM, "gravity": [0.0, 0.0, -9.7]}  # a key of its own: auto never compiles it
+    for label, name, options in (
+        ("panda arm", "panda", PANDA_ARM),
+        ("ur5", "ur5", {}),
+        ("panda arm, never compiled", "panda", never),
+    ):
+        robot = robodyn.load(name, **options)
+        q0 = 0.5 * np.add(*robot.physical_limits())  # mid-range: no limit broken, nothing to report
+        v0 = np.full(robot.nv, 0.1)
+        cases: dict[str, dict] = {"passive, engine='compiled'": {"engine": "compiled"}, "passive, engine='auto'": {}}
+        if options is never:
+            cases = {"passive, engine='auto' (runs on Pinocchio)": {}}
+        else:
+            robodyn.compile(robot)
+        if options is PANDA_ARM:
+            target = (robot.frame_position(q0, robot.end_effector) + 0.02).tolist()
+            cases["PD + gravity in C, engine='compiled'"] = {
+                "engine": "compiled", "controller": PDGravity(robot, q0 + 0.1, kp=50.0, kd=2.0),
+            }  # fmt: skip
+            cases["operational space in C, engine='compiled'"] = {
+                "engine": "compiled", "controller": OperationalSpace(robot, None, target),
+            }  # fmt: skip
+        for case, arguments in cases.items():
+            simulate_run(robot, q0, v0, 0.01, 1e-3, **arguments)  # warm (the kernels' module loaded)
+            whole, fixed = [], []
+            for _ in range(50 if quick else 300):
+                start = time.perf_counter()
+                _, run = simulate_run(robot, q0, v0, 0.01, 1e-3, **arguments)
+                whole.append(time.perf_counter() - start)
+                fixed.append(whole[-1] - run.loop_time)
+            median = statistics.median(fixed) * 1e3
+            rows.append(
+                {
+                    "robot": label, "run": case, "steps": 10, "engine": run.engine,
+                    "whole_call_ms": statistics.median(whole) * 1e3, "loop_ms": run.loop_time * 1e3,
+                    "fixed_cost_ms": median, "target": f"<= 1 ms: {'met' if median <= 1.0 else 'missed'}",
+                    "load_average": os.getloadavg()[0],
+                }
+            )  # fmt: skip
+    return rows
+
+
+def bench_simulate_vs_mujoco(quick: bool) -> list[dict]:
+    """2 s of the panda arm at 1 kHz (issue 43: RK4 and semi-implicit Euler >= 4x MuJoCo, the
+    loop and the whole call): the C loop alone (the module's ``simulate``), the whole
+    ``robodyn.simulate(engine="compiled")`` call, and MuJoCo's ``mj_step`` loop (RK4 / its
+    Euler) on the same URDF, the three alternated in each repeat; CPU-time medians and the
+    medians of the per-repeat ratios (and the wall-time ratio of the whole call)."""
+    import mujoco
+
+    robot, compiled = _compiled("panda", PANDA_ARM)
+    q0, v0 = robot.neutral_configuration() + 0.3, np.full(robot.nv, 0.1)  # compiled-simulation's state
+    duration, dt = 2.0, 1e-3
+    steps = round(duration / dt)
+    model = _mujoco_model(robot)
+    rows = []
+    for integrator, mj_integrator in (("rk4", "mjINT_RK4"), ("semi-implicit-euler", "mjINT_EULER")):
+        model.opt.integrator = getattr(mujoco.mjtIntegrator, mj_integrator)
+        out = [np.empty((steps + 1, robot.nv)) for _ in range(4)]
+        rk4 = int(integrator == "rk4")
+
+        def loop(rk4=rk4, out=out) -> None:
+            compiled.module.simulate(q0, v0, dt, steps, 0.0, rk4, 0, 0, np.zeros(robot.nv), None, *out, None, None)
+
+        def whole(integrator=integrator) -> None:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # the fall breaks a joint limit: reported, silenced here
+                simulate(robot, q0, v0, duration, dt, integrator=integrator, engine="compiled", joint_friction=False)
+
+        def mj_loop() -> None:
+            data = mujoco.MjData(model)
+            data.qpos[:], data.qvel[:] = q0, v0
+            for _ in range(steps):
+                mujoco.mj_step(model, data)
+
+        cpu: list[list[float]] = [[], [], []]
+        wall: list[list[float]] = [[], [], []]
+        for _ in range(5 if quick else 15):
+            functions: tuple[Callable[[], None], ...] = (loop, whole, mj_loop)
+            for index, function in enumerate(functions):
+                started, started_cpu = time.perf_counter(), time.process_time()
+                function()
+                cpu[index].append(time.process_time() - started_cpu)
+                wall[index].append(time.perf_counter() - started)
+        rows.append(
+            {
+                "robot": "panda (arm, fingers locked)", "integrator": integrator, "duration_s": duration, "dt_s": dt,
+                "loop_us_per_step": statistics.median(cpu[0]) / steps * 1e6,
+                "whole_call_us_per_step": statistics.median(cpu[1]) / steps * 1e6,
+                "mujoco_us_per_step": statistics.median(cpu[2]) / steps * 1e6,
+                "loop_vs_mujoco": _ratio(cpu[0], cpu[2]), "whole_call_vs_mujoco": _ratio(cpu[1], cpu[2]),
+                "whole_call_vs_mujoco_wall": _ratio(wall[1], wall[2]),
+                "target": ">= 4x, loop and whole call", "load_average": os.getloadavg()[0],
+                "note": f"MuJoCo {mujoco.__version__}, CPU time",
+            }
+        )  # fmt: skip
+    return rows
+
+
+def _ratio(ours: list[float], theirs: list[float]) -> float:
+    """The median of the per-repeat ratios ``theirs / ours`` (how many times faster ours is)."""
+    return statistics.median([t / o for o, t in zip(ours, theirs, strict=True)])
+
+
+def bench_linearize_batch(quick: bool) -> list[dict]:
+    """``linearize`` along a trajectory (issue 43): N states in one call (one derivative call
+    a stage) against a loop of single calls, continuous and one RK4 step; every row checked
+    bit for bit against its single call."""
+    from robodyn.sim.linearize import linearize
+
+    robot = robodyn.load("panda", **PANDA_ARM)
+    rng = np.random.default_rng(0)
+    count = 200 if quick else 1000
+    q, v, tau = robot.random_configuration(rng, count), rng.normal(size=(count, robot.nv)), rng.normal(size=(count, robot.nv))
+    rows = []
+    for label, dt in (("continuous", None), ("one RK4 step, dt = 1 ms", 1e-3)):
+
+        def singles(dt: float | None = dt) -> list[tuple[np.ndarray, np.ndarray]]:
+            return [linearize(robot, *state, dt=dt) for state in zip(q, v, tau, strict=True)]
+
+        equal: bool | str
+        try:
+            stacked = linearize(robot, q, v, tau, dt=dt)
+        except robodyn.InputError:  # before issue 43: batches refused
+            batch_s, equal = float("nan"), "refused"
+        else:
+            reference = singles()
+            equal = all(
+                np.array_equal(stacked[0][i], a) and np.array_equal(stacked[1][i], b) for i, (a, b) in enumerate(reference)
+            )
+            batch_s = median_cpu(functools.partial(linearize, robot, q, v, tau, dt=dt), repeats=5)
+        loop_s = median_cpu(singles, repeats=5)
+        rows.append(
+            {
+                "robot": "panda (arm, fingers locked)", "linearization": label, "states": count,
+                "batch_states_per_s": count / batch_s, "single_call_loop_states_per_s": count / loop_s,
+                "speedup": loop_s / batch_s, "rows_equal_single_calls": equal, "load_average": os.getloadavg()[0],
+            }
+        )  # fmt: skip
+    return rows
+
+
 def bench_derivatives(quick: bool) -> list[dict]:
     """Robot.*_derivatives single calls vs the raw Pinocchio analytical derivatives (panda arm, ur5)."""
     rows = []
@@ -1332,6 +1490,9 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-compile": bench_compiled_compile,
     "compiled-batch-simd": bench_compiled_batch_simd,
     "compiled-simulation": bench_compiled_simulation,
+    "simulate-fixed-cost": bench_simulate_fixed_cost,
+    "simulate-vs-mujoco": bench_simulate_vs_mujoco,
+    "linearize-batch": bench_linearize_batch,
     "derivatives": bench_derivatives,
     "export": bench_export,
     "compiled-derivatives-single": bench_compiled_derivatives_single,

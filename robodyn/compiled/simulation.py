@@ -42,6 +42,8 @@ __all__ = [
     "SimulationArrays",
     "compiled_controller",
     "has_twin",
+    "law_torque",
+    "simulate_checked",
     "simulate_compiled",
 ]
 
@@ -105,8 +107,44 @@ def simulate_compiled(
     (q, v), batch = compiled.robot.validate(q=q0, v=v0)
     if batch:
         raise InputError("q0", "one state (1-D)", f"shape {q.shape}")
+    return simulate_checked(
+        compiled, q, v, steps, float(dt), integrator=integrator, controller=controller, control_period=control_period,
+        hold=hold, damping=damping,
+    )  # fmt: skip
+
+
+def simulate_checked(
+    compiled: CompiledRobot,
+    q: np.ndarray,
+    v: np.ndarray,
+    steps: int,
+    dt: float,
+    *,
+    integrator: str,
+    controller: CompiledLaw | PythonController | None,
+    control_period: float | None,
+    hold: bool,
+    damping: np.ndarray | None,
+) -> SimulationArrays:
+    """:func:`simulate_compiled` on arguments already checked (the caller did what it does:
+    ``q``, ``v`` one valid state, ``steps`` of ``dt`` from :func:`step_count`, a known
+    integrator, ``damping`` the joints' ``b`` or ``None``, no Coulomb friction), so a run
+    planned once (:mod:`robodyn.sim.plan`) is not checked twice.
+
+    Args:
+        compiled: The plant.
+        q, v: The initial state, checked, shapes (nq,) and (nv,).
+        steps: Steps of ``dt`` (the run has ``steps + 1`` samples).
+        dt: The step in [s].
+        integrator, controller, control_period, hold: As :func:`simulate_compiled`.
+        damping: The joints' damping ``b`` acting in C, shape (nv,), float64; ``None``: none.
+
+    Raises:
+        InputError: For a bad controller or control period.
+        SimulationError: If the state stops being finite.
+    """
     out = [np.empty((steps + 1, size)) for size in (compiled.nq, compiled.nv, compiled.nv, compiled.nv)]
-    q, v = np.ascontiguousarray(q), np.ascontiguousarray(v)
+    q, v = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float)
     if controller is None or isinstance(controller, CompiledLaw):
         if control_period is not None:
             raise InputError("control_period", "used with a Python controller only", repr(control_period))
@@ -123,6 +161,33 @@ def simulate_compiled(
     if steps:  # the last sample's own acceleration, under the torque held at the end (as robodyn.simulate)
         a_out[-1] = compiled.forward_dynamics(q_out[-1], v_out[-1], damped(tau_out[-1], damping, v_out[-1]))
     return SimulationArrays(np.arange(steps + 1) * dt, *out)
+
+
+def law_torque(compiled: CompiledRobot, twin: CompiledLaw) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """The twin's torque ``tau(0, q, v)`` evaluated in C: the first sample's torque of one
+    step of the loop (for a check that evaluates a library law many times, such as its
+    feedback by differences).
+
+    Args:
+        compiled: The plant.
+        twin: A controller's compiled twin (:mod:`robodyn.compiled.controllers`).
+
+    Returns:
+        ``torque(q, v)``, shape (nv,), for checked states of the plant.
+
+    Raises:
+        InputError: For a twin that does not fit the plant (as :func:`simulate_compiled`).
+    """
+    kind, params, model, frame = _law(compiled, twin)
+    nq, nv, simulate = compiled.nq, compiled.nv, compiled.module.simulate
+
+    def torque(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = [np.empty((2, nq)), np.empty((2, nv)), np.empty((2, nv)), np.empty((2, nv))]
+        q, v = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float)
+        simulate(q, v, 1e-6, 1, 0.0, 0, kind, 1, params, model, *out, frame, None)
+        return out[3][0].copy()
+
+    return torque
 
 
 def _law(compiled: CompiledRobot, twin: CompiledLaw | None) -> tuple[int, np.ndarray, object | None, object | None]:

@@ -12,8 +12,10 @@ prepared (:func:`prepare`).
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass
 from time import perf_counter
 from typing import TYPE_CHECKING
@@ -21,10 +23,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robodyn.common.text import quoted
-from robodyn.compiled.build import is_compiled
+from robodyn.compiled.build import is_compiled, loaded
 from robodyn.compiled.controllers import CompiledLaw, HasTwin
 from robodyn.compiled.loop_rules import damped
-from robodyn.compiled.simulation import SimulationArrays, simulate_compiled
+from robodyn.compiled.simulation import SimulationArrays, law_torque, simulate_checked
 from robodyn.dynamics.robot import Robot
 from robodyn.sim.plan import Outcome, RunPlan
 from robodyn.sim.python_loop import Forward, Stepper, integrate
@@ -82,7 +84,12 @@ def twin_runs(plan: RunPlan) -> bool:
     """Whether the plan's controller runs in C: it owns a twin and is evaluated at every
     stage or sampled once a step."""
     controller = plan.controller
-    return isinstance(controller, HasTwin) and plan.every in (None, 1) and controller.twin_refusal() is None
+    return (
+        controller is not None
+        and isinstance(controller, HasTwin)
+        and plan.every in (None, 1)
+        and controller.twin_refusal() is None
+    )
 
 
 def not_ready(plan: RunPlan) -> list[str]:
@@ -91,14 +98,21 @@ def not_ready(plan: RunPlan) -> list[str]:
     the robot not compiled before (a cache lookup: no code generator is loaded)."""
     if plan.controller is not None and not twin_runs(plan):
         return ["a Python controller (called from Python at every stage in either engine)"]
-    candidates = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
-    if not any(shutil.which(candidate) for candidate in candidates):
+    candidates = (os.environ["CC"],) if os.environ.get("CC") else ("cc", "gcc", "clang")
+    if not _compiler_on_path(candidates, os.environ.get("PATH")):
         return [f"no C compiler (none of {', '.join(candidates)} on the PATH)"]
     model = getattr(plan.controller, "model", None)
     models = [plan.robot] if not isinstance(model, Robot) else [plan.robot, model]
-    if not all(is_compiled(each) for each in models):
+    if not all(loaded(each) is not None or is_compiled(each) for each in models):
         return ["not compiled yet (engine='compiled' builds it once, in seconds to minutes; auto uses it from then on)"]
     return []
+
+
+@functools.lru_cache(maxsize=8)
+def _compiler_on_path(candidates: tuple[str, ...], path: str | None) -> bool:
+    """Whether one of the compilers is on the PATH (a search of the folders, remembered for
+    this PATH: every ``engine="auto"`` run asks)."""
+    return any(shutil.which(candidate, path=path) for candidate in candidates)
 
 
 def ready_reason(plan: RunPlan) -> str:
@@ -128,6 +142,16 @@ def prepare(plan: RunPlan) -> Prepared:
     return Prepared(plant, twin)
 
 
+def twin_torque(prepared: Prepared) -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
+    """The prepared controller's torque ``tau(0, q, v)`` by its twin in C (``None``: no twin
+    runs), for the step check's screen (:func:`robodyn.sim.stability.step_warning`).
+
+    Args:
+        prepared: The plant and the twin, from :func:`prepare`.
+    """
+    return None if prepared.twin is None else law_torque(prepared.plant, prepared.twin)
+
+
 def run(plan: RunPlan, prepared: Prepared) -> Outcome:
     """Integrate the plan on the compiled kernels (prepared by :func:`prepare`).
 
@@ -140,10 +164,11 @@ def run(plan: RunPlan, prepared: Prepared) -> Outcome:
     else:
         law = prepared.twin if prepared.twin is not None else plan.controller
         sampled = prepared.twin is None and plan.controller is not None
-        arrays = simulate_compiled(
-            prepared.plant, plan.q0, plan.v0, plan.steps * plan.dt, plan.dt, integrator=plan.integrator, controller=law,
+        damping = plan.damping  # Coulomb friction: unsupported, refused before
+        arrays = simulate_checked(
+            prepared.plant, plan.q0, plan.v0, plan.steps, plan.dt, integrator=plan.integrator, controller=law,
             control_period=plan.control_period if sampled else None, hold=plan.every is not None,
-            joint_friction=plan.friction,  # Coulomb friction: unsupported, refused before
+            damping=None if damping is None else np.ascontiguousarray(damping, dtype=float),
         )  # fmt: skip
     return Outcome(arrays, perf_counter() - began, prepared.twin is not None)
 

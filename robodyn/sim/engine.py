@@ -10,13 +10,16 @@ Choosing costs a cache lookup (:mod:`robodyn.compiled.lookup`), never the code g
 from __future__ import annotations
 
 import warnings
+import weakref
 from dataclasses import dataclass
 from time import perf_counter
 from typing import Any, Literal
 
+import numpy as np
+
 from robodyn.exceptions import CompileError, InputError, JointLimitWarning, RobodynWarning
 from robodyn.sim import compiled_backend, pinocchio_loop
-from robodyn.sim.limits import JointLimits, warning_text
+from robodyn.sim.limits import TOLERANCE, JointLimits, warning_text
 from robodyn.sim.plan import Outcome, RunPlan
 from robodyn.sim.stability import step_warning, task_warning
 from robodyn.trajectory import Trajectory
@@ -90,12 +93,9 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
             (:mod:`robodyn.sim.stability`).
         JointLimitWarning: With ``limits="warn"``, for the limits the run broke.
     """
-    for sentence in (step_warning(plan), task_warning(plan)):  # stack level 4: the caller of simulate
-        if sentence:
-            warnings.warn(RobodynWarning(sentence), stacklevel=4)
     began = perf_counter()
     engine, reason = choose(plan)
-    outcome: Outcome | None = None
+    prepared: compiled_backend.Prepared | None = None
     if engine == "compiled":
         try:
             prepared = compiled_backend.prepare(plan)
@@ -103,18 +103,50 @@ def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
             if plan.engine == "compiled":
                 raise
             engine, reason = "pinocchio", f"the compiled engine does not apply: {error}"
-        else:
-            compile_time = perf_counter() - began
-            outcome = compiled_backend.run(plan, prepared)
-    if outcome is None:
-        compile_time = 0.0 if plan.engine == "pinocchio" else perf_counter() - began
-        outcome = pinocchio_loop.run(plan)
+    compile_time = 0.0 if plan.engine == "pinocchio" else perf_counter() - began
+    law = None if prepared is None else compiled_backend.twin_torque(prepared)  # the screen's feedback in C
+    for sentence in (step_warning(plan, law), task_warning(plan)):  # stack level 4: the caller of simulate
+        if sentence:
+            warnings.warn(RobodynWarning(sentence), stacklevel=4)
+    outcome: Outcome = pinocchio_loop.run(plan) if prepared is None else compiled_backend.run(plan, prepared)
     robot = plan.robot
     trajectory = Trajectory(plan.times(), *outcome.arrays[1:], list(robot.joint_names), robot.name)
-    violations = [] if plan.limits == "ignore" else JointLimits(robot).violations(trajectory)
+    violations = [] if plan.limits == "ignore" else _violations(robot, trajectory)
     if violations:  # stack level 4: the caller of simulate / simulate_run
         warnings.warn(JointLimitWarning(warning_text(robot.name, violations), violations), stacklevel=4)
     return trajectory, EngineRun(
         engine, reason, outcome.loop_time, compile_time, plan.control_period, outcome.controller_in_c, outcome.contact,
         outcome.constrained,
     )  # fmt: skip
+
+
+#: Per robot: its ``dofs`` (the limits' source, a tuple of frozen values) and the screen's
+#: thresholds (:func:`_thresholds`), so a run reads them instead of rebuilding them.
+_THRESHOLDS: weakref.WeakKeyDictionary[Any, tuple[tuple, tuple[np.ndarray, ...]]] = weakref.WeakKeyDictionary()
+
+
+def _thresholds(robot: Any) -> tuple[np.ndarray, ...]:
+    """The screen's bounds of a robot: position lower and upper (the joints' coordinates),
+    speed and effort (per velocity coordinate), each moved outward by half the tolerance
+    :meth:`JointLimits.violations` allows (±inf where unlimited). Cached per robot while its
+    ``dofs`` are the same object."""
+    cached = _THRESHOLDS.get(robot)
+    if cached is not None and cached[0] is robot.dofs:
+        return cached[1]
+    limits = JointLimits(robot)
+    slack = [0.5 * TOLERANCE * (1.0 + np.abs(bound)) for bound in (limits.lower, limits.upper, limits.velocity, limits.effort)]
+    found = (limits.lower - slack[0], limits.upper + slack[1], limits.velocity + slack[2], limits.effort + slack[3])
+    _THRESHOLDS[robot] = (robot.dofs, found)
+    return found
+
+
+def _violations(robot: Any, trajectory: Trajectory) -> list:
+    """``JointLimits(robot).violations(trajectory)``, skipped (``[]``) when a whole-array
+    screen finds nothing beyond any threshold of :func:`_thresholds` (half the tolerance the
+    violations allow, so everything they would report passes the screen)."""
+    lower, upper, speed, effort = _thresholds(robot)
+    joints = trajectory.q[:, trajectory.q.shape[1] - lower.size :]
+    beyond = bool((joints < lower).any() or (joints > upper).any() or (np.abs(trajectory.v) > speed).any())
+    if not beyond and trajectory.tau is not None:
+        beyond = bool((np.abs(trajectory.tau) > effort).any())
+    return JointLimits(robot).violations(trajectory) if beyond else []

@@ -25,6 +25,7 @@ URDF's "unknown"). A floating base has no limits.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -133,34 +134,52 @@ class JointLimits:
         return q, v
 
     def violations(self, trajectory: Trajectory) -> list[LimitViolation]:
-        """Every limit the trajectory broke, by joint then quantity (units from ``robot.dofs``)."""
+        """Every limit the trajectory broke, by joint then quantity (units from ``robot.dofs``).
+
+        Each column's comparisons, first times and worst samples come from whole-array
+        operations (one per quantity, every joint at once); a violation is then read off its
+        column."""
+        if len(trajectory.t) == 0:
+            return []
+        # one row a joint (contiguous: the reductions run along rows)
+        positions = np.ascontiguousarray(trajectory.q[:, self._q_start :].T)
+        velocities = np.ascontiguousarray(trajectory.v[:, self._v_start :].T)
+        torques = (
+            np.zeros_like(velocities) if trajectory.tau is None else np.ascontiguousarray(trajectory.tau[:, self._v_start :].T)
+        )
+        speed, effort = self.velocity[self._v_start :], self.effort[self._v_start :]
+        lower, upper = self.lower[:, None], self.upper[:, None]
+        checks = [  # quantity, side, values compared, signed values, limits, beyond, worst sample
+            ("position", "lower", positions, None, self.lower, positions < lower - _slack(lower), positions.argmin(axis=1)),
+            ("position", "upper", positions, None, self.upper, positions > upper + _slack(upper), positions.argmax(axis=1)),
+            ("velocity", "magnitude", np.abs(velocities), velocities, speed, None, None),
+            ("effort", "magnitude", np.abs(torques), torques, effort, None, None),
+        ]
+        columns = []
+        for quantity, side, values, signed, limits, beyond, worst in checks:
+            if beyond is None:
+                beyond, worst = values > limits[:, None] + _slack(limits[:, None]), values.argmax(axis=1)
+            hit = beyond.any(axis=1) & np.isfinite(limits)
+            if hit.any():
+                rows = np.flatnonzero(hit)
+                times = trajectory.t[beyond[rows].argmax(axis=1)].tolist()
+                worsts = values[rows, worst[rows]] if signed is None else signed[rows, worst[rows]]
+                found_here = zip(times, worsts.tolist(), limits[rows].tolist(), strict=True)
+                columns.append((quantity, side, dict(zip(rows.tolist(), found_here, strict=True))))
         found = []
-        positions = trajectory.q[:, self._q_start :]
-        velocities = trajectory.v[:, self._v_start :]
-        torques = np.zeros_like(trajectory.v) if trajectory.tau is None else trajectory.tau[:, self._v_start :]
         for index, dof in enumerate(self.robot.dofs[self._v_start :]):
-            for side, limit in (("lower", self.lower[index]), ("upper", self.upper[index])):
-                found += _beyond(trajectory.t, positions[:, index], limit, side, dof.joint, "position", dof.position_unit)
-            for quantity, values, limit, unit in (
-                ("velocity", velocities[:, index], self.velocity[self._v_start + index], dof.velocity_unit),
-                ("effort", torques[:, index], self.effort[self._v_start + index], dof.effort_unit),
-            ):
-                found += _beyond(trajectory.t, np.abs(values), limit, "magnitude", dof.joint, quantity, unit, values)
+            units = {"position": dof.position_unit, "velocity": dof.velocity_unit, "effort": dof.effort_unit}
+            for quantity, side, broken in columns:
+                if index in broken:
+                    time, worst, limit = broken[index]
+                    bound = limit if side != "magnitude" else math.copysign(limit, worst)
+                    found.append(LimitViolation(dof.joint, quantity, side, time, worst, bound, units[quantity]))
         return found
 
 
-def _beyond(times, values, limit, side, joint, quantity, unit, signed=None) -> list[LimitViolation]:
-    if not np.isfinite(limit):
-        return []
-    slack = TOLERANCE * (1.0 + abs(limit))
-    outside = values < limit - slack if side == "lower" else values > limit + slack
-    if not outside.any():
-        return []
-    first = int(np.argmax(outside))
-    worst_index = int(np.argmin(values) if side == "lower" else np.argmax(values))
-    worst = float(values[worst_index] if signed is None else signed[worst_index])
-    bound = float(limit if signed is None else np.copysign(limit, worst))
-    return [LimitViolation(joint, quantity, side, float(times[first]), worst, bound, unit)]
+def _slack(limits: np.ndarray) -> np.ndarray:
+    """The tolerance a value may pass each limit by before it counts (relative and absolute)."""
+    return TOLERANCE * (1.0 + np.abs(limits))
 
 
 def limit_violations(robot: Robot, trajectory: Trajectory) -> list[LimitViolation]:

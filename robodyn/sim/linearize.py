@@ -15,6 +15,11 @@ of the actuated joints, :func:`actuation_matrix`).
   (:meth:`robodyn.Robot.forward_dynamics_derivatives`), not finite differences. A
   controller designed on them is designed on the simulator that runs it.
 
+A batch (2-D ``q``, ``v``, ``tau``: one state a row, N rows) gives stacks ``A`` (N, 2 nv,
+2 nv) and ``B`` (N, 2 nv, nu), each row what its single call gives: the derivatives of the
+whole batch in one call of :meth:`robodyn.Robot.forward_dynamics_derivatives` per stage (one
+in continuous time, four for an RK4 step), the chain rule on stacks.
+
 Floating base: ``q`` perturbations are in the tangent space (Pinocchio's convention,
 ``q ⊕ δq = robot.integrate(q, δq)``: the base's six entries are its displacement in the
 base frame, linear then angular), so ``A`` is (2 nv, 2 nv), not (nq + nv)². In continuous
@@ -188,10 +193,10 @@ def linearize(
 
     Args:
         robot: The robot.
-        q: Configuration, shape (nq,).
-        v: Velocity, shape (nv,).
-        tau: Torques in [N m] / [N], shape (nv,); ``None``: the torque that holds
-            ``(q, v)`` at zero acceleration, ``C(q, v) v + G(q)``.
+        q: Configuration, shape (nq,), or (N, nq): a batch, one state a row.
+        v: Velocity, shape (nv,) or (N, nv).
+        tau: Torques in [N m] / [N], shape (nv,) or (N, nv); ``None``: the torque that
+            holds ``(q, v)`` at zero acceleration, ``C(q, v) v + G(q)``.
         dt: Step in [s] for the Jacobians of one integrator step; ``None``: continuous time.
         integrator: With ``dt``: ``"rk4"`` or ``"semi-implicit-euler"`` (as :func:`robodyn.simulate`).
         actuation: ``S_act`` of shape (nv, nu), torques ``τ = S_act u``; default the identity.
@@ -202,16 +207,17 @@ def linearize(
             differentiable there); ``False`` linearizes the rigid-body dynamics.
 
     Returns:
-        ``A`` of shape (2 nv, 2 nv) and ``B`` of shape (2 nv, nu) (module docstring:
-        conventions, the floating base's tangent space).
+        ``A`` of shape (2 nv, 2 nv) and ``B`` of shape (2 nv, nu), or stacks (N, 2 nv, 2 nv)
+        and (N, 2 nv, nu) for a batch (module docstring: conventions, the floating base's
+        tangent space).
 
     Raises:
-        InputError: For a state that is not one valid state, a bad step, integrator or
-            actuation matrix.
-        SingularMassMatrixError: If ``M(q)`` is singular.
+        InputError: For states that are not valid (or mix 1-D and 2-D), a bad step,
+            integrator or actuation matrix.
+        SingularMassMatrixError: If ``M(q)`` is singular (at any row of a batch).
     """
-    result = linearization(robot, q, v, tau, dt=dt, integrator=integrator, actuation=actuation, joint_friction=joint_friction)
-    return result.A, result.B
+    _, _, A, B = _matrices(robot, q, v, tau, dt, integrator, actuation, joint_friction, batch_ok=True)
+    return A, B
 
 
 def linearization(
@@ -225,8 +231,29 @@ def linearization(
     actuation: np.ndarray | None = None,
     joint_friction: bool = True,
 ) -> Linearization:
-    """:func:`linearize` with the state, names and units (a :class:`Linearization`)."""
-    q, v, tau = _state(robot, q, v, tau)
+    """:func:`linearize` of one state with the state, names and units (a :class:`Linearization`)."""
+    (q, v, tau), selection, A, B = _matrices(robot, q, v, tau, dt, integrator, actuation, joint_friction, batch_ok=False)
+    return Linearization(
+        robot.name, robot.dofs, q, v, tau, None if dt is None else float(dt),
+        None if dt is None else integrator, A, B, selection,
+    )  # fmt: skip
+
+
+def _matrices(
+    robot: Robot,
+    q: Any,
+    v: Any,
+    tau: Any,
+    dt: float | None,
+    integrator: str,
+    actuation: Any,
+    joint_friction: bool,
+    *,
+    batch_ok: bool,
+) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """The checked state ``(q, v, tau)``, the actuation matrix and ``(A, B)`` (stacks for a
+    batch, when ``batch_ok``)."""
+    q, v, tau = _state(robot, q, v, tau, batch_ok)
     friction = _joint_friction(robot, v, bool(joint_friction))
     selection = _actuation(robot, actuation)
     if dt is not None and not (isinstance(dt, numbers.Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0):
@@ -236,20 +263,17 @@ def linearization(
         A, B = _continuous(robot, q, v, tau, selection, friction)
     else:
         A, B = _Step(robot, tau, selection, friction).jacobians(q, v, float(dt), integrator)
-    return Linearization(
-        robot.name, robot.dofs, q, v, tau, None if dt is None else float(dt),
-        None if dt is None else integrator, A, B, selection,
-    )  # fmt: skip
+    return (q, v, tau), selection, A, B
 
 
-def _state(robot: Robot, q: Any, v: Any, tau: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One checked state; the holding torque ``C v + G`` for ``tau=None``."""
+def _state(robot: Robot, q: Any, v: Any, tau: Any, batch_ok: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One checked state (or, ``batch_ok``, a batch); the holding torque ``C v + G`` for ``tau=None``."""
     named = {"q": q, "v": v} if tau is None else {"q": q, "v": v, "tau": tau}
     arrays, batch = robot.validate(**named)
-    if batch:
+    if batch and not batch_ok:
         raise InputError("q", "one state (1-D arrays): a linearisation is about one state", f"shape {arrays[0].shape}")
     if tau is None:
-        arrays.append(robot.nonlinear_effects(arrays[0], arrays[1]))
+        arrays.append(_by_row(robot.nonlinear_effects, arrays[1].shape, arrays[0], arrays[1]))
     return arrays[0], arrays[1], arrays[2]
 
 
@@ -262,7 +286,7 @@ def _joint_friction(robot: Robot, v: np.ndarray, on: bool) -> tuple[np.ndarray, 
     """
     if not on:
         return np.zeros(robot.nv), np.zeros(robot.nv)
-    stuck = [dof.name for dof in robot.dofs if dof.friction > 0 and v[dof.index] == 0]
+    stuck = [dof.name for dof in robot.dofs if dof.friction > 0 and (v[..., dof.index] == 0).any()]
     if stuck:
         listed = ", ".join(quoted(name) for name in stuck[:8]) + (", …" if len(stuck) > 8 else "")
         raise InputError(
@@ -286,15 +310,18 @@ def _actuation(robot: Robot, actuation: Any) -> np.ndarray:
 def _continuous(
     robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, selection: np.ndarray, friction: tuple[np.ndarray, np.ndarray]
 ):
-    """Continuous-time ``(A, B)`` (``friction``: the joints' ``(b, f)`` included)."""
+    """Continuous-time ``(A, B)`` (``friction``: the joints' ``(b, f)`` included); stacks
+    for a batch (one derivative call for all of it)."""
     nv = robot.nv
     dq, dv, inverse = robot.forward_dynamics_derivatives(q, v, tau + friction_torque(*friction, v))
     dv = dv - inverse * friction[0]
-    velocity_block = np.zeros((nv, nv))
+    velocity_block = np.zeros(dq.shape)
     if robot.floating_base:  # the tangent space moves with the base: −ad(v_base)
-        velocity_block[:6, :6] = -pin.Motion(v[:6]).action
-    A = np.block([[velocity_block, np.eye(nv)], [dq, dv]])
-    B = np.vstack([np.zeros((nv, selection.shape[1])), inverse @ selection])
+        actions = [-pin.Motion(row[:6]).action for row in v.reshape(-1, nv)]
+        velocity_block[..., :6, :6] = np.reshape(actions, (*v.shape[:-1], 6, 6))
+    top = np.concatenate([velocity_block, np.broadcast_to(np.eye(nv), dq.shape)], axis=-1)
+    A = np.concatenate([top, np.concatenate([dq, dv], axis=-1)], axis=-2)
+    B = np.concatenate([np.zeros((*dq.shape[:-1], selection.shape[1])), inverse @ selection], axis=-2)
     return A, B
 
 
@@ -316,9 +343,11 @@ class _Step:
         if not robot.floating_base:
             return q + h * w, self.dq0 + h * dw
         step = h * w
-        by_q = pin.dIntegrate(robot.model, q, step, pin.ArgumentPosition.ARG0)
-        by_step = pin.dIntegrate(robot.model, q, step, pin.ArgumentPosition.ARG1)
-        return robot.integrate(q, step), by_q @ self.dq0 + h * by_step @ dw
+        by_q, by_step = (
+            _by_row(lambda x, y, a=argument: pin.dIntegrate(robot.model, x, y, a), (*q.shape[:-1], robot.nv, robot.nv), q, step)
+            for argument in (pin.ArgumentPosition.ARG0, pin.ArgumentPosition.ARG1)
+        )
+        return _by_row(robot.integrate, q.shape, q, step), by_q @ self.dq0 + h * by_step @ dw
 
     def acceleration(self, q: np.ndarray, dq: np.ndarray, v: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Forward dynamics at a stage and its Jacobian by the chain rule."""
@@ -326,7 +355,7 @@ class _Step:
         tau = self.tau + friction_torque(*friction, v)
         by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, tau)
         by_v = by_v - inverse * friction[0]
-        return robot.forward_dynamics(q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
+        return _by_row(robot.forward_dynamics, v.shape, q, v, tau), by_q @ dq + by_v @ dv + inverse @ self.dtau
 
     def jacobians(self, q: np.ndarray, v: np.ndarray, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
         """``(A, B)`` of one step of ``dt`` from ``(q, v)``."""
@@ -346,8 +375,16 @@ class _Step:
             mean, dmean = v + v4 + 2.0 * (v2 + v3), dv0 + dv4 + 2.0 * (dv2 + dv3)
             _, dq_next = self.configuration(q, mean, dmean, sixth)
             dv_next = dv0 + sixth * (da1 + da4 + 2.0 * (da2 + da3))
-        jacobian = np.vstack([dq_next, dv_next])
-        return jacobian[:, : 2 * nv], jacobian[:, 2 * nv :]
+        jacobian = np.concatenate([dq_next, dv_next], axis=-2)
+        return jacobian[..., : 2 * nv], jacobian[..., 2 * nv :]
+
+
+def _by_row(function: Any, shape: tuple[int, ...], *states: np.ndarray) -> np.ndarray:
+    """``function`` of one state, or of each row of a batch stacked to ``shape`` (N may be 0):
+    every row its single call's (a batch call may differ from it in the last bits)."""
+    if states[0].ndim == 1:
+        return function(*states)
+    return np.array([function(*row) for row in zip(*states, strict=True)]).reshape(shape)
 
 
 __all__ = ["STEP_INTEGRATORS", "Linearization", "StepIntegrator", "actuation_matrix", "linearization", "linearize"]

@@ -102,3 +102,58 @@ def test_an_unknown_limits_mode_is_refused_naming_the_parameter_and_the_value():
         check_mode("clamp")
     assert error.value.argument == "limits"
     assert "one of warn, enforce, ignore" in str(error.value) and "'clamp'" in str(error.value)
+
+
+def _column_by_column(robot, trajectory):
+    """The report column by column (the algorithm before the whole-array one): an independent
+    reading of the same rules (tolerance TOLERANCE * (1 + |limit|), first time, worst sample)."""
+    from robodyn.sim.limits import JointLimits
+
+    limits, found = JointLimits(robot), []
+    joints = robot.joints[1:] if robot.floating_base else robot.joints
+    q_start, v_start = robot.nq - len(joints), robot.nv - len(joints)
+    tau = np.zeros_like(trajectory.v) if trajectory.tau is None else trajectory.tau
+    for index, dof in enumerate(robot.dofs[v_start:]):
+        column = trajectory.q[:, q_start + index]
+        for side, limit in (("lower", limits.lower[index]), ("upper", limits.upper[index])):
+            outside = (
+                column < limit - TOLERANCE * (1 + abs(limit))
+                if side == "lower"
+                else column > limit + TOLERANCE * (1 + abs(limit))
+            )
+            if np.isfinite(limit) and outside.any():
+                worst = column[np.argmin(column) if side == "lower" else np.argmax(column)]
+                found.append((dof.joint, "position", side, trajectory.t[np.argmax(outside)], worst, limit))
+        for quantity, signed, limit in (
+            ("velocity", trajectory.v[:, v_start + index], limits.velocity[v_start + index]),
+            ("effort", tau[:, v_start + index], limits.effort[v_start + index]),
+        ):
+            outside = np.abs(signed) > limit + TOLERANCE * (1 + limit)
+            if np.isfinite(limit) and outside.any():
+                worst = signed[np.argmax(np.abs(signed))]
+                found.append(
+                    (dof.joint, quantity, "magnitude", trajectory.t[np.argmax(outside)], worst, np.copysign(limit, worst))
+                )
+    return found
+
+
+@pytest.mark.parametrize("floating", [False, True])
+def test_the_whole_array_report_is_the_column_by_column_one(floating):
+    """Random motions around every limit (a NaN sample included): the same violations, in
+    the same order, as a column-by-column reading; a calm motion reports none (negative control)."""
+    robot = arm(floating=floating)
+    rng = np.random.default_rng(7)
+    for trial in range(6):
+        slide = rng.uniform(-1.2, 0.7, size=40)
+        speed = rng.uniform(-3.5, 3.5, size=40)
+        tau = rng.uniform(-35.0, 35.0, size=(40, 2))
+        if trial == 3:
+            speed[5] = np.nan
+        trajectory = motion(robot, slide, speed, tau)
+        ours = [(v.joint, v.quantity, v.side, v.first_time, v.worst, v.limit) for v in limit_violations(robot, trajectory)]
+        assert ours
+        np.testing.assert_equal(
+            ours, [tuple(x.item() if hasattr(x, "item") else x for x in row) for row in _column_by_column(robot, trajectory)]
+        )  # NaN == NaN here
+    calm = motion(robot, np.full(5, 0.1), np.full(5, 1.0), np.ones((5, 2)))
+    assert limit_violations(robot, calm) == [] == _column_by_column(robot, calm)

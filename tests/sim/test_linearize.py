@@ -128,11 +128,12 @@ def test_bad_options_are_refused_naming_them(options, argument, rng):
     assert error.value.argument == argument
 
 
-def test_a_batch_and_unknown_joints_are_refused(rng):
+def test_a_linearization_of_a_batch_and_unknown_joints_are_refused(rng):
+    """A Linearization is one state's (a batch goes to linearize, which stacks)."""
     robot = load_case("double_pendulum_continuous")
     q, v, _ = random_states(robot, rng, 2)
     with pytest.raises(robodyn.InputError, match="one state"):
-        linearize(robot, q, v)
+        linearization(robot, q, v)
     with pytest.raises(robodyn.InputError) as error:
         actuation_matrix(robot, ["no_such_joint"])
     assert error.value.argument == "actuated"
@@ -220,3 +221,97 @@ def test_coulomb_friction_at_rest_is_refused_naming_the_way_out():
         linearize(robot, q, np.zeros(robot.nv))
     A, _ = linearize(robot, q, np.zeros(robot.nv), joint_friction=False)
     assert np.isfinite(A).all()
+
+
+def _count_derivative_calls(robot, monkeypatch) -> list[int]:
+    """Rows of each call of the robot's forward-dynamics derivatives, recorded."""
+    calls: list[int] = []
+    original = robot.forward_dynamics_derivatives
+
+    def counted(q, v, tau):
+        calls.append(1 if np.ndim(q) == 1 else len(q))
+        return original(q, v, tau)
+
+    monkeypatch.setattr(robot, "forward_dynamics_derivatives", counted)
+    return calls
+
+
+@pytest.mark.parametrize("name", ["gripper", "oblique_floating", "z1"])
+@pytest.mark.parametrize("count", [1, 7, 13])
+def test_a_trajectory_linearizes_as_one_batch_each_row_its_single_call(name, count, rng, monkeypatch):
+    """N states a row (N = 1, 7, 13: not multiples of the thread count) give stacks whose rows
+    are their single calls bit for bit, continuous (one derivative call for the batch) and one
+    RK4 / Euler step (one call a stage); a mimic gripper, a moving floating base, z1's Coulomb
+    friction on moving joints, the holding torque of tau=None."""
+    robot = load_case(name)
+    q, v, tau = random_states(robot, rng, count)
+    v = np.where(np.abs(v) < 0.05, 0.3, v)  # z1's joints slide (stiction is refused at rest)
+    cases = [({}, 1), ({"dt": 2e-3, "integrator": "rk4"}, 4), ({"dt": 2e-3, "integrator": "semi-implicit-euler"}, 1)]
+    for options, stages in cases:
+        for torques in (tau, None) if not options else (tau,):
+            calls = _count_derivative_calls(robot, monkeypatch)
+            A, B = linearize(robot, q, v, torques, **options)
+            assert calls == [count] * stages
+            monkeypatch.undo()
+            assert A.shape == (count, 2 * robot.nv, 2 * robot.nv) and B.shape == (count, 2 * robot.nv, robot.nv)
+            for i in range(count):
+                single = linearize(robot, q[i], v[i], None if torques is None else torques[i], **options)
+                np.testing.assert_array_equal(A[i], single[0])
+                np.testing.assert_array_equal(B[i], single[1])
+
+
+def _continuous_differences(robot, q, v, tau, eps=1e-6):
+    """Central differences of ``ẋ = (v, q̈(q, v, τ + friction))``, q along ``integrate``."""
+    nv = robot.nv
+
+    def rate(qi, vi, taui):
+        from robodyn.dynamics.joint_dynamics import friction_torque
+
+        return robot.forward_dynamics(qi, vi, taui + friction_torque(robot.joint_damping, robot.joint_friction, vi))
+
+    A, B = np.zeros((2 * nv, 2 * nv)), np.zeros((2 * nv, nv))
+    A[:nv, nv:] = np.eye(nv)
+    for j in range(nv):
+        unit = np.eye(nv)[j] * eps
+        A[nv:, j] = (rate(robot.integrate(q, unit), v, tau) - rate(robot.integrate(q, -unit), v, tau)) / (2 * eps)
+        A[nv:, nv + j] = (rate(q, v + unit, tau) - rate(q, v - unit, tau)) / (2 * eps)
+        B[nv:, j] = (rate(q, v, tau + unit) - rate(q, v, tau - unit)) / (2 * eps)
+    return A, B
+
+
+def test_a_batchs_rows_match_central_differences_and_not_their_neighbours(rng):
+    """The double pendulum with damping (the −M⁻¹ diag(b) term), 7 states: each row of the
+    batch against central differences of forward dynamics at its own state; the rows shifted
+    by one (negative control) do not match."""
+    robot = load_case("double_pendulum_continuous")
+    q, v, tau = random_states(robot, rng, 7)
+    A, B = linearize(robot, q, v, tau)
+    numeric = [_continuous_differences(robot, q[i], v[i], tau[i]) for i in range(7)]
+    for i in range(7):
+        assert relative(A[i, robot.nv :], numeric[i][0][robot.nv :]) < 1e-6
+        assert relative(B[i], numeric[i][1]) < 1e-6
+        assert relative(A[i, robot.nv :], numeric[(i + 1) % 7][0][robot.nv :]) > 1e-3
+
+
+def test_a_bad_batch_is_refused_naming_the_argument(rng):
+    """Rows that do not match, a 1-D v with a 2-D q, a NaN in one row; a Linearization (one
+    state's names and units) refuses a batch."""
+    robot = load_case("double_pendulum_continuous")
+    q, v, tau = random_states(robot, rng, 5)
+    bad_row = v.copy()
+    bad_row[3, 1] = np.nan
+    for arguments, name in [((q, v[:4], tau), "v"), ((q, v[0], tau), "v"), ((q, bad_row, tau), "v"), ((q, v, tau[:, :1]), "tau")]:
+        with pytest.raises(robodyn.InputError) as error:
+            linearize(robot, *arguments)
+        assert error.value.argument == name
+    with pytest.raises(robodyn.InputError, match="one state"):
+        linearization(robot, q, v, tau)
+
+
+@pytest.mark.parametrize("name", ["double_pendulum_continuous", "oblique_floating"])
+def test_an_empty_batch_gives_empty_stacks(name):
+    robot = load_case(name)
+    q, v = np.zeros((0, robot.nq)), np.zeros((0, robot.nv))
+    for options in ({}, {"dt": 1e-3}, {"dt": 1e-3, "integrator": "semi-implicit-euler"}):
+        A, B = linearize(robot, q, v, **options)
+        assert A.shape == (0, 2 * robot.nv, 2 * robot.nv) and B.shape == (0, 2 * robot.nv, robot.nv)

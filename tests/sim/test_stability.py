@@ -3,16 +3,19 @@ with the step that would not; a divergence inside a step is reported as a diverg
 
 from __future__ import annotations
 
+import contextlib
+import shutil
 import warnings
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import robodyn
 from robodyn.exceptions import RobodynWarning, SimulationError
 from robodyn.sim.control import PDGravity
 from robodyn.sim.plan import plan
-from robodyn.sim.stability import largest_stable_step, step_warning
+from robodyn.sim.stability import clearly_stable, largest_stable_step, step_warning
 
 LIGHT_DAMPED = """<robot name="light_damped">
   <link name="base"/>
@@ -139,3 +142,109 @@ def test_a_checked_call_failing_on_a_blown_up_state_is_a_divergence_not_a_singul
         robodyn.simulate(robot, q0, np.zeros(2), 0.1, 1e-3, controller=law, limits="ignore", engine="pinocchio")
     assert type(raised.value) is SimulationError and "diverged" in str(raised.value)
     assert not isinstance(raised.value, SingularMassMatrixError)
+
+
+def _fastest(plan_):
+    """The fastest rate of the plant at the plan's start by the eigenvalues of ``linearize``'s A
+    (the independent side of the screen's bound)."""
+    from robodyn.sim.linearize import linearize
+
+    damped = plan_.friction and not plan_.coulomb
+    A, _ = linearize(plan_.robot, plan_.q0, plan_.v0, np.zeros(plan_.robot.nv), joint_friction=damped)
+    return float(np.abs(np.linalg.eigvals(A)).max())
+
+
+@pytest.mark.parametrize("name", ["light_damped", "panda", "oblique_floating", "gripper"])
+def test_the_screens_bound_is_never_below_the_fastest_rate(name, rng):
+    """The screen's bound (no eigenvalues) against the eigenvalues of the linearisation, at
+    random states of a damped light finger, the panda (damped, mimic finger), a floating base
+    moving (its −ad(v) block) and a mimic gripper; the bound without its velocity rows
+    (negative control) falls below the damped finger's rate."""
+    from robodyn.sim.stability import spectral_bound
+    from tests.conftest import NONDEGENERATE_CASES
+
+    if name == "light_damped":
+        robot = robodyn.load(LIGHT_DAMPED)
+    elif name in NONDEGENERATE_CASES:
+        path, options = NONDEGENERATE_CASES[name]
+        robot = robodyn.load(path, gravity=[0.8, 1.1, -9.3], **options)
+    else:
+        robot = robodyn.load(name)
+    for q, v in zip(robot.random_configuration(rng, 3), 2.0 * rng.normal(size=(3, robot.nv)), strict=True):
+        run = plan(robot, q, v, 0.01, 1e-3, limits="ignore")
+        fastest = _fastest(run)
+        damping = robot.joint_damping if run.friction else np.zeros(robot.nv)
+        by_q, by_v, inverse = robot.forward_dynamics_derivatives(q, v, -damping * v)
+        by_v = by_v - inverse * damping
+        top = float(np.abs(pin.Motion(v[:6]).action).sum(axis=1).max()) if robot.floating_base else 0.0
+        rows_q, rows_v = np.abs(by_q).sum(axis=1), np.abs(by_v).sum(axis=1)
+        assert spectral_bound(top, rows_q, rows_v) >= fastest * (1 - 1e-12)
+        if name == "light_damped":
+            assert spectral_bound(top, rows_q, np.zeros(robot.nv)) < 0.5 * fastest
+
+
+def test_a_passive_run_that_fits_its_step_is_cleared_without_a_linearisation(monkeypatch):
+    """The screen clears the panda arm at 1 ms with one derivative call (the eigenvalues and
+    linearize are not reached: simulate's fixed cost); at a step that does not fit, the full
+    check runs and warns as before, with the same sentence."""
+    from robodyn.sim import stability
+
+    robot = robodyn.load("panda", lock={"panda_finger_joint1": 0.0})
+    q0 = 0.5 * np.add(*robot.physical_limits())
+    calls = []
+    original = stability.linearize
+    monkeypatch.setattr(stability, "linearize", lambda *a, **k: calls.append(1) or original(*a, **k))
+    fits = plan(robot, q0, np.full(7, 0.1), 0.01, 1e-3, limits="ignore")
+    assert stability.clearly_stable(fits) and step_warning(fits) is None and calls == []
+    limit, _, _ = largest_stable_step(fits)
+    assert calls and limit > 1e-3  # the full check agrees (negative control: it linearizes)
+    calls.clear()
+    too_long = plan(robot, q0, np.full(7, 0.1), 2 * limit, 2 * limit, limits="ignore")
+    assert not stability.clearly_stable(too_long)
+    said = step_warning(too_long)
+    assert calls and said is not None and f"use dt <= {limit:.2g} s" in said
+
+
+def test_the_screen_never_clears_a_step_the_eigenvalues_refuse():
+    """PD + gravity on the panda arm from soft to stiff gains, steps from 10 µs to 10 ms, both
+    integrators: whenever the screen clears a step, the eigenvalues' largest stable step holds
+    it; the screen clears some steps and not others (it decides something)."""
+    robot = robodyn.load("panda", lock={"panda_finger_joint1": 0.0})
+    q0 = 0.5 * np.add(*robot.physical_limits())
+    cleared = []
+    for kp, kd in ((50.0, 2.0), (1e4, 50.0), (1e6, 500.0)):
+        law = PDGravity(robot, q0 + 0.1, kp=kp, kd=kd)
+        for integrator in ("rk4", "semi-implicit-euler"):
+            limit, _, _ = largest_stable_step(plan(robot, q0, np.full(7, 0.2), 0.0, 1e-3, controller=law, integrator=integrator))
+            for dt in np.geomspace(1e-5, 1e-2, 7):
+                start = plan(robot, q0, np.full(7, 0.2), 0.0, dt, controller=law, integrator=integrator)
+                if clearly_stable(start):
+                    assert dt <= limit, (kp, integrator, dt, limit)
+                cleared.append(clearly_stable(start))
+    assert any(cleared) and not all(cleared)
+
+
+@pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
+def test_a_controller_in_c_is_screened_by_its_twin_and_warned_about_by_itself(monkeypatch):
+    """rp_arm under PD in C: a soft law is cleared with the twin's feedback (the Python law is
+    not called by the check); a stiff one is warned about with the very sentence the
+    Pinocchio engine gives (the check then runs on the law itself)."""
+    robot = robodyn.load("rp_arm")
+    q0 = robot.default_configuration()
+    calls = []
+    original = PDGravity.__call__
+    monkeypatch.setattr(PDGravity, "__call__", lambda self, t, q, v: calls.append(t) or original(self, t, q, v))
+    soft = PDGravity(robot, q0 + 0.1, kp=100.0, kd=5.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robodyn.simulate(robot, q0, np.zeros(2), 0.01, 1e-3, controller=soft, engine="compiled", limits="ignore")
+    assert calls == [] and not [w for w in caught if issubclass(w.category, RobodynWarning)]
+    stiff = PDGravity(robot, q0 + 0.1, kp=1e7, kd=20.0)
+    said = {}
+    for engine in ("compiled", "pinocchio"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with contextlib.suppress(SimulationError):  # it diverges, as warned
+                robodyn.simulate(robot, q0, np.zeros(2), 0.01, 1e-3, controller=stiff, engine=engine, limits="ignore")
+        said[engine] = [str(w.message) for w in caught if issubclass(w.category, RobodynWarning)]
+    assert len(said["compiled"]) == 1 and said["compiled"] == said["pinocchio"] and "PDGravity gains" in said["compiled"][0]
