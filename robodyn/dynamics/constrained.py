@@ -1,20 +1,29 @@
 """Constrained dynamics on Pinocchio: ``Φ``, ``J``, ``J̇ v`` of a robot's constraints, and the KKT solves.
 
 The rows of each constraint are :mod:`robodyn.constraints.algebra`'s; Pinocchio supplies
-the kinematics of their ends (frame placements, ``LOCAL_WORLD_ALIGNED`` frame Jacobians,
-classical accelerations at ``v̇ = 0``), shifted from the link's origin to the end's point.
+the kinematics of their ends from one pass a state (:mod:`robodyn.dynamics.constraint_rows`:
+each end a frame of a copy of the model, so its placement, ``LOCAL_WORLD_ALIGNED`` Jacobian
+and classical acceleration at ``v̇ = 0`` are taken at its own point).
 
 **Forward dynamics** solves the KKT system of ``M v̇ + C v + G = τ + Jᵀ λ`` with
 ``J v̇ + J̇ v = 0`` by its own factorisation, not Pinocchio's ``constraintDynamics``:
-``M⁻¹ [τ − C v − G, Jᵀ]`` by one LU solve (robodyn's ``M``, so mimic joints and armature are included,
-which Pinocchio's constraint algorithms do not take), the Delassus matrix
-``A = J M⁻¹ Jᵀ`` and ``λ = A⁺ b`` by its eigendecomposition, eigenvalues below
-:data:`RANK_TOLERANCE` times the largest dropped. For a redundant set (a planar four-bar
-closed by a 3-row point anchor, where one row repeats the others) that is the
-least-norm ``λ``: the limit of the proximal iteration ``(A + ρ I) λₖ₊₁ = b + ρ λₖ`` from
-``λ₀ = 0`` (what Pinocchio's ``ProximalSettings`` runs), computed in one step. ``v̇`` is
-unique either way; :func:`constraint_rank` reports how many rows are independent. Pinocchio's
+``M⁻¹ (τ − C v − G)`` and ``M⁻¹ Jᵀ`` from one Cholesky factorisation of robodyn's ``M`` (so
+mimic joints and armature are included, which Pinocchio's constraint algorithms do not
+take), the Delassus matrix ``A = J M⁻¹ Jᵀ`` and ``λ = A⁺ b`` by its eigendecomposition,
+eigenvalues below :data:`RANK_TOLERANCE` times the largest dropped (above
+:data:`EIGEN_ROWS` rows a Cholesky factorisation of ``A`` answers first when a bound on its
+condition proves nothing would be dropped). The factorisations are Eigen's, through
+eigenpy (Pinocchio's own bindings): for matrices this small, numpy's wrappers cost more
+than the work. For a redundant set (a planar four-bar closed by a 3-row point anchor, where
+one row repeats the others) that is the least-norm ``λ``: the limit of the proximal
+iteration ``(A + ρ I) λₖ₊₁ = b + ρ λₖ`` from ``λ₀ = 0`` (what Pinocchio's
+``ProximalSettings`` runs), computed in one step. ``v̇`` is unique either way;
+:func:`constraint_rank` reports how many rows are independent. Pinocchio's
 ``constraintDynamics`` is the outside check (tests/dynamics/test_constrained.py).
+
+Inner loops (:func:`state_rows`, :func:`forward_dynamics_unchecked`) get the last state's
+results again, read-only, when asked for the same state (a simulation's projection and its
+next step's first stage); the public functions return arrays of their own.
 """
 
 from __future__ import annotations

@@ -55,26 +55,31 @@ class EndFrames:
         self._local = threading.local()
 
     def _thread(self) -> Any:
-        """This thread's data of :attr:`model` and its last results."""
+        """This thread's data of :attr:`model`, its buffers of the ends' kinematics and its last results."""
         local = self._local
         if not hasattr(local, "data"):
+            count, nv = len(self.frames), len(self.zeros)
             local.data, local.memo = self.model.createData(), {}
+            local.ends = np.empty((count, 3)), np.empty((count, 6, nv)), np.empty((count, 6))
         return local
 
     def compute(self, q: np.ndarray, v: np.ndarray) -> Rows:
         """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state (float64 1-D ``q``, ``v``)."""
         if not self.frames:
             return np.zeros(0), np.zeros((0, len(self.zeros))), np.zeros(0)
-        model, data, world = self.model, self._thread().data, pin.LOCAL_WORLD_ALIGNED
+        local, world = self._thread(), pin.LOCAL_WORLD_ALIGNED
+        model, data, (positions, jacobians, drifts) = self.model, local.data, local.ends
         pin.forwardKinematics(model, data, q, v, self.zeros)
         pin.computeJointJacobians(model, data)  # from the placements just computed
-        placements = [pin.updateFramePlacement(model, data, frame) for frame in self.frames]
-        return self.layout.assemble(
-            np.array([placement.translation for placement in placements]),
-            [placement.rotation for placement in placements],
-            np.array([pin.getFrameJacobian(model, data, frame, world) for frame in self.frames]),
-            np.array([pin.getFrameClassicalAcceleration(model, data, frame, world).vector for frame in self.frames]),
-        )
+        rotations = []
+        for index, frame in enumerate(self.frames):
+            placement = pin.updateFramePlacement(model, data, frame)
+            positions[index] = placement.translation
+            if self.layout.welds:
+                rotations.append(placement.rotation)
+            jacobians[index] = pin.getFrameJacobian(model, data, frame, world)
+            drifts[index] = pin.getFrameClassicalAcceleration(model, data, frame, world).vector
+        return self.layout.assemble(positions, rotations, jacobians, drifts)  # new arrays: the buffers stay here
 
     def rows(self, q: np.ndarray, v: np.ndarray) -> Rows:
         """:meth:`compute`, or the same state's rows again (read-only, shared): see the module docstring."""
