@@ -33,6 +33,8 @@ Sections:
     single-thin          Robot single calls vs raw Pinocchio on a preallocated Data (CPU time; target 1.3)
     compile-scaling      cold compile time against DoF, chains and trees: sympy derivation vs cc
     engines              loop-only real-time factor per engine (demo, ur5 PD) and their agreement
+    constrained-step     the four-bar's constrained simulation per step, before vs after issue 40's
+                         follow-up, same run (scripts/bench_constrained.py)
 """
 
 from __future__ import annotations
@@ -1477,6 +1479,13 @@ def bench_robot_engine(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_constrained(quick: bool) -> list[dict]:
+    """The four-bar's constrained step, before vs after (scripts/bench_constrained.py)."""
+    from bench_constrained import bench_constrained_step  # scripts/ is the script's folder
+
+    return bench_constrained_step(quick)
+
+
 SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "single": bench_single,
     "batch": bench_batch,
@@ -1505,6 +1514,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "engines": bench_engines,
     "compiled-floating": bench_compiled_floating,
     "robot-engine": bench_robot_engine,
+    "constrained-step": bench_constrained,
 }
 
 

@@ -1,20 +1,29 @@
 """Constrained dynamics on Pinocchio: ``Φ``, ``J``, ``J̇ v`` of a robot's constraints, and the KKT solves.
 
 The rows of each constraint are :mod:`robodyn.constraints.algebra`'s; Pinocchio supplies
-the kinematics of their ends (frame placements, ``LOCAL_WORLD_ALIGNED`` frame Jacobians,
-classical accelerations at ``v̇ = 0``), shifted from the link's origin to the end's point.
+the kinematics of their ends from one pass a state (:mod:`robodyn.dynamics.constraint_rows`:
+each end a frame of a copy of the model, so its placement, ``LOCAL_WORLD_ALIGNED`` Jacobian
+and classical acceleration at ``v̇ = 0`` are taken at its own point).
 
 **Forward dynamics** solves the KKT system of ``M v̇ + C v + G = τ + Jᵀ λ`` with
 ``J v̇ + J̇ v = 0`` by its own factorisation, not Pinocchio's ``constraintDynamics``:
-``M⁻¹ [τ − C v − G, Jᵀ]`` by one LU solve (robodyn's ``M``, so mimic joints and armature are included,
-which Pinocchio's constraint algorithms do not take), the Delassus matrix
-``A = J M⁻¹ Jᵀ`` and ``λ = A⁺ b`` by its eigendecomposition, eigenvalues below
-:data:`RANK_TOLERANCE` times the largest dropped. For a redundant set (a planar four-bar
-closed by a 3-row point anchor, where one row repeats the others) that is the
-least-norm ``λ``: the limit of the proximal iteration ``(A + ρ I) λₖ₊₁ = b + ρ λₖ`` from
-``λ₀ = 0`` (what Pinocchio's ``ProximalSettings`` runs), computed in one step. ``v̇`` is
-unique either way; :func:`constraint_rank` reports how many rows are independent. Pinocchio's
+``M⁻¹ (τ − C v − G)`` and ``M⁻¹ Jᵀ`` from one Cholesky factorisation of robodyn's ``M`` (so
+mimic joints and armature are included, which Pinocchio's constraint algorithms do not
+take), the Delassus matrix ``A = J M⁻¹ Jᵀ`` and ``λ = A⁺ b`` by its eigendecomposition,
+eigenvalues below :data:`RANK_TOLERANCE` times the largest dropped (above
+:data:`EIGEN_ROWS` rows a Cholesky factorisation of ``A`` answers first when a bound on its
+condition proves nothing would be dropped). The factorisations are Eigen's, through
+eigenpy (Pinocchio's own bindings): for matrices this small, numpy's wrappers cost more
+than the work. For a redundant set (a planar four-bar closed by a 3-row point anchor, where
+one row repeats the others) that is the least-norm ``λ``: the limit of the proximal
+iteration ``(A + ρ I) λₖ₊₁ = b + ρ λₖ`` from ``λ₀ = 0`` (what Pinocchio's
+``ProximalSettings`` runs), computed in one step. ``v̇`` is unique either way;
+:func:`constraint_rank` reports how many rows are independent. Pinocchio's
 ``constraintDynamics`` is the outside check (tests/dynamics/test_constrained.py).
+
+Inner loops (:func:`state_rows`, :func:`forward_dynamics_unchecked`) get the last state's
+results again, read-only, when asked for the same state (a simulation's projection and its
+next step's first stage); the public functions return arrays of their own.
 """
 
 from __future__ import annotations
@@ -23,11 +32,13 @@ import weakref
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+import eigenpy
 import numpy as np
 import pinocchio as pin
 
 from robodyn.constraints import Constraint, as_constraints, check_frames
-from robodyn.constraints.algebra import Bound, End, EndKinematics, bind, stack, world_end
+from robodyn.constraints.algebra import Bound, bind
+from robodyn.dynamics.constraint_rows import EndFrames
 from robodyn.exceptions import InputError, NonFiniteResultError, SingularMassMatrixError
 
 if TYPE_CHECKING:
@@ -35,9 +46,15 @@ if TYPE_CHECKING:
 
 #: Eigenvalues of the Delassus matrix below this times the largest are redundant rows.
 RANK_TOLERANCE = 1e-10
+#: Delassus matrices of more rows than this try a Cholesky factorisation (and a bound on
+#: their condition) before an eigendecomposition: for fewer, the eigendecomposition of
+#: Eigen (through eigenpy, Pinocchio's bindings) costs no more than the test.
+EIGEN_ROWS = 6
 #: Largest unbalanced force on the unactuated rows, relative to ``max |M a + C v + G|``
 #: (and 1), that :func:`contact_inverse_dynamics` accepts.
 BALANCE_TOLERANCE = 1e-8
+
+_SUCCESS = eigenpy.ComputationInfo.Success
 
 _BOUND: weakref.WeakKeyDictionary[Any, dict[tuple[Constraint, ...], tuple[Bound, ...]]] = weakref.WeakKeyDictionary()
 
@@ -63,50 +80,23 @@ def bound(robot: Robot, constraints: object) -> tuple[Bound, ...]:
     return cache[given]
 
 
-def _end_kinematics(robot: Robot, v: np.ndarray) -> Callable[[End], EndKinematics]:
-    """An end's kinematics from the Pinocchio data of the state just computed."""
-    model, data, frames, nv = robot.model, robot.handle.data, robot.handle.frames, robot.nv
-
-    def kinematics(end: End) -> EndKinematics:
-        if end.link is None:
-            return world_end(end, nv)
-        index = frames[end.link]
-        placement = data.oMf[index]
-        lever = placement.rotation @ end.position
-        jacobian = pin.getFrameJacobian(model, data, index, pin.LOCAL_WORLD_ALIGNED).reshape(6, nv)
-        angular = jacobian[3:]
-        omega = angular @ v
-        acceleration = pin.getFrameClassicalAcceleration(model, data, index, pin.LOCAL_WORLD_ALIGNED)
-        alpha = acceleration.angular.copy()
-        return EndKinematics(
-            placement.translation + lever,
-            placement.rotation @ end.rotation,
-            jacobian[:3] - _skew(lever) @ angular,
-            angular.copy(),
-            acceleration.linear + _cross(alpha, lever) + _cross(omega, _cross(omega, lever)),
-            alpha,
-        )
-
-    return kinematics
+_ENDS: weakref.WeakKeyDictionary[Any, dict[tuple[Bound, ...], EndFrames]] = weakref.WeakKeyDictionary()
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` of two 3-vectors (``np.cross`` costs ten times more on one pair)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _skew(a: np.ndarray) -> np.ndarray:
-    """The matrix of ``a × ·``."""
-    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+def end_frames(robot: Robot, bounds: tuple[Bound, ...]) -> EndFrames:
+    """The rows of ``bounds`` (from :func:`bound`) on ``robot``, made once a set."""
+    cache = _ENDS.setdefault(robot, {})
+    ends = cache.get(bounds)
+    if ends is None:
+        ends = cache[bounds] = EndFrames(robot, bounds)
+    return ends
 
 
 def state_rows(robot: Robot, bounds: tuple[Bound, ...], q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
-    """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state."""
-    model, data = robot.model, robot.handle.data
-    pin.computeJointJacobians(model, data, q)
-    pin.forwardKinematics(model, data, q, v, np.zeros(robot.nv))
-    pin.updateFramePlacements(model, data)
-    return stack(bounds, _end_kinematics(robot, v), robot.nv)
+    """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state, for inner loops: the
+    arrays are read-only, and shared with the next call at the same state
+    (:meth:`~robodyn.dynamics.constraint_rows.EndFrames.rows`)."""
+    return end_frames(robot, bounds).rows(q, v)
 
 
 def _per_state(
@@ -141,7 +131,7 @@ def constraint_residual(robot: Robot, q: np.ndarray, constraints: object = None)
     bounds = bound(robot, constraints)
     (q,), batch = robot.validate(q=q)
     zeros = np.zeros(robot.nv)
-    return _per_state(robot, lambda qi: state_rows(robot, bounds, qi, zeros)[:1], batch, q)[0]
+    return _per_state(robot, lambda qi: end_frames(robot, bounds).compute(qi, zeros)[:1], batch, q)[0]
 
 
 def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
@@ -149,14 +139,14 @@ def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None)
     bounds = bound(robot, constraints)
     (q,), batch = robot.validate(q=q)
     zeros = np.zeros(robot.nv)
-    return _per_state(robot, lambda qi: state_rows(robot, bounds, qi, zeros)[1:2], batch, q)[0]
+    return _per_state(robot, lambda qi: end_frames(robot, bounds).compute(qi, zeros)[1:2], batch, q)[0]
 
 
 def constraint_drift(robot: Robot, q: np.ndarray, v: np.ndarray, constraints: object = None) -> np.ndarray:
     """``J̇(q, v) v``, shape (m,) or (N, m): the rows' accelerations at ``v̇ = 0``."""
     bounds = bound(robot, constraints)
     (q, v), batch = robot.validate(q=q, v=v)
-    return _per_state(robot, lambda qi, vi: state_rows(robot, bounds, qi, vi)[2:], batch, q, v)[0]
+    return _per_state(robot, lambda qi, vi: end_frames(robot, bounds).compute(qi, vi)[2:], batch, q, v)[0]
 
 
 def constraint_rank(robot: Robot, q: np.ndarray, constraints: object = None) -> int:
@@ -175,21 +165,46 @@ def solve_kkt(
     """``(v̇, λ)`` of ``M v̇ = force + Jᵀ λ``, ``J v̇ = −drift`` (λ least-norm; module docstring).
 
     Raises:
-        SingularMassMatrixError: If ``M`` is singular.
+        SingularMassMatrixError: If ``M`` is not positive definite.
+        numpy.linalg.LinAlgError: If the Delassus matrix's eigendecomposition does not converge
+            (non-finite numbers).
     """
-    try:  # M⁻¹ [force, Jᵀ] in one LAPACK call (M is positive definite: no massless subtree)
-        solved = np.linalg.solve(mass, np.column_stack([force, jacobian.T]))
-    except np.linalg.LinAlgError:
-        raise SingularMassMatrixError(name, []) from None
-    free, response = solved[:, 0], solved[:, 1:]
+    if not len(force):
+        return np.zeros(0), np.zeros(len(drift))
+    cholesky = eigenpy.LLT(mass)  # M is positive definite (no massless subtree): one Cholesky factorisation
+    if cholesky.info() != _SUCCESS:
+        raise SingularMassMatrixError(name, [])
+    free = cholesky.solve(force).reshape(-1)  # eigenpy returns a vector or a column matrix: shapes made sure
     if not len(drift):
         return free, np.zeros(0)
-    delassus = jacobian @ response
-    values, vectors = np.linalg.eigh(0.5 * (delassus + delassus.T))
-    keep = values > RANK_TOLERANCE * max(float(values[-1]), 1e-300)
-    target = -(drift + jacobian @ free)
-    multipliers = vectors[:, keep] @ ((vectors[:, keep].T @ target) / values[keep])
+    response = cholesky.solve(jacobian.T).reshape(len(free), len(drift))  # M⁻¹ Jᵀ
+    multipliers = _least_norm(jacobian @ response, -(drift + jacobian @ free))
     return free + response @ multipliers, multipliers
+
+
+def _least_norm(delassus: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """``A⁺ b`` of the Delassus matrix ``A`` (symmetric: its lower triangle is read), its
+    eigenvalues below :data:`RANK_TOLERANCE` times the largest dropped.
+
+    Above :data:`EIGEN_ROWS` rows a Cholesky factorisation comes first and answers when a
+    bound proves no eigenvalue is dropped (``λ_min ≥ 1 / tr A⁻¹``, ``λ_max ≤ tr A``); else,
+    and for fewer rows (where the eigendecomposition costs no more than that test), ``A``'s
+    eigendecomposition gives the least-norm ``λ``.
+    """
+    if len(target) > EIGEN_ROWS:
+        cholesky = eigenpy.LLT(delassus)
+        if cholesky.info() == _SUCCESS:
+            inverse = cholesky.solve(np.eye(len(target))).reshape(len(target), len(target))
+            if RANK_TOLERANCE * float(delassus.trace()) * float(inverse.trace()) < 1.0:
+                return inverse @ target
+    eigen = eigenpy.SelfAdjointEigenSolver(delassus)
+    if eigen.info() != _SUCCESS:
+        raise np.linalg.LinAlgError("the Delassus matrix's eigendecomposition did not converge")
+    values, vectors = eigen.eigenvalues(), eigen.eigenvectors()  # the solver's own arrays: used while it lives
+    floor, kept = RANK_TOLERANCE * max(float(values[-1]), 1e-300), 0  # values ascending
+    while kept < len(values) and values[kept] <= floor:
+        kept += 1
+    return vectors[:, kept:] @ ((target @ vectors[:, kept:]) / values[kept:])
 
 
 def forward_dynamics(
@@ -204,7 +219,7 @@ def forward_dynamics(
     return _finite(
         robot,
         "constrained dynamics",
-        lambda: _per_state(robot, lambda *state: forward_dynamics_unchecked(robot, bounds, *state), batch, q, v, tau),
+        lambda: _per_state(robot, lambda *state: _dynamics(robot, bounds, *state), batch, q, v, tau),
     )
 
 
@@ -212,7 +227,15 @@ def forward_dynamics_unchecked(
     robot: Robot, bounds: tuple[Bound, ...], q: np.ndarray, v: np.ndarray, tau: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`forward_dynamics` of one checked state (float64 1-D arrays of the right sizes)
-    and bound constraints (:func:`bound`): for inner loops (simulation)."""
+    and bound constraints (:func:`bound`), for inner loops (simulation): the arrays are
+    read-only, and shared with the next call at the same state and torques."""
+    return end_frames(robot, bounds).remember("dynamics", (q, v, tau), lambda: _dynamics(robot, bounds, q, v, tau))
+
+
+def _dynamics(
+    robot: Robot, bounds: tuple[Bound, ...], q: np.ndarray, v: np.ndarray, tau: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(v̇, λ)`` of one checked state."""
     mass, bias = robot.mass_matrix(q), robot.nonlinear_effects(q, v)
     _, jacobian, drift = state_rows(robot, bounds, q, v)
     return solve_kkt(mass, tau - bias, jacobian, drift, robot.name)

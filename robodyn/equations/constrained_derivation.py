@@ -3,12 +3,18 @@
 After the Lagrangian derivation of :mod:`robodyn.equations.derivation` (``M``, ``C q̇``,
 ``G``), the steps a lecture adds for constraints:
 
-7. ``Φ(q) = 0``: each constrained point ``p(q)`` from the reference's forward kinematics in
-   closed form (:func:`robodyn.reference.symbolic.body_poses`), and the rows: a point
-   anchor's ``p₁(q) − p₂(q)`` (two links: a loop closure; or a link and the world), a
-   frictionless contact's ``n·(p(q) − c)``. A row that is ``0 = 0`` for every ``q`` (a
-   planar linkage's out-of-plane row) is dropped and said so: its multiplier is zero;
-8. ``J = ∂Φ/∂q`` and ``J̇ q̇ = Σ_k ∂(J q̇)/∂q_k q̇_k`` (the rows' acceleration at ``q̈ = 0``);
+7. ``Φ(q) = 0``: each constraint's ends from the reference's forward kinematics in closed
+   form (:mod:`robodyn.equations.constrained_kinematics`), and the rows: a point anchor's
+   ``p₁(q) − p₂(q)`` (two links: a loop closure; or a link and the world), a frictionless
+   contact's ``n·(p(q) − c)``, a weld's ``p₁ − p₂`` and ``log(R₁ R₂ᵀ) = θ a``, shown as
+   ``sin θ a = ½ vee(R₁ R₂ᵀ − R₂ R₁ᵀ)`` (the same zeros below a half turn). A row that is
+   ``0 = 0`` for every ``q`` (a planar linkage's out-of-plane row; a weld's rotation row
+   whose angular velocity is 0) is dropped and said so: its multiplier is zero;
+8. ``J``: ``∂Φ/∂q``, except a weld's rotation rows, whose ``J`` is the relative angular
+   velocity's Jacobian (``ω₁ − ω₂ = J q̇``, world axes), as robodyn's numeric ``J``
+   (:mod:`robodyn.constraints.algebra`): it is not the derivative of ``log(R₁ R₂ᵀ)``
+   (they agree where ``Φ = 0``); and ``J̇ q̇ = Σ_k ∂(J q̇)/∂q_k q̇_k`` (the rows'
+   acceleration at ``q̈ = 0``);
 9. ``M q̈ + C q̇ + G = τ + Jᵀ λ`` with ``J q̈ + J̇ q̇ = 0``: the KKT system
    ``[[M, −Jᵀ], [J, 0]] (q̈, λ) = (τ − C q̇ − G, −J̇ q̇)``;
 10. eliminating ``q̈``: ``λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇)`` in closed form
@@ -18,10 +24,11 @@ After the Lagrangian derivation of :mod:`robodyn.equations.derivation` (``M``, `
 The worked example is the RP arm whose tip slides without friction on the wall ``x = c``
 (``PointContact("end_effector", normal=(−1, 0, 0), friction=0, plane_point=(c, 0, 0))``):
 ``λ`` is the wall's normal force. A four-bar's loop (``PointAnchor`` between the coupler
-and the rocker) gives its two in-plane rows and the KKT system. Constraints whose ``J``
-is not ``∂Φ/∂q`` (welds, sticking contacts) are refused. Numbers are exact (the file's as
-rationals); no Pinocchio. :meth:`ConstrainedDerivation.solve` evaluates the derivation's
-own matrices at a state, to check them against robodyn's numeric dynamics.
+and the rocker) gives its two in-plane rows and the KKT system. A sticking contact
+(friction > 0: its tangential rows hold a velocity, not a position) is refused. Numbers
+are exact (the file's as rationals); no Pinocchio. :meth:`ConstrainedDerivation.solve`
+evaluates the derivation's own matrices at a state, to check them against robodyn's
+numeric dynamics.
 """
 
 from __future__ import annotations
@@ -35,13 +42,14 @@ import sympy as sp
 
 from robodyn import reference
 from robodyn.common.text import identifier, printable
-from robodyn.constraints import Constraint, PointAnchor, PointContact, as_constraints
-from robodyn.constraints.algebra import End, row_labels
+from robodyn.constraints import Constraint, FrameAnchor, PointContact, as_constraints
+from robodyn.constraints.algebra import row_labels
+from robodyn.equations.constrained_kinematics import EndFrame, Kinematics, sine_vector
 from robodyn.equations.derivation import DerivationSteps, derive_steps
 from robodyn.equations.derivation_latex import _names as _latex_names  # steps 1–6: q_1, dot q_1
 from robodyn.exceptions import InputError
-from robodyn.reference.constraints import bound, link_frames
-from robodyn.reference.symbolic import body_coordinates, body_poses, exact_matrix
+from robodyn.reference.constraints import bound
+from robodyn.reference.symbolic import exact_matrix
 
 #: Most joints for which ``λ`` is put in closed form (beyond: the KKT system).
 CLOSED_FORM_JOINTS = 2
@@ -69,6 +77,10 @@ class ConstrainedDerivation:
         tau: The torque symbols ``tau_<joint>`` (n).
         lam: ``λ(q, q̇, τ)`` of the kept rows in closed form (rows × 1), in [N]; ``None``
             when too large (then ``λ`` is the KKT system's solution).
+        angular: Indices (into ``labels``) of the kept rows of welds' rotations: their
+            ``Φ`` is shown as ``sin θ a`` and their ``J`` is the relative angular
+            velocity's Jacobian (``ω₁ − ω₂ = J q̇``), not ``∂Φ/∂q``.
+        relative_rotations: Each weld's ``R₁(q) R₂(q)ᵀ`` (3 × 3), in order.
     """
 
     steps: DerivationSteps
@@ -81,6 +93,8 @@ class ConstrainedDerivation:
     Jdot_qd: sp.Matrix
     tau: tuple[sp.Symbol, ...]
     lam: sp.Matrix | None
+    angular: tuple[int, ...] = ()
+    relative_rotations: tuple[sp.Matrix, ...] = ()
 
     @property
     def constraint(self) -> Constraint:
@@ -133,37 +147,30 @@ class ConstrainedDerivation:
         return lam
 
 
-def _point(model: reference.ReferenceRobot, steps: DerivationSteps, end: End) -> sp.Matrix:
-    """An end's point in world coordinates, as a function of ``q`` (exact numbers)."""
-    if end.link is None:
-        return exact_matrix(np.asarray(end.position, float)[:, None], 1e-12)
-    body, to_link = link_frames(model)[end.link]
-    position = to_link[:3, :3] @ np.asarray(end.position, float) + to_link[:3, 3]
-    offset = exact_matrix(position[:, None], 1e-12)
-    if body < 0:
-        return offset
-    theta, _ = body_coordinates(model, list(steps.q), list(steps.qd))
-    rotations, positions, _ = body_poses(model, theta)
-    return sp.expand(positions[body] + rotations[body] * offset)
-
-
 def _supported(constraints: Sequence[Constraint]) -> None:
-    """Refuse a constraint whose ``J`` is not ``∂Φ/∂q`` (welds, sticking contacts)."""
+    """Refuse a sticking contact: its tangential rows hold a velocity, not a position."""
     for index, constraint in enumerate(constraints):
-        if not (isinstance(constraint, PointAnchor) or (isinstance(constraint, PointContact) and constraint.rows == 1)):
+        if isinstance(constraint, PointContact) and constraint.rows != 1:
             raise InputError(
                 f"constraints[{index}]" if len(constraints) > 1 else "constraint",
-                "a PointAnchor or a frictionless PointContact (J = ∂Φ/∂q; a weld's and a sticking contact's J is not)",
-                f"a {constraint.kind}{' with friction' if isinstance(constraint, PointContact) else ''}",
+                "a PointAnchor, a FrameAnchor (weld) or a frictionless PointContact: a sticking contact's "
+                "tangential rows hold a velocity, not a position, and are not derived (with friction 0 its "
+                "normal row is; without constraints, the open tree's derivation)",
+                f"a point contact with friction {constraint.friction:.6g}",
             )
 
 
-def _rows(constraint: Constraint, first: sp.Matrix, second: sp.Matrix) -> sp.Matrix:
-    """``Φ(q)`` of a supported constraint from its two points."""
+def _rows(constraint: Constraint, first: EndFrame, second: EndFrame) -> tuple[sp.Matrix, sp.Matrix | None]:
+    """``Φ(q)`` of a constraint from its two ends, and a weld's relative angular velocity
+    ``ω₁ − ω₂`` (its rotation rows' velocity; ``None`` for the others)."""
+    gap = sp.expand(first.position - second.position)
     if isinstance(constraint, PointContact):
         normal = exact_matrix(np.array(constraint.normal)[:, None], 1e-12)
-        return sp.Matrix([sp.expand((normal.T * (first - second))[0])])
-    return sp.expand(first - second)
+        return sp.Matrix([sp.expand((normal.T * gap)[0])]), None
+    if isinstance(constraint, FrameAnchor):
+        relative = first.rotation * second.rotation.T
+        return sp.Matrix.vstack(gap, sine_vector(relative)), sp.expand(first.omega - second.omega)
+    return gap, None
 
 
 def _refuse_constant_rows(rows: sp.Matrix, q: Sequence[sp.Symbol], constraints: Sequence[Constraint]) -> None:
@@ -189,13 +196,13 @@ def derive_constrained(
             :data:`~robodyn.equations.derivation.MAX_MOVING_JOINTS` moving joints). Its
             file's own constraints (MJCF ``<equality>``) are not added: pass them.
         constraints: One constraint or several: :class:`~robodyn.constraints.PointAnchor`
-            (between two links, or a link and the world) and frictionless
-            :class:`~robodyn.constraints.PointContact`.
+            (between two links, or a link and the world), :class:`~robodyn.constraints.FrameAnchor`
+            (a weld) and frictionless :class:`~robodyn.constraints.PointContact`.
         gravity: Gravity in the world frame, in [m/s²]; default ``(0, 0, -9.81)``.
 
     Raises:
-        InputError: For another constraint, none, a link the robot does not have, or a
-            robot too large to work by hand.
+        InputError: For a sticking contact, none, a link the robot does not have, rows no
+            configuration satisfies, or a robot too large to work by hand.
     """
     given = as_constraints(constraints, "constraints")
     if not given:
@@ -204,13 +211,21 @@ def derive_constrained(
     model = reference.load(source, gravity=gravity)
     bounds, _ = bound(model, given)
     steps = derive_steps(source, gravity=gravity)
-    points = tuple((_point(model, steps, b.first), _point(model, steps, b.second)) for b in bounds)
-    every = sp.Matrix.vstack(*(_rows(c, *pair) for c, pair in zip(given, points, strict=True)))
+    kinematics = Kinematics(model, steps)
+    ends = [(kinematics.end(b.first), kinematics.end(b.second)) for b in bounds]
+    parts = [_rows(c, *pair) for c, pair in zip(given, ends, strict=True)]
     q, qd = sp.Matrix(steps.q), sp.Matrix(steps.qd)
-    kept = tuple(i for i in range(every.rows) if every[i] != 0)
+    every = sp.Matrix.vstack(*(phi for phi, _ in parts))
+    # each row's velocity J q̇: dΦ/dt, or (a weld's rotation rows) ω₁ − ω₂
+    velocity: list[sp.Expr] = []
+    for phi, omega in parts:
+        velocity += [sp.expand((sp.Matrix([phi[i]]).jacobian(q) * qd)[0]) for i in range(3 if omega is not None else phi.rows)]
+        velocity += list(omega) if omega is not None else []
+    angular = tuple(i for i, (_, component, _) in enumerate(row_labels(given)) if component.startswith("m"))
+    kept = tuple(i for i in range(every.rows) if (velocity[i] != 0 if i in angular else every[i] != 0))
     _refuse_constant_rows(every, steps.q, given)
     phi = every.extract(list(kept), [0])
-    jacobian = sp.simplify(phi.jacobian(q))
+    jacobian = sp.simplify(sp.Matrix([velocity[i] for i in kept]).jacobian(qd))
     drift = sp.expand((jacobian * qd).jacobian(q) * qd).applyfunc(lambda row: sp.trigsimp(sp.collect(row, list(qd))))
     taken = {str(s) for s in (*steps.q, *steps.qd, *steps.qdd)}
     tau = tuple(sp.Symbol(identifier(name, taken, prefix="tau_"), real=True) for name in steps.joint_names)
@@ -219,7 +234,15 @@ def derive_constrained(
         mass_inverse_jt = steps.M.LUsolve(jacobian.T)
         free = steps.M.LUsolve(sp.Matrix(tau) - steps.Cv - steps.G)
         lam = (-(jacobian * mass_inverse_jt).LUsolve(jacobian * free + drift)).applyfunc(sp.simplify)
-    return ConstrainedDerivation(steps, given, points, tuple(row_labels(given)), kept, phi, jacobian, drift, tau, lam)
+    points = tuple((first.position, second.position) for first, second in ends)
+    rotations = tuple(
+        sp.simplify(first.rotation * second.rotation.T)
+        for c, (first, second) in zip(given, ends, strict=True)
+        if isinstance(c, FrameAnchor)
+    )
+    labels = tuple(row_labels(given))
+    angular_kept = tuple(i for i in kept if i in angular)
+    return ConstrainedDerivation(steps, given, points, labels, kept, phi, jacobian, drift, tau, lam, angular_kept, rotations)
 
 
 def readable(matrix: sp.Matrix, precision: int) -> sp.Matrix:
@@ -259,12 +282,25 @@ def to_text(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
     lines += ["", "step 7: Φ(q) = 0, with the constrained points p₁(q), p₂(q) ="]
     for first, second in derivation.points:
         lines += [*show(first), "  and", *show(second)]
+    for rotation in derivation.relative_rotations:
+        lines += ["  a weld's R₁(q) R₂(q)ᵀ =", *show(rotation)]
     lines += [f"  Φ(q) = p₁ − p₂ (rows {_row_names(derivation, derivation.kept)}) ="]
+    if derivation.angular:
+        lines[-1] = (
+            f"  Φ(q) = p₁ − p₂, and for rows {_row_names(derivation, derivation.angular)} log(R₁ R₂ᵀ) = θ a, shown as "
+            f"sin θ a = ½ vee(R₁ R₂ᵀ − R₂ R₁ᵀ) (the same zeros for θ < π) (rows {_row_names(derivation, derivation.kept)}) ="
+        )
     lines += show(derivation.phi)
     if derivation.dropped:
         dropped = [i for i in range(len(derivation.labels)) if i not in derivation.kept]
         lines.append(f"  rows {_row_names(derivation, dropped)}: 0 = 0 for every q (dropped; their λ is 0)")
-    lines += ["step 8: J = ∂Φ/∂q =", *show(derivation.J), "  J̇ q̇ =", *show(derivation.Jdot_qd)]
+    step8 = "step 8: J = ∂Φ/∂q ="
+    if derivation.angular:
+        step8 = (
+            f"step 8: J = ∂Φ/∂q, except rows {_row_names(derivation, derivation.angular)}: the relative angular "
+            "velocity's Jacobian (ω₁ − ω₂ = J q̇, world axes; not ∂Φ/∂q, equal to it where Φ = 0) ="
+        )
+    lines += [step8, *show(derivation.J), "  J̇ q̇ =", *show(derivation.Jdot_qd)]
     lines.append("step 9: M q̈ + C q̇ + G = τ + Jᵀ λ, with J q̈ + J̇ q̇ = 0: [[M, −Jᵀ], [J, 0]] (q̈, λ) = (τ − C q̇ − G, −J̇ q̇)")
     if derivation.lam is None:
         joints, rows = len(derivation.steps.q), len(derivation.kept)
@@ -292,6 +328,13 @@ def to_latex(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
         return sp.latex(readable(matrix, precision), symbol_names=names)
 
     points = [rf"p_{{{k + 1}}}(q) &= {latex(a)}, \quad {latex(b)} \\" for k, (a, b) in enumerate(derivation.points)]
+    points += [rf"R_1 R_2^\top &= {latex(rotation)} \\" for rotation in derivation.relative_rotations]
+    angular = (
+        r"\ \text{(a weld's rotation rows: } \Phi = \sin\theta\, a \text{ of } \log(R_1 R_2^\top)\text{, } "
+        r"J \dot q = \omega_1 - \omega_2\text{, not } \partial \Phi / \partial q\text{)}"
+        if derivation.angular
+        else ""
+    )
     kkt = r"\begin{pmatrix} M & -J^\top \\ J & 0 \end{pmatrix} \begin{pmatrix} \ddot q \\ \lambda \end{pmatrix}"
     system = rf"{kkt} &= \begin{{pmatrix}} \tau - C \dot q - G \\ -\dot J \dot q \end{{pmatrix}}"
     lam = r"\lambda &= -(J M^{-1} J^\top)^{-1} \left(J M^{-1} (\tau - C \dot q - G) + \dot J \dot q\right)"
@@ -300,7 +343,7 @@ def to_latex(derivation: ConstrainedDerivation, *, precision: int = 6) -> str:
             r"\begin{align*}",
             *points,
             rf"\Phi(q) &= {latex(derivation.phi)} = 0 \\",
-            rf"J = \frac{{\partial \Phi}}{{\partial q}} &= {latex(derivation.J)} \\",
+            rf"J = \frac{{\partial \Phi}}{{\partial q}}{angular} &= {latex(derivation.J)} \\",
             rf"\dot J \dot q &= {latex(derivation.Jdot_qd)} \\",
             r"M \ddot q + C \dot q + G &= \tau + J^\top \lambda, \quad J \ddot q + \dot J \dot q = 0 \\",
             rf"{system} \\",

@@ -38,8 +38,10 @@ def _strings(matrix: sp.Matrix | None) -> list[Any] | None:
 def constrained_dict(derivation: ConstrainedDerivation) -> dict[str, Any]:
     """Steps 7–10 as a dictionary: ``constraints`` (descriptions), ``rows`` and
     ``dropped_rows`` (``"<constraint>.<component>"``), ``points``, ``phi``, ``J``,
-    ``Jdot_qd``, ``tau`` (the torque symbols), ``lambda`` (``None`` when only the KKT
-    system states it) and ``kkt``.
+    ``Jdot_qd``, ``angular_rows`` (a weld's rotation rows: ``phi`` ``sin θ a``, ``J`` the
+    relative angular velocity's Jacobian, not ``∂Φ/∂q``), ``relative_rotations`` (each
+    weld's ``R₁ R₂ᵀ``), ``tau`` (the torque symbols), ``lambda`` (``None`` when only the
+    KKT system states it) and ``kkt``.
 
     Args:
         derivation: The derivation with multipliers.
@@ -53,6 +55,8 @@ def constrained_dict(derivation: ConstrainedDerivation) -> dict[str, Any]:
         "phi": _strings(derivation.phi),
         "J": _strings(derivation.J),
         "Jdot_qd": _strings(derivation.Jdot_qd),
+        "angular_rows": [name[i] for i in derivation.angular],
+        "relative_rotations": [_strings(rotation) for rotation in derivation.relative_rotations],
         "tau": [str(symbol) for symbol in derivation.tau],
         "lambda": _strings(derivation.lam),
         "kkt": "[[M, -J^T], [J, 0]] (qdd, lambda) = (tau - Cv - G, -Jdot_qd)",

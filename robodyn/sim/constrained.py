@@ -197,6 +197,11 @@ def constrained_rk4_step(
         raise InputError("q", "one state (1-D arrays): a step is of one state", f"shape {q.shape}")
     if tau is not None and not callable(tau):
         (tau,), _ = robot.validate(tau=tau)
+    return _step(robot, bounds, q, v, tau, dt, t)
+
+
+def _step(robot: Robot, bounds, q: np.ndarray, v: np.ndarray, tau: Torques, dt: float, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`constrained_rk4_step` of a checked state and torques and bound constraints."""
     model = robot.model
 
     def rate(time: float, qi: np.ndarray, vi: np.ndarray) -> np.ndarray:
@@ -263,14 +268,14 @@ def simulate_constrained(
     start = q
     q, v = project(robot, q, v, bounds)
     times = np.arange(steps + 1) * dt
-    samples = _run(robot, bounds, q, v, tau, times, constraints)
+    samples = _run(robot, bounds, q, v, tau, times)
     trajectory = Trajectory(times, samples["q"], samples["v"], samples["a"], samples["tau"], list(robot.joint_names), robot.name)
     labels = tuple(row_labels([b.constraint for b in bounds]))
     lam = samples["lambda"].reshape(len(times), len(labels))
     return ConstrainedSimulation(trajectory, lam, samples["residual"], float(np.abs(q - start).max()), labels)
 
 
-def _run(robot: Robot, bounds, q: np.ndarray, v: np.ndarray, tau: Torques, times: np.ndarray, constraints: object) -> dict:
+def _run(robot: Robot, bounds, q: np.ndarray, v: np.ndarray, tau: Torques, times: np.ndarray) -> dict:
     """The samples of a motion from a projected state: ``q``, ``v``, ``a``, ``tau``,
     ``lambda`` (stacked) and ``residual`` (``max |Φ|``) at each time."""
     samples: dict[str, list] = {key: [] for key in ("q", "v", "a", "tau", "lambda", "residual")}
@@ -283,7 +288,7 @@ def _run(robot: Robot, bounds, q: np.ndarray, v: np.ndarray, tau: Torques, times
             samples[key].append(value)
         if step == len(times) - 1:
             break
-        q, v = constrained_rk4_step(robot, q, v, tau, dt, constraints, t=float(t))
+        q, v = _step(robot, bounds, q, v, tau, dt, float(t))
         if not (np.isfinite(q).all() and np.isfinite(v).all()):
             raise SimulationError(float(t), step, robot.dofs[int(np.argmax(~np.isfinite(v)))].joint)
     return {key: np.array(values) for key, values in samples.items()}

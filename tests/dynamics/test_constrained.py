@@ -189,3 +189,40 @@ def test_an_empty_batch_gives_empty_stacks():
     assert a.shape == (0, 3) and lam.shape == (0, 3)
     assert robot.constraint_jacobian(empty).shape == (0, 3, 3)
     assert robodyn.check_robot(robot, samples=0).passed
+
+
+def _solo_standing(extra=()):
+    robot = robodyn.load("solo12", gravity=(0.3, -0.2, -9.7))
+    feet = [PointContact(foot, friction=0.7) for foot in FEET] + list(extra)
+    q = robot.neutral_configuration()
+    q[2] = 0.3
+    q[7:] = np.tile([0.1, 0.8, -1.6], 4)
+    return robot, constrained.bound(robot, feet), q
+
+
+def test_a_full_rank_set_above_six_rows_solved_by_cholesky_is_the_eigendecompositions_solution(rng, monkeypatch):
+    robot, bounds, q = _solo_standing()
+    v, tau = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    mass, bias = robot.mass_matrix(q), robot.nonlinear_effects(q, v)
+    _, jacobian, drift = constrained.state_rows(robot, bounds, q, v)
+    assert len(drift) == 12 > constrained.EIGEN_ROWS
+    cholesky = constrained.solve_kkt(mass, tau - bias, jacobian, drift)
+    monkeypatch.setattr(constrained, "EIGEN_ROWS", 100)  # the eigendecomposition for every size
+    eigen = constrained.solve_kkt(mass, tau - bias, jacobian, drift)
+    assert agreement(*cholesky, *eigen) < 1e-12
+    assert np.allclose(jacobian @ cholesky[0] + drift, 0.0, atol=1e-9)
+    assert agreement(*constrained.solve_kkt(mass, tau - bias, jacobian, 0 * drift), *eigen) > 1e-3
+
+
+def test_a_redundant_set_above_six_rows_gets_the_least_norm_multipliers(rng):
+    # a fifth contact on a foot already held: 15 rows, 12 independent; the foot's force is
+    # shared equally between its two contacts (the least-norm λ), never a NaN
+    robot, bounds, q = _solo_standing([PointContact(FEET[0], friction=0.7)])
+    v, tau = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    a, lam = constrained.forward_dynamics(robot, q, v, tau, [b.constraint for b in bounds])
+    single, lam_single = constrained.forward_dynamics(robot, q, v, tau, [b.constraint for b in bounds[:4]])
+    combined = lam[:12].copy()
+    combined[:3] += lam[12:]
+    assert np.isfinite(lam).all() and agreement(a, combined, single, lam_single) < 1e-9
+    assert np.allclose(lam[:3], lam[12:], rtol=0.0, atol=1e-9 * np.abs(lam).max())
+    assert not np.allclose(lam[:3], lam_single[:3], atol=1e-3)  # the check can fail: the force is split

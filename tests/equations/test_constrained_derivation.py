@@ -9,10 +9,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import robodyn
 from robodyn.constraints import FrameAnchor, PointAnchor, PointContact
 from robodyn.equations.constrained_derivation import derive_constrained, to_latex, to_text
+from robodyn.equations.constrained_document import constrained_dict
 from robodyn.exceptions import InputError
 from robodyn.urdf.models import RPArmParameters
 
@@ -49,9 +51,9 @@ def test_the_steps_are_printed(derivation):
     assert r"\lambda &=" in to_latex(derivation)
 
 
-def test_a_constraint_whose_jacobian_is_not_the_derivative_of_its_rows_is_refused():
-    with pytest.raises(InputError, match="constraint"):
-        derive_constrained("rp_arm", FrameAnchor("link2"))
+def test_a_sticking_contact_is_refused_saying_what_is_not_derived_and_where_the_open_tree_is():
+    with pytest.raises(InputError, match=r"tangential rows hold a velocity.*not derived.*without constraints, the open tree"):
+        derive_constrained("rp_arm", PointContact("link2", friction=0.5))
     with pytest.raises(InputError, match="constraints"):
         derive_constrained("rp_arm", PointContact("nowhere", friction=0.0))
 
@@ -102,3 +104,47 @@ def test_a_loop_between_two_bodies_is_the_numeric_dynamics_and_a_wrong_sign_is_c
     text, latex = to_text(loop_derivation), to_latex(loop_derivation)
     assert "rows pin.z: 0 = 0 for every q" in text and "step 10: λ = " in text
     assert r"\lambda &=" in latex and r"\begin{pmatrix} M & -J^\top" in latex and "q_{1}" in latex
+
+
+# A weld: the RP arm's second link held where it is at the neutral configuration, the welded
+# frame offset and turned in the link, gravity not the default. The arm moves in the x–z
+# plane: rows x, z and my are derived (3 rows on 2 joints: the KKT system), y, mx, mz are
+# 0 = 0.
+WELD = FrameAnchor("link2", (0.1, 0.02, 0.0, 0.0, 0.0, 0.3), name="weld")
+
+
+def sine_of(log: np.ndarray) -> np.ndarray:
+    """``sin θ a`` of a rotation vector ``θ a`` (how the derivation shows a weld's rotation rows)."""
+    angle = np.linalg.norm(log)
+    return log if angle == 0 else np.sin(angle) * log / angle
+
+
+@pytest.mark.slow
+def test_a_weld_is_derived_its_rotation_rows_by_the_angular_velocity_jacobian_as_the_numeric_one(rng):
+    from dataclasses import replace
+
+    derivation = derive_constrained("rp_arm", WELD, gravity=GRAVITY)
+    robot = robodyn.load("rp_arm", constraints=[WELD], gravity=GRAVITY)
+    assert [derivation.labels[i][1] for i in derivation.kept] == ["x", "z", "my"]
+    assert [derivation.labels[i][1] for i in derivation.angular] == ["my"]
+    # the negative control: the rotation row's J as ∂/∂q of the Φ shown (sin θ a), right only where Φ = 0
+    q_symbols = sp.Matrix(derivation.steps.q)
+    derivative = replace(derivation, J=derivation.phi.jacobian(q_symbols))
+    order = [robot.joint_names.index(name) for name in derivation.steps.joint_names]
+    zero = np.zeros(2)
+    assert numeric_terms(robot, derivative, zero, zero, zero)["J"] < 1e-12
+    for _ in range(3):
+        q, v, tau = rng.uniform(-1.0, 1.0, 2), rng.normal(size=2), rng.normal(scale=3.0, size=2)
+        terms = numeric_terms(robot, derivation, q, v, tau)
+        assert max(value for key, value in terms.items() if key != "phi") <= 1e-9
+        residual = robot.constraint_residual(q)
+        shown = np.concatenate([residual[:3], sine_of(residual[3:])])[list(derivation.kept)]
+        derived = derivation._numbers(derivation.phi, q[order], v[order], tau[order]).ravel()
+        assert np.abs(derived - shown).max() <= 1e-9
+        assert numeric_terms(robot, derivative, q, v, tau)["J"] > 1e-3  # the check can fail
+        assert numeric_terms(robot, replace(derivation, J=-derivation.J), q, v, tau)["lambda"] > 1e-3
+    text, latex = to_text(derivation), to_latex(derivation)
+    assert "rows weld.y, weld.mx, weld.mz: 0 = 0 for every q" in text
+    assert "except rows weld.my: the relative angular velocity's Jacobian" in text and "R₁(q) R₂(q)ᵀ" in text
+    assert r"\omega_1 - \omega_2" in latex and r"R_1 R_2^\top" in latex
+    assert constrained_dict(derivation)["angular_rows"] == ["weld.my"]
