@@ -84,7 +84,12 @@ _ENDS: weakref.WeakKeyDictionary[Any, dict[tuple[Bound, ...], EndFrames]] = weak
 
 
 def end_frames(robot: Robot, bounds: tuple[Bound, ...]) -> EndFrames:
-    """The rows of ``bounds`` (from :func:`bound`) on ``robot``, made once a set."""
+    """The rows of ``bounds`` (from :func:`bound`) on ``robot``, made once a set.
+
+    Args:
+        robot: The robot the constraints act on.
+        bounds: Its constraints bound to its frames (:func:`bound`).
+    """
     cache = _ENDS.setdefault(robot, {})
     ends = cache.get(bounds)
     if ends is None:
@@ -95,7 +100,14 @@ def end_frames(robot: Robot, bounds: tuple[Bound, ...]) -> EndFrames:
 def state_rows(robot: Robot, bounds: tuple[Bound, ...], q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
     """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state, for inner loops: the
     arrays are read-only, and shared with the next call at the same state
-    (:meth:`~robodyn.dynamics.constraint_rows.EndFrames.rows`)."""
+    (:meth:`~robodyn.dynamics.constraint_rows.EndFrames.rows`).
+
+    Args:
+        robot: The robot the constraints act on.
+        bounds: Its constraints bound to its frames (:func:`bound`).
+        q: Configuration, float64, shape (nq,).
+        v: Velocity, float64, shape (nv,).
+    """
     return end_frames(robot, bounds).rows(q, v)
 
 

@@ -64,7 +64,12 @@ class EndFrames:
         return local
 
     def compute(self, q: np.ndarray, v: np.ndarray) -> Rows:
-        """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state (float64 1-D ``q``, ``v``)."""
+        """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one checked state.
+
+        Args:
+            q: Configuration, float64, shape (nq,).
+            v: Velocity, float64, shape (nv,).
+        """
         if not self.frames:
             return np.zeros(0), np.zeros((0, len(self.zeros))), np.zeros(0)
         local, world = self._thread(), pin.LOCAL_WORLD_ALIGNED
@@ -82,12 +87,23 @@ class EndFrames:
         return self.layout.assemble(positions, rotations, jacobians, drifts)  # new arrays: the buffers stay here
 
     def rows(self, q: np.ndarray, v: np.ndarray) -> Rows:
-        """:meth:`compute`, or the same state's rows again (read-only, shared): see the module docstring."""
+        """:meth:`compute`, or the same state's rows again (read-only, shared): see the module docstring.
+
+        Args:
+            q: Configuration, float64, shape (nq,).
+            v: Velocity, float64, shape (nv,).
+        """
         return self.remember("rows", (q, v), lambda: self.compute(q, v))
 
     def remember(self, what: str, state: tuple[np.ndarray, ...], compute: Callable[[], tuple[np.ndarray, ...]]) -> Any:
         """``compute()``, or its arrays of the last call with the same ``what`` and equal
-        ``state`` arrays in this thread (read-only: they are shared)."""
+        ``state`` arrays in this thread (read-only: they are shared).
+
+        Args:
+            what: The name of the result (one memo a name).
+            state: The arrays the result depends on.
+            compute: Computes the result's arrays when the state is new.
+        """
         memo, key = self._thread().memo, b"".join(array.tobytes() for array in state)
         last = memo.get(what)
         if last is not None and last[0] == key:

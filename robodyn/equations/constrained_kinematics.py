@@ -53,7 +53,11 @@ class Kinematics:
             self.omegas.append(parent + axes[index] * theta_dot[index] if body.revolute else parent)
 
     def end(self, end: End) -> EndFrame:
-        """An end's frame (:class:`EndFrame`)."""
+        """An end's frame (:class:`EndFrame`).
+
+        Args:
+            end: A constraint's end (a link, or the world when its link is ``None``).
+        """
         if end.link is None:
             return EndFrame(
                 exact_matrix(np.asarray(end.position, float)[:, None], SNAP), exact_matrix(end.rotation, SNAP), sp.zeros(3, 1)
@@ -72,7 +76,11 @@ class Kinematics:
 
 def sine_vector(rotation: sp.Matrix) -> sp.Matrix:
     """``½ vee(R − Rᵀ) = sin θ a`` of a rotation ``R = exp(θ [a]×)``: zero exactly where its
-    logarithm ``θ a`` is, for ``θ < π`` (how the derivation prints a weld's rotation rows)."""
+    logarithm ``θ a`` is, for ``θ < π`` (how the derivation prints a weld's rotation rows).
+
+    Args:
+        rotation: A symbolic rotation matrix, 3 × 3.
+    """
     skew = (rotation - rotation.T) / 2
     return sp.Matrix([skew[2, 1], skew[0, 2], skew[1, 0]]).applyfunc(lambda entry: sp.trigsimp(sp.expand(entry)))
 

@@ -16,7 +16,7 @@ SMALL_ANGLE = 0.05
 
 
 def log_jacobian(phi: np.ndarray) -> np.ndarray:
-    """``Jr⁻¹(φ) = I + φ̂/2 + c(θ) φ̂²``: ``d/dt log(R) = Jr⁻¹ ω_b`` (θ = |φ|, shape (3, 3)).
+    """``Jr⁻¹(φ) = I + φ̂/2 + c(θ) φ̂²``: ``d/dt log(R) = Jr⁻¹ ω_b`` (θ = ‖φ‖, shape (3, 3)).
 
     Args:
         phi: ``φ``, a rotation vector in [rad], shape (3,).
