@@ -15,6 +15,7 @@ from robodyn.dynamics import centroidal, configurations, energies, kinematics
 if TYPE_CHECKING:
     from robodyn.dynamics.dofs import Dof
     from robodyn.dynamics.handle import ModelHandle
+    from robodyn.urdf.source_type import URDFSource
 
 
 class RobotKinematics:
@@ -22,6 +23,7 @@ class RobotKinematics:
 
     handle: ModelHandle
     dofs: tuple[Dof, ...]
+    source: URDFSource
 
     # ----------------------------------------------------------------------------------
     # Energies (robodyn.dynamics.energies)
@@ -100,13 +102,17 @@ class RobotKinematics:
         return configurations.upper_limits(self.dofs)
 
     def neutral_configuration(self) -> np.ndarray:
-        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
+        """Pinocchio's neutral configuration (zero joint positions, the base at the origin,
+        unrotated), shape (nq,); the robot's start is :meth:`default_configuration`."""
         return configurations.neutral_configuration(self.handle)
 
     def default_configuration(self) -> np.ndarray:
-        """The neutral configuration clipped into the joint position limits, shape (nq,)
+        """The robot's start, shape (nq,): a floating base where the file puts it (MJCF:
+        the free body's pose, MuJoCo's ``qpos0``), the joints at zero clipped into their
+        position limits; every default start (simulations, contact runs, the CLI's
+        ``q0``, the viewer) is this one
         (:func:`robodyn.dynamics.configurations.default_configuration`)."""
-        return configurations.default_configuration(self.handle, self.dofs)
+        return configurations.default_configuration(self.handle, self.dofs, self.source.base_pose)
 
     def physical_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Position limits of the joints (floating base excluded), placeholders and empty

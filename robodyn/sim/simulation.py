@@ -142,7 +142,7 @@ def choose_engine(
     joint_friction: bool = False,
 ) -> tuple[Literal["pinocchio", "compiled"], str]:
     """The engine ``engine="auto"`` runs for a robot and controller, and why
-    (:func:`robodyn.sim.engine.choose` of their plan, at the neutral configuration).
+    (:func:`robodyn.sim.engine.choose` of their plan, at the robot's start).
 
     Args:
         robot: The plant.
@@ -150,7 +150,7 @@ def choose_engine(
         external, limits, observer, joint_friction: As for :func:`simulate`.
         every: Steps between two samples of a held controller (``None``: every stage).
     """
-    state = (robot.neutral_configuration(), np.zeros(robot.nv))
+    state = (robot.default_configuration(), np.zeros(robot.nv))
     period = {"control_period": float(every)} if every is not None and controller is not None else {}
     return engines.choose(
         plan(robot, *state, 0.0, 1.0, controller=controller, external=external, limits=limits,  # type: ignore[arg-type]

@@ -117,6 +117,7 @@ def mjcf_source(
         actuated=None if robot.actuated is None else tuple(sorted(robot.actuated)),
         joint_offsets=tuple(robot.refs.items()),
         ground=ground,
+        base_pose=robot.base_pose,
     )
 
 
@@ -184,6 +185,7 @@ def _read_world(root: ET.Element, robot: MjcfRobot) -> None:
     assert world is not None  # it has bodies
     if free:
         robot.floating = True
+        robot.ids["site"] += len(world.findall("site"))  # MuJoCo's ids count the world's sites first
         read_body(robot, bodies[0], None, np.eye(4), "main")
         for index, site in enumerate(world.findall("site")):
             robot.note(
