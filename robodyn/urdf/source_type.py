@@ -45,6 +45,9 @@ class URDFSource:
             body's ``<body pos quat>``, MuJoCo's ``qpos0``): position in [m] then quaternion
             x, y, z, w, robodyn's ``q[:7]`` (:meth:`robodyn.Robot.default_configuration`);
             ``None``: at the origin, unrotated.
+        keyframes: ``(name, qpos)`` of the file's MJCF ``<keyframe>`` s, ``qpos`` in
+            MuJoCo's order, completed as MuJoCo completes it; a start only when asked for
+            (:meth:`robodyn.Robot.default_configuration` ``keyframe=``).
     """
 
     text: str
@@ -60,6 +63,7 @@ class URDFSource:
     joint_offsets: tuple[tuple[str, float], ...] = ()
     ground: tuple[float, tuple[float, float, float], float] | None = None
     base_pose: tuple[float, ...] | None = None
+    keyframes: tuple[tuple[str, tuple[float, ...]], ...] = ()
 
     @property
     def mesh_context(self) -> dict:

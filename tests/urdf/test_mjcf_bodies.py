@@ -222,3 +222,30 @@ def test_unnamed_bodies_joints_and_sites_are_named_after_mujocos_ids(tmp_path, f
         anchor = ours.oMi[robot.model.parents[joint]] * robot.model.jointPlacements[joint]
         assert np.abs(anchor.translation - data.xanchor[index]).max() < 1e-12, name
     assert min(names.values()) >= 2  # the file has unnamed ones of each kind
+
+
+KEYS = """<keyframe><key name="crouch" qpos="0.1 0.2 0.5 0.6 0 0.8 0 0.9 -0.05"/><key time="1"/>
+<key name="short" qpos="0.6 0 0.8 0 0.9 -0.05"/></keyframe></mujoco>"""
+
+
+def test_keyframes_are_reported_in_one_line_and_each_is_a_start_on_request(tmp_path):
+    path = tmp_path / "keys.xml"
+    path.write_text(START.replace("ORIENTATION", "").replace("</mujoco>", KEYS))
+    """A short ``qpos`` is completed as MuJoCo completes it (its ``qpos0``, the quaternion normalised)."""
+    with pytest.warns(robodyn.RobodynWarning, match=r"keyframes are not the start, MuJoCo's qpos0 is \(crouch, key1, short\)"):
+        robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    for key in range(model.nkey):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_KEY, key) or f"key{key}"
+        qpos = robot.to_mujoco(robot.default_configuration(keyframe=name))[0]
+        assert np.abs(qpos - model.key_qpos[key]).max() < 1e-15, name
+    assert np.abs(model.key_qpos[0] - model.qpos0).max() > 0.5  # the named key is not the start
+    with pytest.raises(
+        robodyn.InputError, match=r"keyframe must be one of the file's MJCF keyframes \('crouch', 'key1', 'short'\)"
+    ):
+        robot.default_configuration(keyframe="stand")
+    path.write_text(START.replace("ORIENTATION", "").replace("</mujoco>", KEYS.replace(" -0.05", " -0.05 3", 1)))
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_path(str(path))
+    with pytest.raises(robodyn.URDFError, match=r"keyframe 'crouch': qpos has 10 numbers, more than the model's 9"):
+        robodyn.load(path)
