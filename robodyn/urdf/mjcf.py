@@ -111,6 +111,8 @@ def mjcf_source(
     ground = plane_ground(robot)
     _report(robot, source.label, strict)
     keyframes = read_keyframes(root, robot)
+    if robot.outside:
+        _start_line(source.label, "joints whose qpos0 (ref) is outside their range start at the nearest limit", robot.outside)
     return replace(
         source,
         text=ET.tostring(robot.urdf, encoding="unicode"),
@@ -156,14 +158,19 @@ def read_keyframes(root: ET.Element, robot: MjcfRobot) -> tuple[tuple[str, tuple
             qpos[3:7] = unit(robot.label, where, qpos[3:7])
         found.append((name, tuple(qpos.tolist())))
     if found:
-        shown = ", ".join(printable(name) for name, _ in found[:8]) + (", ..." if len(found) > 8 else "")
-        warnings.warn(
-            f"{robot.label}: MJCF keyframes are not the start, MuJoCo's qpos0 is ({shown}); "
-            "default_configuration(keyframe=NAME) gives a keyframe's qpos as q (its qvel, act, ctrl are not read)",
-            RobodynWarning,
-            stacklevel=5,
+        _start_line(
+            robot.label,
+            "keyframes are not the start, MuJoCo's qpos0 is",
+            [name for name, _ in found],
+            "; default_configuration(keyframe=NAME) gives a keyframe's qpos as q (its qvel, act, ctrl are not read)",
         )
     return tuple(found)
+
+
+def _start_line(label: str, text: str, names: list[str], tail: str = "") -> None:
+    """One warning line about the robot's start (never refused: the start is no model)."""
+    shown = ", ".join(printable(name) for name in names[:8]) + (", ..." if len(names) > 8 else "")
+    warnings.warn(f"{label}: MJCF {text} ({shown}){tail}", RobodynWarning, stacklevel=6)
 
 
 def _report(robot: MjcfRobot, label: str, strict: bool) -> None:

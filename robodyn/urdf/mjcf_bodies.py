@@ -137,6 +137,8 @@ def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: st
     ET.SubElement(joint, "axis", xyz=text(axis))
     effort = joint_effort(robot, where, name, values)
     limit = {} if math.isinf(effort) else {"effort": repr(effort)}
+    if not lower <= ref <= upper:  # MuJoCo starts it outside its range; robodyn at the nearest limit
+        robot.outside.append(name)
     if math.isfinite(lower):
         ET.SubElement(joint, "limit", {"lower": repr(lower - ref), "upper": repr(upper - ref), **limit})
     elif urdf_type == "prismatic":  # Bullet's encoding of no position limit, marked as robodyn's own (no warning)

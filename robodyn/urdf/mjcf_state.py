@@ -110,6 +110,8 @@ class MjcfRobot:
         base_pose: The free top body's placement in the world (its ``<body pos>`` and
             orientation: MuJoCo's ``qpos0``), position in [m] then quaternion x, y, z, w
             (robodyn's ``q``), or ``None``.
+        outside: The joints whose ``qpos0`` (their ``ref``) lies outside their range: the
+            robot's start has them at the nearest limit.
         ids: The next MuJoCo id of each kind (``"body"``, ``"joint"``, ``"site"``): an
             unnamed element is named after its id in MuJoCo's order (world body = 0).
     """
@@ -134,6 +136,7 @@ class MjcfRobot:
     plane: dict[str, str] | None = None
     colliding: list[dict[str, str]] = field(default_factory=list)
     base_pose: tuple[float, ...] | None = None
+    outside: list[str] = field(default_factory=list)
     ids: dict[str, int] = field(default_factory=lambda: {"body": 1, "joint": 0, "site": 0})
 
     def next_id(self, kind: str) -> int:

@@ -249,3 +249,18 @@ def test_keyframes_are_reported_in_one_line_and_each_is_a_start_on_request(tmp_p
         mujoco.MjModel.from_xml_path(str(path))
     with pytest.raises(robodyn.URDFError, match=r"keyframe 'crouch': qpos has 10 numbers, more than the model's 9"):
         robodyn.load(path)
+
+
+def test_a_joint_whose_ref_is_outside_its_range_starts_at_the_nearest_limit_said_in_one_line(tmp_path):
+    """Gymnasium's ant: MuJoCo starts its ankles at 0, outside their 30°–70°; robodyn's start
+    is MuJoCo's qpos0 clipped into the ranges (a start inside the limits it enforces)."""
+    path = tmp_path / "outside.xml"
+    path.write_text(START.replace("ORIENTATION", "").replace('ref="0.4" range="-1 1.5"', 'ref="0.4" range="0.6 1.5"'))
+    with pytest.warns(robodyn.RobodynWarning, match=r"qpos0 \(ref\) is outside their range start at the nearest limit \(hinge\)"):
+        robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    qpos = robot.to_mujoco(robot.default_configuration())[0]
+    hinge = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hinge")]
+    assert model.qpos0[hinge] == pytest.approx(0.4) and qpos[hinge] == pytest.approx(0.6, abs=1e-15)
+    qpos[hinge] = model.qpos0[hinge]
+    assert np.abs(qpos - model.qpos0).max() < 1e-15
