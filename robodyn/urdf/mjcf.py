@@ -136,6 +136,10 @@ def read_keyframes(root: ET.Element, robot: MjcfRobot) -> tuple[tuple[str, tuple
     ``qpos0``; the free joint's quaternion normalised); reported in one line: they are
     not the start.
 
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The reading's state, its bodies and joints read.
+
     Raises:
         URDFError: A ``qpos`` of more than MuJoCo's ``nq`` numbers, or not finite ones.
     """

@@ -140,8 +140,12 @@ class MjcfRobot:
     ids: dict[str, int] = field(default_factory=lambda: {"body": 1, "joint": 0, "site": 0})
 
     def next_id(self, kind: str) -> int:
-        """MuJoCo's id of the next ``kind`` (``"body"``, ``"joint"``, ``"site"``) in its
-        order (bodies depth first from the world's 0; joints and sites body by body)."""
+        """MuJoCo's id of the next element of a kind in its order (bodies depth first from
+        the world's 0; joints and sites body by body).
+
+        Args:
+            kind: ``"body"``, ``"joint"`` or ``"site"``.
+        """
         self.ids[kind] += 1
         return self.ids[kind] - 1
 

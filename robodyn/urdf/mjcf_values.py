@@ -107,8 +107,11 @@ def quaternion_matrix(label: str, where: str, wxyz: np.ndarray) -> np.ndarray:
 
 
 def matrix_quaternion(rotation: np.ndarray) -> np.ndarray:
-    """The unit quaternion **x, y, z, w** (robodyn's order, ``w >= 0``) of a rotation matrix
-    (3, 3)."""
+    """The unit quaternion **x, y, z, w** (robodyn's order, ``w >= 0``) of a rotation.
+
+    Args:
+        rotation: A rotation matrix, shape (3, 3).
+    """
     trace = float(np.trace(rotation))
     if trace > 0:
         s = 2.0 * math.sqrt(1.0 + trace)
