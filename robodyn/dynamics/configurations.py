@@ -1,4 +1,4 @@
-"""Configurations of a robot: its joint limits, and the neutral, default and random ``q``.
+"""Configurations of a robot: its joint limits, and the neutral, default (the start) and random ``q``.
 
 Functions of a :class:`~robodyn.dynamics.handle.ModelHandle` and the robot's degrees of
 freedom (:attr:`robodyn.Robot.dofs`, which own the limits); :class:`robodyn.Robot` has them
@@ -42,22 +42,36 @@ def upper_limits(dofs: Sequence[Dof]) -> np.ndarray:
 
 
 def neutral_configuration(handle: ModelHandle) -> np.ndarray:
-    """The neutral configuration (zero joint positions, identity base), shape (nq,).
+    """Pinocchio's neutral configuration (zero joint positions, the base at the origin,
+    unrotated), shape (nq,).
 
-    It may lie outside the joint limits (panda's joint 4 lives in [-3.07, -0.07] rad);
-    :func:`default_configuration` does not.
+    It may lie outside the joint limits (panda's joint 4 lives in [-3.07, -0.07] rad) and
+    ignores where the file puts a floating base; :func:`default_configuration` (the
+    robot's start) does neither.
     """
     return pin.neutral(handle.model)
 
 
-def default_configuration(handle: ModelHandle, dofs: Sequence[Dof]) -> np.ndarray:
-    """The neutral configuration clipped into the joint position limits, shape (nq,).
+def default_configuration(handle: ModelHandle, dofs: Sequence[Dof], base_pose: Sequence[float] | None = None) -> np.ndarray:
+    """The robot's start: the file's base pose, the joints at zero clipped into their
+    position limits, shape (nq,).
 
     The initial state of simulations and motions when none is given: every joint at
     zero, or at its nearest limit when zero is outside them (placeholder limits, see
-    :func:`random_configuration`, are ignored).
+    :func:`random_configuration`, are ignored); a floating base where the file puts it
+    (MJCF: the free body's ``<body pos quat>``, so that with the joints' ``ref`` as
+    robodyn's zero this is MuJoCo's ``qpos0`` where it lies within the limits), else at
+    the origin, unrotated.
+
+    Args:
+        handle: The robot's model handle.
+        dofs: Its degrees of freedom (:attr:`robodyn.Robot.dofs`).
+        base_pose: The floating base's start, position in [m] then quaternion x, y, z, w
+            (:attr:`robodyn.urdf.sources.URDFSource.base_pose`); ignored for a fixed base.
     """
     q = neutral_configuration(handle)
+    if handle.floating_base and base_pose is not None:
+        q[:7] = base_pose
     lower, upper = physical_limits(dofs)
     start = handle.nq - lower.size
     q[start:] = np.clip(q[start:], lower, upper)

@@ -6,15 +6,19 @@ centroidal quantities: thin methods over :mod:`~robodyn.dynamics.kinematics`,
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from robodyn.dynamics import centroidal, configurations, energies, kinematics
+from robodyn.common.text import quoted
+from robodyn.dynamics import centroidal, configurations, energies, kinematics, mujoco_state
+from robodyn.exceptions import InputError
 
 if TYPE_CHECKING:
     from robodyn.dynamics.dofs import Dof
     from robodyn.dynamics.handle import ModelHandle
+    from robodyn.dynamics.robot import Robot
+    from robodyn.urdf.source_type import URDFSource
 
 
 class RobotKinematics:
@@ -22,6 +26,7 @@ class RobotKinematics:
 
     handle: ModelHandle
     dofs: tuple[Dof, ...]
+    source: URDFSource
 
     # ----------------------------------------------------------------------------------
     # Energies (robodyn.dynamics.energies)
@@ -100,13 +105,31 @@ class RobotKinematics:
         return configurations.upper_limits(self.dofs)
 
     def neutral_configuration(self) -> np.ndarray:
-        """The neutral configuration (zero joint positions, identity base), shape (nq,)."""
+        """Pinocchio's neutral configuration (zero joint positions, the base at the origin,
+        unrotated), shape (nq,); the robot's start is :meth:`default_configuration`."""
         return configurations.neutral_configuration(self.handle)
 
-    def default_configuration(self) -> np.ndarray:
-        """The neutral configuration clipped into the joint position limits, shape (nq,)
-        (:func:`robodyn.dynamics.configurations.default_configuration`)."""
-        return configurations.default_configuration(self.handle, self.dofs)
+    def default_configuration(self, *, keyframe: str | None = None) -> np.ndarray:
+        """The robot's start, shape (nq,): a floating base where the file puts it (MJCF:
+        the free body's pose, MuJoCo's ``qpos0``), the joints at zero clipped into their
+        position limits; every default start (simulations, contact runs, the CLI's
+        ``q0``, the viewer) is this one
+        (:func:`robodyn.dynamics.configurations.default_configuration`).
+
+        Args:
+            keyframe: The name of one of the MJCF file's ``<keyframe>`` s: its ``qpos``
+                as robodyn's ``q`` (:meth:`from_mujoco`; unclipped, as MuJoCo starts it).
+
+        Raises:
+            InputError: If the file has no keyframe of that name.
+        """
+        if keyframe is None:
+            return configurations.default_configuration(self.handle, self.dofs, self.source.base_pose)
+        keys = dict(self.source.keyframes)
+        if keyframe not in keys:
+            known = ", ".join(quoted(name) for name in keys) or "none"
+            raise InputError("keyframe", f"one of the file's MJCF keyframes ({known})", quoted(keyframe))
+        return mujoco_state.from_mujoco(cast("Robot", self), np.array(keys[keyframe]))[0]
 
     def physical_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Position limits of the joints (floating base excluded), placeholders and empty

@@ -48,15 +48,15 @@ class SimulationError(RobodynError):
         time: Simulation time of the last finite state, in [s].
         step: Index of the step that diverged.
         joint: Name of the first joint whose position or velocity is not finite.
+        advice: The likely cause and the remedy (default: a smaller ``dt``).
     """
 
-    def __init__(self, time: float, step: int, joint: str):
+    def __init__(self, time: float, step: int, joint: str, advice: str = "try a smaller dt"):
         self.time = time
         self.step = step
         self.joint = joint
-        super().__init__(
-            f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; try a smaller dt."
-        )
+        self.advice = advice
+        super().__init__(f"simulation diverged at t = {time:.6g} s (step {step}): joint {joint!r} is no longer finite; {advice}.")
 
 
 class ControllerFailedError(SimulationError):

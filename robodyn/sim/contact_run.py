@@ -170,7 +170,7 @@ def simulate_contact(
         controller: ``tau(t, q, v) -> (nv,)``, a constant (nv,), or ``None`` (no torque).
         duration: Simulated time in [s].
         dt: Step in [s].
-        q0: Initial configuration (nq,), default the neutral one.
+        q0: Initial configuration (nq,), default the robot's start (:meth:`~robodyn.Robot.default_configuration`).
         v0: Initial velocity (nv,), default zero.
         settings: Solver settings (:class:`~robodyn.sim.contact.ContactSettings`).
         limits: ``"enforce"``: the joints' position limits are one-sided rows of the contact
@@ -195,7 +195,7 @@ def simulate_contact(
     if steps > MAX_STEPS:
         raise InputError("duration", f"at most {MAX_STEPS} steps of dt", f"{steps} steps")
     found = contact_points(robot, contacts)
-    q = robot.neutral_configuration() if q0 is None else q0
+    q = robot.default_configuration() if q0 is None else q0
     if np.ndim(q) != 1:
         raise InputError("q0", "one configuration (a 1-D array)", f"shape {np.shape(q)}")
     (q, v), _ = robot.validate(q=q, v=np.zeros(robot.nv) if v0 is None else v0)

@@ -113,7 +113,7 @@ def run_simulation(
             robot's end effector; it must be a frame some joint moves); under the other
             controllers it only names the path a recording draws.
         q0: Initial configuration; default :meth:`Robot.default_configuration` (the
-            neutral one clipped into the joint limits).
+            file's base pose, the joints at zero clipped into their limits).
         duration, dt, integrator, limits, engine: As for :func:`robodyn.simulate` (the
             controller is evaluated at every integrator stage in either engine).
         posture: osc only: a configuration (nq) drawn toward in the task's null space.
@@ -210,12 +210,13 @@ def run_simulation(
 def _start(
     robot: Robot, controller: str, q0: list[float] | None, ground: Ground | None, contacts: Any
 ) -> tuple[np.ndarray, tuple[str, ...]]:
-    """The start configuration and its summary line: a floating robot on a ground with no
-    ``q0`` is dropped from 5 cm, not started in the floor (stand: placed by :func:`stand_law`)."""
+    """The start and its summary line (a floating robot in the floor is lifted 5 cm above it; stand: :func:`stand_law`)."""
     start = robot.default_configuration() if q0 is None else np.asarray(q0, dtype=float)
     if q0 is None and ground is not None and robot.floating_base and controller != "stand":
-        start, lift = start_above(robot, start, ground, contacts)
-        return start, (f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point 5 cm above it)",)
+        lifted, lift = start_above(robot, start, ground, contacts, clearance=0.05)
+        line = f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point 5 cm above it)"
+        if lift > 0.05:  # a contact point in the ground (else the file's start, as MuJoCo's)
+            return lifted, (line,)
     return start, ()
 
 

@@ -64,6 +64,7 @@ from robodyn.sim.plan import (
     external_torques,
     plan,
 )
+from robodyn.sim.stability import largest_stable_step
 from robodyn.trajectory import Trajectory
 
 __all__ = [
@@ -115,12 +116,14 @@ def simulate(run_plan: RunPlan) -> Trajectory:
         FrameError: An external wrench on a frame that is unknown or that no joint moves.
         SingularMassMatrixError: If the mass matrix is singular (no motion is defined).
         SimulationError: If the state stops being finite (``ControllerFailedError``: if
-            the controller's own numerics fail, e.g. a singular solve on a blown-up state).
+            the controller's own numerics fail, e.g. a singular solve on a blown-up state);
+            when ``dt`` was above the largest stable step at the start, it names that step,
+            the joint and the cause (gains, damping on light links).
 
     Warns:
         JointLimitWarning: With ``limits="warn"``, when a limit was broken.
     """
-    return engines.run(run_plan)[0]
+    return _run(run_plan)[0]
 
 
 @_from_plan(plan)
@@ -128,7 +131,25 @@ def simulate_run(run_plan: RunPlan) -> tuple[Trajectory, EngineRun]:
     """:func:`simulate`, also saying which engine ran, why, and the loop's and the
     compilation's wall-clock times (:class:`EngineRun`). Arguments, errors and warnings
     are :func:`simulate`'s."""
-    return engines.run(run_plan)
+    return _run(run_plan)
+
+
+def _run(run_plan: RunPlan) -> tuple[Trajectory, EngineRun]:
+    """:func:`robodyn.sim.engine.run`; a divergence from a step above the largest stable one
+    at the start is re-raised naming it, its joint and its cause (gains, damping on light
+    links: :func:`robodyn.sim.stability.largest_stable_step`)."""
+    try:
+        return engines.run(run_plan)
+    except SimulationError as error:
+        found = largest_stable_step(run_plan) if type(error) is SimulationError else None
+        if found is None or run_plan.dt <= found[0]:
+            raise
+        limit, joint, cause = found
+        advice = (
+            f"dt = {run_plan.dt:.3g} s is above the largest stable step at the start, about {limit:.2g} s (its fastest "
+            f"mode, mostly joint {joint!r}, set by {cause}): use dt <= {limit:.2g} s"
+        )
+        raise SimulationError(error.time, error.step, error.joint, advice) from None
 
 
 def choose_engine(
@@ -142,7 +163,7 @@ def choose_engine(
     joint_friction: bool = False,
 ) -> tuple[Literal["pinocchio", "compiled"], str]:
     """The engine ``engine="auto"`` runs for a robot and controller, and why
-    (:func:`robodyn.sim.engine.choose` of their plan, at the neutral configuration).
+    (:func:`robodyn.sim.engine.choose` of their plan, at the robot's start).
 
     Args:
         robot: The plant.
@@ -150,7 +171,7 @@ def choose_engine(
         external, limits, observer, joint_friction: As for :func:`simulate`.
         every: Steps between two samples of a held controller (``None``: every stage).
     """
-    state = (robot.neutral_configuration(), np.zeros(robot.nv))
+    state = (robot.default_configuration(), np.zeros(robot.nv))
     period = {"control_period": float(every)} if every is not None and controller is not None else {}
     return engines.choose(
         plan(robot, *state, 0.0, 1.0, controller=controller, external=external, limits=limits,  # type: ignore[arg-type]

@@ -20,16 +20,20 @@ The reading, as MuJoCo's compiler does it (docs/robot-files.md states every rule
   ``childclass``);
 - orientations ``quat`` (**w x y z**), ``axisangle``, ``euler``, ``xyaxes``, ``zaxis``;
 - bodies: a body's joints act in order at their ``pos`` (a chain through massless links);
-  a body without joints is welded; ``hinge``, ``slide`` and a ``free`` top body; a joint's
-  ``ref`` is the offset q = qpos − ref (the body in its modelled pose at q = 0, limits
-  shifted); ``<site>`` s are frames (``site:NAME`` where a body has the name; a
+  a body without joints is welded; ``hinge``, ``slide`` and a ``free`` top body (its
+  ``<body pos quat>`` the robot's start, :attr:`~robodyn.urdf.sources.URDFSource.base_pose`,
+  as MuJoCo's ``qpos0``); a joint's ``ref`` is the offset q = qpos − ref (the body in its
+  modelled pose at q = 0, limits shifted); unnamed bodies, joints and sites are named
+  ``bodyN``, ``jointN``, ``siteN`` after MuJoCo's ids (world body 0); ``<site>`` s are frames (``site:NAME`` where a body has the name; a
   ``fromto`` placed as MuJoCo places it; the world's on the fixed base);
 - ``<inertial>`` or the inertia of the body's solid geoms (:mod:`robodyn.urdf.geom_inertia`);
 - geoms that collide with the world's plane (``contype`` / ``conaffinity``) as
   ``<collision>`` s, the first ``<worldbody>`` plane as the robot's ground
   (:attr:`~robodyn.urdf.sources.URDFSource.ground`, :mod:`~robodyn.urdf.mjcf_geoms`);
 - ``<option gravity>`` / ``<flag gravity>``, actuators (effort limits, the actuated set),
-  ``<equality connect/weld>`` records (:mod:`~robodyn.urdf.mjcf_physics`).
+  ``<equality connect/weld>`` records (:mod:`~robodyn.urdf.mjcf_physics`);
+- ``<keyframe>`` s kept (:attr:`~robodyn.urdf.sources.URDFSource.keyframes`, a start on
+  request) and reported in one line: they are not the start.
 
 Values are read as MuJoCo validates them; bodies and degrees of freedom are counted while
 parsing (:class:`~robodyn.urdf.mjcf_state.Census`). Refused with one sentence: ``ball``
@@ -60,8 +64,9 @@ from robodyn.urdf.mjcf_includes import expand_includes
 from robodyn.urdf.mjcf_physics import read_actuators, read_equalities, read_option
 from robodyn.urdf.mjcf_settings import read_compiler, read_defaults
 from robodyn.urdf.mjcf_state import DEFAULT_MAX_DOF, Census, MjcfRobot
+from robodyn.urdf.mjcf_values import number, unit
 from robodyn.urdf.source_type import URDFSource
-from robodyn.urdf.xmltext import parse_xml
+from robodyn.urdf.xmltext import parse_xml, split_numbers
 
 if TYPE_CHECKING:
     from robodyn.urdf.packages import PackageLookup
@@ -105,6 +110,9 @@ def mjcf_source(
     robot = read_mjcf(root, source.label, base_dir)
     ground = plane_ground(robot)
     _report(robot, source.label, strict)
+    keyframes = read_keyframes(root, robot)
+    if robot.outside:
+        _start_line(source.label, "joints whose qpos0 (ref) is outside their range start at the nearest limit", robot.outside)
     return replace(
         source,
         text=ET.tostring(robot.urdf, encoding="unicode"),
@@ -117,7 +125,56 @@ def mjcf_source(
         actuated=None if robot.actuated is None else tuple(sorted(robot.actuated)),
         joint_offsets=tuple(robot.refs.items()),
         ground=ground,
+        base_pose=robot.base_pose,
+        keyframes=keyframes,
     )
+
+
+def read_keyframes(root: ET.Element, robot: MjcfRobot) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    """The ``<keyframe>`` s' ``qpos`` in MuJoCo's order by name (an unnamed key ``keyN``, N
+    its MuJoCo id), as MuJoCo completes them (the values given first, the rest
+    ``qpos0``; the free joint's quaternion normalised); reported in one line: they are
+    not the start.
+
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The reading's state, its bodies and joints read.
+
+    Raises:
+        URDFError: A ``qpos`` of more than MuJoCo's ``nq`` numbers, or not finite ones.
+    """
+    order = [node.get("name", "") for node in robot.urdf.findall("joint") if node.get("type") != "fixed"]
+    qpos0 = [robot.refs.get(name, 0.0) for name in order]
+    if robot.floating:
+        x, y, z, qx, qy, qz, qw = robot.base_pose or (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+        qpos0 = [x, y, z, qw, qx, qy, qz, *qpos0]
+    found = []
+    for index, key in enumerate(key for section in root.findall("keyframe") for key in section.findall("key")):
+        name = key.get("name") or f"key{index}"
+        where = f"keyframe {printable(name)!r}: qpos"
+        given = [number(robot.label, where, token) for token in split_numbers(key.get("qpos", ""))]
+        if len(given) > len(qpos0):
+            raise URDFError(
+                robot.label, f"{where} has {len(given)} numbers, more than the model's {len(qpos0)} (as MuJoCo refuses)"
+            )
+        qpos = np.array(given + qpos0[len(given) :])
+        if robot.floating:
+            qpos[3:7] = unit(robot.label, where, qpos[3:7])
+        found.append((name, tuple(qpos.tolist())))
+    if found:
+        _start_line(
+            robot.label,
+            "keyframes are not the start, MuJoCo's qpos0 is",
+            [name for name, _ in found],
+            "; default_configuration(keyframe=NAME) gives a keyframe's qpos as q (its qvel, act, ctrl are not read)",
+        )
+    return tuple(found)
+
+
+def _start_line(label: str, text: str, names: list[str], tail: str = "") -> None:
+    """One warning line about the robot's start (never refused: the start is no model)."""
+    shown = ", ".join(printable(name) for name in names[:8]) + (", ..." if len(names) > 8 else "")
+    warnings.warn(f"{label}: MJCF {text} ({shown}){tail}", RobodynWarning, stacklevel=6)
 
 
 def _report(robot: MjcfRobot, label: str, strict: bool) -> None:
@@ -184,6 +241,7 @@ def _read_world(root: ET.Element, robot: MjcfRobot) -> None:
     assert world is not None  # it has bodies
     if free:
         robot.floating = True
+        robot.ids["site"] += len(world.findall("site"))  # MuJoCo's ids count the world's sites first
         read_body(robot, bodies[0], None, np.eye(4), "main")
         for index, site in enumerate(world.findall("site")):
             robot.note(

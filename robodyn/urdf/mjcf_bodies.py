@@ -17,7 +17,20 @@ from robodyn.exceptions import URDFError
 from robodyn.urdf.mjcf_geoms import write_link
 from robodyn.urdf.mjcf_physics import joint_effort
 from robodyn.urdf.mjcf_state import MjcfRobot, attributes
-from robodyn.urdf.mjcf_values import AUTO, BOOLEAN, angle, floats, keyword, number, pose, text, translation, unit, write_origin
+from robodyn.urdf.mjcf_values import (
+    AUTO,
+    BOOLEAN,
+    angle,
+    floats,
+    keyword,
+    matrix_quaternion,
+    number,
+    pose,
+    text,
+    translation,
+    unit,
+    write_origin,
+)
 
 #: MuJoCo's ``mjMINVAL``: the least mass of a moving body.
 MIN_MASS = 1e-15
@@ -45,13 +58,17 @@ def read_body(robot: MjcfRobot, body: ET.Element, parent: str | None, placement:
     """
     childclass = body.get("childclass") or childclass
     values = attributes(robot, body, childclass)
-    name = robot.unique(body.get("name") or f"body{len(robot.names)}", "an MJCF body")
+    body_id = robot.next_id("body")  # an unnamed body is named after MuJoCo's id
+    name = robot.unique(body.get("name") or f"body{body_id}", "an MJCF body")
     where = f'body "{name}"'
     if keyword(robot.label, where, "mocap", values.get("mocap", "false"), BOOLEAN) == "true":
         raise URDFError(robot.label, f"{where}: mocap bodies are not read by robodyn")
     if number(robot.label, f"{where}: gravcomp", values.get("gravcomp", "0")) != 0:
         robot.note("body gravcomp settings", name)
     frame = placement @ pose(robot, where, values) if parent is not None else np.eye(4)
+    if parent is None:  # a free body starts where the file puts it (MuJoCo's qpos0)
+        start = pose(robot, where, values)
+        robot.base_pose = (*start[:3, 3].tolist(), *matrix_quaternion(start[:3, :3]).tolist())
     link, offset = _read_joints(robot, body, name, parent, frame, childclass)
     robot.offsets[name] = offset
     mass = write_link(robot, body, name, link, offset, childclass)
@@ -73,10 +90,11 @@ def _read_joints(
         raise URDFError(robot.label, f'body "{name}": a free body with more joints is not read by robodyn')
     if parent is not None and any(node.tag == "freejoint" for node in joints):
         raise URDFError(robot.label, f'body "{name}": a free joint is only read on the top body (a floating base)')
+    ids = {id(node): robot.next_id("joint") for node in joints}  # MuJoCo's joint ids, the free joint's too
     previous, previous_pos = parent, np.zeros(3)
     for index, node in enumerate(moving):
         values = attributes(robot, node, childclass)
-        joint_name = node.get("name") or f"{name}_joint{index}"
+        joint_name = node.get("name") or f"joint{ids[id(node)]}"
         position = floats(robot.label, f'joint "{joint_name}"', values.get("pos", "0 0 0"), 3)
         link_name = name if index == len(moving) - 1 else robot.unique(f"{name}__{joint_name}", "a link between joints")
         origin = frame @ translation(position) if index == 0 else translation(position - previous_pos)
@@ -119,6 +137,8 @@ def _write_joint(robot: MjcfRobot, name: str, values: dict[str, str], parent: st
     ET.SubElement(joint, "axis", xyz=text(axis))
     effort = joint_effort(robot, where, name, values)
     limit = {} if math.isinf(effort) else {"effort": repr(effort)}
+    if not lower <= ref <= upper:  # MuJoCo starts it outside its range; robodyn at the nearest limit
+        robot.outside.append(name)
     if math.isfinite(lower):
         ET.SubElement(joint, "limit", {"lower": repr(lower - ref), "upper": repr(upper - ref), **limit})
     elif urdf_type == "prismatic":  # Bullet's encoding of no position limit, marked as robodyn's own (no warning)

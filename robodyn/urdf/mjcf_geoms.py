@@ -71,7 +71,7 @@ def write_link(robot: MjcfRobot, body: ET.Element, name: str, link: ET.Element, 
 def write_sites(robot: MjcfRobot, body: ET.Element, name: str, shift: np.ndarray, childclass: str) -> None:
     """The body's sites as frames: massless links on fixed joints, named as the site, or
     ``site:NAME`` where a body has the name (MuJoCo's bodies and sites are separate
-    namespaces; robodyn's links are one).
+    namespaces; robodyn's links are one); an unnamed one ``siteN``, N its MuJoCo id.
 
     Args:
         robot: The reading's state.
@@ -80,9 +80,10 @@ def write_sites(robot: MjcfRobot, body: ET.Element, name: str, shift: np.ndarray
         shift: The body's frame in its link's, 4×4.
         childclass: The default class in force.
     """
-    for index, site in enumerate(body.findall("site")):
+    for site in body.findall("site"):
         values = attributes(robot, site, childclass)
-        given = site.get("name") or f"{name}_site{index}"
+        site_id = robot.next_id("site")  # an unnamed site is named after MuJoCo's id
+        given = site.get("name") or f"site{site_id}"
         site_name = robot.unique(f"site:{given}" if given in robot.bodies else given, "an MJCF site")
         joint = ET.SubElement(robot.urdf, "joint", name=robot.unique(f"{site_name}_site", "a site's joint"), type="fixed")
         write_origin(joint, shift @ _site_pose(robot, f'site "{given}"', values))

@@ -107,6 +107,13 @@ class MjcfRobot:
         plane: The attributes of ``<worldbody>``'s first plane geom (its defaults under
             them), the robot's ground, or ``None``.
         colliding: The attributes of each geom written as a ``<collision>``.
+        base_pose: The free top body's placement in the world (its ``<body pos>`` and
+            orientation: MuJoCo's ``qpos0``), position in [m] then quaternion x, y, z, w
+            (robodyn's ``q``), or ``None``.
+        outside: The joints whose ``qpos0`` (their ``ref``) lies outside their range: the
+            robot's start has them at the nearest limit.
+        ids: The next MuJoCo id of each kind (``"body"``, ``"joint"``, ``"site"``): an
+            unnamed element is named after its id in MuJoCo's order (world body = 0).
     """
 
     label: str
@@ -128,6 +135,19 @@ class MjcfRobot:
     equalities: tuple[EqualityRecord, ...] = ()
     plane: dict[str, str] | None = None
     colliding: list[dict[str, str]] = field(default_factory=list)
+    base_pose: tuple[float, ...] | None = None
+    outside: list[str] = field(default_factory=list)
+    ids: dict[str, int] = field(default_factory=lambda: {"body": 1, "joint": 0, "site": 0})
+
+    def next_id(self, kind: str) -> int:
+        """MuJoCo's id of the next element of a kind in its order (bodies depth first from
+        the world's 0; joints and sites body by body).
+
+        Args:
+            kind: ``"body"``, ``"joint"`` or ``"site"``.
+        """
+        self.ids[kind] += 1
+        return self.ids[kind] - 1
 
     def note(self, kind: str, name: str) -> None:
         """Report ``name`` under ``kind``, a kind of what the dynamics leaves out (one

@@ -106,6 +106,33 @@ def quaternion_matrix(label: str, where: str, wxyz: np.ndarray) -> np.ndarray:
     )
 
 
+def matrix_quaternion(rotation: np.ndarray) -> np.ndarray:
+    """The unit quaternion **x, y, z, w** (robodyn's order, ``w >= 0``) of a rotation.
+
+    Args:
+        rotation: A rotation matrix, shape (3, 3).
+    """
+    trace = float(np.trace(rotation))
+    if trace > 0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        w, x, y, z = (
+            s / 4,
+            (rotation[2, 1] - rotation[1, 2]) / s,
+            (rotation[0, 2] - rotation[2, 0]) / s,
+            (rotation[1, 0] - rotation[0, 1]) / s,
+        )
+    else:
+        i = int(np.argmax(np.diag(rotation)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(max(1.0 + rotation[i, i] - rotation[j, j] - rotation[k, k], 0.0))
+        vector = np.empty(3)
+        vector[i], vector[j], vector[k] = s / 4, (rotation[j, i] + rotation[i, j]) / s, (rotation[k, i] + rotation[i, k]) / s
+        w, (x, y, z) = (rotation[k, j] - rotation[j, k]) / s, vector
+    quaternion = np.array([x, y, z, w])
+    quaternion /= np.linalg.norm(quaternion)
+    return -quaternion if quaternion[3] < 0 else quaternion
+
+
 def _euler(robot: MjcfRobot, angles: np.ndarray) -> np.ndarray:
     rotation = np.eye(3)
     for axis_name, value in zip(robot.compiler.eulerseq, angles, strict=True):

@@ -41,6 +41,13 @@ class URDFSource:
             ``(height, normal, friction)``, the height in [m] of the plane along world
             ``z`` at ``x = y = 0``, its unit normal and the Coulomb coefficient; ``None``:
             the file has none (:func:`robodyn.sim.ground.resolve_ground`).
+        base_pose: Where the file puts a floating base at the start (MJCF: the free top
+            body's ``<body pos quat>``, MuJoCo's ``qpos0``): position in [m] then quaternion
+            x, y, z, w, robodyn's ``q[:7]`` (:meth:`robodyn.Robot.default_configuration`);
+            ``None``: at the origin, unrotated.
+        keyframes: ``(name, qpos)`` of the file's MJCF ``<keyframe>`` s, ``qpos`` in
+            MuJoCo's order, completed as MuJoCo completes it; a start only when asked for
+            (:meth:`robodyn.Robot.default_configuration` ``keyframe=``).
     """
 
     text: str
@@ -55,6 +62,8 @@ class URDFSource:
     actuated: tuple[str, ...] | None = None
     joint_offsets: tuple[tuple[str, float], ...] = ()
     ground: tuple[float, tuple[float, float, float], float] | None = None
+    base_pose: tuple[float, ...] | None = None
+    keyframes: tuple[tuple[str, tuple[float, ...]], ...] = ()
 
     @property
     def mesh_context(self) -> dict:

@@ -119,12 +119,12 @@ class LiveViewer:
             self._socket.recv()
 
     def show(self, robot: Robot, trajectory: Trajectory | None = None, *, fps: float = 30.0, target=None, frame=None) -> None:
-        """Draw the robot (at its neutral configuration, or playing the trajectory) with its
+        """Draw the robot (at its start, :meth:`~robodyn.Robot.default_configuration`, or playing the trajectory) with its
         task: ground grid, ``target`` marker (X,Z or X,Y,Z in [m]) and the frame's path."""
         from robodyn.viz.recording import motion_commands
 
         if trajectory is None:
-            q = robot.neutral_configuration()[None]
+            q = robot.default_configuration()[None]
             zeros = np.zeros((1, robot.nv))
             trajectory = Trajectory(np.zeros(1), q, zeros, zeros, zeros, robot.joint_names, robot.name)
         commands, _duration, _placeholders = motion_commands(robot, trajectory, fps=fps, target=target, frame=frame)

@@ -102,3 +102,15 @@ def test_the_readmes_ground_commands_run_from_the_repositorys_root(capsys, monke
     for command in commands[:2]:
         status, text, err = run(capsys, *command)
         assert status == 0 and "contacts active at the end" in text, err
+
+
+def test_a_divergence_from_damping_on_a_light_body_is_warned_and_explained_on_the_command_line(capsys, tmp_path):
+    from tests.sim.test_simulation import LIGHT_FINGER
+
+    path = tmp_path / "finger.xml"
+    path.write_text(LIGHT_FINGER)
+    status, _, err = run(capsys, "simulate", str(path), "--duration", "0.1")
+    warning, error = err.strip().splitlines()[-2:]
+    assert status == 2 and "largest stable step" in warning and "'fingertip'" in warning
+    assert error.startswith("robodyn: error: simulation diverged") and "damping on light links" in error
+    assert "use dt <= " in error

@@ -186,3 +186,20 @@ def test_a_two_value_target_is_refused_for_an_arm_that_moves_along_y():
     rp_arm = robodyn.load("rp_arm")
     _, summary = run_simulation(rp_arm, controller="task-space", target=[0.7, 0.7], duration=0.01)
     assert summary.task is not None and summary.task.target[1] == 0.0
+
+
+def test_a_floating_mjcf_robot_above_its_files_plane_starts_where_the_file_puts_it(tmp_path):
+    """As MuJoCo does (its qpos0), not moved to 5 cm above it; the same box at the origin, half
+    in the floor (the negative control), is lifted to 5 cm above it, said in the summary."""
+    box = '<body name="box" pos="0.1 0.2 0.4" euler="0 0 30"><freejoint/><geom type="box" size="0.1 0.1 0.1" mass="2"/></body>'
+    path = tmp_path / "box.xml"
+    path.write_text(f'<mujoco><worldbody><geom type="plane" size="5 5 0.1"/>{box}</worldbody></mujoco>')
+    robot = robodyn.load(path)
+    trajectory, summary = run_simulation(robot, ground="file", duration=0.002)
+    np.testing.assert_array_equal(trajectory.q[0], robot.default_configuration())
+    assert trajectory.q[0][2] == 0.4 and not any(line.startswith("start:") for line in summary.ground)
+    path.write_text(
+        f'<mujoco><worldbody><geom type="plane" size="5 5 0.1"/>{box.replace("0.1 0.2 0.4", "0 0 0")}</worldbody></mujoco>'
+    )
+    trajectory, summary = run_simulation(robodyn.load(path), ground="file", duration=0.002)
+    assert trajectory.q[0][2] == pytest.approx(0.15) and summary.ground[0].startswith("start: the base moved 0.15 m")

@@ -239,3 +239,29 @@ def test_unreadable_trajectory_is_a_robodyn_error(tmp_path):
     bad.write_text("not,a\ntrajectory,file\n")
     with pytest.raises(robodyn.RobodynError):
         Trajectory.load(bad)
+
+
+#: dm_control's manipulator finger in small: 7e-8 kg m² about its hinge, damping 0.01 N m s/rad
+#: (the rate b / I ≈ 1.4e5 1/s: RK4 needs dt under ~2e-5 s).
+LIGHT_FINGER = """<mujoco><compiler angle="radian"/><worldbody>
+<body name="hand" pos="0 0 1"><joint name="wrist" axis="0 1 0" damping="0.5"/>
+  <geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.02" mass="0.3"/>
+  <body name="finger" pos="0.2 0 0"><joint name="fingertip" axis="0 1 0" damping="0.01"/>
+    <inertial pos="0.005 0 0" mass="1e-3" diaginertia="4.5e-8 4.5e-8 4.5e-8"/></body>
+</body></worldbody></mujoco>"""
+
+
+def test_a_divergence_from_damping_on_a_light_body_names_the_cause_and_the_step_that_holds(tmp_path):
+    """The run is warned about at its start and its error says why and which step would do;
+    at that step it stays finite (the negative control: the default step diverges)."""
+    path = tmp_path / "finger.xml"
+    path.write_text(LIGHT_FINGER)
+    robot = robodyn.load(path)
+    q0 = np.array([0.3, 0.2])
+    warned = pytest.warns(robodyn.RobodynWarning, match=r"largest stable step .*'fingertip'.*damping on light links")
+    with warned, pytest.raises(SimulationError, match=r"diverged at .*damping on light links\): use dt <= \S+ s\.$") as error:
+        simulate(robot, q0, np.zeros(2), 0.1, 1e-3, limits="ignore")
+    step = float(str(error.value).rsplit("<= ", 1)[1].removesuffix(" s."))
+    assert 1e-5 < step < 3e-5
+    calm = simulate(robot, q0, np.zeros(2), 200 * step, step, limits="ignore")
+    assert np.isfinite(calm.q).all()

@@ -3,6 +3,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import pickle
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -136,3 +139,128 @@ def test_a_sphere_site_with_fromto_is_refused_as_mujoco_refuses_it_and_a_floatin
     )
     with pytest.warns(robodyn.RobodynWarning, match=r"<worldbody> sites beside a floating robot .*\(goal\)"):
         robodyn.load(floating)
+
+
+START = """<mujoco><compiler angle="radian"/><worldbody><geom type="plane" size="5 5 0.1"/>
+<body name="torso" pos="0.3 -0.2 1.1" ORIENTATION><freejoint name="root"/><geom type="box" size="0.2 0.1 0.05"/>
+  <body name="arm" pos="0.2 0 0"><joint name="hinge" axis="0 1 0" ref="0.4" range="-1 1.5"/><geom type="sphere" size="0.05"/>
+    <body name="slider" pos="0 0 -0.1"><joint name="slide" type="slide" axis="1 0 0" ref="-0.03" range="-0.1 0.1"/>
+      <geom type="sphere" size="0.03"/></body>
+  </body>
+</body></worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("orientation", ['quat="0.8 0.1 -0.3 0.5"', 'euler="0.4 -1.2 2.9"'])
+def test_the_default_configuration_is_mujocos_qpos0_the_free_body_where_the_file_puts_it(tmp_path, orientation):
+    """A free MJCF body starts at its ``<body pos quat>`` (Gymnasium's humanoid at 1.4 m), not
+    at the origin in the floor; its joints at their ``ref`` (robodyn's zero)."""
+    path = tmp_path / "start.xml"
+    path.write_text(START.replace("ORIENTATION", orientation))
+    robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    qpos = robot.to_mujoco(robot.default_configuration())[0]
+    sign = np.sign(qpos[3] * model.qpos0[3])  # q and -q are one rotation (MuJoCo's euler may give either)
+    assert np.abs(np.concatenate([qpos[:3], sign * qpos[3:7], qpos[7:]]) - model.qpos0).max() < 1e-15
+    assert np.abs(model.qpos0[3:7] - [1, 0, 0, 0]).max() > 0.1 and abs(model.qpos0[2]) > 1
+    neutral = robot.to_mujoco(robot.neutral_configuration())[0]  # the negative control: Pinocchio's neutral
+    assert np.abs(neutral[:7] - model.qpos0[:7]).max() > 1
+    for copy in (pickle.loads(pickle.dumps(robot)), robodyn.load(path, floating_base=True)):
+        np.testing.assert_array_equal(copy.default_configuration(), robot.default_configuration())
+    assert robodyn.load(path, floating_base=False).default_configuration().shape == (2,)
+
+
+def test_a_free_body_on_the_files_plane_starts_above_it_in_a_contact_run(tmp_path):
+    """The trap: the default start put the box 5 cm into the floor and the run was refused."""
+    path = tmp_path / "start.xml"
+    path.write_text(START.replace("ORIENTATION", ""))
+    robot = robodyn.load(path)
+    trajectory = robodyn.simulate(robot, robot.default_configuration(), np.zeros(robot.nv), 0.002, 1e-3, ground="file")
+    assert trajectory.q[0][2] == pytest.approx(1.1)
+    with pytest.raises(robodyn.InputError, match="below"):
+        robodyn.simulate(robot, robot.neutral_configuration(), np.zeros(robot.nv), 0.002, 1e-3, ground="file")
+
+
+UNNAMED = """<mujoco><worldbody><site pos="0 0 0.1"/>
+<body pos="0 0 1">ROOT<geom type="sphere" size="0.1"/><site pos="0.1 0 0"/>
+  <body name="named" pos="0.3 0 0"><joint axis="1 0 0"/><joint name="twist" axis="0 0 1"/><geom type="sphere" size="0.1"/>
+    <body pos="0 0.2 0"><joint type="slide" axis="0 1 0"/><geom type="sphere" size="0.1"/><site pos="0 0 0.3"/></body>
+  </body>
+  <body pos="-0.3 0 0.1"><geom type="sphere" size="0.1"/><site name="tip" pos="0.2 0 0"/><site pos="0 0.2 0"/></body>
+</body>
+OTHER</worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("floating", [False, True])
+def test_unnamed_bodies_joints_and_sites_are_named_after_mujocos_ids(tmp_path, floating):
+    """``bodyN``, ``jointN``, ``siteN``: N is MuJoCo's id (the world body 0; a free joint
+    counts, and so do a floating robot's world sites), each where MuJoCo puts it."""
+    other = '<body pos="1 0 0"><joint axis="0 0 1"/><geom type="sphere" size="0.1"/></body>'
+    text = UNNAMED.replace("ROOT", "<freejoint/>" if floating else '<joint axis="0 1 0"/>')
+    text = text.replace("OTHER", "" if floating else other)
+    path = tmp_path / "unnamed.xml"
+    path.write_text(text)
+    with pytest.warns(robodyn.RobodynWarning) if floating else contextlib.nullcontext():
+        robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    q = robot.random_configuration(np.random.default_rng(2))
+    data.qpos[:] = robot.to_mujoco(q)[0]
+    mujoco.mj_kinematics(model, data)
+    ours = placements(robot, q)
+    names = {"body": 0, "site": 0, "joint": 0}
+    for kind, count, where in (("body", model.nbody, data.xpos), ("site", model.nsite, data.site_xpos)):
+        for index in range(1 if kind == "body" else 0, count):
+            name = mujoco.mj_id2name(model, getattr(mujoco.mjtObj, f"mjOBJ_{kind.upper()}"), index) or f"{kind}{index}"
+            if name == "site0" and floating:
+                continue  # a floating robot's world site is reported, not a frame
+            names[kind] += name == f"{kind}{index}"
+            assert np.abs(ours.oMf[robot.frame_id(name)].translation - where[index]).max() < 1e-12, name
+    for index in range(1 if floating else 0, model.njnt):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, index) or f"joint{index}"
+        names["joint"] += name == f"joint{index}"
+        joint = robot.model.getJointId(name)  # its anchor before it moves, as MuJoCo's xanchor
+        anchor = ours.oMi[robot.model.parents[joint]] * robot.model.jointPlacements[joint]
+        assert np.abs(anchor.translation - data.xanchor[index]).max() < 1e-12, name
+    assert min(names.values()) >= 2  # the file has unnamed ones of each kind
+
+
+KEYS = """<keyframe><key name="crouch" qpos="0.1 0.2 0.5 0.6 0 0.8 0 0.9 -0.05"/><key time="1"/>
+<key name="short" qpos="0.6 0 0.8 0 0.9 -0.05"/></keyframe></mujoco>"""
+
+
+def test_keyframes_are_reported_in_one_line_and_each_is_a_start_on_request(tmp_path):
+    path = tmp_path / "keys.xml"
+    path.write_text(START.replace("ORIENTATION", "").replace("</mujoco>", KEYS))
+    """A short ``qpos`` is completed as MuJoCo completes it (its ``qpos0``, the quaternion normalised)."""
+    with pytest.warns(robodyn.RobodynWarning, match=r"keyframes are not the start, MuJoCo's qpos0 is \(crouch, key1, short\)"):
+        robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    for key in range(model.nkey):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_KEY, key) or f"key{key}"
+        qpos = robot.to_mujoco(robot.default_configuration(keyframe=name))[0]
+        assert np.abs(qpos - model.key_qpos[key]).max() < 1e-15, name
+    assert np.abs(model.key_qpos[0] - model.qpos0).max() > 0.5  # the named key is not the start
+    with pytest.raises(
+        robodyn.InputError, match=r"keyframe must be one of the file's MJCF keyframes \('crouch', 'key1', 'short'\)"
+    ):
+        robot.default_configuration(keyframe="stand")
+    path.write_text(START.replace("ORIENTATION", "").replace("</mujoco>", KEYS.replace(" -0.05", " -0.05 3", 1)))
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_path(str(path))
+    with pytest.raises(robodyn.URDFError, match=r"keyframe 'crouch': qpos has 10 numbers, more than the model's 9"):
+        robodyn.load(path)
+
+
+def test_a_joint_whose_ref_is_outside_its_range_starts_at_the_nearest_limit_said_in_one_line(tmp_path):
+    """Gymnasium's ant: MuJoCo starts its ankles at 0, outside their 30°–70°; robodyn's start
+    is MuJoCo's qpos0 clipped into the ranges (a start inside the limits it enforces)."""
+    path = tmp_path / "outside.xml"
+    path.write_text(START.replace("ORIENTATION", "").replace('ref="0.4" range="-1 1.5"', 'ref="0.4" range="0.6 1.5"'))
+    with pytest.warns(robodyn.RobodynWarning, match=r"qpos0 \(ref\) is outside their range start at the nearest limit \(hinge\)"):
+        robot = robodyn.load(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    qpos = robot.to_mujoco(robot.default_configuration())[0]
+    hinge = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hinge")]
+    assert model.qpos0[hinge] == pytest.approx(0.4) and qpos[hinge] == pytest.approx(0.6, abs=1e-15)
+    qpos[hinge] = model.qpos0[hinge]
+    assert np.abs(qpos - model.qpos0).max() < 1e-15

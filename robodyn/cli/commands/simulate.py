@@ -38,7 +38,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "must move); with any controller, the path --record and --plot draw",
     )
     _add_controller_options(parser)
-    parser.add_argument("--q0", type=vector, help="initial configuration (default: neutral, clipped into the joint limits)")
+    parser.add_argument("--q0", type=vector, help="start (default: joints at 0 in their limits, an MJCF free body at its pose)")
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
     parser.add_argument("--dt", type=float, default=1e-3, help=f"step, {RANGES['dt'].text()}, at most --duration (default 0.001)")
     parser.add_argument(
