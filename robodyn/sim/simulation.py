@@ -64,7 +64,7 @@ from robodyn.sim.plan import (
     external_torques,
     plan,
 )
-from robodyn.sim.stability import largest_stable_step
+from robodyn.sim.stability import largest_stable_step, round_step
 from robodyn.trajectory import Trajectory
 
 __all__ = [
@@ -147,7 +147,7 @@ def _run(run_plan: RunPlan) -> tuple[Trajectory, EngineRun]:
         limit, joint, cause = found
         advice = (
             f"dt = {run_plan.dt:.3g} s is above the largest stable step at the start, about {limit:.2g} s (its fastest "
-            f"mode, mostly joint {joint!r}, set by {cause}): use dt <= {limit:.2g} s"
+            f"mode, mostly joint {joint!r}, set by {cause}): use dt <= {limit:.2g} s (e.g. {round_step(limit):g} s)"
         )
         raise SimulationError(error.time, error.step, error.joint, advice) from None
 

@@ -21,6 +21,7 @@ microseconds instead of hundreds); otherwise the eigenvalues decide, as before.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -93,8 +94,20 @@ def step_warning(plan: RunPlan, law: Torque | None = None) -> str | None:
     return (
         f"{plan.robot.name}: dt = {plan.dt:.3g} s is above the largest stable step of its fastest mode at the start, "
         f"about {limit:.2g} s ({fastest:.3g} 1/s, mostly joint {joint!r}, set by {cause}): the run will likely "
-        f"diverge; use dt <= {limit:.2g} s"
+        f"diverge; use dt <= {limit:.2g} s (e.g. {round_step(limit):g} s)"
     )
+
+
+def round_step(limit: float) -> float:
+    """The largest step of the 1-2-5 series (…, 1e-5, 2e-5, 5e-5, 1e-4, …) at most ``limit``:
+    a step to type that divides the usual durations (1.2e-5 s would leave 0.1 s a fraction
+    of a step, which a run refuses).
+
+    Args:
+        limit: The largest stable step, in [s] (> 0).
+    """
+    decade = 10.0 ** math.floor(math.log10(limit))
+    return max(factor * decade for factor in (1.0, 2.0, 5.0) if factor * decade <= limit * (1 + 1e-12))
 
 
 def clearly_stable(plan: RunPlan, start: _Start | None = None) -> bool:

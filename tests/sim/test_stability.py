@@ -248,3 +248,16 @@ def test_a_controller_in_c_is_screened_by_its_twin_and_warned_about_by_itself(mo
                 robodyn.simulate(robot, q0, np.zeros(2), 0.01, 1e-3, controller=stiff, engine=engine, limits="ignore")
         said[engine] = [str(w.message) for w in caught if issubclass(w.category, RobodynWarning)]
     assert len(said["compiled"]) == 1 and said["compiled"] == said["pinocchio"] and "PDGravity gains" in said["compiled"][0]
+
+
+def test_the_suggested_step_is_the_largest_of_the_one_two_five_series_within_the_limit():
+    from robodyn.sim.stability import round_step
+
+    assert round_step(1.2e-5) == pytest.approx(1e-5)
+    assert round_step(7.2e-4) == pytest.approx(5e-4)
+    assert round_step(2.0e-3) == pytest.approx(2e-3)
+    assert round_step(1.99e-3) == pytest.approx(1e-3)
+    for limit in np.geomspace(1e-7, 1.0, 41):
+        step = round_step(limit)
+        assert step <= limit * (1 + 1e-12) and step > limit / 2.5 - 1e-18
+        assert round(1.0 / step) * step == pytest.approx(1.0)  # a whole number of steps in 1 s
