@@ -35,6 +35,9 @@ def at_height(box: robodyn.Robot, z: float, pitch: float = 0.0) -> np.ndarray:
     ("ground", "contacts", "changed", "message"),
     [
         (None, ["box"], {}, "contacts must be given only with a ground, got ['box']."),
+        (None, "box", {}, "contacts must be given only with a ground, got 'box'."),
+        (None, ["b" * 100], {}, f"contacts must be given only with a ground, got {repr(['b' * 100])[:80]}."),
+        ("g" * 100, "collision", {}, f"ground must be a robodyn.sim.ground.Ground (a plane, its normal and friction), got {repr('g' * 100)[:80]}."),
         ("floor", "collision", {}, "ground must be a robodyn.sim.ground.Ground (a plane, its normal and friction), got 'floor'."),
         (Ground(), "collision", {"integrator": "rk4"}, "integrator must be 'semi-implicit-euler' with a ground (the contact step's scheme), got 'rk4'."),
         (
@@ -91,3 +94,9 @@ def test_start_above_lifts_along_the_grounds_normal_to_the_clearance(box, cleara
     np.testing.assert_allclose(moved[:3] - q0[:3], lift * np.array(ground.normal), atol=1e-15)
     np.testing.assert_array_equal(moved[3:], q0[3:])
     assert q0[2] == -0.2  # the caller's array untouched
+
+
+def test_start_above_takes_a_configuration_of_integers():
+    box = robodyn.load(BOX, floating_base=True)
+    moved, lift = start_above(box, np.array([0, 0, 0, 0, 0, 0, 1]), Ground(), "collision")
+    assert lift == pytest.approx(0.1) and moved[2] == pytest.approx(0.1)  # the bottom face 5 cm above z = 0
