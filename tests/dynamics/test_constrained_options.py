@@ -54,7 +54,7 @@ FACTORS: dict[str, list] = {
     "armature": [False, True],
     "lock": [False, True],
     "threads": [1, 2, 3],
-    "batch": [1, 7, 13],
+    "batch": [1, 5, 7],
 }
 
 
@@ -147,8 +147,8 @@ def test_constrained_dynamics_and_momentum_agree_with_the_reference_under_every_
     for dropped in ("gravity", "armature"):
         if dropped in options:
             other = reference.load(source, **{key: value for key, value in options.items() if key != dropped})
-            a_other, lam_other, _ = reference_terms(robot, other, constraints, q, v, tau)
-            assert max(np.abs(a - a_other).max(), np.abs(lam - lam_other).max()) > 1e-4 * scale, dropped
+            a_other, lam_other, _ = reference_terms(robot, other, constraints, q[:2], v[:2], tau[:2])
+            assert max(np.abs(a[:2] - a_other).max(), np.abs(lam[:2] - lam_other).max()) > 1e-4 * scale, dropped
 
 
 FEET = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]

@@ -45,7 +45,7 @@ def test_a_box_on_flat_ground_under_tilted_gravity_sticks_or_slides_by_coulombs_
     box = robodyn.load(BOX, floating_base=True, gravity=gravity)
     up = np.array([0.0, 0.0, 1.0])
     q0 = resting(box, up)
-    run = simulate_contact(box, ground=Ground(friction=friction), duration=0.2, dt=1e-3, q0=q0)
+    run = simulate_contact(box, ground=Ground(friction=friction), duration=0.12, dt=1e-3, q0=q0)
     q = run.trajectory.q
     assert np.abs(q[:, 2] - HALF_HEIGHT).max() < 1e-9  # on the plane throughout
     if math.tan(theta) < friction:  # sticks: it stays, the ground carries −m g, tangential part included
@@ -65,6 +65,6 @@ def test_a_box_on_a_frictionless_plane_normal_to_tilted_gravity_stays_put():
     normal = -gravity / np.linalg.norm(gravity)
     box = robodyn.load(BOX, floating_base=True, gravity=gravity)
     q0 = resting(box, normal)
-    run = simulate_contact(box, ground=Ground(normal=tuple(normal), friction=0.0), duration=0.1, dt=1e-3, q0=q0)
+    run = simulate_contact(box, ground=Ground(normal=tuple(normal), friction=0.0), duration=0.05, dt=1e-3, q0=q0)
     assert np.abs(run.trajectory.q[-1, :3] - q0[:3]).max() < 1e-9
     np.testing.assert_allclose(run.forces[-1].sum(axis=0), -MASS * gravity, rtol=0, atol=1e-6 * MASS * G)
