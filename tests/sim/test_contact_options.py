@@ -68,3 +68,38 @@ def test_a_box_on_a_frictionless_plane_normal_to_tilted_gravity_stays_put():
     run = simulate_contact(box, ground=Ground(normal=tuple(normal), friction=0.0), duration=0.05, dt=1e-3, q0=q0)
     assert np.abs(run.trajectory.q[-1, :3] - q0[:3]).max() < 1e-9
     np.testing.assert_allclose(run.forces[-1].sum(axis=0), -MASS * gravity, rtol=0, atol=1e-6 * MASS * G)
+
+
+@pytest.mark.slow
+def test_a_damped_pendulum_run_with_a_ground_loses_what_its_damping_dissipates():
+    """The contact step's explicit joint damping (``−b v``), on a fixed-base pendulum with
+    armature under tilted gravity, the ground out of reach: the energy lost is ``Σ b v² dt``
+    to within semi-implicit Euler's energy wobble; without joint friction none is lost."""
+    robot = robodyn.load(
+        BOX.parent.parent / "robots" / "damped_pendulum.urdf", gravity=(1.0, -2.0, -9.0), armature={"hinge": 0.02}
+    )
+    dt = 1e-3
+
+    def run(joint_friction: bool) -> tuple[np.ndarray, np.ndarray]:
+        trajectory = robodyn.simulate(
+            robot,
+            np.array([1.0]),
+            np.array([0.0]),
+            0.5,
+            dt,
+            ground=Ground(height=-10.0),
+            contacts=["pole"],
+            integrator="semi-implicit-euler",
+            joint_friction=joint_friction,
+        )
+        energy = np.array(
+            [robot.kinetic_energy(q, v) + robot.potential_energy(q) for q, v in zip(trajectory.q, trajectory.v, strict=True)]
+        )
+        return energy, trajectory.v[:, 0]
+
+    energy, speed = run(True)
+    dissipated = np.concatenate([[0.0], np.cumsum(robot.joint_damping[0] * speed[1:] ** 2 * dt)])
+    assert dissipated[-1] > 0.3  # [J]
+    np.testing.assert_allclose(energy[0] - energy, dissipated, rtol=0, atol=0.015 * dissipated[-1])
+    passive, _ = run(False)
+    assert np.abs(passive - passive[0]).max() < 0.015 * dissipated[-1]  # the control: no loss without it
