@@ -10,14 +10,17 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 import robodyn
-from robodyn.exceptions import InputError
+from robodyn.exceptions import FrameError, InputError, StaticFrameError
 from robodyn.sim.ground import ContactPoint, Ground, collision_points, contact_points, resolve_ground
+
+DATA_MJCF = Path(__file__).resolve().parent.parent / "data" / "mjcf"
 
 
 @pytest.mark.parametrize(
@@ -176,3 +179,94 @@ def test_named_contacts_are_frames_in_order_and_a_name_twice_or_none_is_refused(
     with pytest.raises(InputError) as error:
         contact_points(robot, [])
     assert str(error.value) == "contacts must be at least one contact point: name the frames that touch the ground, got none."
+
+
+def test_a_frictionless_ground_and_the_tilted_planes_default_friction():
+    assert Ground(friction=0).friction == 0.0
+    assert Ground.tilted(0.2).friction == 1.0 and Ground.tilted(0.2).height == 0.0
+
+
+class _Text:
+    """A stand-in robot for :func:`collision_points`, which reads only the URDF text."""
+
+    def __init__(self, links: str) -> None:
+        self.urdf = f'<robot name="stub">{links}</robot>'
+
+
+def test_shapes_without_sizes_are_points_and_an_origin_without_rpy_is_unrotated():
+    found = collision_points(
+        _Text(
+            '<link name="a"><collision><origin xyz="0.1 0.2 0.3"/><geometry><box size="0.2 0.4 0.6"/></geometry></collision>'
+            '<collision><origin xyz="0 0 1"/><geometry><sphere/></geometry></collision>'
+            '<collision name="mjcf:capsule"><origin xyz="0 1 0"/><geometry><cylinder radius="0.1"/></geometry></collision>'
+            '<collision name="mjcf:capsule"><geometry><cylinder length="0.4"/></geometry></collision>'
+            "<collision><geometry><box/></geometry></collision></link>"
+        )
+    )
+    points = {point.name: point for point in found.points}
+    for j, signs in enumerate(itertools.product((-1.0, 1.0), repeat=3)):  # no rpy: the box's own axes
+        assert points[f"a.box0.corner{j}"].position == pytest.approx(
+            tuple(np.array([0.1, 0.2, 0.3]) + 0.5 * np.array([0.2, 0.4, 0.6]) * signs)
+        )
+    assert (points["a.sphere1"].position, points["a.sphere1"].radius) == ((0.0, 0.0, 1.0), 0.0)
+    assert [points[f"a.capsule2.end{end}"].position for end in (0, 1)] == [
+        (0.0, 1.0, 0.0)
+    ] * 2  # no length: both ends at its centre
+    assert points["a.capsule3.end0"].radius == 0.0 and points["a.capsule3.end1"].position == (0.0, 0.0, 0.2)
+    assert {points[f"a.box4.corner{j}"].position for j in range(8)} == {(0.0, 0.0, 0.0)}
+
+
+@pytest.mark.parametrize(("count", "shown"), [(3, "('l0', 'l1', 'l2')"), (4, "('l0', 'l1', 'l2', …)")])
+def test_a_note_names_three_links_then_an_ellipsis(count, shown):
+    links = "".join(
+        f'<link name="l{i}"><collision><geometry><cylinder radius="1" length="1"/></geometry></collision></link>'
+        for i in range(count)
+    )
+    assert collision_points(_Text(links)).skipped == (
+        f"collision geometry not modelled as contacts (spheres, boxes and capsules are): cylinder × {count} {shown}",
+    )
+
+
+def test_an_mjcf_geom_with_no_urdf_shape_is_said_by_its_type():
+    found = collision_points(robodyn.load(DATA_MJCF / "geoms.xml"))
+    assert found.skipped == (
+        "collision geometry not modelled as contacts (spheres, boxes and capsules are): cylinder × 1 ('lower')",
+        "collision geometry not modelled as contacts (spheres, boxes and capsules are): ellipsoid × 1 ('hand')",
+        "capsules × 2: approximated by the spheres at their two ends (their sides do not touch)",
+    )
+
+
+def test_the_links_named_foot_that_a_joint_moves_are_the_contacts_without_spheres_or_boxes():
+    urdf = f"""<robot name="leg">
+      <link name="base"/><link name="base_foot"/><link name="leg">{INERTIA}</link><link name="foot"/>
+      <joint name="weld" type="fixed"><parent link="base"/><child link="base_foot"/></joint>
+      <joint name="hip" type="revolute"><parent link="base"/><child link="leg"/><axis xyz="0 1 0"/>
+        <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="ankle" type="fixed"><parent link="leg"/><child link="foot"/><origin xyz="0 0 -0.5"/></joint>
+    </robot>"""
+    found = contact_points(robodyn.load(urdf), "collision")
+    assert found.names == ["foot"]  # moved by the first joint; the world's base_foot is not
+    assert found.skipped == ("contacts: the links named *foot (1), the collision geometry has no sphere or box",)
+
+
+def test_the_ground_a_file_states_is_its_plane():
+    robot = robodyn.load(DATA_MJCF / "contact_box.xml")  # <geom type="plane" pos="0 0 0.1" friction="0.7"/>
+    ground = resolve_ground(robot, "file")
+    assert (ground.height, ground.normal, ground.friction) == (0.1, (0.0, 0.0, 1.0), 0.7)
+
+
+def test_an_unknown_or_world_fixed_contact_frame_is_refused_in_one_sentence():
+    robot = robodyn.load("solo12")
+    close = [name for name in robot.frame_ids if "l" in name.lower()][:5]
+    assert len([name for name in robot.frame_ids if "l" in name.lower()]) > 5
+    with pytest.raises(FrameError) as error:
+        contact_points(robot, ["L"])
+    assert str(error.value) == f"robot 'solo12' has no frame named 'L' (did you mean {', '.join(repr(name) for name in close)}?)."
+    with pytest.raises(StaticFrameError) as static:
+        contact_points(robodyn.load(SHAPES), ["base"])
+    assert str(static.value).startswith(
+        "robot 'shapes': frame 'base' is fixed to the world (no joint moves it), so a contact point on it would have no effect"
+    )
+    with pytest.raises(InputError) as named:
+        ContactPoint(b"x" * 100, "foot")
+    assert str(named.value) == f"name must be a non-empty name, got {repr(b'x' * 100)[:80]}."
