@@ -25,8 +25,11 @@ _LISTED = 30
 
 
 def _numbers(value: Any, argument: str, size: int, unit: str) -> tuple[float, ...]:
-    """``value`` as ``size`` finite floats, or an :class:`InputError` naming ``argument``."""
+    """``value`` as ``size`` finite floats, or an :class:`InputError` naming ``argument``
+    (text and booleans are not numbers: ``"123"`` is not ``(1, 2, 3)``)."""
     try:
+        if isinstance(value, str | bytes) or any(isinstance(x, bool | str | bytes) for x in value):
+            raise TypeError(value)
         numbers = tuple(float(x) for x in value)
     except (TypeError, ValueError):
         raise InputError(argument, f"{size} finite numbers in {unit}", printable(repr(value))[:80]) from None

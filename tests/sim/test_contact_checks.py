@@ -1,14 +1,107 @@
-"""The checks around a run on the ground: links that are no contact points going under it."""
+"""Issue 39, what a run on the ground may ask (``robodyn/sim/contact_checks.py``, through its
+public functions): each refusal's whole sentence, the start's penetration bound on both
+sides of 1 mm naming the deepest point, and a floating robot lifted along a tilted
+ground's normal until its lowest contact point has the clearance asked; links that are no
+contact points going under the ground."""
 
 from __future__ import annotations
 
+import math
+from pathlib import Path
+
 import numpy as np
+import pytest
 
 import robodyn
-from robodyn.sim.contact_checks import buried_line
+from robodyn.exceptions import InputError
+from robodyn.sim.contact import contact_kinematics
+from robodyn.sim.contact_checks import START_PENETRATION, buried_line, check_contact_run, start_above
 from robodyn.sim.ground import Ground, contact_points
 
+BOX = Path(__file__).resolve().parent.parent / "data" / "contact" / "box.urdf"  # 0.3 × 0.2 × 0.1 m
 FEET = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+FINE = {"integrator": "semi-implicit-euler", "every": None, "limits": "warn", "observer": None}
+
+
+@pytest.fixture(scope="module")
+def box() -> robodyn.Robot:
+    return robodyn.load(BOX, floating_base=True)
+
+
+def at_height(box: robodyn.Robot, z: float, pitch: float = 0.0) -> np.ndarray:
+    """The box's centre at height ``z``, pitched about y (its +x end down for pitch > 0)."""
+    return box.floating_configuration([0.0, 0.0, z], [0.0, pitch, 0.0])
+
+
+@pytest.mark.parametrize(
+    ("ground", "contacts", "changed", "message"),
+    [
+        (None, ["box"], {}, "contacts must be given only with a ground, got ['box']."),
+        (None, "box", {}, "contacts must be given only with a ground, got 'box'."),
+        (None, ["b" * 100], {}, f"contacts must be given only with a ground, got {repr(['b' * 100])[:80]}."),
+        ("g" * 100, "collision", {}, f"ground must be a robodyn.sim.ground.Ground (a plane, its normal and friction), got {repr('g' * 100)[:80]}."),
+        ("floor", "collision", {}, "ground must be a robodyn.sim.ground.Ground (a plane, its normal and friction), got 'floor'."),
+        (Ground(), "collision", {"integrator": "rk4"}, "integrator must be 'semi-implicit-euler' with a ground (the contact step's scheme), got 'rk4'."),
+        (
+            Ground(),
+            "collision",
+            {"every": 2},
+            "control_period must be the step dt with a ground (the contact step samples the controller each step), got 2 steps.",
+        ),
+        (Ground(), "collision", {"limits": "enforce"}, "limits must be 'warn' or 'ignore' with a ground (the contact step does not enforce limits), got 'enforce'."),
+        (Ground(), "collision", {"observer": object()}, "observer must be none with a ground (the contact step runs no observer), got an observer."),
+    ],
+)  # fmt: skip
+def test_what_a_ground_run_does_not_do_is_refused_in_one_sentence(box, ground, contacts, changed, message):
+    with pytest.raises(InputError) as error:
+        check_contact_run(box, ground, contacts, q0=at_height(box, 0.1), **(FINE | changed))
+    assert str(error.value) == message
+
+
+def test_without_a_ground_there_are_no_contacts_and_a_control_period_of_one_step_is_the_step(box):
+    assert check_contact_run(box, None, "collision", q0=at_height(box, 0.1), **FINE) is None
+    found = check_contact_run(box, Ground(), "collision", q0=at_height(box, 0.1), **(FINE | {"every": 1}))
+    assert found is not None and len(found.points) == 8
+
+
+def test_a_start_deeper_than_a_millimetre_is_refused_naming_the_deepest_point(box):
+    below = 0.05 - 0.9 * START_PENETRATION  # the bottom face 0.9 mm in the ground: accepted
+    assert check_contact_run(box, Ground(), "collision", q0=at_height(box, below), **FINE) is not None
+    # pitched: the +x bottom corners deepest, 1.2 mm in the ground
+    pitch = 0.05
+    depth = 0.15 * math.sin(pitch) + 0.05 * math.cos(pitch)
+    q0 = at_height(box, depth - 1.2e-3, pitch)
+    found = contact_points(box, "collision")
+    gaps = contact_kinematics(box, q0, Ground(), found.points)[0]
+    deepest = found.names[int(np.argmin(gaps))]
+    with pytest.raises(InputError) as error:
+        check_contact_run(box, Ground(), "collision", q0=q0, **FINE)
+    assert str(error.value) == (
+        "q0 must be a configuration with every contact point above the ground (at most 0.001 m below), "
+        f"got {deepest!r} 0.0012 m below."
+    )
+    assert abs(gaps.min() + 1.2e-3) < 1e-12 and sorted(gaps)[2] > gaps.min() + 1e-3  # two corners that deep, not more
+
+
+@pytest.mark.parametrize("clearance", [None, 0.0, 0.02])
+def test_start_above_lifts_along_the_grounds_normal_to_the_clearance(box, clearance):
+    ground = Ground.tilted(math.radians(20.0), friction=0.5, height=0.3)
+    q0 = at_height(box, -0.2, 0.1)  # under the plane
+    moved, lift = start_above(box, q0, ground, "collision", **({} if clearance is None else {"clearance": clearance}))
+    clearance = 0.05 if clearance is None else clearance  # the default: 5 cm
+    gaps_before = contact_kinematics(box, q0, ground, contact_points(box, "collision").points)[0]
+    gaps = contact_kinematics(box, moved, ground, contact_points(box, "collision").points)[0]
+    assert gaps.min() == pytest.approx(clearance, abs=1e-12)
+    assert lift == pytest.approx(clearance - gaps_before.min(), abs=1e-12)
+    np.testing.assert_allclose(moved[:3] - q0[:3], lift * np.array(ground.normal), atol=1e-15)
+    np.testing.assert_array_equal(moved[3:], q0[3:])
+    assert q0[2] == -0.2  # the caller's array untouched
+
+
+def test_start_above_takes_a_configuration_of_integers():
+    box = robodyn.load(BOX, floating_base=True)
+    moved, lift = start_above(box, np.array([0, 0, 0, 0, 0, 0, 1]), Ground(), "collision")
+    assert lift == pytest.approx(0.1) and moved[2] == pytest.approx(0.1)  # the bottom face 5 cm above z = 0
 
 
 def test_a_link_that_is_no_contact_point_under_the_ground_is_named_with_its_depth():
