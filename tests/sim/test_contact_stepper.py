@@ -1,0 +1,112 @@
+"""The fast contact step (:class:`robodyn.sim.contact.ContactStepper`) against the general one."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robodyn
+from robodyn.sim import contact
+from robodyn.sim.contact import ContactSettings, ContactStepper, contact_kinematics, contact_step, generic_step
+from robodyn.sim.ground import ContactPoint, Ground, contact_points
+
+DATA = Path(__file__).parents[1] / "data" / "contact"
+FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+
+
+@pytest.fixture(scope="module")
+def solo() -> robodyn.Robot:
+    return robodyn.load("solo12")
+
+
+@pytest.fixture(scope="module")
+def box() -> robodyn.Robot:
+    return robodyn.load(DATA / "box.urdf", floating_base=True)
+
+
+def _both(robot, q, v, controller, ground, points, steps):
+    """Per step, the fast and the general step's (q⁺, v⁺, forces), each on its own run."""
+    settings, runs = ContactSettings(), []
+    for fast in (True, False):
+        state, guess, rows = (q, v), None, []
+        for _ in range(steps):
+            tau = controller(state[0], state[1])
+            if fast:
+                result = contact_step(robot, *state, tau, 1e-3, ground, points, settings=settings, guess=guess)
+            else:
+                result = generic_step(robot, *state, tau, 1e-3, ground, points, settings, guess)
+            rows.append((result.q, result.v, result.forces, result.iterations))
+            state, guess = (result.q, result.v), result.impulses
+        runs.append(rows)
+    return runs
+
+
+def _largest_difference(runs, index):
+    return max(float(np.abs(a[index] - b[index]).max()) for a, b in zip(*runs, strict=True))
+
+
+@pytest.mark.parametrize(("friction", "push"), [(0.8, 0.0), (0.2, 0.5)])
+def test_solo12_landing_on_its_feet_is_the_general_steps_motion(solo, friction, push):
+    """Standing (μ = 0.8) and landing while sliding and turning (μ = 0.2: slipping modes):
+    the same ADMM iterations every step; the motions part only by ADMM's own tolerance
+    (1e-10) acting on round-off (measured: v⁺ 7e-12 / 1e-9 m/s, forces 3e-10 / 4e-8 N)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    ground = Ground(height=0.01, friction=friction)  # a raised floor: its level counts
+    q0 = solo.neutral_configuration()
+    q0[7:] += np.linspace(-0.2, 0.2, 12)  # legs apart from the neutral pose: every mask matters
+    q0[2] += -contact_kinematics(solo, q0, ground, points)[0].min() + 0.005
+    v0 = np.zeros(solo.nv)
+    v0[[0, 1, 5]] = (push, 0.6 * push, 0.8 * push)
+    target = q0[7:].copy()
+
+    def hold(q, v):
+        tau = np.zeros(solo.nv)
+        tau[6:] = 5.0 * (target - q[7:]) - 0.1 * v[6:]
+        return tau
+
+    runs = _both(solo, q0, v0, hold, ground, points, 150)
+    assert any(row[3] > 0 for row in runs[0]) and any(row[3] == 0 for row in runs[0])  # ADMM, and modes kept
+    assert [row[3] for row in runs[0]] == [row[3] for row in runs[1]]
+    assert _largest_difference(runs, 2) < 1e-8 * solo.total_mass * 9.81  # forces, [N]
+    assert _largest_difference(runs, 1) < 1e-8  # v⁺ [m/s, rad/s]
+    assert _largest_difference(runs, 0) < 1e-11  # q⁺
+
+
+def test_the_steppers_jacobian_is_the_frame_jacobians_and_a_point_seeing_every_joint_is_not(solo):
+    points = (*contact_points(solo, list(FEET)).points, ContactPoint("knee", "FR_LOWER_LEG", (0.01, -0.02, 0.03), 0.02))
+    ground = Ground.tilted(0.3, friction=0.5, height=-0.1)
+    q = solo.random_configuration(np.random.default_rng(7))
+    stepper = ContactStepper(solo, ground, points)
+    gaps, jacobian = contact_kinematics(solo, q, ground, points)
+    fast_gaps, fast_jacobian = stepper.kinematics(q)
+    assert np.abs(fast_gaps - gaps).max() < 1e-15 and np.abs(fast_jacobian - jacobian).max() < 1e-14
+    stepper.mask[:] = 1.0  # negative control: every column to every point
+    assert np.abs(stepper.kinematics(q)[1] - jacobian).max() > 1e-2
+
+
+def test_a_run_keeps_its_stepper_and_a_first_step_or_new_points_make_a_new_one(box):
+    ground, points = Ground(friction=0.5), contact_points(box, "collision").points
+    q, v, tau = box.neutral_configuration(), np.zeros(box.nv), np.zeros(box.nv)
+    q[2] = 0.06
+    first = contact_step(box, q, v, tau, 1e-3, ground, points)
+    stepper = contact._LOCAL.stepper
+    contact_step(box, first.q, first.v, tau, 1e-3, ground, points, guess=first.impulses)
+    assert contact._LOCAL.stepper is stepper
+    contact_step(box, first.q, first.v, tau, 1e-3, ground, points[:4], guess=first.impulses[:4])
+    assert contact._LOCAL.stepper is not stepper
+    stepper = contact._LOCAL.stepper
+    contact_step(box, first.q, first.v, tau, 1e-3, ground, points[:4])
+    assert contact._LOCAL.stepper is not stepper  # guess=None: a run's first step, built again
+
+
+def test_pinocchios_cholesky_inverse_is_robodyns_mass_matrix_inverse(solo):
+    """The stepper's ``M⁻¹`` (Pinocchio's sparse LDLᵀ of CRBA's M) against ``Robot.mass_matrix``."""
+    q = solo.random_configuration(np.random.default_rng(5))
+    stepper = ContactStepper(solo, Ground(), ())
+    pin.crba(stepper.model, stepper.data, q)
+    pin.cholesky.decompose(stepper.model, stepper.data)
+    inverse = pin.cholesky.computeMinv(stepper.model, stepper.data)
+    assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() < 1e-12
