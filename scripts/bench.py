@@ -30,6 +30,7 @@ Sections:
     single-thin          Robot single calls vs raw Pinocchio on a preallocated Data (CPU time; target 1.3)
     compile-scaling      cold compile time against DoF, chains and trees: sympy derivation vs cc
     engines              loop-only real-time factor per engine (demo, ur5 PD) and their agreement
+    contact              solo12 standing on four feet at 1 kHz: robodyn's contact step vs MuJoCo's (issue 41)
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+from bench_contact import bench_contact  # scripts/: this script's folder is on sys.path
 
 import robodyn
 from robodyn import reference
@@ -1344,6 +1346,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "engines": bench_engines,
     "compiled-floating": bench_compiled_floating,
     "robot-engine": bench_robot_engine,
+    "contact": bench_contact,
 }
 
 

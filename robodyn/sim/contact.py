@@ -45,6 +45,7 @@ from typing import NamedTuple
 import numpy as np
 import pinocchio as pin
 
+from robodyn.compiled.contact import kept_step
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import SingularMassMatrixError
 from robodyn.sim.contact_solver import ContactSettings, solve_impulses
@@ -193,6 +194,8 @@ class ContactStepper:
         self.normal, self.level = self.axes[2], float(ground.point @ self.axes[2])
         self.offsets = np.array([point.radius * self.normal for point in points]).reshape(count, 3)
         self.skew = np.array([_skew(unit).ravel() for unit in np.eye(3)])  # p @ skew: [p]× of every point, flat
+        #: The compiled step of kept modes (robodyn.compiled.contact), or None: Python alone.
+        self.kept = kept_step()
 
     def serves(self, robot: Robot, ground: Ground, points: tuple[ContactPoint, ...]) -> bool:
         """Whether this stepper is the one of these very objects."""
@@ -220,6 +223,12 @@ class ContactStepper:
         inverse = pin.cholesky.computeMinv(model, data)
         bias = pin.nonLinearEffects(model, data, q, v)
         gaps, jacobian = self.kinematics(q)
+        if self.kept is not None and guess is not None and settings.polish and gaps.size:
+            scalars = np.array([dt, settings.baumgarte, self.ground.friction])
+            done = self.kept(inverse, jacobian, v, tau, bias, gaps, guess, self.axes, scalars)
+            if done is not None:  # the previous modes hold: solved in C
+                v_next, impulses, forces, slip = done
+                return ContactStep(integrate(self.robot, q, dt * v_next), v_next, impulses, forces, gaps, slip, 0, True)
         response = inverse @ jacobian.T
         free = v + dt * (inverse @ (tau - bias))
         if not math.isfinite(free @ free) and not np.isfinite(inverse).all():  # (a huge free: not finite squared)

@@ -91,9 +91,11 @@ def solve_impulses(
     robot's ``nv`` (``A``'s rank is at most that: more rows are redundant), if known."""
     count = len(velocity) // 3
     if settings.polish and guess is not None and count:  # the previous step's modes may still hold: no ADMM
-        kept = polish(delassus, velocity, friction, np.asarray(guess, dtype=float).reshape(-1), dofs=dofs)
-        if kept is not None:
-            return kept, 0, True
+        previous = np.asarray(guess, dtype=float).reshape(-1)
+        for cone in (True, False):  # every closed contact sticking, then the modes its velocities show
+            kept = polish(delassus, velocity, friction, previous, dofs=dofs, cone=cone)
+            if kept is not None:
+                return kept, 0, True
     key = (count, friction, settings)
     if key not in _WORKSPACES:
         _WORKSPACES[key] = _Workspace(count, friction, settings)
@@ -113,11 +115,17 @@ def solve_impulses(
 
 
 def polish(
-    delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses: np.ndarray, *, dofs: int | None = None
-) -> np.ndarray | None:
+    delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses: np.ndarray, *, dofs: int | None = None,
+    cone: bool = False,
+) -> np.ndarray | None:  # fmt: skip
     """The exact impulses of the contact modes ``impulses`` shows (module docstring), or
     ``None`` when they are not a solution of the cone complementarity problem. More
     equalities than ``dofs`` (the robot's ``nv``, if given) are redundant: least-norm at once.
+
+    A closed contact slips when the velocity ``u = A p + c`` of the impulses moves it; with
+    ``cone`` (the previous step's impulses), every closed contact sticks if each impulse is
+    inside its cone (to 1e-6), else ``None``: a robot standing while its joints move keeps
+    its modes, which the velocities of last step's impulses would call slipping.
 
     Sticking contacts alone (a robot standing) are one solve of their rows of ``A``; a
     slipping one adds a column ``(−μ s, 1)`` of its normal impulse. The modes are read
@@ -131,7 +139,9 @@ def polish(
     sliding: list[tuple[int, float, float]] = []
     for index in range(0, len(p), 3):
         if p[index + 2] > 1e-6 * scale_p:  # closed (the others are open)
-            slip = math.hypot(u[index], u[index + 1])
+            if cone and not math.hypot(p[index], p[index + 1]) < (1 - 1e-6) * friction * p[index + 2]:
+                return None  # on its cone's boundary (or frictionless): it slipped
+            slip = 0.0 if cone else math.hypot(u[index], u[index + 1])
             if friction == 0.0 or slip > 1e-6 * scale_u:  # frictionless: the normal row only
                 size = max(slip, 1e-300)
                 sliding.append((index, u[index] / size, u[index + 1] / size))

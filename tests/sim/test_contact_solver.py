@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 
 import robodyn
+from robodyn.sim.contact import contact_kinematics
 from robodyn.sim.contact_run import simulate_contact
 from robodyn.sim.contact_solver import ContactSettings, polish, solve_impulses
-from robodyn.sim.ground import Ground
+from robodyn.sim.ground import ContactPoint, Ground
 
 DATA = Path(__file__).parents[1] / "data" / "contact"
 
@@ -56,3 +57,34 @@ def test_a_box_thrown_tumbling_lands_with_every_step_solved_exactly():
     assert run.converged.all()
     assert (run.iterations > 0).sum() <= 8  # 5 measured (11 before)
     assert abs(run.normal_forces[-1].sum() / (2.5 * 9.81) - 1) < 1e-12
+
+
+def test_solo12_standing_while_its_joints_move_keeps_its_modes_without_admm():
+    """A PD moving the legs 0.02 rad from a 1 mm landing: the feet stick throughout. The
+    velocities of last step's impulses move them (the joints accelerate), which read as
+    slips sent every step to ADMM (100–300 iterations); their impulses inside the cones
+    keep them sticking."""
+    robot = robodyn.load("solo12")
+    feet = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in feet)
+    q0 = robot.neutral_configuration()
+    q0[2] -= contact_kinematics(robot, q0, Ground(), points)[0].min() - 1e-3
+    target = q0[7:] + 0.02
+
+    def hold(t, q, v):
+        return np.r_[np.zeros(6), 5.0 * (target - q[7:]) - 0.1 * v[6:]]
+
+    run = simulate_contact(robot, ground=Ground(friction=0.8), contacts=points, controller=hold, duration=0.1, q0=q0)
+    assert run.active[20:].all() and run.slip[20:].max() < 1e-12  # standing, sticking
+    assert (run.iterations[20:] == 0).all()  # its modes kept at every step
+    assert run.converged.all()
+
+
+def test_impulses_on_their_cones_are_not_read_as_sticking():
+    """The negative control of the cone reading: a contact pushed along its plane slips
+    (its impulse on the cone); ``cone=True`` declines it, the velocities' reading keeps it."""
+    delassus, velocity = np.eye(3), np.array([1.0, 0.0, -1.0])  # pushed along t₁ and into the plane
+    impulses = solve_impulses(delassus, velocity, 0.4, ContactSettings())[0]
+    assert abs(np.hypot(*impulses[:2]) - 0.4 * impulses[2]) < 1e-12  # on the cone: slipping
+    assert polish(delassus, velocity, 0.4, impulses, cone=True) is None
+    assert polish(delassus, velocity, 0.4, impulses) is not None

@@ -110,3 +110,72 @@ def test_pinocchios_cholesky_inverse_is_robodyns_mass_matrix_inverse(solo):
     pin.cholesky.decompose(stepper.model, stepper.data)
     inverse = pin.cholesky.computeMinv(stepper.model, stepper.data)
     assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() < 1e-12
+
+
+def _standing(solo, steps, compiled):
+    """solo12 landing from 1 mm (40 steps, Python alone), then ``steps`` steps from there
+    with its C step on or off (the previous modes hold from step 18 on)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    ground = Ground(friction=0.8)
+    q = solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, ground, points)[0].min() - 1e-3
+    target, v, guess = q[7:] + 0.02, np.zeros(solo.nv), None
+    stepper = ContactStepper(solo, ground, points)
+    compiled, stepper.kept = (stepper.kept if compiled else None), None
+    rows = []
+    for step in range(40 + steps):
+        stepper.kept = compiled if step >= 40 else None
+        tau = np.zeros(solo.nv)
+        tau[6:] = 5.0 * (target - q[7:]) - 0.1 * v[6:]
+        result = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+        q, v, guess = result.q, result.v, result.impulses
+        rows.append(result)
+    return rows[40:]
+
+
+def test_the_compiled_step_of_kept_modes_is_the_python_polish(solo):
+    """The C step (robodyn/compiled/contact.c) and numpy's polish of the same modes, step by step."""
+    if ContactStepper(solo, Ground(), ()).kept is None:
+        pytest.skip("no C compiler: the contact step is Python's alone")
+    ours, theirs = _standing(solo, 60, True), _standing(solo, 60, False)
+    assert all(row.iterations == 0 for row in ours)  # every step kept its modes
+    for a, b in zip(ours, theirs, strict=True):
+        assert a.iterations == b.iterations
+        assert np.abs(a.forces - b.forces).max() < 1e-12 * solo.total_mass * 9.81  # [N]
+        assert np.abs(a.v - b.v).max() < 1e-13 and np.abs(a.slip - b.slip).max() < 1e-13
+
+
+def test_the_compiled_step_declines_what_is_not_its_case(solo):
+    """Arrays of a wrong size, type or layout, a slipping contact, more rows than nv: None (Python's path)."""
+    kept = ContactStepper(solo, Ground(), ()).kept
+    if kept is None:
+        pytest.skip("no C compiler: the contact step is Python's alone")
+    rng = np.random.default_rng(2)
+    nv, k = 6, 2
+    inverse, jacobian = np.eye(nv), rng.normal(size=(3 * k, nv))
+    v, zero, gaps = np.zeros(nv), np.zeros(nv), np.zeros(k)
+    axes, settings = np.eye(3), np.array([1e-3, 0.2, 0.5])
+    push = jacobian.T @ np.tile([0.0, 0.0, -1.0], k)  # a torque pressing both points into the ground
+    stuck = np.tile([0.0, 0.0, 1e-3], k)  # the impulses that hold them: the previous step's
+    assert kept(inverse, jacobian, v, push, zero, gaps, stuck, axes, settings) is not None  # the case itself
+    assert kept(inverse, jacobian, v, push, zero, gaps[:1], stuck, axes, settings) is None  # wrong size
+    assert kept(inverse, jacobian.astype(np.float32), v, push, zero, gaps, stuck, axes, settings) is None
+    assert kept(inverse, np.asfortranarray(jacobian), v, push, zero, gaps, stuck, axes, settings) is None
+    assert kept(inverse, jacobian, v, push, zero, gaps, stuck.tolist(), axes, settings) is None
+    sliding = jacobian.T @ np.tile([5.0, 0.0, -1.0], k)  # pushed along t₁ five times its weight: slips
+    assert kept(inverse, jacobian, v, sliding, zero, gaps, stuck, axes, settings) is None
+    three = rng.normal(size=(9, nv))  # 9 rows of a 6-dof body: redundant
+    assert (
+        kept(
+            inverse,
+            three,
+            v,
+            three.T @ np.tile([0.0, 0.0, -1.0], 3),
+            zero,
+            np.zeros(3),
+            np.tile([0.0, 0.0, 1e-3], 3),
+            axes,
+            settings,
+        )
+        is None
+    )

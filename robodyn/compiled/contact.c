@@ -1,0 +1,232 @@
+/* robodyn contact step, previous modes kept (robodyn/compiled/contact.py): after the
+ * includes and core.c. One METH_FASTCALL entry point,
+ *
+ *   kept(inverse, jacobian, v, tau, bias, gaps, guess, axes, settings)
+ *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,)) or None
+ *
+ * with M⁻¹ (nv, nv), J (3k, nv) in the contact axes, the gaps (k,), the previous step's
+ * impulses (3k,), the axes (3, 3) as rows (t1, t2, n) and settings = (dt, baumgarte,
+ * friction). It is robodyn.sim.contact_solver's polish of the previous impulses with
+ * cone=True (every closed contact sticking, its impulse inside its cone) on a regular
+ * system: the same modes, an LU solve of the sticking rows (partial pivoting), the same
+ * bound and the same complementarity check. None means "not this case" (a contact on its
+ * cone, more rows than nv, a singular or too large answer, a failed check, or an argument
+ * that is not a C-contiguous float64 array of the expected size): the caller then takes
+ * the Python path, which solves the same problem.
+ */
+
+#define RDC_TOLERANCE 1e-9 /* contact_solver.POLISH_TOLERANCE */
+
+static const double *rdc_array(PyObject *object, npy_intp size) {
+    if (!PyArray_CheckExact(object)) return NULL;
+    PyArrayObject *array = (PyArrayObject *)object;
+    if (PyArray_TYPE(array) != NPY_DOUBLE || !PyArray_ISCARRAY_RO(array) || !PyArray_ISNOTSWAPPED(array)) return NULL;
+    if (PyArray_SIZE(array) != size) return NULL;
+    return (const double *)PyArray_DATA(array);
+}
+
+static double rdc_largest(const double *x, int n) {
+    double largest = 0.0;
+    for (int i = 0; i < n; ++i)
+        if (fabs(x[i]) > largest || isnan(x[i])) largest = isnan(x[i]) ? NAN : fabs(x[i]);
+    return largest;
+}
+
+/* Solves a x = b in place (a: m x m row-major, overwritten; b becomes x). 0 on a zero pivot. */
+static int rdc_lu_solve(double *a, double *b, int m) {
+    for (int k = 0; k < m; ++k) {
+        int pivot = k;
+        double best = fabs(a[k * m + k]);
+        for (int i = k + 1; i < m; ++i)
+            if (fabs(a[i * m + k]) > best) best = fabs(a[i * m + k]), pivot = i;
+        if (!(best > 0.0)) return 0;
+        if (pivot != k) {
+            for (int j = 0; j < m; ++j) {
+                double t = a[k * m + j];
+                a[k * m + j] = a[pivot * m + j];
+                a[pivot * m + j] = t;
+            }
+            double t = b[k];
+            b[k] = b[pivot];
+            b[pivot] = t;
+        }
+        for (int i = k + 1; i < m; ++i) {
+            double factor = a[i * m + k] / a[k * m + k];
+            for (int j = k + 1; j < m; ++j) a[i * m + j] -= factor * a[k * m + j];
+            b[i] -= factor * b[k];
+        }
+    }
+    for (int i = m - 1; i >= 0; --i) {
+        double sum = b[i];
+        for (int j = i + 1; j < m; ++j) sum -= a[i * m + j] * b[j];
+        b[i] = sum / a[i * m + i];
+    }
+    return 1;
+}
+
+/* The impulses of the sticking contacts `stuck` (count), others open, into p; 0: not this case. */
+static int rdc_stick(const double *A, const double *c, const double *guess, const int *stuck, int count, int r,
+                     double scale_p, double scale_u, double *work, double *p) {
+    const int m = 3 * count;
+    double *sub = work, *x = work + m * m;
+    for (int a = 0; a < m; ++a) {
+        const int row = 3 * stuck[a / 3] + a % 3;
+        x[a] = -c[row];
+        for (int b = 0; b < m; ++b) sub[a * m + b] = A[row * r + 3 * stuck[b / 3] + b % 3];
+    }
+    double bound = 1e6 * (scale_p > scale_u ? scale_p : scale_u); /* every contact sticks */
+    if (m < r) {
+        double target = rdc_largest(x, m), impulses = rdc_largest(guess, r);
+        bound = 1e6 * fmax(fmax(impulses, target), 1e-300);
+    }
+    if (!rdc_lu_solve(sub, x, m) || !(rdc_largest(x, m) <= bound)) return 0;
+    for (int i = 0; i < r; ++i) p[i] = 0.0;
+    for (int a = 0; a < m; ++a) p[3 * stuck[a / 3] + a % 3] = x[a];
+    return 1;
+}
+
+/* contact_solver._solves: every impulse in its cone, no contact penetrating or pushing apart,
+ * no slip turned against the modes' (before). */
+static int rdc_solves(const double *A, const double *c, const double *p, const double *before, double friction, int r,
+                      double *u) {
+    for (int a = 0; a < r; ++a) {
+        double sum = c[a];
+        for (int b = 0; b < r; ++b) sum += A[a * r + b] * p[b];
+        u[a] = sum;
+    }
+    const double size_p = RDC_TOLERANCE * fmax(rdc_largest(p, r), 1e-12);
+    const double size_u = RDC_TOLERANCE * fmax(rdc_largest(c, r), 1e-12);
+    const double pushing = size_u * size_p / RDC_TOLERANCE;
+    for (int i = 0; i < r; i += 3) {
+        const double normal = p[i + 2], speed = u[i + 2];
+        if (!(normal >= -size_p) || hypot(p[i], p[i + 1]) > friction * normal + size_p) return 0;
+        if (!(speed >= -size_u) || fabs(speed) * fabs(normal) > pushing) return 0;
+        const int turned = u[i] * before[i] + u[i + 1] * before[i + 1] <= 0;
+        if (turned && normal > size_p && hypot(u[i], u[i + 1]) > size_u) return 0;
+    }
+    return 1;
+}
+
+/* free = v + dt M⁻¹ (tau − bias), R = M⁻¹ Jᵀ (nv x r), A = J R, c = J free + the gaps' bias. */
+static void rdc_terms(const double *inverse, const double *J, const double *v, const double *tau, const double *bias,
+                      const double *gaps, const double *settings, int nv, int r, double *free, double *R, double *A,
+                      double *c) {
+    const double dt = settings[0], beta = settings[1];
+    for (int i = 0; i < nv; ++i) {
+        double sum = 0.0;
+        for (int j = 0; j < nv; ++j) sum += inverse[i * nv + j] * (tau[j] - bias[j]);
+        free[i] = v[i] + dt * sum;
+        for (int a = 0; a < r; ++a) {
+            double s = 0.0;
+            for (int j = 0; j < nv; ++j) s += inverse[i * nv + j] * J[a * nv + j];
+            R[i * r + a] = s;
+        }
+    }
+    for (int a = 0; a < r; ++a) {
+        double s = 0.0;
+        for (int i = 0; i < nv; ++i) s += J[a * nv + i] * free[i];
+        c[a] = s;
+        for (int b = 0; b < r; ++b) {
+            double t = 0.0;
+            for (int i = 0; i < nv; ++i) t += J[a * nv + i] * R[i * r + b];
+            A[a * r + b] = t;
+        }
+    }
+    for (int a = 2; a < r; a += 3) {
+        const double gap = gaps[a / 3];
+        c[a] += gap >= 0.0 ? gap / dt : beta * gap / dt;
+    }
+}
+
+/* The polish of the previous impulses (contact_solver's polish with cone=True): every closed
+ * contact sticks, its impulse inside its cone; 0: not this case. */
+static int rdc_kept(const double *A, const double *c, const double *guess, double friction, int r, int nv, double *work,
+                    double *p) {
+    double *u_before = work, *u = work + r;
+    int *stuck = (int *)(work + 2 * r), count = 0;
+    for (int a = 0; a < r; ++a) {
+        double sum = c[a];
+        for (int b = 0; b < r; ++b) sum += A[a * r + b] * guess[b];
+        u_before[a] = sum;
+    }
+    const double scale_p = fmax(rdc_largest(guess, r), 1e-300), scale_u = fmax(rdc_largest(c, r), 1e-300);
+    if (isnan(scale_p) || isnan(scale_u)) return 0;
+    for (int i = 0; i < r; i += 3) {
+        const double normal = guess[i + 2];
+        if (!(normal > 1e-6 * scale_p)) continue; /* open */
+        if (!(hypot(guess[i], guess[i + 1]) < (1 - 1e-6) * friction * normal)) return 0; /* on its cone: slipped */
+        stuck[count++] = i / 3;
+    }
+    if (3 * count > nv) return 0; /* redundant rows: least-norm, in Python */
+    if (count == 0)
+        for (int i = 0; i < r; ++i) p[i] = 0.0;
+    else if (!rdc_stick(A, c, guess, stuck, count, r, scale_p, scale_u, work + 3 * r, p))
+        return 0;
+    return rdc_solves(A, c, p, u_before, friction, r, u);
+}
+
+static PyObject *rdc_result(const double *free, const double *R, const double *J, const double *p, const double *axes,
+                            double dt, int nv, int r) {
+    const npy_intp k = r / 3, vector[1] = {nv}, matrix[2] = {k, 3}, slips[1] = {k};
+    PyObject *v_next = PyArray_SimpleNew(1, vector, NPY_DOUBLE), *impulses = PyArray_SimpleNew(2, matrix, NPY_DOUBLE);
+    PyObject *forces = PyArray_SimpleNew(2, matrix, NPY_DOUBLE), *slip = PyArray_SimpleNew(1, slips, NPY_DOUBLE);
+    if (!v_next || !impulses || !forces || !slip) {
+        Py_XDECREF(v_next), Py_XDECREF(impulses), Py_XDECREF(forces), Py_XDECREF(slip);
+        return NULL;
+    }
+    double *vn = PyArray_DATA((PyArrayObject *)v_next), *pi = PyArray_DATA((PyArrayObject *)impulses);
+    double *f = PyArray_DATA((PyArrayObject *)forces), *s = PyArray_DATA((PyArrayObject *)slip);
+    for (int i = 0; i < nv; ++i) {
+        double sum = 0.0;
+        for (int a = 0; a < r; ++a) sum += R[i * r + a] * p[a];
+        vn[i] = free[i] + sum;
+    }
+    for (int a = 0; a < r; ++a) pi[a] = p[a];
+    for (int i = 0; i < k; ++i) {
+        for (int j = 0; j < 3; ++j)
+            f[3 * i + j] = (p[3 * i] * axes[j] + p[3 * i + 1] * axes[3 + j] + p[3 * i + 2] * axes[6 + j]) / dt;
+        double tangent[2];
+        for (int t = 0; t < 2; ++t) {
+            double sum = 0.0;
+            for (int j = 0; j < nv; ++j) sum += J[(3 * i + t) * nv + j] * vn[j];
+            tangent[t] = sum;
+        }
+        s[i] = hypot(tangent[0], tangent[1]);
+    }
+    return Py_BuildValue("(NNNN)", v_next, impulses, forces, slip);
+}
+
+static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 9 || !PyArray_CheckExact(args[2]) || !PyArray_CheckExact(args[6])) Py_RETURN_NONE;
+    const int nv = (int)PyArray_SIZE((PyArrayObject *)args[2]), r = (int)PyArray_SIZE((PyArrayObject *)args[6]);
+    const double *inverse = rdc_array(args[0], (npy_intp)nv * nv), *J = rdc_array(args[1], (npy_intp)r * nv);
+    const double *v = rdc_array(args[2], nv), *tau = rdc_array(args[3], nv), *bias = rdc_array(args[4], nv);
+    const double *gaps = rdc_array(args[5], r / 3), *guess = rdc_array(args[6], r), *axes = rdc_array(args[7], 9);
+    const double *settings = rdc_array(args[8], 3);
+    if (!inverse || !J || !v || !tau || !bias || !gaps || !guess || !axes || !settings || r % 3 || r == 0) Py_RETURN_NONE;
+    const size_t size = (size_t)nv + 2 * (size_t)nv * r + 2 * (size_t)r * r + 6 * (size_t)r + 2;
+    double *buffer = malloc(size * sizeof(double));
+    if (!buffer) return PyErr_NoMemory();
+    double *free_velocity = buffer, *R = free_velocity + nv, *A = R + nv * r, *c = A + r * r, *p = c + r;
+    double *work = p + r; /* u_before, u, stuck (r ints), then the r x r system and its right side */
+    rdc_terms(inverse, J, v, tau, bias, gaps, settings, nv, r, free_velocity, R, A, c);
+    PyObject *result = NULL;
+    if (rdc_kept(A, c, guess, settings[2], r, nv, work, p))
+        result = rdc_result(free_velocity, R, J, p, axes, settings[0], nv, r);
+    else
+        result = Py_NewRef(Py_None);
+    free(buffer);
+    return result;
+}
+
+static PyMethodDef rdc_methods[] = {
+    {"kept", (PyCFunction)(void (*)(void))rdc_kept_step, METH_FASTCALL, "kept(inverse, jacobian, v, tau, bias, gaps, guess, axes, settings)"},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyObject *rdc_module(const char *name) {
+    import_array1(NULL);
+    static struct PyModuleDef definition = {PyModuleDef_HEAD_INIT, NULL, "robodyn compiled contact step", -1, rdc_methods};
+    definition.m_name = name;
+    return PyModule_Create(&definition);
+}
