@@ -1,10 +1,11 @@
 /* robodyn contact step, previous modes kept (robodyn/compiled/contact.py): after the
  * includes and core.c. One METH_FASTCALL entry point,
  *
- *   kept(inverse, jacobian, v, tau, bias, gaps, guess, axes, settings)
+ *   kept(inverse, joints, points, mask, v, tau, bias, gaps, guess, axes, settings)
  *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,)) or None
  *
- * with M⁻¹ (nv, nv), J (3k, nv) in the contact axes, the gaps (k,), the previous step's
+ * with M⁻¹ (nv, nv), the joints' world Jacobians (6, nv, column-major: Pinocchio's data.J), the points
+ * in world axes (k, 3), which columns each point sees (k, nv: 0 or 1), the gaps (k,), the previous step's
  * impulses (3k,), the axes (3, 3) as rows (t1, t2, n) and settings = (dt, baumgarte,
  * friction). It is robodyn.sim.contact_solver's polish of the previous impulses with
  * cone=True (every closed contact sticking, its impulse inside its cone) on a regular
@@ -22,6 +23,15 @@ static const double *rdc_array(PyObject *object, npy_intp size) {
     PyArrayObject *array = (PyArrayObject *)object;
     if (PyArray_TYPE(array) != NPY_DOUBLE || !PyArray_ISCARRAY_RO(array) || !PyArray_ISNOTSWAPPED(array)) return NULL;
     if (PyArray_SIZE(array) != size) return NULL;
+    return (const double *)PyArray_DATA(array);
+}
+
+/* A Fortran-ordered (column-major) one: Eigen's, as Pinocchio's data.J. */
+static const double *rdc_columns(PyObject *object, npy_intp size) {
+    if (!PyArray_CheckExact(object)) return NULL;
+    PyArrayObject *array = (PyArrayObject *)object;
+    if (PyArray_TYPE(array) != NPY_DOUBLE || !PyArray_ISFARRAY_RO(array) || !PyArray_ISNOTSWAPPED(array)) return NULL;
+    if (PyArray_NDIM(array) != 2 || PyArray_SIZE(array) != size) return NULL;
     return (const double *)PyArray_DATA(array);
 }
 
@@ -196,19 +206,38 @@ static PyObject *rdc_result(const double *free, const double *R, const double *J
     return Py_BuildValue("(NNNN)", v_next, impulses, forces, slip);
 }
 
+/* The points' Jacobian J (3k x nv) in the contact axes: row t of point i is
+ * a_t · (J_v − [p_i]× J_ω) over the columns it sees (robodyn.sim.contact.ContactStepper.jacobian). */
+static void rdc_jacobian(const double *joints, const double *points, const double *mask, const double *axes, int k, int nv,
+                         double *J) {
+    for (int i = 0; i < k; ++i) {
+        const double *p = points + 3 * i;
+        for (int j = 0; j < nv; ++j) {
+            const double m = mask[i * nv + j], *column = joints + 6 * j; /* column-major (6, nv) */
+            const double vx = column[0] * m, vy = column[1] * m, vz = column[2] * m;
+            const double wx = column[3] * m, wy = column[4] * m, wz = column[5] * m;
+            const double lx = vx - (-p[2] * wy + p[1] * wz), ly = vy - (p[2] * wx - p[0] * wz), lz = vz - (-p[1] * wx + p[0] * wy);
+            for (int t = 0; t < 3; ++t) J[(3 * i + t) * nv + j] = axes[3 * t] * lx + axes[3 * t + 1] * ly + axes[3 * t + 2] * lz;
+        }
+    }
+}
+
 static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 9 || !PyArray_CheckExact(args[2]) || !PyArray_CheckExact(args[6])) Py_RETURN_NONE;
-    const int nv = (int)PyArray_SIZE((PyArrayObject *)args[2]), r = (int)PyArray_SIZE((PyArrayObject *)args[6]);
-    const double *inverse = rdc_array(args[0], (npy_intp)nv * nv), *J = rdc_array(args[1], (npy_intp)r * nv);
-    const double *v = rdc_array(args[2], nv), *tau = rdc_array(args[3], nv), *bias = rdc_array(args[4], nv);
-    const double *gaps = rdc_array(args[5], r / 3), *guess = rdc_array(args[6], r), *axes = rdc_array(args[7], 9);
-    const double *settings = rdc_array(args[8], 3);
-    if (!inverse || !J || !v || !tau || !bias || !gaps || !guess || !axes || !settings || r % 3 || r == 0) Py_RETURN_NONE;
-    const size_t size = (size_t)nv + 2 * (size_t)nv * r + 2 * (size_t)r * r + 6 * (size_t)r + 2;
+    if (nargs != 11 || !PyArray_CheckExact(args[4]) || !PyArray_CheckExact(args[7])) Py_RETURN_NONE;
+    const int nv = (int)PyArray_SIZE((PyArrayObject *)args[4]), k = (int)PyArray_SIZE((PyArrayObject *)args[7]), r = 3 * k;
+    const double *inverse = rdc_array(args[0], (npy_intp)nv * nv), *joints = rdc_columns(args[1], 6 * (npy_intp)nv);
+    const double *points = rdc_array(args[2], r), *mask = rdc_array(args[3], (npy_intp)k * nv);
+    const double *v = rdc_array(args[4], nv), *tau = rdc_array(args[5], nv), *bias = rdc_array(args[6], nv);
+    const double *gaps = rdc_array(args[7], k), *guess = rdc_array(args[8], r), *axes = rdc_array(args[9], 9);
+    const double *settings = rdc_array(args[10], 3);
+    if (!inverse || !joints || !points || !mask || !v || !tau || !bias || !gaps || !guess || !axes || !settings || k == 0)
+        Py_RETURN_NONE;
+    const size_t size = (size_t)nv + 3 * (size_t)nv * r + 2 * (size_t)r * r + 6 * (size_t)r + 2;
     double *buffer = malloc(size * sizeof(double));
     if (!buffer) return PyErr_NoMemory();
     double *free_velocity = buffer, *R = free_velocity + nv, *A = R + nv * r, *c = A + r * r, *p = c + r;
-    double *work = p + r; /* u_before, u, stuck (r ints), then the r x r system and its right side */
+    double *J = p + r, *work = J + (size_t)r * nv; /* u_before, u, stuck (r ints), then the sticking system */
+    rdc_jacobian(joints, points, mask, axes, k, nv, J);
     rdc_terms(inverse, J, v, tau, bias, gaps, settings, nv, r, free_velocity, R, A, c);
     PyObject *result = NULL;
     if (rdc_kept(A, c, guess, settings[2], r, nv, work, p))
@@ -220,7 +249,8 @@ static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize
 }
 
 static PyMethodDef rdc_methods[] = {
-    {"kept", (PyCFunction)(void (*)(void))rdc_kept_step, METH_FASTCALL, "kept(inverse, jacobian, v, tau, bias, gaps, guess, axes, settings)"},
+    {"kept", (PyCFunction)(void (*)(void))rdc_kept_step, METH_FASTCALL,
+     "kept(inverse, joints, points, mask, v, tau, bias, gaps, guess, axes, settings)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -203,15 +203,23 @@ class ContactStepper:
 
     def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The points' gaps (k,) [m] and Jacobian (3k, nv) (:func:`contact_kinematics`)."""
-        model, data = self.model, self.data
-        pin.computeJointJacobians(model, data, q)
-        placements = data.oMi
+        world, gaps = self.locate(q)
+        return gaps, self.jacobian(world)
+
+    def locate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The points in world axes (k, 3) [m] and their gaps (k,) [m]; the joints' world
+        Jacobians are then in ``data.J``."""
+        pin.computeJointJacobians(self.model, self.data, q)
+        placements = self.data.oMi
         world = np.array([placements[joint].act(anchor) for joint, anchor in self.anchors]) - self.offsets
+        return world, world @ self.normal - self.level
+
+    def jacobian(self, world: np.ndarray) -> np.ndarray:
+        """The points' Jacobian (3k, nv) in their contact axes, after :meth:`locate`."""
         count = len(self.anchors)
-        columns = data.J * self.mask  # (k, 6, nv): each point's joint's world Jacobian
+        columns = self.data.J * self.mask  # (k, 6, nv): each point's joint's world Jacobian
         linear = columns[:, :3] - (world @ self.skew).reshape(count, 3, 3) @ columns[:, 3:]
-        jacobian = _local_jacobian(self.axes, linear).reshape(3 * count, -1)
-        return world @ self.normal - self.level, jacobian
+        return _local_jacobian(self.axes, linear).reshape(3 * count, -1)
 
     def step(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, settings: ContactSettings, guess: np.ndarray | None
@@ -222,13 +230,14 @@ class ContactStepper:
         pin.cholesky.decompose(model, data)
         inverse = pin.cholesky.computeMinv(model, data)
         bias = pin.nonLinearEffects(model, data, q, v)
-        gaps, jacobian = self.kinematics(q)
+        world, gaps = self.locate(q)
         if self.kept is not None and guess is not None and settings.polish and gaps.size:
             scalars = np.array([dt, settings.baumgarte, self.ground.friction])
-            done = self.kept(inverse, jacobian, v, tau, bias, gaps, guess, self.axes, scalars)
+            done = self.kept(inverse, data.J, world, self.mask, v, tau, bias, gaps, guess, self.axes, scalars)
             if done is not None:  # the previous modes hold: solved in C
                 v_next, impulses, forces, slip = done
                 return ContactStep(integrate(self.robot, q, dt * v_next), v_next, impulses, forces, gaps, slip, 0, True)
+        jacobian = self.jacobian(world)
         response = inverse @ jacobian.T
         free = v + dt * (inverse @ (tau - bias))
         if not math.isfinite(free @ free) and not np.isfinite(inverse).all():  # (a huge free: not finite squared)

@@ -122,6 +122,15 @@ def _standing(solo, steps, compiled):
     target, v, guess = q[7:] + 0.02, np.zeros(solo.nv), None
     stepper = ContactStepper(solo, ground, points)
     compiled, stepper.kept = (stepper.kept if compiled else None), None
+    if compiled is not None:  # counts the steps the C step answered
+        kept = compiled
+
+        def compiled(*arguments):
+            done = kept(*arguments)
+            answered.append(done is not None)
+            return done
+
+    answered: list[bool] = []
     rows = []
     for step in range(40 + steps):
         stepper.kept = compiled if step >= 40 else None
@@ -130,6 +139,7 @@ def _standing(solo, steps, compiled):
         result = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
         q, v, guess = result.q, result.v, result.impulses
         rows.append(result)
+    assert not compiled or answered == [True] * steps  # every step after the landing: in C
     return rows[40:]
 
 
@@ -145,37 +155,56 @@ def test_the_compiled_step_of_kept_modes_is_the_python_polish(solo):
         assert np.abs(a.v - b.v).max() < 1e-13 and np.abs(a.slip - b.slip).max() < 1e-13
 
 
-def test_the_compiled_step_declines_what_is_not_its_case(solo):
-    """Arrays of a wrong size, type or layout, a slipping contact, more rows than nv: None (Python's path)."""
-    kept = ContactStepper(solo, Ground(), ()).kept
+def _kept_arguments(robot, ground, points, q, guess):
+    """The C step's arguments at ``q``, at rest, with ``guess`` (the stepper's own; the joints' torques their ``G``)."""
+    stepper = ContactStepper(robot, ground, points)
+    model, data = stepper.model, stepper.data
+    pin.crba(model, data, q)
+    pin.cholesky.decompose(model, data)
+    inverse, bias = pin.cholesky.computeMinv(model, data), pin.nonLinearEffects(model, data, q, np.zeros(robot.nv))
+    world, gaps = stepper.locate(q)
+    tau = np.r_[np.zeros(6), bias[6:]]  # the joints hold their own weight, the feet the base's
+    settings = np.array([1e-3, 0.2, ground.friction])
+    return stepper.kept, [
+        inverse,
+        data.J,
+        world,
+        stepper.mask,
+        np.zeros(robot.nv),
+        tau,
+        bias,
+        gaps,
+        guess,
+        stepper.axes,
+        settings,
+    ]
+
+
+def test_the_compiled_step_declines_what_is_not_its_case(solo, box):
+    """Arrays of a wrong size, type or layout, a contact on its cone, more rows than nv:
+    None (Python's path); the case itself: the impulses that hold solo12 up."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    q = solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, Ground(), points)[0].min()
+    weight = np.tile([0.0, 0.0, solo.total_mass * 9.81 * 1e-3 / 4], 4)  # [N s]
+    kept, arguments = _kept_arguments(solo, Ground(friction=0.8), points, q, weight)
     if kept is None:
         pytest.skip("no C compiler: the contact step is Python's alone")
-    rng = np.random.default_rng(2)
-    nv, k = 6, 2
-    inverse, jacobian = np.eye(nv), rng.normal(size=(3 * k, nv))
-    v, zero, gaps = np.zeros(nv), np.zeros(nv), np.zeros(k)
-    axes, settings = np.eye(3), np.array([1e-3, 0.2, 0.5])
-    push = jacobian.T @ np.tile([0.0, 0.0, -1.0], k)  # a torque pressing both points into the ground
-    stuck = np.tile([0.0, 0.0, 1e-3], k)  # the impulses that hold them: the previous step's
-    assert kept(inverse, jacobian, v, push, zero, gaps, stuck, axes, settings) is not None  # the case itself
-    assert kept(inverse, jacobian, v, push, zero, gaps[:1], stuck, axes, settings) is None  # wrong size
-    assert kept(inverse, jacobian.astype(np.float32), v, push, zero, gaps, stuck, axes, settings) is None
-    assert kept(inverse, np.asfortranarray(jacobian), v, push, zero, gaps, stuck, axes, settings) is None
-    assert kept(inverse, jacobian, v, push, zero, gaps, stuck.tolist(), axes, settings) is None
-    sliding = jacobian.T @ np.tile([5.0, 0.0, -1.0], k)  # pushed along t₁ five times its weight: slips
-    assert kept(inverse, jacobian, v, sliding, zero, gaps, stuck, axes, settings) is None
-    three = rng.normal(size=(9, nv))  # 9 rows of a 6-dof body: redundant
-    assert (
-        kept(
-            inverse,
-            three,
-            v,
-            three.T @ np.tile([0.0, 0.0, -1.0], 3),
-            zero,
-            np.zeros(3),
-            np.tile([0.0, 0.0, 1e-3], 3),
-            axes,
-            settings,
-        )
-        is None
-    )
+    assert kept(*arguments) is not None  # the case itself
+    assert abs(kept(*arguments)[2][:, 2].sum() / (solo.total_mass * 9.81) - 1) < 1e-2  # holding it up
+    for index, bad in (
+        (7, arguments[7][:3]),
+        (1, arguments[1].astype(np.float32)),
+        (1, np.ascontiguousarray(arguments[1])),
+        (0, np.asfortranarray(arguments[0][:, :6])),
+        (8, list(arguments[8])),
+    ):
+        assert kept(*arguments[:index], bad, *arguments[index + 1 :]) is None
+    on_cone = weight.copy()
+    on_cone[0] = 0.8 * on_cone[2]  # the first foot's impulse on its cone: it slipped
+    assert kept(*arguments[:8], on_cone, *arguments[9:]) is None
+    corners = contact_points(box, "collision").points
+    q = box.neutral_configuration()
+    q[2] = 0.05
+    kept, arguments = _kept_arguments(box, Ground(friction=0.5), corners, q, np.tile([0.0, 0.0, 2.5 * 9.81 * 1e-3 / 4], 8))
+    assert kept(*arguments) is None  # four resting corners: 12 rows of a 6-dof body
