@@ -4,7 +4,7 @@
  *   kept(inverse, joints, points, mask, v, tau, bias, gaps, guess, axes, settings)
  *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,)) or None
  *
- * with M⁻¹ (nv, nv), the joints' world Jacobians (6, nv, column-major: Pinocchio's data.J), the points
+ * with M⁻¹ (nv, nv, its upper triangle read), the joints' world Jacobians (6, nv, column-major: Pinocchio's data.J), the points
  * in world axes (k, 3), which columns each point sees (k, nv: 0 or 1), the gaps (k,), the previous step's
  * impulses (3k,), the axes (3, 3) as rows (t1, t2, n) and settings = (dt, baumgarte,
  * friction). It is robodyn.sim.contact_solver's polish of the previous impulses with
@@ -117,6 +117,9 @@ static int rdc_solves(const double *A, const double *c, const double *p, const d
     return 1;
 }
 
+/* M⁻¹ (i, j) from its upper triangle (Pinocchio's computeMinverse fills that one). */
+#define RDC_INVERSE(i, j) ((i) <= (j) ? inverse[(i) * nv + (j)] : inverse[(j) * nv + (i)])
+
 /* free = v + dt M⁻¹ (tau − bias), R = M⁻¹ Jᵀ (nv x r), A = J R, c = J free + the gaps' bias. */
 static void rdc_terms(const double *inverse, const double *J, const double *v, const double *tau, const double *bias,
                       const double *gaps, const double *settings, int nv, int r, double *free, double *R, double *A,
@@ -124,11 +127,11 @@ static void rdc_terms(const double *inverse, const double *J, const double *v, c
     const double dt = settings[0], beta = settings[1];
     for (int i = 0; i < nv; ++i) {
         double sum = 0.0;
-        for (int j = 0; j < nv; ++j) sum += inverse[i * nv + j] * (tau[j] - bias[j]);
+        for (int j = 0; j < nv; ++j) sum += RDC_INVERSE(i, j) * (tau[j] - bias[j]);
         free[i] = v[i] + dt * sum;
         for (int a = 0; a < r; ++a) {
             double s = 0.0;
-            for (int j = 0; j < nv; ++j) s += inverse[i * nv + j] * J[a * nv + j];
+            for (int j = 0; j < nv; ++j) s += RDC_INVERSE(i, j) * J[a * nv + j];
             R[i * r + a] = s;
         }
     }

@@ -29,10 +29,10 @@ without penetrating); a penetrating point (``g < 0``) is pushed out by the fract
 lands becomes zero within the step (no restitution). Contacts are rigid (no compliance).
 
 **Speed** (:class:`ContactStepper`): a run's steps reuse one workspace; ``M⁻¹`` comes from
-Pinocchio's sparse ``LDLᵀ`` of CRBA's ``M``, every point's Jacobian from one
-``computeJointJacobians``; a step whose previous contact modes still hold (a robot
-standing) is one small solve and the complementarity check, no ADMM
-(:mod:`robodyn.sim.contact_solver`). Robots with mimic joints take :func:`generic_step`
+Pinocchio's ``computeMinverse``, every point's Jacobian from one ``computeJointJacobians``;
+a step whose previous contacts all stick (a robot standing) is one C call
+(:mod:`robodyn.compiled.contact`: the sticking rows' solve and the complementarity check,
+no ADMM; the same in numpy without a C compiler, :mod:`robodyn.sim.contact_solver`). Robots with mimic joints take :func:`generic_step`
 (``Robot``'s ``M``); both agree to ADMM's tolerance (tests/sim/test_contact_stepper.py).
 """
 
@@ -173,7 +173,7 @@ class ContactStepper:
     workspace kept from step to step: one Pinocchio ``Data``, the points' anchors in their
     joints' frames and the rows of ``J`` each point sees.
 
-    A step is one pass of Pinocchio per quantity (CRBA, its sparse ``LDLᵀ`` and ``M⁻¹``,
+    A step is one pass of Pinocchio per quantity (``M⁻¹`` by its ABA-like recursion,
     ``C v + G``, the joints' world Jacobians) and a few stacked products: each point's
     Jacobian is ``axes (J_v − [p]× J_ω)`` of its joint's world Jacobian (``v_p = v₀ + ω × p``
     at the world origin, the joint's supporting columns), every point at once.
@@ -194,6 +194,7 @@ class ContactStepper:
         self.normal, self.level = self.axes[2], float(ground.point @ self.axes[2])
         self.offsets = np.array([point.radius * self.normal for point in points]).reshape(count, 3)
         self.skew = np.array([_skew(unit).ravel() for unit in np.eye(3)])  # p @ skew: [p]× of every point, flat
+        self.lower = np.tri(nv, nv, -1, dtype=bool)
         #: The compiled step of kept modes (robodyn.compiled.contact), or None: Python alone.
         self.kept = kept_step()
 
@@ -226,9 +227,7 @@ class ContactStepper:
     ) -> ContactStep:
         """:func:`contact_step` of this robot, ground and points."""
         model, data = self.model, self.data
-        pin.crba(model, data, q)  # M's upper triangle, read by the factorisation
-        pin.cholesky.decompose(model, data)
-        inverse = pin.cholesky.computeMinv(model, data)
+        inverse = pin.computeMinverse(model, data, q)  # M⁻¹'s upper triangle (armature included)
         bias = pin.nonLinearEffects(model, data, q, v)
         world, gaps = self.locate(q)
         if self.kept is not None and guess is not None and settings.polish and gaps.size:
@@ -238,6 +237,7 @@ class ContactStepper:
                 v_next, impulses, forces, slip = done
                 return ContactStep(integrate(self.robot, q, dt * v_next), v_next, impulses, forces, gaps, slip, 0, True)
         jacobian = self.jacobian(world)
+        np.copyto(inverse, inverse.T, where=self.lower)
         response = inverse @ jacobian.T
         free = v + dt * (inverse @ (tau - bias))
         if not math.isfinite(free @ free) and not np.isfinite(inverse).all():  # (a huge free: not finite squared)

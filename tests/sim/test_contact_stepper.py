@@ -102,57 +102,57 @@ def test_a_run_keeps_its_stepper_and_a_first_step_or_new_points_make_a_new_one(b
     assert contact._LOCAL.stepper is not stepper  # guess=None: a run's first step, built again
 
 
-def test_pinocchios_cholesky_inverse_is_robodyns_mass_matrix_inverse(solo):
-    """The stepper's ``M⁻¹`` (Pinocchio's sparse LDLᵀ of CRBA's M) against ``Robot.mass_matrix``."""
+def test_pinocchios_inverse_is_the_inverse_of_robodyns_mass_matrix_armature_included(solo):
+    """The stepper's ``M⁻¹`` (``computeMinverse``'s upper triangle) against ``Robot.mass_matrix``,
+    and on a model with armature against CRBA's ``M``, which adds it."""
     q = solo.random_configuration(np.random.default_rng(5))
     stepper = ContactStepper(solo, Ground(), ())
-    pin.crba(stepper.model, stepper.data, q)
-    pin.cholesky.decompose(stepper.model, stepper.data)
-    inverse = pin.cholesky.computeMinv(stepper.model, stepper.data)
+    inverse = pin.computeMinverse(stepper.model, stepper.data, q)
+    np.copyto(inverse, inverse.T, where=stepper.lower)
     assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() < 1e-12
-
-
-def _standing(solo, steps, compiled):
-    """solo12 landing from 1 mm (40 steps, Python alone), then ``steps`` steps from there
-    with its C step on or off (the previous modes hold from step 18 on)."""
-    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
-    ground = Ground(friction=0.8)
-    q = solo.neutral_configuration()
-    q[2] -= contact_kinematics(solo, q, ground, points)[0].min() - 1e-3
-    target, v, guess = q[7:] + 0.02, np.zeros(solo.nv), None
-    stepper = ContactStepper(solo, ground, points)
-    compiled, stepper.kept = (stepper.kept if compiled else None), None
-    if compiled is not None:  # counts the steps the C step answered
-        kept = compiled
-
-        def compiled(*arguments):
-            done = kept(*arguments)
-            answered.append(done is not None)
-            return done
-
-    answered: list[bool] = []
-    rows = []
-    for step in range(40 + steps):
-        stepper.kept = compiled if step >= 40 else None
-        tau = np.zeros(solo.nv)
-        tau[6:] = 5.0 * (target - q[7:]) - 0.1 * v[6:]
-        result = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
-        q, v, guess = result.q, result.v, result.impulses
-        rows.append(result)
-    assert not compiled or answered == [True] * steps  # every step after the landing: in C
-    return rows[40:]
+    model = solo.model.copy()
+    model.armature[6:] = np.linspace(0.01, 0.1, 12)
+    data = model.createData()
+    mass, inverse = pin.crba(model, data, q).copy(), pin.computeMinverse(model, data, q).copy()
+    mass, inverse = np.triu(mass) + np.triu(mass, 1).T, np.triu(inverse) + np.triu(inverse, 1).T
+    assert np.abs(inverse @ mass - np.eye(solo.nv)).max() < 1e-12
+    assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() > 1e-3  # the armature counts
 
 
 def test_the_compiled_step_of_kept_modes_is_the_python_polish(solo):
-    """The C step (robodyn/compiled/contact.c) and numpy's polish of the same modes, step by step."""
-    if ContactStepper(solo, Ground(), ()).kept is None:
+    """solo12 landing from 1 mm (40 steps, Python alone), then 60 steps standing while its
+    legs move: at each, the C step (robodyn/compiled/contact.c) and numpy's polish of the
+    same modes from the same state, and the run goes on from the C step's."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    ground = Ground(friction=0.8)
+    stepper = ContactStepper(solo, ground, points)
+    compiled = stepper.kept
+    if compiled is None:
         pytest.skip("no C compiler: the contact step is Python's alone")
-    ours, theirs = _standing(solo, 60, True), _standing(solo, 60, False)
-    assert all(row.iterations == 0 for row in ours)  # every step kept its modes
-    for a, b in zip(ours, theirs, strict=True):
-        assert a.iterations == b.iterations
-        assert np.abs(a.forces - b.forces).max() < 1e-12 * solo.total_mass * 9.81  # [N]
-        assert np.abs(a.v - b.v).max() < 1e-13 and np.abs(a.slip - b.slip).max() < 1e-13
+    answered: list[bool] = []
+
+    def counted(*arguments):
+        done = compiled(*arguments)
+        answered.append(done is not None)
+        return done
+
+    q = solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, ground, points)[0].min() - 1e-3
+    target, v, guess = q[7:] + 0.02, np.zeros(solo.nv), None
+    for step in range(100):
+        tau = np.r_[np.zeros(6), 5.0 * (target - q[7:]) - 0.1 * v[6:]]
+        stepper.kept = None
+        theirs = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+        if step >= 40:
+            stepper.kept = counted
+            ours = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+            assert ours.iterations == theirs.iterations == 0
+            assert np.abs(ours.forces - theirs.forces).max() < 1e-12 * solo.total_mass * 9.81  # [N]
+            assert np.abs(ours.v - theirs.v).max() < 1e-14 and np.abs(ours.slip - theirs.slip).max() < 1e-14
+            assert np.abs(ours.q - theirs.q).max() < 1e-16
+            theirs = ours
+        q, v, guess = theirs.q, theirs.v, theirs.impulses
+    assert answered == [True] * 60  # every step after the landing: in C
 
 
 def _kept_arguments(robot, ground, points, q, guess):
