@@ -117,32 +117,34 @@ static int rdc_solves(const double *A, const double *c, const double *p, const d
     return 1;
 }
 
-/* M⁻¹ (i, j) from its upper triangle (Pinocchio's computeMinverse fills that one). */
-#define RDC_INVERSE(i, j) ((i) <= (j) ? inverse[(i) * nv + (j)] : inverse[(j) * nv + (i)])
-
-/* free = v + dt M⁻¹ (tau − bias), R = M⁻¹ Jᵀ (nv x r), A = J R, c = J free + the gaps' bias. */
+/* free = v + dt M⁻¹ (tau − bias), R = M⁻¹ Jᵀ stored transposed (r x nv), A = J R (symmetric:
+ * its upper triangle mirrored), c = J free + the gaps' bias. M⁻¹ is read from its upper
+ * triangle (Pinocchio's computeMinverse fills that one) into `full` (nv x nv). */
 static void rdc_terms(const double *inverse, const double *J, const double *v, const double *tau, const double *bias,
-                      const double *gaps, const double *settings, int nv, int r, double *free, double *R, double *A,
-                      double *c) {
+                      const double *gaps, const double *settings, int nv, int r, double *full, double *free, double *R,
+                      double *A, double *c) {
     const double dt = settings[0], beta = settings[1];
+    for (int i = 0; i < nv; ++i)
+        for (int j = i; j < nv; ++j) full[i * nv + j] = full[j * nv + i] = inverse[i * nv + j];
     for (int i = 0; i < nv; ++i) {
         double sum = 0.0;
-        for (int j = 0; j < nv; ++j) sum += RDC_INVERSE(i, j) * (tau[j] - bias[j]);
+        for (int j = 0; j < nv; ++j) sum += full[i * nv + j] * (tau[j] - bias[j]);
         free[i] = v[i] + dt * sum;
-        for (int a = 0; a < r; ++a) {
-            double s = 0.0;
-            for (int j = 0; j < nv; ++j) s += RDC_INVERSE(i, j) * J[a * nv + j];
-            R[i * r + a] = s;
-        }
     }
+    for (int a = 0; a < r; ++a)
+        for (int i = 0; i < nv; ++i) {
+            double s = 0.0;
+            for (int j = 0; j < nv; ++j) s += full[i * nv + j] * J[a * nv + j];
+            R[a * nv + i] = s;
+        }
     for (int a = 0; a < r; ++a) {
         double s = 0.0;
         for (int i = 0; i < nv; ++i) s += J[a * nv + i] * free[i];
         c[a] = s;
-        for (int b = 0; b < r; ++b) {
+        for (int b = a; b < r; ++b) {
             double t = 0.0;
-            for (int i = 0; i < nv; ++i) t += J[a * nv + i] * R[i * r + b];
-            A[a * r + b] = t;
+            for (int i = 0; i < nv; ++i) t += J[a * nv + i] * R[b * nv + i];
+            A[a * r + b] = A[b * r + a] = t;
         }
     }
     for (int a = 2; a < r; a += 3) {
@@ -191,7 +193,7 @@ static PyObject *rdc_result(const double *free, const double *R, const double *J
     double *f = PyArray_DATA((PyArrayObject *)forces), *s = PyArray_DATA((PyArrayObject *)slip);
     for (int i = 0; i < nv; ++i) {
         double sum = 0.0;
-        for (int a = 0; a < r; ++a) sum += R[i * r + a] * p[a];
+        for (int a = 0; a < r; ++a) sum += R[a * nv + i] * p[a];
         vn[i] = free[i] + sum;
     }
     for (int a = 0; a < r; ++a) pi[a] = p[a];
@@ -235,13 +237,13 @@ static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize
     const double *settings = rdc_array(args[10], 3);
     if (!inverse || !joints || !points || !mask || !v || !tau || !bias || !gaps || !guess || !axes || !settings || k == 0)
         Py_RETURN_NONE;
-    const size_t size = (size_t)nv + 3 * (size_t)nv * r + 2 * (size_t)r * r + 6 * (size_t)r + 2;
+    const size_t size = (size_t)nv * (nv + 1) + 3 * (size_t)nv * r + 2 * (size_t)r * r + 6 * (size_t)r + 2;
     double *buffer = malloc(size * sizeof(double));
     if (!buffer) return PyErr_NoMemory();
     double *free_velocity = buffer, *R = free_velocity + nv, *A = R + nv * r, *c = A + r * r, *p = c + r;
-    double *J = p + r, *work = J + (size_t)r * nv; /* u_before, u, stuck (r ints), then the sticking system */
+    double *J = p + r, *full = J + (size_t)r * nv, *work = full + (size_t)nv * nv; /* work: u_before, u, stuck, the system */
     rdc_jacobian(joints, points, mask, axes, k, nv, J);
-    rdc_terms(inverse, J, v, tau, bias, gaps, settings, nv, r, free_velocity, R, A, c);
+    rdc_terms(inverse, J, v, tau, bias, gaps, settings, nv, r, full, free_velocity, R, A, c);
     PyObject *result = NULL;
     if (rdc_kept(A, c, guess, settings[2], r, nv, work, p))
         result = rdc_result(free_velocity, R, J, p, axes, settings[0], nv, r);
