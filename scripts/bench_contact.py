@@ -20,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 
 import robodyn
-from robodyn.sim.contact import contact_kinematics, contact_step, generic_step
+from robodyn.sim.contact import ContactStepper, contact_kinematics, contact_step, generic_step
 from robodyn.sim.contact_run import simulate_contact
 from robodyn.sim.contact_solver import ContactSettings
 from robodyn.sim.ground import ContactPoint, Ground
@@ -66,7 +66,8 @@ def _alternated(functions: list[Callable[[], object]], repeats: int) -> list[tup
 def bench_contact(quick: bool) -> list[dict]:
     """solo12 standing on four feet at 1 kHz: a loop of robodyn's ``contact_step`` vs a loop
     of MuJoCo's ``mj_step``, the same Python controller in both; also ``simulate_contact``
-    (the loop that records every sample), the general path (mimic robots') and a bare
+    (the loop that records every sample), the numpy path (no C compiler), the general path
+    (mimic robots') and a bare
     ``mj_step`` (no controller: solo12 then sags, its contacts still four)."""
     try:
         mujoco, model = _mujoco_solo(robot := robodyn.load("solo12"))
@@ -104,6 +105,9 @@ def bench_contact(quick: bool) -> list[dict]:
 
     ours = loop(lambda q, v, tau, guess: contact_step(robot, q, v, tau, DT, ground, points, settings=settings, guess=guess))
     general = loop(lambda q, v, tau, guess: generic_step(robot, q, v, tau, DT, ground, points, settings, guess))
+    numpy_only = ContactStepper(robot, ground, points)
+    numpy_only.kept = None  # as without a C compiler
+    numpy_path = loop(lambda q, v, tau, guess: numpy_only.step(q, v, tau, DT, settings, guess))
 
     def ours_run() -> None:
         simulate_contact(robot, ground=ground, contacts=points, controller=hold, duration=(steps - 1) * DT, q0=q1, v0=v1)
@@ -120,8 +124,8 @@ def bench_contact(quick: bool) -> list[dict]:
             mujoco.mj_step(model, data)
 
     repeats = 3 if quick else 7
-    timed = _alternated([ours, theirs, ours_run, general, theirs_bare], repeats)
-    (ours_cpu, ours_wall), (mj_cpu, mj_wall), (run_cpu, _), (general_cpu, _), (bare_cpu, _) = timed
+    timed = _alternated([ours, theirs, ours_run, general, theirs_bare, numpy_path], repeats)
+    (ours_cpu, ours_wall), (mj_cpu, mj_wall), (run_cpu, _), (general_cpu, _), (bare_cpu, _), (numpy_cpu, _) = timed
     duration = steps * DT
     run = simulate_contact(robot, ground=ground, contacts=points, controller=hold, duration=(steps - 1) * DT, q0=q1, v0=v1)
     theirs()  # MuJoCo's state after the same second, for the heights
@@ -136,6 +140,7 @@ def bench_contact(quick: bool) -> list[dict]:
             "robodyn_rtf": duration / statistics.median(ours_cpu),
             "mujoco_rtf": duration / statistics.median(mj_cpu),
             "simulate_contact_step_us": statistics.median(run_cpu) / steps * 1e6,
+            "numpy_path_step_us": statistics.median(numpy_cpu) / steps * 1e6,
             "general_path_step_us": statistics.median(general_cpu) / steps * 1e6,
             "mujoco_bare_mj_step_us": statistics.median(bare_cpu) / steps * 1e6,
             "admm_steps": int((run.iterations > 0).sum()),
