@@ -32,8 +32,9 @@ lands becomes zero within the step (no restitution). Contacts are rigid (no comp
 Pinocchio's ``computeMinverse``, every point's Jacobian from one ``computeJointJacobians``;
 a step whose previous contacts all stick (a robot standing) is one C call
 (:mod:`robodyn.compiled.contact`: the sticking rows' solve and the complementarity check,
-no ADMM; the same in numpy without a C compiler, :mod:`robodyn.sim.contact_solver`). Robots with mimic joints take :func:`generic_step`
-(``Robot``'s ``M``); both agree to ADMM's tolerance (tests/sim/test_contact_stepper.py).
+no ADMM; numpy's polish without a C compiler, :mod:`robodyn.sim.contact_solver`). Robots
+with mimic joints take :func:`generic_step` (``Robot``'s ``M``); the two agree to ADMM's
+tolerance (tests/sim/test_contact_stepper.py).
 """
 
 from __future__ import annotations
