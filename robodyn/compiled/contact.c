@@ -1,13 +1,14 @@
 /* robodyn contact step, previous modes kept (robodyn/compiled/contact.py): after the
  * includes and core.c. One METH_FASTCALL entry point,
  *
- *   kept(inverse, joints, points, mask, v, tau, bias, gaps, guess, axes, settings)
- *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,)) or None
+ *   kept(inverse, joints, centres, offsets, mask, v, tau, bias, guess, axes, settings)
+ *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,), gaps (k,)) or None
  *
- * with M⁻¹ (nv, nv, its upper triangle read), the joints' world Jacobians (6, nv, column-major: Pinocchio's data.J), the points
- * in world axes (k, 3), which columns each point sees (k, nv: 0 or 1), the gaps (k,), the previous step's
- * impulses (3k,), the axes (3, 3) as rows (t1, t2, n) and settings = (dt, baumgarte,
- * friction). It is robodyn.sim.contact_solver's polish of the previous impulses with
+ * with M⁻¹ (nv, nv, its upper triangle read), the joints' world Jacobians (6, nv,
+ * column-major: Pinocchio's data.J), the points' anchors in world axes (k, 3) and their
+ * offsets (radius · n, k x 3: a point is its anchor minus its offset), which columns each
+ * point sees (k, nv: 0 or 1), the previous step's impulses (3k,), the axes (3, 3) as rows
+ * (t1, t2, n) and settings = (dt, baumgarte, friction, the plane's level n · c). It is robodyn.sim.contact_solver's polish of the previous impulses with
  * cone=True (every closed contact sticking, its impulse inside its cone) on a regular
  * system: the same modes, an LU solve of the sticking rows (partial pivoting), the same
  * bound and the same complementarity check. None means "not this case" (a contact on its
@@ -180,17 +181,19 @@ static int rdc_kept(const double *A, const double *c, const double *guess, doubl
     return rdc_solves(A, c, p, u_before, friction, r, u);
 }
 
-static PyObject *rdc_result(const double *free, const double *R, const double *J, const double *p, const double *axes,
-                            double dt, int nv, int r) {
+static PyObject *rdc_result(const double *free, const double *R, const double *J, const double *p, const double *gaps,
+                            const double *axes, double dt, int nv, int r) {
     const npy_intp k = r / 3, vector[1] = {nv}, matrix[2] = {k, 3}, slips[1] = {k};
     PyObject *v_next = PyArray_SimpleNew(1, vector, NPY_DOUBLE), *impulses = PyArray_SimpleNew(2, matrix, NPY_DOUBLE);
     PyObject *forces = PyArray_SimpleNew(2, matrix, NPY_DOUBLE), *slip = PyArray_SimpleNew(1, slips, NPY_DOUBLE);
-    if (!v_next || !impulses || !forces || !slip) {
-        Py_XDECREF(v_next), Py_XDECREF(impulses), Py_XDECREF(forces), Py_XDECREF(slip);
+    PyObject *heights = PyArray_SimpleNew(1, slips, NPY_DOUBLE);
+    if (!v_next || !impulses || !forces || !slip || !heights) {
+        Py_XDECREF(v_next), Py_XDECREF(impulses), Py_XDECREF(forces), Py_XDECREF(slip), Py_XDECREF(heights);
         return NULL;
     }
     double *vn = PyArray_DATA((PyArrayObject *)v_next), *pi = PyArray_DATA((PyArrayObject *)impulses);
     double *f = PyArray_DATA((PyArrayObject *)forces), *s = PyArray_DATA((PyArrayObject *)slip);
+    memcpy(PyArray_DATA((PyArrayObject *)heights), gaps, (size_t)k * sizeof(double));
     for (int i = 0; i < nv; ++i) {
         double sum = 0.0;
         for (int a = 0; a < r; ++a) sum += R[a * nv + i] * p[a];
@@ -208,7 +211,7 @@ static PyObject *rdc_result(const double *free, const double *R, const double *J
         }
         s[i] = hypot(tangent[0], tangent[1]);
     }
-    return Py_BuildValue("(NNNN)", v_next, impulses, forces, slip);
+    return Py_BuildValue("(NNNNN)", v_next, impulses, forces, slip, heights);
 }
 
 /* The points' Jacobian J (3k x nv) in the contact axes: row t of point i is
@@ -228,25 +231,31 @@ static void rdc_jacobian(const double *joints, const double *points, const doubl
 }
 
 static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 11 || !PyArray_CheckExact(args[4]) || !PyArray_CheckExact(args[7])) Py_RETURN_NONE;
-    const int nv = (int)PyArray_SIZE((PyArrayObject *)args[4]), k = (int)PyArray_SIZE((PyArrayObject *)args[7]), r = 3 * k;
+    if (nargs != 11 || !PyArray_CheckExact(args[5]) || !PyArray_CheckExact(args[8])) Py_RETURN_NONE;
+    const int nv = (int)PyArray_SIZE((PyArrayObject *)args[5]), r = (int)PyArray_SIZE((PyArrayObject *)args[8]), k = r / 3;
     const double *inverse = rdc_array(args[0], (npy_intp)nv * nv), *joints = rdc_columns(args[1], 6 * (npy_intp)nv);
-    const double *points = rdc_array(args[2], r), *mask = rdc_array(args[3], (npy_intp)k * nv);
-    const double *v = rdc_array(args[4], nv), *tau = rdc_array(args[5], nv), *bias = rdc_array(args[6], nv);
-    const double *gaps = rdc_array(args[7], k), *guess = rdc_array(args[8], r), *axes = rdc_array(args[9], 9);
-    const double *settings = rdc_array(args[10], 3);
-    if (!inverse || !joints || !points || !mask || !v || !tau || !bias || !gaps || !guess || !axes || !settings || k == 0)
+    const double *centres = rdc_array(args[2], r), *offsets = rdc_array(args[3], r);
+    const double *mask = rdc_array(args[4], (npy_intp)k * nv), *v = rdc_array(args[5], nv);
+    const double *tau = rdc_array(args[6], nv), *bias = rdc_array(args[7], nv), *guess = rdc_array(args[8], r);
+    const double *axes = rdc_array(args[9], 9), *settings = rdc_array(args[10], 4);
+    if (!inverse || !joints || !centres || !offsets || !mask || !v || !tau || !bias || !guess || !axes || !settings ||
+        k == 0 || r % 3)
         Py_RETURN_NONE;
-    const size_t size = (size_t)nv * (nv + 1) + 3 * (size_t)nv * r + 2 * (size_t)r * r + 6 * (size_t)r + 2;
+    const size_t size = (size_t)nv * (nv + 1) + 3 * (size_t)nv * r + 2 * (size_t)r * r + 8 * (size_t)r + 2;
     double *buffer = malloc(size * sizeof(double));
     if (!buffer) return PyErr_NoMemory();
     double *free_velocity = buffer, *R = free_velocity + nv, *A = R + nv * r, *c = A + r * r, *p = c + r;
-    double *J = p + r, *full = J + (size_t)r * nv, *work = full + (size_t)nv * nv; /* work: u_before, u, stuck, the system */
+    double *J = p + r, *full = J + (size_t)r * nv, *points = full + (size_t)nv * nv, *gaps = points + r;
+    double *work = gaps + k; /* u_before, u, stuck, the system */
+    for (int i = 0; i < k; ++i) {
+        for (int j = 0; j < 3; ++j) points[3 * i + j] = centres[3 * i + j] - offsets[3 * i + j];
+        gaps[i] = (points[3 * i] * axes[6] + points[3 * i + 1] * axes[7] + points[3 * i + 2] * axes[8]) - settings[3];
+    }
     rdc_jacobian(joints, points, mask, axes, k, nv, J);
     rdc_terms(inverse, J, v, tau, bias, gaps, settings, nv, r, full, free_velocity, R, A, c);
     PyObject *result = NULL;
     if (rdc_kept(A, c, guess, settings[2], r, nv, work, p))
-        result = rdc_result(free_velocity, R, J, p, axes, settings[0], nv, r);
+        result = rdc_result(free_velocity, R, J, p, gaps, axes, settings[0], nv, r);
     else
         result = Py_NewRef(Py_None);
     free(buffer);
@@ -255,7 +264,7 @@ static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize
 
 static PyMethodDef rdc_methods[] = {
     {"kept", (PyCFunction)(void (*)(void))rdc_kept_step, METH_FASTCALL,
-     "kept(inverse, joints, points, mask, v, tau, bias, gaps, guess, axes, settings)"},
+     "kept(inverse, joints, centres, offsets, mask, v, tau, bias, guess, axes, settings)"},
     {NULL, NULL, 0, NULL},
 };
 

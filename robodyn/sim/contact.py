@@ -196,6 +196,7 @@ class ContactStepper:
         self.offsets = np.array([point.radius * self.normal for point in points]).reshape(count, 3)
         self.skew = np.array([_skew(unit).ravel() for unit in np.eye(3)])  # p @ skew: [p]× of every point, flat
         self.lower = np.tri(nv, nv, -1, dtype=bool)
+        self.scalars: tuple[tuple[float, ContactSettings] | None, np.ndarray] = (None, np.zeros(4))  # the C step's
         #: The compiled step of kept modes (robodyn.compiled.contact), or None: Python alone.
         self.kept = kept_step()
 
@@ -211,10 +212,15 @@ class ContactStepper:
     def locate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The points in world axes (k, 3) [m] and their gaps (k,) [m]; the joints' world
         Jacobians are then in ``data.J``."""
+        world = self.centres(q) - self.offsets
+        return world, world @ self.normal - self.level
+
+    def centres(self, q: np.ndarray) -> np.ndarray:
+        """The points' anchors (a sphere's centre) in world axes (k, 3) [m], and the joints'
+        world Jacobians in ``data.J``."""
         pin.computeJointJacobians(self.model, self.data, q)
         placements = self.data.oMi
-        world = np.array([placements[joint].act(anchor) for joint, anchor in self.anchors]) - self.offsets
-        return world, world @ self.normal - self.level
+        return np.array([placements[joint].act(anchor) for joint, anchor in self.anchors]).reshape(-1, 3)
 
     def jacobian(self, world: np.ndarray) -> np.ndarray:
         """The points' Jacobian (3k, nv) in their contact axes, after :meth:`locate`."""
@@ -230,13 +236,16 @@ class ContactStepper:
         model, data = self.model, self.data
         inverse = pin.computeMinverse(model, data, q)  # M⁻¹'s upper triangle (armature included)
         bias = pin.nonLinearEffects(model, data, q, v)
-        world, gaps = self.locate(q)
-        if self.kept is not None and guess is not None and settings.polish and gaps.size:
-            scalars = np.array([dt, settings.baumgarte, self.ground.friction])
-            done = self.kept(inverse, data.J, world, self.mask, v, tau, bias, gaps, guess, self.axes, scalars)
+        centres = self.centres(q)
+        if self.kept is not None and guess is not None and settings.polish and self.anchors:
+            if self.scalars[0] != (dt, settings):
+                self.scalars = ((dt, settings), np.array([dt, settings.baumgarte, self.ground.friction, self.level]))
+            done = self.kept(inverse, data.J, centres, self.offsets, self.mask, v, tau, bias, guess, self.axes, self.scalars[1])
             if done is not None:  # the previous modes hold: solved in C
-                v_next, impulses, forces, slip = done
+                v_next, impulses, forces, slip, gaps = done
                 return ContactStep(integrate(self.robot, q, dt * v_next), v_next, impulses, forces, gaps, slip, 0, True)
+        world = centres - self.offsets
+        gaps = world @ self.normal - self.level
         jacobian = self.jacobian(world)
         np.copyto(inverse, inverse.T, where=self.lower)
         response = inverse @ jacobian.T

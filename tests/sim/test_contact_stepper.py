@@ -162,22 +162,10 @@ def _kept_arguments(robot, ground, points, q, guess):
     pin.crba(model, data, q)
     pin.cholesky.decompose(model, data)
     inverse, bias = pin.cholesky.computeMinv(model, data), pin.nonLinearEffects(model, data, q, np.zeros(robot.nv))
-    world, gaps = stepper.locate(q)
     tau = np.r_[np.zeros(6), bias[6:]]  # the joints hold their own weight, the feet the base's
-    settings = np.array([1e-3, 0.2, ground.friction])
-    return stepper.kept, [
-        inverse,
-        data.J,
-        world,
-        stepper.mask,
-        np.zeros(robot.nv),
-        tau,
-        bias,
-        gaps,
-        guess,
-        stepper.axes,
-        settings,
-    ]
+    settings = np.array([1e-3, 0.2, ground.friction, stepper.level])
+    centres, zero = stepper.centres(q), np.zeros(robot.nv)
+    return stepper.kept, [inverse, data.J, centres, stepper.offsets, stepper.mask, zero, tau, bias, guess, stepper.axes, settings]
 
 
 def test_the_compiled_step_declines_what_is_not_its_case(solo, box):
@@ -190,10 +178,11 @@ def test_the_compiled_step_declines_what_is_not_its_case(solo, box):
     kept, arguments = _kept_arguments(solo, Ground(friction=0.8), points, q, weight)
     if kept is None:
         pytest.skip("no C compiler: the contact step is Python's alone")
-    assert kept(*arguments) is not None  # the case itself
-    assert abs(kept(*arguments)[2][:, 2].sum() / (solo.total_mass * 9.81) - 1) < 1e-2  # holding it up
+    done = kept(*arguments)  # the case itself
+    assert done is not None and abs(done[2][:, 2].sum() / (solo.total_mass * 9.81) - 1) < 1e-2  # holding it up
+    assert np.abs(done[4] - ContactStepper(solo, Ground(), points).locate(q)[1]).max() < 1e-15  # its gaps
     for index, bad in (
-        (7, arguments[7][:3]),
+        (3, arguments[3][:3]),
         (1, arguments[1].astype(np.float32)),
         (1, np.ascontiguousarray(arguments[1])),
         (0, np.asfortranarray(arguments[0][:, :6])),
