@@ -1,14 +1,16 @@
 /* robodyn contact step, previous modes kept (robodyn/compiled/contact.py): after the
  * includes and core.c. One METH_FASTCALL entry point,
  *
- *   kept(inverse, joints, centres, offsets, mask, v, tau, bias, guess, axes, settings)
- *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,), gaps (k,)) or None
+ *   kept(inverse, joints, centres, offsets, mask, v, tau, bias, guess, axes, settings, q)
+ *       -> (v_next (nv,), impulses (k, 3), forces (k, 3), slip (k,), gaps (k,), dq = dt v_next,
+ *           the floating base's new origin (3,) or None) or None
  *
  * with M⁻¹ (nv, nv, its upper triangle read), the joints' world Jacobians (6, nv,
  * column-major: Pinocchio's data.J), the points' anchors in world axes (k, 3) and their
  * offsets (radius · n, k x 3: a point is its anchor minus its offset), which columns each
  * point sees (k, nv: 0 or 1), the previous step's impulses (3k,), the axes (3, 3) as rows
- * (t1, t2, n) and settings = (dt, baumgarte, friction, the plane's level n · c). It is robodyn.sim.contact_solver's polish of the previous impulses with
+ * (t1, t2, n), settings = (dt, baumgarte, friction, the plane's level n · c) and q (a
+ * floating base's configuration, its quaternion (x, y, z, w) at q[3:7]) or None. It is robodyn.sim.contact_solver's polish of the previous impulses with
  * cone=True (every closed contact sticking, its impulse inside its cone) on a regular
  * system: the same modes, an LU solve of the sticking rows (partial pivoting), the same
  * bound and the same complementarity check. None means "not this case" (a contact on its
@@ -181,14 +183,29 @@ static int rdc_kept(const double *A, const double *c, const double *guess, doubl
     return rdc_solves(A, c, p, u_before, friction, r, u);
 }
 
+/* The floating base's new origin q[:3] + R(q) dq[:3] (robodyn.sim.contact.integrate; R as
+ * Eigen's Quaternion::toRotationMatrix of q[3:7] = (x, y, z, w)). */
+static void rdc_base(const double *q, const double *dq, double *base) {
+    const double x = q[3], y = q[4], z = q[5], w = q[6];
+    const double tx = 2 * x, ty = 2 * y, tz = 2 * z;
+    const double twx = tx * w, twy = ty * w, twz = tz * w, txx = tx * x, txy = ty * x, txz = tz * x;
+    const double tyy = ty * y, tyz = tz * y, tzz = tz * z;
+    const double R[9] = {1 - (tyy + tzz), txy - twz, txz + twy, txy + twz, 1 - (txx + tzz),
+                         tyz - twx,       txz - twy, tyz + twx, 1 - (txx + tyy)};
+    for (int i = 0; i < 3; ++i) base[i] = q[i] + (R[3 * i] * dq[0] + R[3 * i + 1] * dq[1] + R[3 * i + 2] * dq[2]);
+}
+
 static PyObject *rdc_result(const double *free, const double *R, const double *J, const double *p, const double *gaps,
-                            const double *axes, double dt, int nv, int r) {
+                            const double *axes, const double *q, double dt, int nv, int r) {
     const npy_intp k = r / 3, vector[1] = {nv}, matrix[2] = {k, 3}, slips[1] = {k};
     PyObject *v_next = PyArray_SimpleNew(1, vector, NPY_DOUBLE), *impulses = PyArray_SimpleNew(2, matrix, NPY_DOUBLE);
     PyObject *forces = PyArray_SimpleNew(2, matrix, NPY_DOUBLE), *slip = PyArray_SimpleNew(1, slips, NPY_DOUBLE);
-    PyObject *heights = PyArray_SimpleNew(1, slips, NPY_DOUBLE);
-    if (!v_next || !impulses || !forces || !slip || !heights) {
+    const npy_intp three[1] = {3};
+    PyObject *heights = PyArray_SimpleNew(1, slips, NPY_DOUBLE), *step = PyArray_SimpleNew(1, vector, NPY_DOUBLE);
+    PyObject *base = q ? PyArray_SimpleNew(1, three, NPY_DOUBLE) : Py_NewRef(Py_None);
+    if (!v_next || !impulses || !forces || !slip || !heights || !step || !base) {
         Py_XDECREF(v_next), Py_XDECREF(impulses), Py_XDECREF(forces), Py_XDECREF(slip), Py_XDECREF(heights);
+        Py_XDECREF(step), Py_XDECREF(base);
         return NULL;
     }
     double *vn = PyArray_DATA((PyArrayObject *)v_next), *pi = PyArray_DATA((PyArrayObject *)impulses);
@@ -211,7 +228,10 @@ static PyObject *rdc_result(const double *free, const double *R, const double *J
         }
         s[i] = hypot(tangent[0], tangent[1]);
     }
-    return Py_BuildValue("(NNNNN)", v_next, impulses, forces, slip, heights);
+    double *dq = PyArray_DATA((PyArrayObject *)step);
+    for (int i = 0; i < nv; ++i) dq[i] = dt * vn[i];
+    if (q) rdc_base(q, dq, PyArray_DATA((PyArrayObject *)base));
+    return Py_BuildValue("(NNNNNNN)", v_next, impulses, forces, slip, heights, step, base);
 }
 
 /* The points' Jacobian J (3k x nv) in the contact axes: row t of point i is
@@ -231,15 +251,17 @@ static void rdc_jacobian(const double *joints, const double *points, const doubl
 }
 
 static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 11 || !PyArray_CheckExact(args[5]) || !PyArray_CheckExact(args[8])) Py_RETURN_NONE;
+    if (nargs != 12 || !PyArray_CheckExact(args[5]) || !PyArray_CheckExact(args[8])) Py_RETURN_NONE;
     const int nv = (int)PyArray_SIZE((PyArrayObject *)args[5]), r = (int)PyArray_SIZE((PyArrayObject *)args[8]), k = r / 3;
     const double *inverse = rdc_array(args[0], (npy_intp)nv * nv), *joints = rdc_columns(args[1], 6 * (npy_intp)nv);
     const double *centres = rdc_array(args[2], r), *offsets = rdc_array(args[3], r);
     const double *mask = rdc_array(args[4], (npy_intp)k * nv), *v = rdc_array(args[5], nv);
     const double *tau = rdc_array(args[6], nv), *bias = rdc_array(args[7], nv), *guess = rdc_array(args[8], r);
     const double *axes = rdc_array(args[9], 9), *settings = rdc_array(args[10], 4);
+    const npy_intp nq = PyArray_CheckExact(args[11]) ? PyArray_SIZE((PyArrayObject *)args[11]) : 0;
+    const double *q = nq >= 7 ? rdc_array(args[11], nq) : NULL; /* a floating base's q */
     if (!inverse || !joints || !centres || !offsets || !mask || !v || !tau || !bias || !guess || !axes || !settings ||
-        k == 0 || r % 3)
+        (args[11] != Py_None && !q) || k == 0 || r % 3)
         Py_RETURN_NONE;
     const size_t size = (size_t)nv * (nv + 1) + 3 * (size_t)nv * r + 2 * (size_t)r * r + 8 * (size_t)r + 2;
     double *buffer = malloc(size * sizeof(double));
@@ -255,7 +277,7 @@ static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize
     rdc_terms(inverse, J, v, tau, bias, gaps, settings, nv, r, full, free_velocity, R, A, c);
     PyObject *result = NULL;
     if (rdc_kept(A, c, guess, settings[2], r, nv, work, p))
-        result = rdc_result(free_velocity, R, J, p, gaps, axes, settings[0], nv, r);
+        result = rdc_result(free_velocity, R, J, p, gaps, axes, q, settings[0], nv, r);
     else
         result = Py_NewRef(Py_None);
     free(buffer);
@@ -264,7 +286,7 @@ static PyObject *rdc_kept_step(PyObject *module, PyObject *const *args, Py_ssize
 
 static PyMethodDef rdc_methods[] = {
     {"kept", (PyCFunction)(void (*)(void))rdc_kept_step, METH_FASTCALL,
-     "kept(inverse, joints, centres, offsets, mask, v, tau, bias, guess, axes, settings)"},
+     "kept(inverse, joints, centres, offsets, mask, v, tau, bias, guess, axes, settings, q)"},
     {NULL, NULL, 0, NULL},
 };
 

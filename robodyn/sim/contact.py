@@ -196,6 +196,7 @@ class ContactStepper:
         self.offsets = np.array([point.radius * self.normal for point in points]).reshape(count, 3)
         self.skew = np.array([_skew(unit).ravel() for unit in np.eye(3)])  # p @ skew: [p]× of every point, flat
         self.lower = np.tri(nv, nv, -1, dtype=bool)
+        self.floating = robot.floating_base
         self.scalars: tuple[tuple[float, ContactSettings] | None, np.ndarray] = (None, np.zeros(4))  # the C step's
         #: The compiled step of kept modes (robodyn.compiled.contact), or None: Python alone.
         self.kept = kept_step()
@@ -240,10 +241,16 @@ class ContactStepper:
         if self.kept is not None and guess is not None and settings.polish and self.anchors:
             if self.scalars[0] != (dt, settings):
                 self.scalars = ((dt, settings), np.array([dt, settings.baumgarte, self.ground.friction, self.level]))
-            done = self.kept(inverse, data.J, centres, self.offsets, self.mask, v, tau, bias, guess, self.axes, self.scalars[1])
-            if done is not None:  # the previous modes hold: solved in C
-                v_next, impulses, forces, slip, gaps = done
-                return ContactStep(integrate(self.robot, q, dt * v_next), v_next, impulses, forces, gaps, slip, 0, True)
+            base = q if self.floating else None
+            done = self.kept(
+                inverse, data.J, centres, self.offsets, self.mask, v, tau, bias, guess, self.axes, self.scalars[1], base
+            )
+            if done is not None:  # the previous modes hold: solved in C, with integrate's base origin
+                v_next, impulses, forces, slip, gaps, dq, origin = done
+                moved = pin.integrate(model, q, dq)
+                if origin is not None:
+                    moved[:3] = origin
+                return ContactStep(moved, v_next, impulses, forces, gaps, slip, 0, True)
         world = centres - self.offsets
         gaps = world @ self.normal - self.level
         jacobian = self.jacobian(world)

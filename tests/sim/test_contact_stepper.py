@@ -165,7 +165,8 @@ def _kept_arguments(robot, ground, points, q, guess):
     tau = np.r_[np.zeros(6), bias[6:]]  # the joints hold their own weight, the feet the base's
     settings = np.array([1e-3, 0.2, ground.friction, stepper.level])
     centres, zero = stepper.centres(q), np.zeros(robot.nv)
-    return stepper.kept, [inverse, data.J, centres, stepper.offsets, stepper.mask, zero, tau, bias, guess, stepper.axes, settings]
+    arrays = [inverse, data.J, centres, stepper.offsets, stepper.mask, zero, tau, bias, guess, stepper.axes]
+    return stepper.kept, [*arrays, settings, q]
 
 
 def test_the_compiled_step_declines_what_is_not_its_case(solo, box):
