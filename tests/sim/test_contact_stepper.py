@@ -119,13 +119,11 @@ def test_pinocchios_inverse_is_the_inverse_of_robodyns_mass_matrix_armature_incl
     assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() > 1e-3  # the armature counts
 
 
-def test_the_compiled_step_of_kept_modes_is_the_python_polish(solo):
-    """solo12 landing from 1 mm (40 steps, Python alone), then 60 steps standing while its
-    legs move: at each, the C step (robodyn/compiled/contact.c) and numpy's polish of the
-    same modes from the same state, and the run goes on from the C step's."""
-    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
-    ground = Ground(friction=0.8)
-    stepper = ContactStepper(solo, ground, points)
+def _c_against_numpy(robot, ground, points, q, controller, settle, steps):
+    """``settle`` steps (numpy alone), then ``steps`` steps: at each, the C step
+    (robodyn/compiled/contact.c) and numpy's polish from the same state; the run goes on
+    from the C step's. Every one of them must be answered in C."""
+    stepper = ContactStepper(robot, ground, points)
     compiled = stepper.kept
     if compiled is None:
         pytest.skip("no C compiler: the contact step is Python's alone")
@@ -136,23 +134,43 @@ def test_the_compiled_step_of_kept_modes_is_the_python_polish(solo):
         answered.append(done is not None)
         return done
 
-    q = solo.neutral_configuration()
-    q[2] -= contact_kinematics(solo, q, ground, points)[0].min() - 1e-3
-    target, v, guess = q[7:] + 0.02, np.zeros(solo.nv), None
-    for step in range(100):
-        tau = np.r_[np.zeros(6), 5.0 * (target - q[7:]) - 0.1 * v[6:]]
+    v, guess, weight = np.zeros(robot.nv), None, 9.81 * robot.total_mass
+    for step in range(settle + steps):
+        tau = controller(q, v)
         stepper.kept = None
         theirs = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
-        if step >= 40:
+        if step >= settle:
             stepper.kept = counted
             ours = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
             assert ours.iterations == theirs.iterations == 0
-            assert np.abs(ours.forces - theirs.forces).max() < 1e-12 * solo.total_mass * 9.81  # [N]
+            assert np.abs(ours.forces - theirs.forces).max() < 1e-12 * weight  # [N]
             assert np.abs(ours.v - theirs.v).max() < 1e-14 and np.abs(ours.slip - theirs.slip).max() < 1e-14
-            assert np.abs(ours.q - theirs.q).max() < 1e-16
+            assert np.abs(ours.q - theirs.q).max() < 1e-16 and np.array_equal(ours.gaps, theirs.gaps)
             theirs = ours
         q, v, guess = theirs.q, theirs.v, theirs.impulses
-    assert answered == [True] * 60  # every step after the landing: in C
+    assert answered == [True] * steps
+
+
+def test_the_compiled_step_of_kept_modes_is_the_python_polish_on_solo12(solo):
+    """solo12 landing from 1 mm, then standing while its legs move (a floating base)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    q = solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, Ground(), points)[0].min() - 1e-3
+    target = q[7:] + 0.02
+
+    def hold(q, v):
+        return np.r_[np.zeros(6), 5.0 * (target - q[7:]) - 0.1 * v[6:]]
+
+    _c_against_numpy(solo, Ground(friction=0.8), points, q, hold, 40, 60)
+
+
+def test_the_compiled_step_of_kept_modes_is_the_python_polish_on_a_fixed_arm():
+    """ur5 falling onto a table 2 cm below its tool, then resting on it (a fixed base, one point)."""
+    arm = robodyn.load("ur5")
+    tip = (ContactPoint("tip", "tool0", (0.0, 0.0, 0.0)),)
+    q = np.zeros(arm.nq)
+    ground = Ground(height=contact_kinematics(arm, q, Ground(), tip)[0][0] - 0.02, friction=5.0)
+    _c_against_numpy(arm, ground, tip, q, lambda q, v: -0.5 * v, 300, 50)
 
 
 def _kept_arguments(robot, ground, points, q, guess):
