@@ -228,7 +228,7 @@ class ContactStepper:
         count = len(self.anchors)
         columns = self.data.J * self.mask  # (k, 6, nv): each point's joint's world Jacobian
         linear = columns[:, :3] - (world @ self.skew).reshape(count, 3, 3) @ columns[:, 3:]
-        return _local_jacobian(self.axes, linear).reshape(3 * count, -1)
+        return _local_jacobian(self.axes, linear).reshape(3 * count, self.model.nv)
 
     def step(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, settings: ContactSettings, guess: np.ndarray | None

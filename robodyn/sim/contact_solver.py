@@ -90,7 +90,9 @@ def solve_impulses(
     (module docstring), with ADMM's iterations and whether it converged; ``dofs``: the
     robot's ``nv`` (``A``'s rank is at most that: more rows are redundant), if known."""
     count = len(velocity) // 3
-    if settings.polish and guess is not None and count:  # the previous step's modes may still hold: no ADMM
+    if not count:  # no contact: nothing to solve (Pinocchio's ADMM would crash on no rows)
+        return np.zeros(0), 0, True
+    if settings.polish and guess is not None:  # the previous step's modes may still hold: no ADMM
         previous = np.asarray(guess, dtype=float).reshape(-1)
         for cone in (True, False):  # every closed contact sticking, then the modes its velocities show
             kept = polish(delassus, velocity, friction, previous, dofs=dofs, cone=cone)

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import robodyn
-from robodyn.sim.contact import contact_kinematics
+from robodyn.sim.contact import contact_kinematics, contact_step
 from robodyn.sim.contact_run import simulate_contact
 from robodyn.sim.contact_solver import ContactSettings, polish, solve_impulses
 from robodyn.sim.ground import ContactPoint, Ground
@@ -88,3 +88,12 @@ def test_impulses_on_their_cones_are_not_read_as_sticking():
     assert abs(np.hypot(*impulses[:2]) - 0.4 * impulses[2]) < 1e-12  # on the cone: slipping
     assert polish(delassus, velocity, 0.4, impulses, cone=True) is None
     assert polish(delassus, velocity, 0.4, impulses) is not None
+
+
+def test_a_step_without_contact_points_is_free_motion():
+    """No rows at all (Pinocchio's ADMM crashed the process on them): the free step."""
+    box = robodyn.load(DATA / "box.urdf", floating_base=True)
+    q, v = box.neutral_configuration(), np.zeros(box.nv)
+    step = contact_step(box, q, v, np.zeros(box.nv), 1e-3, Ground(), ())
+    assert step.forces.shape == (0, 3) and step.iterations == 0 and step.converged
+    assert abs(step.v[2] + 9.81e-3) < 1e-15 and np.abs(np.delete(step.v, 2)).max() < 1e-15  # g dt, down
