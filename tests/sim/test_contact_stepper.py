@@ -9,6 +9,9 @@ import pinocchio as pin
 import pytest
 
 import robodyn
+from robodyn.compiled import build
+from robodyn.compiled import contact as compiled_contact
+from robodyn.exceptions import CompilerNotFoundError
 from robodyn.sim import contact
 from robodyn.sim.contact import ContactSettings, ContactStepper, contact_kinematics, contact_step, generic_step
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
@@ -216,3 +219,22 @@ def test_the_compiled_step_declines_what_is_not_its_case(solo, box):
     q[2] = 0.05
     kept, arguments = _kept_arguments(box, Ground(friction=0.5), corners, q, np.tile([0.0, 0.0, 2.5 * 9.81 * 1e-3 / 4], 8))
     assert kept(*arguments) is None  # four resting corners: 12 rows of a 6-dof body
+
+
+def test_without_a_c_compiler_the_step_is_numpys(solo, monkeypatch, tmp_path):
+    """No compiler (and nothing built in the cache): no C step; a step is numpy's."""
+
+    def missing() -> str:
+        raise CompilerNotFoundError("cc")
+
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))
+    monkeypatch.setattr(build, "find_compiler", missing)
+    compiled_contact.kept_step.cache_clear()
+    try:
+        stepper = ContactStepper(solo, Ground(friction=0.8), contact_points(solo, list(FEET)).points)
+        assert stepper.kept is None
+        q = solo.neutral_configuration()
+        step = stepper.step(q, np.zeros(solo.nv), np.zeros(solo.nv), 1e-3, ContactSettings(), None)
+        assert step.converged and np.isfinite(step.q).all()
+    finally:
+        compiled_contact.kept_step.cache_clear()  # built (or found) again for the tests after
