@@ -35,6 +35,7 @@ Sections:
     engines              loop-only real-time factor per engine (demo, ur5 PD) and their agreement
     constrained-step     the four-bar's constrained simulation per step, before vs after issue 40's
                          follow-up, same run (scripts/bench_constrained.py)
+    contact              solo12 standing on four feet at 1 kHz: robodyn's contact step vs MuJoCo's (issue 41)
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+from bench_contact import bench_contact  # scripts/: this script's folder is on sys.path
 
 import robodyn
 from robodyn import reference
@@ -1515,6 +1517,7 @@ SECTIONS: dict[str, Callable[[bool], list[dict]]] = {
     "compiled-floating": bench_compiled_floating,
     "robot-engine": bench_robot_engine,
     "constrained-step": bench_constrained,
+    "contact": bench_contact,
 }
 
 

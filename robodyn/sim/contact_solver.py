@@ -13,8 +13,9 @@ velocity ``c`` (3k,) (each contact's rows ``t₁, t₂, n``), find the impulses 
    the previous step's contact modes, polished (below), no longer solve the problem.
 2. **Polish** (as OSQP polishes a QP): ADMM's answer names each contact *open* (no
    force), *sticking* (``u = 0``) or *slipping* (``u_n = 0``, ``p_t = −μ p_n s`` along its
-   slip direction ``s``); those equalities are solved exactly (least-norm, the
-   constraints layer's rule for redundant rows) and the result kept only when it is a
+   slip direction ``s``); those equalities are solved exactly (one LU solve; least-norm,
+   the constraints layer's rule, for redundant rows: more of them than the robot's ``nv``,
+   or an LU answer 10⁶ times the problem's scale) and the result kept only when it is a
    solution: every impulse in its cone, every open contact separating, every slip
    continuing along ``s`` (to :data:`POLISH_TOLERANCE`). Otherwise ADMM's answer stands.
 """
@@ -82,15 +83,21 @@ _WORKSPACES: dict[tuple[int, float, ContactSettings], _Workspace] = {}
 
 
 def solve_impulses(
-    delassus: np.ndarray, velocity: np.ndarray, friction: float, settings: ContactSettings, guess: np.ndarray | None = None
-) -> tuple[np.ndarray, int, bool]:
+    delassus: np.ndarray, velocity: np.ndarray, friction: float, settings: ContactSettings, guess: np.ndarray | None = None,
+    *, dofs: int | None = None,
+) -> tuple[np.ndarray, int, bool]:  # fmt: skip
     """The impulses ``p`` (3k,) of the cone complementarity problem ``u = A p + c``
-    (module docstring), with ADMM's iterations and whether it converged."""
+    (module docstring), with ADMM's iterations and whether it converged; ``dofs``: the
+    robot's ``nv`` (``A``'s rank is at most that: more rows are redundant), if known."""
     count = len(velocity) // 3
-    if settings.polish and guess is not None and count:  # the previous step's modes may still hold: no ADMM
-        kept = polish(delassus, velocity, friction, np.asarray(guess, dtype=float).reshape(-1))
-        if kept is not None:
-            return kept, 0, True
+    if not count:  # no contact: nothing to solve (Pinocchio's ADMM would crash on no rows)
+        return np.zeros(0), 0, True
+    if settings.polish and guess is not None:  # the previous step's modes may still hold: no ADMM
+        previous = np.asarray(guess, dtype=float).reshape(-1)
+        for cone in (True, False):  # every closed contact sticking, then the modes its velocities show
+            kept = polish(delassus, velocity, friction, previous, dofs=dofs, cone=cone)
+            if kept is not None:
+                return kept, 0, True
     key = (count, friction, settings)
     if key not in _WORKSPACES:
         _WORKSPACES[key] = _Workspace(count, friction, settings)
@@ -103,67 +110,111 @@ def solve_impulses(
     converged = bool(work.solver.solve(operator, velocity, work.models, work.datas, work.settings, work.result))
     impulses = np.array(work.result.retrieveConstraintImpulses())
     if settings.polish and count:
-        polished = polish(delassus, velocity, friction, impulses)
+        polished = polish(delassus, velocity, friction, impulses, dofs=dofs)
         if polished is not None:
             return polished, int(work.result.iterations), True
     return impulses, int(work.result.iterations), converged
 
 
-def polish(delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses: np.ndarray) -> np.ndarray | None:
+def polish(
+    delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses: np.ndarray, *, dofs: int | None = None,
+    cone: bool = False,
+) -> np.ndarray | None:  # fmt: skip
     """The exact impulses of the contact modes ``impulses`` shows (module docstring), or
-    ``None`` when they are not a solution of the cone complementarity problem."""
-    p, u = impulses.reshape(-1, 3), (delassus @ impulses + velocity).reshape(-1, 3)
-    scale_p = max(float(np.abs(p).max()), 1e-300)
-    scale_u = max(float(np.abs(velocity).max()), 1e-300)
-    slip = np.hypot(u[:, 0], u[:, 1])
-    closed = p[:, 2] > 1e-6 * scale_p  # the others are open
-    slipping = closed & ((friction == 0.0) | (slip > 1e-6 * scale_u))  # frictionless: the normal row only
-    sticking, sliding = np.flatnonzero(closed & ~slipping), np.flatnonzero(slipping)
-    stuck_rows = (3 * sticking[:, None] + np.arange(3)).ravel()
-    rows = np.concatenate([stuck_rows, 3 * sliding + 2])
-    if not len(rows):
-        solution = np.zeros_like(velocity)
+    ``None`` when they are not a solution of the cone complementarity problem. More
+    equalities than ``dofs`` (the robot's ``nv``, if given) are redundant: least-norm at once.
+
+    A closed contact slips when the velocity ``u = A p + c`` of the impulses moves it; with
+    ``cone`` (the previous step's impulses), every closed contact sticks if each impulse is
+    inside its cone (to 1e-6), else ``None``: a robot standing while its joints move keeps
+    its modes, which the velocities of last step's impulses would call slipping.
+
+    Sticking contacts alone (a robot standing) are one solve of their rows of ``A``; a
+    slipping one adds a column ``(−μ s, 1)`` of its normal impulse. The modes are read
+    contact by contact on Python floats (a few contacts: cheaper than numpy's calls).
+    """
+    before = delassus @ impulses + velocity
+    p, u = impulses.tolist(), before.tolist()
+    scale_p = max(max(map(abs, p)), 1e-300)
+    scale_u = max(max(map(abs, velocity.tolist())), 1e-300)
+    stuck: list[int] = []
+    sliding: list[tuple[int, float, float]] = []
+    for index in range(0, len(p), 3):
+        if p[index + 2] > 1e-6 * scale_p:  # closed (the others are open)
+            if cone and not math.hypot(p[index], p[index + 1]) < (1 - 1e-6) * friction * p[index + 2]:
+                return None  # on its cone's boundary (or frictionless): it slipped
+            slip = 0.0 if cone else math.hypot(u[index], u[index + 1])
+            if friction == 0.0 or slip > 1e-6 * scale_u:  # frictionless: the normal row only
+                size = max(slip, 1e-300)
+                sliding.append((index, u[index] / size, u[index + 1] / size))
+            else:
+                stuck += (index, index + 1, index + 2)
+    redundant = dofs is not None and len(stuck) + len(sliding) > dofs
+    if sliding:
+        solution = _with_slips(delassus, velocity, friction, impulses, stuck, sliding, redundant)
+    elif len(stuck) == len(p):  # every contact sticks: its target's scale is the velocity's
+        solution = _least_norm(delassus, -velocity, 0.0 if redundant else 1e6 * max(scale_p, scale_u))
     else:
-        basis = np.zeros((len(velocity), len(rows)))
-        basis[stuck_rows, np.arange(len(stuck_rows))] = 1.0
-        columns = len(stuck_rows) + np.arange(len(sliding))
-        direction = u[sliding, :2] / np.maximum(slip[sliding], 1e-300)[:, None]
-        basis[3 * sliding, columns] = -friction * direction[:, 0]
-        basis[3 * sliding + 1, columns] = -friction * direction[:, 1]
-        basis[3 * sliding + 2, columns] = 1.0
-        solution = basis @ _least_norm((delassus @ basis)[rows], -velocity[rows], impulses)
+        solution = np.zeros_like(velocity)
+        if stuck:
+            target = -velocity[stuck]
+            bound = 0.0 if redundant else _bound(impulses)
+            solution[stuck] = _least_norm(delassus[np.ix_(stuck, stuck)], target, bound)
     return solution if _solves(delassus, velocity, friction, solution, u) else None
 
 
-def _least_norm(matrix: np.ndarray, target: np.ndarray, impulses: np.ndarray) -> np.ndarray:
+def _with_slips(
+    delassus: np.ndarray, velocity: np.ndarray, friction: float, impulses: np.ndarray,
+    stuck: list[int], sliding: list[tuple[int, float, float]], redundant: bool,
+) -> np.ndarray:  # fmt: skip
+    """The impulses of sticking rows ``stuck`` and slipping contacts ``sliding`` (first row, slip direction)."""
+    basis = np.zeros((len(velocity), len(stuck) + len(sliding)))
+    basis[stuck, np.arange(len(stuck))] = 1.0
+    for column, (index, s1, s2) in enumerate(sliding, start=len(stuck)):
+        basis[index : index + 3, column] = (-friction * s1, -friction * s2, 1.0)
+    rows = stuck + [index + 2 for index, _, _ in sliding]
+    target = -velocity[rows]
+    return basis @ _least_norm((delassus @ basis)[rows], target, 0.0 if redundant else _bound(impulses))
+
+
+def _bound(impulses: np.ndarray) -> float:
+    """The largest answer an LU solve may give: 10³ times the impulses' scale (not the
+    target's: its free velocities, up to ``g / dt`` of far points, are no scale of impulses —
+    a singular set, the ant's feet and ankle stops, once passed 384 N s for 0.0022)."""
+    return 1e3 * max(float(np.abs(impulses).max()), 1e-300)
+
+
+def _least_norm(matrix: np.ndarray, target: np.ndarray, bound: float) -> np.ndarray:
     """``matrix⁻¹ target`` by one LU solve when ``matrix`` is regular (the answer no larger
-    than 10³ times the impulses' scale: the target's free velocities, up to ``g / dt`` of far
-    points, are no scale of impulses), else the least-norm solution (redundant rows)."""
-    bound = 1e3 * max(float(np.abs(impulses).max()), 1e-300)
+    than ``bound``), else the least-norm solution (redundant rows; ``bound = 0``: at once)."""
+    if bound <= 0.0:
+        return np.linalg.lstsq(matrix, target, rcond=1e-10)[0]
     try:
-        with np.errstate(all="ignore"):
-            solution = np.linalg.solve(matrix, target)
-        if np.isfinite(solution).all() and float(np.abs(solution).max()) <= bound:
+        solution = np.linalg.solve(matrix, target)  # (numpy.linalg keeps its own errstate)
+        if float(np.abs(solution).max()) <= bound:  # NaN and inf fail
             return solution
     except np.linalg.LinAlgError:
         pass
     return np.linalg.lstsq(matrix, target, rcond=1e-10)[0]
 
 
-def _solves(delassus: np.ndarray, velocity: np.ndarray, friction: float, solution: np.ndarray, before: np.ndarray) -> bool:
+def _solves(delassus: np.ndarray, velocity: np.ndarray, friction: float, solution: np.ndarray, before: list[float]) -> bool:
     """Whether ``solution`` solves the problem (to :data:`POLISH_TOLERANCE`), its slips
-    continuing along ADMM's (``before``)."""
-    p, u = solution.reshape(-1, 3), (delassus @ solution + velocity).reshape(-1, 3)
-    size_p = POLISH_TOLERANCE * max(float(np.abs(p).max()), 1e-12)
-    size_u = POLISH_TOLERANCE * max(float(np.abs(velocity).max()), 1e-12)
-    normal, speed = p[:, 2], u[:, 2]
-    bad = (normal < -size_p) | (np.hypot(p[:, 0], p[:, 1]) > friction * normal + size_p)  # outside a cone
-    bad |= (speed < -size_u) | (
-        np.abs(speed) * np.abs(normal) > size_u * size_p / POLISH_TOLERANCE
-    )  # penetrating, or pushing apart
-    turned = u[:, 0] * before[:, 0] + u[:, 1] * before[:, 1] <= 0
-    bad |= (np.hypot(u[:, 0], u[:, 1]) > size_u) & (normal > size_p) & turned  # a slip that changed direction
-    return not bool(bad.any())
+    continuing along ADMM's (``before``: the velocities ``u`` of the modes' impulses)."""
+    p, u = solution.tolist(), (delassus @ solution + velocity).tolist()
+    size_p = POLISH_TOLERANCE * max(max(map(abs, p)), 1e-12)
+    size_u = POLISH_TOLERANCE * max(max(map(abs, velocity.tolist())), 1e-12)
+    pushing = size_u * size_p / POLISH_TOLERANCE
+    for index in range(0, len(p), 3):
+        normal, speed = p[index + 2], u[index + 2]
+        if normal < -size_p or math.hypot(p[index], p[index + 1]) > friction * normal + size_p:
+            return False  # outside its cone
+        if speed < -size_u or abs(speed) * abs(normal) > pushing:
+            return False  # penetrating, or pushing apart
+        turned = u[index] * before[index] + u[index + 1] * before[index + 1] <= 0
+        if turned and normal > size_p and math.hypot(u[index], u[index + 1]) > size_u:
+            return False  # a slip that changed direction
+    return True
 
 
 __all__ = ["POLISH_TOLERANCE", "ContactSettings", "polish", "solve_impulses"]

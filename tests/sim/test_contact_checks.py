@@ -48,7 +48,6 @@ def at_height(box: robodyn.Robot, z: float, pitch: float = 0.0) -> np.ndarray:
             {"every": 2},
             "control_period must be the step dt with a ground (the contact step samples the controller each step), got 2 steps.",
         ),
-        (Ground(), "collision", {"limits": "enforce"}, "limits must be 'warn' or 'ignore' with a ground (the contact step does not enforce limits), got 'enforce'."),
         (Ground(), "collision", {"observer": object()}, "observer must be none with a ground (the contact step runs no observer), got an observer."),
     ],
 )  # fmt: skip

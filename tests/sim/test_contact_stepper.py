@@ -1,0 +1,240 @@
+"""The fast contact step (:class:`robodyn.sim.contact.ContactStepper`) against the general one."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robodyn
+from robodyn.compiled import build
+from robodyn.compiled import contact as compiled_contact
+from robodyn.exceptions import CompilerNotFoundError
+from robodyn.sim import contact
+from robodyn.sim.contact import ContactSettings, ContactStepper, contact_kinematics, contact_step, generic_step
+from robodyn.sim.ground import ContactPoint, Ground, contact_points
+
+DATA = Path(__file__).parents[1] / "data" / "contact"
+FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+
+
+@pytest.fixture(scope="module")
+def solo() -> robodyn.Robot:
+    return robodyn.load("solo12")
+
+
+@pytest.fixture(scope="module")
+def box() -> robodyn.Robot:
+    return robodyn.load(DATA / "box.urdf", floating_base=True)
+
+
+def _both(robot, q, v, controller, ground, points, steps):
+    """Per step, the fast and the general step's (q⁺, v⁺, forces), each on its own run."""
+    settings, runs = ContactSettings(), []
+    for fast in (True, False):
+        state, guess, rows = (q, v), None, []
+        for _ in range(steps):
+            tau = controller(state[0], state[1])
+            if fast:
+                result = contact_step(robot, *state, tau, 1e-3, ground, points, settings=settings, guess=guess)
+            else:
+                result = generic_step(robot, *state, tau, 1e-3, ground, points, settings, guess)
+            rows.append((result.q, result.v, result.forces, result.iterations))
+            state, guess = (result.q, result.v), result.impulses
+        runs.append(rows)
+    return runs
+
+
+def _largest_difference(runs, index):
+    return max(float(np.abs(a[index] - b[index]).max()) for a, b in zip(*runs, strict=True))
+
+
+@pytest.mark.parametrize(("friction", "push"), [(0.8, 0.0), (0.2, 0.5)])
+def test_solo12_landing_on_its_feet_is_the_general_steps_motion(solo, friction, push):
+    """Standing (μ = 0.8) and landing while sliding and turning (μ = 0.2: slipping modes):
+    the same ADMM iterations every step; the motions part only by ADMM's own tolerance
+    (1e-10) acting on round-off (measured: v⁺ 7e-12 / 1e-9 m/s, forces 3e-10 / 4e-8 N)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    ground = Ground(height=0.01, friction=friction)  # a raised floor: its level counts
+    q0 = solo.neutral_configuration()
+    q0[7:] += np.linspace(-0.2, 0.2, 12)  # legs apart from the neutral pose: every mask matters
+    q0[2] += -contact_kinematics(solo, q0, ground, points)[0].min() + 0.005
+    v0 = np.zeros(solo.nv)
+    v0[[0, 1, 5]] = (push, 0.6 * push, 0.8 * push)
+    target = q0[7:].copy()
+
+    def hold(q, v):
+        tau = np.zeros(solo.nv)
+        tau[6:] = 5.0 * (target - q[7:]) - 0.1 * v[6:]
+        return tau
+
+    runs = _both(solo, q0, v0, hold, ground, points, 150)
+    assert any(row[3] > 0 for row in runs[0]) and any(row[3] == 0 for row in runs[0])  # ADMM, and modes kept
+    assert [row[3] for row in runs[0]] == [row[3] for row in runs[1]]
+    assert _largest_difference(runs, 2) < 1e-8 * solo.total_mass * 9.81  # forces, [N]
+    assert _largest_difference(runs, 1) < 1e-8  # v⁺ [m/s, rad/s]
+    assert _largest_difference(runs, 0) < 1e-11  # q⁺
+
+
+def test_the_steppers_jacobian_is_the_frame_jacobians_and_a_point_seeing_every_joint_is_not(solo):
+    points = (*contact_points(solo, list(FEET)).points, ContactPoint("knee", "FR_LOWER_LEG", (0.01, -0.02, 0.03), 0.02))
+    ground = Ground.tilted(0.3, friction=0.5, height=-0.1)
+    q = solo.random_configuration(np.random.default_rng(7))
+    stepper = ContactStepper(solo, ground, points)
+    gaps, jacobian = contact_kinematics(solo, q, ground, points)
+    fast_gaps, fast_jacobian = stepper.kinematics(q)
+    assert np.abs(fast_gaps - gaps).max() < 1e-15 and np.abs(fast_jacobian - jacobian).max() < 1e-14
+    stepper.mask[:] = 1.0  # negative control: every column to every point
+    assert np.abs(stepper.kinematics(q)[1] - jacobian).max() > 1e-2
+
+
+def test_a_run_keeps_its_stepper_and_a_first_step_or_new_points_make_a_new_one(box):
+    ground, points = Ground(friction=0.5), contact_points(box, "collision").points
+    q, v, tau = box.neutral_configuration(), np.zeros(box.nv), np.zeros(box.nv)
+    q[2] = 0.06
+    first = contact_step(box, q, v, tau, 1e-3, ground, points)
+    stepper = contact._LOCAL.stepper
+    contact_step(box, first.q, first.v, tau, 1e-3, ground, points, guess=first.impulses)
+    assert contact._LOCAL.stepper is stepper
+    contact_step(box, first.q, first.v, tau, 1e-3, ground, points[:4], guess=first.impulses[:4])
+    assert contact._LOCAL.stepper is not stepper
+    stepper = contact._LOCAL.stepper
+    contact_step(box, first.q, first.v, tau, 1e-3, ground, points[:4])
+    assert contact._LOCAL.stepper is not stepper  # guess=None: a run's first step, built again
+
+
+def test_pinocchios_inverse_is_the_inverse_of_robodyns_mass_matrix_armature_included(solo):
+    """The stepper's ``M⁻¹`` (``computeMinverse``'s upper triangle) against ``Robot.mass_matrix``,
+    and on a model with armature against CRBA's ``M``, which adds it."""
+    q = solo.random_configuration(np.random.default_rng(5))
+    stepper = ContactStepper(solo, Ground(), ())
+    inverse = pin.computeMinverse(stepper.model, stepper.data, q)
+    np.copyto(inverse, inverse.T, where=stepper.lower)
+    assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() < 1e-12
+    model = solo.model.copy()
+    model.armature[6:] = np.linspace(0.01, 0.1, 12)
+    data = model.createData()
+    mass, inverse = pin.crba(model, data, q).copy(), pin.computeMinverse(model, data, q).copy()
+    mass, inverse = np.triu(mass) + np.triu(mass, 1).T, np.triu(inverse) + np.triu(inverse, 1).T
+    assert np.abs(inverse @ mass - np.eye(solo.nv)).max() < 1e-12
+    assert np.abs(inverse @ solo.mass_matrix(q) - np.eye(solo.nv)).max() > 1e-3  # the armature counts
+
+
+def _c_against_numpy(robot, ground, points, q, controller, settle, steps):
+    """``settle`` steps (numpy alone), then ``steps`` steps: at each, the C step
+    (robodyn/compiled/contact.c) and numpy's polish from the same state; the run goes on
+    from the C step's. Every one of them must be answered in C."""
+    stepper = ContactStepper(robot, ground, points)
+    compiled = stepper.kept
+    if compiled is None:
+        pytest.skip("no C compiler: the contact step is Python's alone")
+    answered: list[bool] = []
+
+    def counted(*arguments):
+        done = compiled(*arguments)
+        answered.append(done is not None)
+        return done
+
+    v, guess, weight = np.zeros(robot.nv), None, 9.81 * robot.total_mass
+    for step in range(settle + steps):
+        tau = controller(q, v)
+        stepper.kept = None
+        theirs = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+        if step >= settle:
+            stepper.kept = counted
+            ours = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+            assert ours.iterations == theirs.iterations == 0
+            assert np.abs(ours.forces - theirs.forces).max() < 1e-12 * weight  # [N]
+            assert np.abs(ours.v - theirs.v).max() < 1e-14 and np.abs(ours.slip - theirs.slip).max() < 1e-14
+            assert np.abs(ours.q - theirs.q).max() < 1e-16 and np.array_equal(ours.gaps, theirs.gaps)
+            theirs = ours
+        q, v, guess = theirs.q, theirs.v, theirs.impulses
+    assert answered == [True] * steps
+
+
+def test_the_compiled_step_of_kept_modes_is_the_python_polish_on_solo12(solo):
+    """solo12 landing from 1 mm, then standing while its legs move (a floating base)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    q = solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, Ground(), points)[0].min() - 1e-3
+    target = q[7:] + 0.02
+
+    def hold(q, v):
+        return np.r_[np.zeros(6), 5.0 * (target - q[7:]) - 0.1 * v[6:]]
+
+    _c_against_numpy(solo, Ground(friction=0.8), points, q, hold, 40, 60)
+
+
+def test_the_compiled_step_of_kept_modes_is_the_python_polish_on_a_fixed_arm():
+    """ur5 falling onto a table 2 cm below its tool, then resting on it (a fixed base, one point)."""
+    arm = robodyn.load("ur5")
+    tip = (ContactPoint("tip", "tool0", (0.0, 0.0, 0.0)),)
+    q = np.zeros(arm.nq)
+    ground = Ground(height=contact_kinematics(arm, q, Ground(), tip)[0][0] - 0.02, friction=5.0)
+    _c_against_numpy(arm, ground, tip, q, lambda q, v: -0.5 * v, 300, 50)
+
+
+def _kept_arguments(robot, ground, points, q, guess):
+    """The C step's arguments at ``q``, at rest, with ``guess`` (the stepper's own; the joints' torques their ``G``)."""
+    stepper = ContactStepper(robot, ground, points)
+    model, data = stepper.model, stepper.data
+    pin.crba(model, data, q)
+    pin.cholesky.decompose(model, data)
+    inverse, bias = pin.cholesky.computeMinv(model, data), pin.nonLinearEffects(model, data, q, np.zeros(robot.nv))
+    tau = np.r_[np.zeros(6), bias[6:]]  # the joints hold their own weight, the feet the base's
+    settings = np.array([1e-3, 0.2, ground.friction, stepper.level])
+    centres, zero = stepper.centres(q), np.zeros(robot.nv)
+    arrays = [inverse, data.J, centres, stepper.offsets, stepper.mask, zero, tau, bias, guess, stepper.axes]
+    return stepper.kept, [*arrays, settings, q]
+
+
+def test_the_compiled_step_declines_what_is_not_its_case(solo, box):
+    """Arrays of a wrong size, type or layout, a contact on its cone, more rows than nv:
+    None (Python's path); the case itself: the impulses that hold solo12 up."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    q = solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, Ground(), points)[0].min()
+    weight = np.tile([0.0, 0.0, solo.total_mass * 9.81 * 1e-3 / 4], 4)  # [N s]
+    kept, arguments = _kept_arguments(solo, Ground(friction=0.8), points, q, weight)
+    if kept is None:
+        pytest.skip("no C compiler: the contact step is Python's alone")
+    done = kept(*arguments)  # the case itself
+    assert done is not None and abs(done[2][:, 2].sum() / (solo.total_mass * 9.81) - 1) < 1e-2  # holding it up
+    assert np.abs(done[4] - ContactStepper(solo, Ground(), points).locate(q)[1]).max() < 1e-15  # its gaps
+    for index, bad in (
+        (3, arguments[3][:3]),
+        (1, arguments[1].astype(np.float32)),
+        (1, np.ascontiguousarray(arguments[1])),
+        (0, np.asfortranarray(arguments[0][:, :6])),
+        (8, list(arguments[8])),
+    ):
+        assert kept(*arguments[:index], bad, *arguments[index + 1 :]) is None
+    on_cone = weight.copy()
+    on_cone[0] = 0.8 * on_cone[2]  # the first foot's impulse on its cone: it slipped
+    assert kept(*arguments[:8], on_cone, *arguments[9:]) is None
+    corners = contact_points(box, "collision").points
+    q = box.neutral_configuration()
+    q[2] = 0.05
+    kept, arguments = _kept_arguments(box, Ground(friction=0.5), corners, q, np.tile([0.0, 0.0, 2.5 * 9.81 * 1e-3 / 4], 8))
+    assert kept(*arguments) is None  # four resting corners: 12 rows of a 6-dof body
+
+
+def test_without_a_c_compiler_the_step_is_numpys(solo, monkeypatch, tmp_path):
+    """No compiler (and nothing built in the cache): no C step; a step is numpy's."""
+
+    def missing() -> str:
+        raise CompilerNotFoundError("cc")
+
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))
+    monkeypatch.setattr(build, "find_compiler", missing)
+    compiled_contact.kept_step.cache_clear()
+    try:
+        stepper = ContactStepper(solo, Ground(friction=0.8), contact_points(solo, list(FEET)).points)
+        assert stepper.kept is None
+        q = solo.neutral_configuration()
+        step = stepper.step(q, np.zeros(solo.nv), np.zeros(solo.nv), 1e-3, ContactSettings(), None)
+        assert step.converged and np.isfinite(step.q).all()
+    finally:
+        compiled_contact.kept_step.cache_clear()  # built (or found) again for the tests after
