@@ -51,13 +51,17 @@ static int rdd_fd_finish(const double *M, double *const *out) {
     return 0;
 }
 
-/* q̈ = M⁻¹ (τ − h); ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈; ∂q̈/∂τ = M⁻¹ (one factorisation). */
+/* q̈ = M⁻¹ (τ − h); ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈; ∂q̈/∂τ = M⁻¹ (one factorisation): the
+ * generated rdd_fd_derivatives solves on the directions in SIMD lanes, rdd_fd_finish's
+ * operations on each column (the same bits as the pairs' and blocks' column by column). */
 static int rdd_row_fd(const double *const *in, double *const *out) {
     double M[RD_NV * RD_NV], a[RD_NV];
     const int status = rdd_fd_start(in, M, a);
     if (status) return status;
-    rdd_tau_derivatives(in[0], in[1], a, out[0], out[1]);
-    return rdd_fd_finish(M, out);
+    rdd_fd_derivatives(in[0], in[1], a, M, out[0], out[1], out[2]);
+    for (int k = 0; k < 3; ++k)
+        if (!rd_finite(out[k], RD_NV * RD_NV)) return 3;
+    return 0;
 }
 
 /* Two rows at once (a batch): the derivative kernel on two states in SIMD lanes. */

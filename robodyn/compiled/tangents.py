@@ -39,6 +39,8 @@ Term = tuple[float, str | None]
 #: the constant it is); a constant vector when the name is None (``lanes``: its non-zero
 #: entries).
 Tangent = tuple[float, str | None, dict[int, float | None]]
+#: A vector statement of the single call: ``(name, [(coefficient, factor, tangent), ...])``.
+Statement = tuple[str, list[tuple[float, str | None, Tangent]]]
 #: The two groups of directions: ``q`` (lane ``j``: ``q_j``) and ``v`` (lane ``j``: ``v_j``).
 GROUPS = ("q", "v")
 
@@ -99,7 +101,6 @@ class TangentWriter:
         self.selection = np.asarray(selection, float)
         self.offset = np.asarray(offset, float)
         self.bodies, self.nv = self.selection.shape
-        self.width = max(2, 1 << (self.nv - 1).bit_length())  # lanes of a direction vector
         self.names: dict[sp.Symbol, str] = {symbol: f"r{i}" for i, (symbol, _) in enumerate(program.assignments)}
         inputs = (program.inputs["q"], program.inputs["qd"], program.inputs["qdd"])
         for symbols, local in zip(inputs, ("th", "thd", "thdd"), strict=True):
@@ -117,7 +118,9 @@ class TangentWriter:
         self._known = {expr: symbol for symbol, expr in program.assignments if isinstance(expr, trig)}
         self._partials: dict[sp.Expr, str] = {}
         self.lines: list[str] = []  # lane by lane (the batches' statements)
-        self.vector_lines: list[str] = []  # directions in lanes (the single call's)
+        # The single call's: scalar lines, and vector statements (name, terms) printed for a
+        # width of vectors by _vector_body.
+        self.vector_lines: list[str | Statement] = []
 
     def _both(self, line: str) -> None:
         self.lines.append(line)
@@ -155,13 +158,14 @@ class TangentWriter:
             self._both(f"    const double {name} = {self.printer.expression(partial)};")
         return 1.0, name
 
-    def _vector_term(self, coefficient: float, factor: str | None, tangent: Tangent) -> str:
-        scale, name, lanes = tangent
+    def _vector_term(self, coefficient: float, factor: str | None, tangent: Tangent, lanes: range, vector: str) -> str:
+        """A term of a vector statement on the chunk of directions ``lanes`` (type ``vector``)."""
+        scale, name, values = tangent
         if name is not None:
-            return _product(coefficient * scale, [factor, name])
-        values = ", ".join(c_number(coefficient * scale * (lanes.get(k) or 0.0)) for k in range(self.width))
-        constant = f"(rdd_dir){{{values}}}"
-        return f"{factor}*{constant}" if factor else constant
+            return _product(coefficient * scale, [factor, f"{name}_c{lanes.start // len(lanes)}"])
+        constant = ", ".join(c_number(coefficient * scale * (values.get(k) or 0.0)) for k in lanes)
+        literal = f"({vector}){{{constant}}}"
+        return f"{factor}*{literal}" if factor else literal
 
     @staticmethod
     def _lane_term(coefficient: float, factor: str | None, tangent: Tangent, lane: int) -> str | float:
@@ -197,8 +201,7 @@ class TangentWriter:
             if name is not None:
                 return coefficient * scale, name, lanes
             return 1.0, None, {k: coefficient * scale * cast(float, value) for k, value in lanes.items()}
-        value = " + ".join(self._vector_term(c, factor, tangent) for c, factor, tangent in terms)
-        self.vector_lines.append(f"    const rdd_dir {target} = {value};")
+        self.vector_lines.append((target, terms))
         result: dict[int, float | None] = {}
         for k in sorted({k for _, _, tangent in terms for k in tangent[2]}):
             lane = self._lane_sum([self._lane_term(c, factor, tangent, k) for c, factor, tangent in terms if k in tangent[2]])
@@ -244,14 +247,15 @@ class TangentWriter:
         single = self._single(used, stores)
         return "\n".join(single + pair_function(self, used, results) + block_functions(self, used, results))
 
-    def _outputs(self, outputs: Sequence[sp.Symbol]) -> tuple[list[tuple[str, int, str]], list[str]]:
+    def _outputs(self, outputs: Sequence[sp.Symbol]) -> tuple[list[tuple[str, int, str]], list[Statement]]:
         """``(array, index, C value)`` of every entry of ``dq`` and ``dv`` lane by lane, and
         the single call's stores (``Sᵀ`` times the bodies' tangents)."""
         n, S = self.nv, self.selection
-        results, stores = [], []
+        results: list[tuple[str, int, str]] = []
+        stores: list[Statement] = []
         for j in range(n):
             for group, array in zip(GROUPS, ("dq", "dv"), strict=True):
-                terms = [
+                terms: list[tuple[float, str | None, Tangent]] = [
                     (float(S[b, j]), None, self.tangents[outputs[b]][group])
                     for b in range(self.bodies)
                     if S[b, j] != 0 and group in self.tangents.get(outputs[b], {})
@@ -260,51 +264,131 @@ class TangentWriter:
                     parts = [self._lane_term(c, f, t, k) for c, f, t in terms if k in t[2]]
                     lane = self._lane_sum(parts) if parts else 0.0
                     results.append((array, j * n + k, c_number(lane) if isinstance(lane, float) else lane))
-                if terms:
-                    value = " + ".join(self._vector_term(c, f, t) for c, f, t in terms)
-                    stores.append(
-                        f"    {{ const rdd_dir o = {value}; for (int k = 0; k < {n}; ++k) {array}[{j * n} + k] = o[k]; }}"
-                    )
-                else:
-                    stores.append(f"    for (int k = 0; k < {n}; ++k) {array}[{j * n} + k] = 0.0;")
+                stores.append((f"b{group}[{j}]", terms))
         return results, stores
 
-    def _single(self, used: set[sp.Basic], stores: list[str]) -> list[str]:
-        """``rdd_tau_derivatives``: the vector statements in a body inlined into one plain
-        function and one per SIMD variant (its ``target``), the widest the CPU runs chosen
-        at the first call."""
-        signature = "(const double *q, const double *v, const double *a, double *dq, double *dv)"
+    def _vector_body(self, used: set[sp.Basic], stores: list[Statement], width: int) -> list[str]:
+        """``rdd_dirs_w<width>``: the single call's statements, each tangent in chunks of
+        ``width`` directions (a chunk no lane of which can be non-zero is not computed)."""
+        vector, chunks = f"rdd_w{width}", -(-self.nv // width)
         lines = [
-            f"typedef double rdd_dir __attribute__((vector_size({8 * self.width})));",
-            f"static inline __attribute__((always_inline)) void rdd_single_body{signature} {{",
+            f"typedef double {vector} __attribute__((vector_size({8 * width})));",
+            _SOLVE.replace("TYPE", vector).replace("CHUNKS", str(chunks)),
+            f"static inline __attribute__((always_inline)) void rdd_dirs_w{width}("
+            f"const double *q, const double *v, const double *a, {vector} (*bq)[{chunks}], {vector} (*bv)[{chunks}]) {{",
             *self._coordinates(used),
-            *self.vector_lines,
-            *stores,
-            "}",
-            f"static void rdd_single_plain{signature} {{ rdd_single_body(q, v, a, dq, dv); }}",
         ]
-        choose = []
-        wide = [(name, target) for name, lanes, target in self.variants if lanes > 2]
-        if wide:
-            lines.append("#if defined(__x86_64__) && defined(__GNUC__)")
-            for name, target in wide:
-                lines.append(
-                    f'static __attribute__((target("{target}"))) void rdd_single_{name}{signature} '
-                    "{ rdd_single_body(q, v, a, dq, dv); __builtin_ia32_vzeroupper(); }"
-                )
-                choose.append(f'        if (__builtin_cpu_supports("{target}")) chosen = rdd_single_{name};')
-            lines.append("#endif")
-        guard = ["#if defined(__x86_64__) && defined(__GNUC__)", "        __builtin_cpu_init();", *choose, "#endif"]
-        return [
-            *lines,
-            f"static void rdd_tau_derivatives{signature} {{",
-            f"    static void (*current){signature} = NULL;",
-            "    if (!current) {",
-            f"        void (*chosen){signature} = rdd_single_plain;",
-            *(guard if choose else []),
-            "        current = chosen;",
-            "    }",
-            "    current(q, v, a, dq, dv);",
-            "}",
-            "",
-        ]
+        for item in [*self.vector_lines, *stores]:
+            if isinstance(item, str):
+                lines.append(item)
+                continue
+            target, terms = item
+            for c in range(chunks):
+                lanes = range(c * width, (c + 1) * width)
+                present = [(k, f, t) for k, f, t in terms if any(lane in t[2] for lane in lanes)]
+                value = " + ".join(self._vector_term(k, f, t, lanes, vector) for k, f, t in present) or f"({vector}){{0.0}}"
+                if target.startswith("b"):
+                    lines.append(f"    {target}[{c}] = {value};")
+                elif present:
+                    lines.append(f"    const {vector} {target}_c{c} = {value};")
+        return [*lines, "}"]
+
+    def _single(self, used: set[sp.Basic], stores: list[Statement]) -> list[str]:
+        """``rdd_tau_derivatives`` and ``rdd_fd_derivatives`` (:data:`_SINGLE`): the vector
+        statements in chunks of the instruction set's width, compiled plainly (2 lanes, SSE2)
+        and once per SIMD variant of the build (its ``target``), the widest the CPU runs
+        chosen at the first call."""
+        variants = [("plain", 2, "")] + [(name, lanes, target) for name, lanes, target in self.variants if lanes > 2]
+        lines: list[str] = []
+        for width in sorted({lanes for _, lanes, _ in variants}):
+            lines += self._vector_body(used, stores, width)
+        choice = []
+        for name, lanes, target in variants:
+            attribute = f'__attribute__((target("{target}")))' if target else ""
+            text = (
+                _SINGLE.replace("NAME", name)
+                .replace("ATTR", attribute)
+                .replace("VZEROUPPER", "" if not target else "__builtin_ia32_vzeroupper();")
+            )
+            text = text.replace("TYPE", f"rdd_w{lanes}").replace("CHUNKS", str(-(-self.nv // lanes))).replace("WIDTH", str(lanes))
+            if target:
+                text = f"#if defined(__x86_64__) && defined(__GNUC__)\n{text}\n#endif"
+                choice.append(f'    if (__builtin_cpu_supports("{target}")) tau = rdd_tau_{name}, fd = rdd_fd_{name};')
+            lines.append(text)
+        choose = ["#if defined(__x86_64__) && defined(__GNUC__)", "    __builtin_cpu_init();", *choice, "#endif"]
+        return [*lines, _DISPATCH.replace("CHOOSE", "\n".join(choose if choice else [])), ""]
+
+
+#: ``b -> M⁻¹ b`` for direction vectors ``b`` (a row ``CHUNKS`` vectors of ``TYPE``) with the
+#: factor of ``rd_ldl_factor``: core.c's ``ldl_apply_columns``' operations, column ``c`` in
+#: lane ``c`` (the same bits).
+_SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
+    const int n = RD_NV;
+    RD_UNROLL for (int i = n - 1; i >= 0; --i)
+        RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
+            const int j = rd_ancestor[i][a];
+            RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[j][c] -= M[i * n + j] * b[i][c];
+        }
+    RD_UNROLL for (int i = 0; i < n; ++i)
+        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] /= M[i * n + i];
+    RD_UNROLL for (int i = 0; i < n; ++i)
+        RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
+            const int j = rd_ancestor[i][a];
+            RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] -= M[i * n + j] * b[j][c];
+        }
+}"""
+#: One variant's functions: the direction vectors, then ``∂τ`` stored, or ``∂q̈ = −M⁻¹ ∂τ``
+#: and ``M⁻¹`` (derivatives.c's ``rdd_fd_finish``: solved, then negated).
+_SINGLE = """static ATTR void rdd_dirs_NAME(const double *q, const double *v, const double *a, TYPE (*bq)[CHUNKS],
+                               TYPE (*bv)[CHUNKS]) {
+    rdd_dirs_wWIDTH(q, v, a, bq, bv);
+}
+static ATTR void rdd_tau_NAME(const double *q, const double *v, const double *a, double *dq, double *dv) {
+    TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS];
+    rdd_dirs_NAME(q, v, a, bq, bv);
+    for (int j = 0; j < RD_NV; ++j)
+        for (int k = 0; k < RD_NV; ++k)
+            dq[j * RD_NV + k] = bq[j][k / WIDTH][k % WIDTH], dv[j * RD_NV + k] = bv[j][k / WIDTH][k % WIDTH];
+    VZEROUPPER
+}
+static ATTR void rdd_fd_NAME(const double *q, const double *v, const double *a, const double *M, double *dq,
+                             double *dv, double *minv) {
+    TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS], bi[RD_NV][CHUNKS];
+    rdd_dirs_NAME(q, v, a, bq, bv);
+    for (int j = 0; j < RD_NV; ++j) {
+        for (int c = 0; c < CHUNKS; ++c) bi[j][c] = (TYPE){0.0};
+        bi[j][j / WIDTH][j % WIDTH] = 1.0;
+    }
+    rdd_apply_TYPE(M, bq);
+    rdd_apply_TYPE(M, bv);
+    rdd_apply_TYPE(M, bi);
+    for (int j = 0; j < RD_NV; ++j)
+        for (int k = 0; k < RD_NV; ++k) {
+            dq[j * RD_NV + k] = -bq[j][k / WIDTH][k % WIDTH], dv[j * RD_NV + k] = -bv[j][k / WIDTH][k % WIDTH];
+            minv[j * RD_NV + k] = bi[j][k / WIDTH][k % WIDTH];
+        }
+    VZEROUPPER
+}"""
+#: ``rdd_tau_derivatives`` (one state: ``∂τ/∂q``, ``∂τ/∂v``) and ``rdd_fd_derivatives`` (one
+#: state at ``a = q̈`` with ``M`` factored: ``∂q̈/∂q``, ``∂q̈/∂v``, ``M⁻¹``), each the widest
+#: variant the CPU runs.
+_DISPATCH = """typedef void (*rdd_tau_fn)(const double *, const double *, const double *, double *, double *);
+typedef void (*rdd_fd_fn)(const double *, const double *, const double *, const double *, double *, double *, double *);
+static rdd_tau_fn rdd_tau_current = NULL;
+static rdd_fd_fn rdd_fd_current = NULL;
+static void rdd_choose(void) {
+    rdd_tau_fn tau = rdd_tau_plain;
+    rdd_fd_fn fd = rdd_fd_plain;
+CHOOSE
+    rdd_fd_current = fd;
+    rdd_tau_current = tau;
+}
+static void rdd_tau_derivatives(const double *q, const double *v, const double *a, double *dq, double *dv) {
+    if (!rdd_tau_current) rdd_choose();
+    rdd_tau_current(q, v, a, dq, dv);
+}
+static void rdd_fd_derivatives(const double *q, const double *v, const double *a, const double *M, double *dq,
+                               double *dv, double *minv) {
+    if (!rdd_fd_current) rdd_choose();
+    rdd_fd_current(q, v, a, M, dq, dv, minv);
+}"""
