@@ -346,27 +346,31 @@ _SINGLE = """static ATTR void rdd_dirs_NAME(const double *q, const double *v, co
 static ATTR void rdd_tau_NAME(const double *q, const double *v, const double *a, double *dq, double *dv) {
     TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS];
     rdd_dirs_NAME(q, v, a, bq, bv);
-    for (int j = 0; j < RD_NV; ++j)
-        for (int k = 0; k < RD_NV; ++k)
-            dq[j * RD_NV + k] = bq[j][k / WIDTH][k % WIDTH], dv[j * RD_NV + k] = bv[j][k / WIDTH][k % WIDTH];
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j) RD_UNROLL for (int c = 0; c < CHUNKS; ++c) {
+        const int size = 8 * (c + 1 < CHUNKS ? WIDTH : RD_NV - c * WIDTH);
+        memcpy(dq + j * RD_NV + c * WIDTH, &bq[j][c], size);
+        memcpy(dv + j * RD_NV + c * WIDTH, &bv[j][c], size);
+    }
     VZEROUPPER
 }
 static ATTR void rdd_fd_NAME(const double *q, const double *v, const double *a, const double *M, double *dq,
                              double *dv, double *minv) {
     TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS], bi[RD_NV][CHUNKS];
     rdd_dirs_NAME(q, v, a, bq, bv);
-    for (int j = 0; j < RD_NV; ++j) {
-        for (int c = 0; c < CHUNKS; ++c) bi[j][c] = (TYPE){0.0};
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j) {
+        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) bi[j][c] = (TYPE){0.0};
         bi[j][j / WIDTH][j % WIDTH] = 1.0;
     }
     rdd_apply_TYPE(M, bq);
     rdd_apply_TYPE(M, bv);
     rdd_apply_TYPE(M, bi);
-    for (int j = 0; j < RD_NV; ++j)
-        for (int k = 0; k < RD_NV; ++k) {
-            dq[j * RD_NV + k] = -bq[j][k / WIDTH][k % WIDTH], dv[j * RD_NV + k] = -bv[j][k / WIDTH][k % WIDTH];
-            minv[j * RD_NV + k] = bi[j][k / WIDTH][k % WIDTH];
-        }
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j) RD_UNROLL for (int c = 0; c < CHUNKS; ++c) {
+        const int size = 8 * (c + 1 < CHUNKS ? WIDTH : RD_NV - c * WIDTH);
+        const TYPE nq = -bq[j][c], nv = -bv[j][c];
+        memcpy(dq + j * RD_NV + c * WIDTH, &nq, size);
+        memcpy(dv + j * RD_NV + c * WIDTH, &nv, size);
+        memcpy(minv + j * RD_NV + c * WIDTH, &bi[j][c], size);
+    }
     VZEROUPPER
 }"""
 #: ``rdd_tau_derivatives`` (one state: ``∂τ/∂q``, ``∂τ/∂v``) and ``rdd_fd_derivatives`` (one
