@@ -21,7 +21,7 @@ about as much CPU as the robot's ``tau`` program, plus the C compiler). The func
     static void rdd_tau_derivatives2(...);  /* 2 states, SSE2; rdd8_...: 8 states, AVX-512 */
 
 The single call runs the directions in lanes (the widest instruction set of the build the CPU
-runs: panda arm 0.41× Pinocchio's ``computeRNEADerivatives`` against 0.75× written direction
+runs: panda arm 0.43× Pinocchio's ``computeRNEADerivatives`` against 0.78× written direction
 by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
 of the instruction set the build chose (:func:`robodyn.compiled.simd.build_variants`, as the
 dynamics' SIMD blocks: the widest the CPU runs, or ``$ROBODYN_SIMD``; 2, 4 or 8 lanes,

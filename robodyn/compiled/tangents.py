@@ -1,15 +1,17 @@
 """The Newton–Euler program differentiated forward, its directions in SIMD lanes.
 
 :class:`TangentWriter` writes ``rdd_tau_derivatives`` (``∂τ/∂q``, ``∂τ/∂v`` of one state) and
-its batch forms for :mod:`robodyn.compiled.derivatives`. For ``x = e(y1, y2, …)`` the partials
+its batch forms (and ``rdd_fd_derivatives``: ``−M⁻¹ ∂τ`` and ``M⁻¹`` of one state) for
+:mod:`robodyn.compiled.derivatives`. For ``x = e(y1, y2, …)`` the partials
 ``∂e/∂y`` are differentiated symbolically (sympy, on the program's small expressions;
 ``∂cos θ/∂θ`` is the program's own ``−sin θ``) and printed once as scalars; the tangents are
 vectors over the directions, one group for ``q_0 … q_{n−1}`` and one for ``v_0 … v_{n−1}``
-(a lane a direction, ``W`` lanes: the next power of two from ``n``):
-``dx = Σ ∂e/∂y · dy`` is one vector statement however many directions reach ``x``. The
+(a lane a direction, in chunks of the instruction set's width ``W``: 2 SSE2, 4 AVX2, 8
+AVX-512): ``dx = Σ ∂e/∂y · dy`` is one vector statement a chunk however many directions
+reach ``x``, and a chunk no lane of which can be non-zero is not computed. The
 directions are seeded through the bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``:
-mimic joints included) and projected back (``∂τ/∂x = Sᵀ ∂τ_bodies/∂x``). A tangent that is
-a constant times another is not a statement at all; which lanes can be non-zero is tracked.
+mimic joints included) and projected back (``∂τ/∂x = Sᵀ ∂τ_bodies/∂x``); a tangent that is
+a constant times another is not a statement.
 
 The single call runs these vector statements (GCC/Clang vector extension; compiled once
 plainly and once per instruction set of the build's SIMD variants, the widest the CPU runs
@@ -17,7 +19,8 @@ chosen at the first call). A batch runs states in lanes instead (``rdd_tau_deriv
 ``rdd<L>_tau_derivatives``: :mod:`robodyn.compiled.derivatives`), from the same statements
 written lane by lane: each direction's entry is the vector statement's lane, the same IEEE
 operations in the same order, the terms a lane cannot have left out (they add an exact
-zero in the vector), so a batch row equals its single call (no FMA: contraction is off).
+zero in the vector: at most the sign of a zero differs), so a batch row equals its single
+call (no FMA: contraction is off).
 """
 
 from __future__ import annotations
@@ -319,9 +322,8 @@ class TangentWriter:
         return [*lines, _DISPATCH.replace("CHOOSE", "\n".join(choose if choice else [])), ""]
 
 
-#: ``b -> M⁻¹ b`` for direction vectors ``b`` (a row ``CHUNKS`` vectors of ``TYPE``) with the
-#: factor of ``rd_ldl_factor``: core.c's ``ldl_apply_columns``' operations, column ``c`` in
-#: lane ``c`` (the same bits).
+#: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
+#: core.c's ``ldl_apply_columns``' operations, column ``c`` in lane ``c`` (the same bits).
 _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
     const int n = RD_NV;
     RD_UNROLL for (int i = n - 1; i >= 0; --i)
