@@ -17,12 +17,27 @@
 
 typedef int (*rdd_row)(const double *const *in, double *const *out);
 
+/* rd_finite's answer on outputs (a row's, a block's), without a branch an entry: x * 0 is ±0 for a
+ * finite x and NaN otherwise (four sums: no one chain of dependent additions). */
+static inline int rdd_finite(const double *x, int n) {
+    double z0 = 0.0, z1 = 0.0, z2 = 0.0, z3 = 0.0;
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        z0 += x[i] * 0.0;
+        z1 += x[i + 1] * 0.0;
+        z2 += x[i + 2] * 0.0;
+        z3 += x[i + 3] * 0.0;
+    }
+    for (; i < n; ++i) z0 += x[i] * 0.0;
+    return (z0 + z1) + (z2 + z3) == 0.0;
+}
+
 static int rdd_row_tau(const double *const *in, double *const *out) {
     if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     rdd_tau_derivatives(in[0], in[1], in[2], out[0], out[1]);
     rd_mass(in[0], out[2]);
     for (int k = 0; k < 3; ++k)
-        if (!rd_finite(out[k], RD_NV * RD_NV)) return 2;
+        if (!rdd_finite(out[k], RD_NV * RD_NV)) return 2;
     return 0;
 }
 
@@ -51,13 +66,17 @@ static int rdd_fd_finish(const double *M, double *const *out) {
     return 0;
 }
 
-/* q̈ = M⁻¹ (τ − h); ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈; ∂q̈/∂τ = M⁻¹ (one factorisation). */
+/* q̈ = M⁻¹ (τ − h); ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈; ∂q̈/∂τ = M⁻¹ (one factorisation): the
+ * generated rdd_fd_derivatives solves on the directions in SIMD lanes, rdd_fd_finish's
+ * operations on each column (the same bits as the pairs' and blocks' column by column). */
 static int rdd_row_fd(const double *const *in, double *const *out) {
     double M[RD_NV * RD_NV], a[RD_NV];
     const int status = rdd_fd_start(in, M, a);
     if (status) return status;
-    rdd_tau_derivatives(in[0], in[1], a, out[0], out[1]);
-    return rdd_fd_finish(M, out);
+    rdd_fd_derivatives(in[0], in[1], a, M, out[0], out[1], out[2]);
+    for (int k = 0; k < 3; ++k)
+        if (!rdd_finite(out[k], RD_NV * RD_NV)) return 3;
+    return 0;
 }
 
 /* Two rows at once (a batch): the derivative kernel on two states in SIMD lanes. */
@@ -93,20 +112,6 @@ static int rdd_pair_fd(const double *const *in0, const double *const *in1, doubl
  * target attribute, the SIMD dynamics' vector prefix, the exit's vzeroupper). */
 typedef int (*rdd_block)(const double *const *in, double *const *out);
 
-/* rd_finite's answer on a block's outputs, without a branch an entry: x * 0 is ±0 for a
- * finite x and NaN otherwise (four sums: no one chain of dependent additions). */
-static inline int rdd_finite(const double *x, int n) {
-    double z0 = 0.0, z1 = 0.0, z2 = 0.0, z3 = 0.0;
-    int i = 0;
-    for (; i + 4 <= n; i += 4) {
-        z0 += x[i] * 0.0;
-        z1 += x[i + 1] * 0.0;
-        z2 += x[i + 2] * 0.0;
-        z3 += x[i + 3] * 0.0;
-    }
-    for (; i < n; ++i) z0 += x[i] * 0.0;
-    return (z0 + z1) + (z2 + z3) == 0.0;
-}
 typedef struct {
     const char *name;
     int lanes;

@@ -1,0 +1,116 @@
+"""The batch forms of the derivative kernel: states in SIMD lanes (see :mod:`robodyn.compiled.tangents`).
+
+``rdd_tau_derivatives2`` (two states, SSE2) and ``rdd<L>_tau_derivatives`` (``L`` states, one
+per SIMD variant of the build) run the writer's lane-by-lane statements (each direction's
+entry written out) on vectors of states: the same IEEE operations in the same order as the
+single call's lane, so a batch row is bit for bit its single call.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import TYPE_CHECKING
+
+import sympy as sp
+
+from robodyn.equations.c_printer import c_number
+
+if TYPE_CHECKING:
+    from robodyn.compiled.tangents import TangentWriter
+
+#: A scalar call left in a vector statement (the vector forms take none).
+SCALAR_CALL = re.compile(r"(?<!\w)(?:rd_)?(?:cos|sin|pow)\(")
+
+
+def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
+    """``rdd_tau_derivatives2``: the same statements on two states, one a SIMD lane
+    (GCC/Clang vector extension; the same IEEE operations, so bit-identical results)."""
+    pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
+    body = [pattern.sub(r"= rdd_\1_2(\2);", line).replace("const double ", "const rdd_v2 ") for line in writer.lines]
+    if any(SCALAR_CALL.search(line) for line in body):
+        return ["#define RDD_PAIRS 0", ""]
+    lanes = zip(writer._coordinates(used, "0"), writer._coordinates(used, "1"), strict=True)
+    head = [
+        f"{one.split(' = ')[0].replace('double', 'rdd_v2')} = {{{one.split(' = ')[1][:-1]}, {two.split(' = ')[1][:-1]}}};"
+        for one, two in lanes
+    ]
+    tail = []
+    for out, index, value in results:
+        try:  # a constant: the same in both lanes
+            tail.append(f"    {out}0[{index}] = {out}1[{index}] = {c_number(float(value))};")
+        except ValueError:
+            tail.append(f"    {{ const rdd_v2 o = {value}; {out}0[{index}] = o[0]; {out}1[{index}] = o[1]; }}")
+    return [
+        "#define RDD_PAIRS 1",
+        "typedef double rdd_v2 __attribute__((vector_size(16)));",
+        "static inline rdd_v2 rdd_cos_2(rdd_v2 x) { const rdd_v2 r = {rd_cos(x[0]), rd_cos(x[1])}; return r; }",
+        "static inline rdd_v2 rdd_sin_2(rdd_v2 x) { const rdd_v2 r = {rd_sin(x[0]), rd_sin(x[1])}; return r; }",
+        "static void rdd_tau_derivatives2(const double *q0, const double *v0, const double *a0, const double *q1,",
+        "                                 const double *v1, const double *a1, double *dq0, double *dv0, double *dq1, double *dv1) {",
+        *head,
+        *body,
+        *tail,
+        "}",
+        "",
+    ]
+
+
+def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
+    """``rdd<L>_tau_derivatives``: the same statements on ``L`` states at once, one a lane
+    of a vector of the instruction set of each of :attr:`TangentWriter.variants` (``(name, L, GCC
+    target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
+    with its ``target`` attribute; ``cos``/``sin`` the SIMD dynamics' (``rds<L>_sin``: the
+    single call's ``rd_sin`` on every lane). ``RDD_BLOCKS`` names the variants for
+    ``derivatives.c``'s blocks and dispatch."""
+    pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
+    out: list[str] = []
+    names: list[str] = []
+    for name, lanes, target in writer.variants:
+        vector, attribute = f"rdd{lanes}", f'__attribute__((target("{target}")))'
+        body = [pattern.sub(rf"= {vector}_\1(\2);", line).replace("const double ", f"const {vector} ") for line in writer.lines]
+        if any(SCALAR_CALL.search(line) for line in body):
+            return ["#define RDD_BLOCKS(X)", ""]
+        lane_values = [writer._coordinates(used, str(lane)) for lane in range(lanes)]
+        head = []
+        for i, first in enumerate(lane_values[0]):
+            values = ", ".join(lane_values[lane][i].split(" = ", 1)[1][:-1] for lane in range(lanes))
+            head.append(f"    const {vector} {first.split(' = ')[0].split()[-1]} = {{{values}}};")
+        tail = []
+        for array, index, value in results:
+            try:  # a constant: the same in every lane
+                constant = c_number(float(value))
+                tail.append("    " + " = ".join(f"{array}{lane}[{index}]" for lane in range(lanes)) + f" = {constant};")
+            except ValueError:
+                stores = " ".join(f"{array}{lane}[{index}] = o[{lane}];" for lane in range(lanes))
+                tail.append(f"    {{ const {vector} o = {value}; {stores} }}")
+        pointers = [
+            f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];"
+            f" double *dq{lane} = dq[{lane}], *dv{lane} = dv[{lane}];"
+            for lane in range(lanes)
+        ]
+        inline = f"static inline __attribute__((always_inline)) {attribute}"
+        lane_loop = f"{vector} r; for (int l = 0; l < {lanes}; ++l) r[l] ="
+        out += [
+            f"typedef double {vector} __attribute__((vector_size({8 * lanes})));",
+            "#ifdef RD_SIMD",  # the SIMD dynamics' sin and cos on vectors: rd_sin's operations on every lane
+            f"{inline} {vector} {vector}_cos({vector} x) {{ return rds{lanes}_cos(x); }}",
+            f"{inline} {vector} {vector}_sin({vector} x) {{ return rds{lanes}_sin(x); }}",
+            "#else",
+            f"{inline} {vector} {vector}_cos({vector} x) {{ {lane_loop} rd_cos(x[l]); return r; }}",
+            f"{inline} {vector} {vector}_sin({vector} x) {{ {lane_loop} rd_sin(x[l]); return r; }}",
+            "#endif",
+            f"static {attribute} void {vector}_tau_derivatives(const double *const *q, const double *const *v,",
+            "        const double *const *a, double *const *dq, double *const *dv) {",
+            *pointers,
+            *head,
+            *body,
+            *tail,
+            "}",
+            "",
+        ]
+        vzeroupper = "__builtin_ia32_vzeroupper();" if lanes > 2 else ""
+        names.append(f'X({vector}, {lanes}, "{name}", "{target}", {attribute}, rds{lanes}, {vzeroupper})')
+    if not out:
+        return ["#define RDD_BLOCKS(X)", ""]
+    guard = "#if defined(__x86_64__) && defined(__GNUC__)"
+    return [guard, *out, f"#define RDD_BLOCKS(X) {' '.join(names)}", "#else", "#define RDD_BLOCKS(X)", "#endif", ""]

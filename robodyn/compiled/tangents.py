@@ -1,0 +1,400 @@
+"""The Newton–Euler program differentiated forward, its directions in SIMD lanes.
+
+:class:`TangentWriter` writes ``rdd_tau_derivatives`` (``∂τ/∂q``, ``∂τ/∂v`` of one state) and
+its batch forms (and ``rdd_fd_derivatives``: ``−M⁻¹ ∂τ`` and ``M⁻¹`` of one state) for
+:mod:`robodyn.compiled.derivatives`. For ``x = e(y1, y2, …)`` the partials
+``∂e/∂y`` are differentiated symbolically (sympy, on the program's small expressions;
+``∂cos θ/∂θ`` is the program's own ``−sin θ``) and printed once as scalars; the tangents are
+vectors over the directions, one group for ``q_0 … q_{n−1}`` and one for ``v_0 … v_{n−1}``
+(a lane a direction, in chunks of the instruction set's width ``W``: 2 SSE2, 4 AVX2, 8
+AVX-512): ``dx = Σ ∂e/∂y · dy`` is one vector statement a chunk however many directions
+reach ``x``, and a chunk no lane of which can be non-zero is not computed. The
+directions are seeded through the bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``:
+mimic joints included) and projected back (``∂τ/∂x = Sᵀ ∂τ_bodies/∂x``); a tangent that is
+a constant times another is not a statement.
+
+The single call runs these vector statements (GCC/Clang vector extension; compiled once
+plainly and once per instruction set of the build's SIMD variants, the widest the CPU runs
+chosen at the first call). A batch runs states in lanes instead (``rdd_tau_derivatives2``,
+``rdd<L>_tau_derivatives``: :mod:`robodyn.compiled.derivatives`), from the same statements
+written lane by lane: each direction's entry is the vector statement's lane, the same IEEE
+operations in the same order, the terms a lane cannot have left out (they add an exact
+zero in the vector: at most the sign of a zero differs), so a batch row equals its single
+call (no FMA: contraction is off).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import cast
+
+import numpy as np
+import sympy as sp
+
+from robodyn.compiled.tangent_batches import block_functions, pair_function
+from robodyn.equations.c_printer import CPrinter, c_number
+from robodyn.equations.program import Program, needed
+
+#: A value in the generated code: ``coefficient * name`` (``name`` None: the constant).
+Term = tuple[float, str | None]
+#: A tangent: ``(coefficient, vector name, lanes)``: ``coefficient * name`` with the lanes
+#: that can be non-zero (a lane's value: None for the lane's own variable ``name_k``, else
+#: the constant it is); a constant vector when the name is None (``lanes``: its non-zero
+#: entries).
+Tangent = tuple[float, str | None, dict[int, float | None]]
+#: A vector statement of the single call: ``(name, [(coefficient, factor, tangent), ...])``.
+Statement = tuple[str, list[tuple[float, str | None, Tangent]]]
+#: The two groups of directions: ``q`` (lane ``j``: ``q_j``) and ``v`` (lane ``j``: ``v_j``).
+GROUPS = ("q", "v")
+
+
+def _diff(expr: sp.Expr, symbol: sp.Symbol) -> sp.Expr:
+    """``∂expr/∂symbol``: by hand for the program's sums of products of symbols and whole
+    powers (fast), by ``sympy.diff`` for anything else."""
+    if expr == symbol:
+        return sp.Integer(1)
+    if expr.is_Add:
+        return sp.Add(*(_diff(term, symbol) for term in expr.args if symbol in term.free_symbols))
+    if expr.is_Mul:
+        inside = [i for i, factor in enumerate(expr.args) if symbol in factor.free_symbols]
+        if len(inside) == 1:
+            i = inside[0]
+            rest = expr.args[:i] + expr.args[i + 1 :]
+            return sp.Mul(*rest, _diff(expr.args[i], symbol))
+    if expr.is_Pow and expr.base == symbol and expr.exp.is_Integer:
+        return expr.exp * symbol ** (expr.exp - 1)
+    return sp.diff(expr, symbol)
+
+
+def _term(expr: sp.Expr, names: dict[sp.Symbol, str]) -> Term | None:
+    """``expr`` as ``coefficient * name`` if it is that simple (a number, a symbol, or
+    number × symbol), else None."""
+    if expr.is_Number:
+        return float(expr), None
+    if expr.is_Symbol:
+        return 1.0, names[expr]
+    if expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Symbol:
+        return float(expr.args[0]), names[expr.args[1]]
+    return None
+
+
+def _product(coefficient: float, factors: Sequence[str | None]) -> str:
+    """``c*f1*f2`` (evaluated left to right: ``(c*f1)*f2``), unit coefficients left out."""
+    names = [f for f in factors if f]
+    if not names:
+        return c_number(coefficient)
+    return "*".join(names) if coefficient == 1.0 else f"{c_number(coefficient)}*" + "*".join(names)
+
+
+class TangentWriter:
+    """Writes ``rdd_tau_derivatives`` for a Newton–Euler program over bodies (see the module).
+
+    Args:
+        program: ``tau`` of the bodies (inputs ``q``, ``qd``, ``qdd``, one per body).
+        selection: ``S``, shape (n_bodies, nv).
+        offset: Shape (n_bodies,).
+        variants: The build's SIMD variants ``(name, lanes, GCC target)``.
+    """
+
+    def __init__(
+        self, program: Program, selection: np.ndarray, offset: np.ndarray, variants: Sequence[tuple[str, int, str]] = ()
+    ):
+        self.program = program
+        self.variants = tuple(variants)
+        self.selection = np.asarray(selection, float)
+        self.offset = np.asarray(offset, float)
+        self.bodies, self.nv = self.selection.shape
+        self.names: dict[sp.Symbol, str] = {symbol: f"r{i}" for i, (symbol, _) in enumerate(program.assignments)}
+        inputs = (program.inputs["q"], program.inputs["qd"], program.inputs["qdd"])
+        for symbols, local in zip(inputs, ("th", "thd", "thdd"), strict=True):
+            self.names.update({symbol: f"{local}{b}" for b, symbol in enumerate(symbols)})
+        self.printer = CPrinter(self.names, trig="rd_")  # the kernels' own sin and cos (trig.c)
+        # Each quantity's tangents by group.
+        self.tangents: dict[sp.Symbol, dict[str, Tangent]] = {}
+        for b in range(self.bodies):
+            seeds = {j: float(s) for j, s in enumerate(self.selection[b]) if s != 0}
+            if seeds:
+                lanes: dict[int, float | None] = dict(seeds)
+                self.tangents[program.inputs["q"][b]] = {"q": (1.0, None, lanes)}
+                self.tangents[program.inputs["qd"][b]] = {"v": (1.0, None, dict(lanes))}
+        trig = (sp.sin, sp.cos)
+        self._known = {expr: symbol for symbol, expr in program.assignments if isinstance(expr, trig)}
+        self._partials: dict[sp.Expr, str] = {}
+        self.lines: list[str] = []  # lane by lane (the batches' statements)
+        # The single call's: scalar lines, and vector statements (name, terms) printed for a
+        # width of vectors by _vector_body.
+        self.vector_lines: list[str | Statement] = []
+
+    def _both(self, line: str) -> None:
+        self.lines.append(line)
+        self.vector_lines.append(line)
+
+    def _coordinates(self, used: set[sp.Basic], suffix: str = "") -> list[str]:
+        """``th``/``thd``/``thdd`` values of the body coordinates the program uses, as
+        ``const double name = C expression in q{suffix}, v{suffix}, a{suffix};``."""
+        values = []
+        inputs = (self.program.inputs["q"], self.program.inputs["qd"], self.program.inputs["qdd"])
+        for b in range(self.bodies):
+            for symbols, (local, array) in zip(inputs, (("th", "q"), ("thd", "v"), ("thdd", "a")), strict=True):
+                if symbols[b] not in used:
+                    continue
+                terms = [(self.selection[b, j], f"{array}{suffix}[{j}]") for j in range(self.nv) if self.selection[b, j] != 0]
+                value = " + ".join(_product(c, [name]) for c, name in terms) or "0.0"
+                if local == "th" and self.offset[b] != 0:
+                    value += f" + {c_number(self.offset[b])}"
+                values.append(f"    const double {local}{b} = {value};")
+        return values
+
+    def _partial(self, expr: sp.Expr, symbol: sp.Symbol) -> Term | None:
+        """``∂expr/∂symbol`` as a term (named by a new statement when not simple), None if 0."""
+        partial = _diff(expr, symbol).xreplace(self._known)
+        if partial == 0:
+            return None
+        if not partial.free_symbols:  # a constant such as √2/2: folded like a number
+            return float(partial), None
+        simple = _term(partial, self.names)
+        if simple is not None:
+            return simple
+        name = self._partials.get(partial)
+        if name is None:
+            name = self._partials[partial] = f"p{len(self._partials)}"
+            self._both(f"    const double {name} = {self.printer.expression(partial)};")
+        return 1.0, name
+
+    def _vector_term(self, coefficient: float, factor: str | None, tangent: Tangent, lanes: range, vector: str) -> str:
+        """A term of a vector statement on the chunk of directions ``lanes`` (type ``vector``)."""
+        scale, name, values = tangent
+        if name is not None:
+            return _product(coefficient * scale, [factor, f"{name}_c{lanes.start // len(lanes)}"])
+        constant = ", ".join(c_number(coefficient * scale * (values.get(k) or 0.0)) for k in lanes)
+        literal = f"({vector}){{{constant}}}"
+        return f"{factor}*{literal}" if factor else literal
+
+    @staticmethod
+    def _lane_term(coefficient: float, factor: str | None, tangent: Tangent, lane: int) -> str | float:
+        """Lane ``lane`` of :meth:`_vector_term`: its C, or a float when it is a constant
+        (the same IEEE product the vector's lane makes)."""
+        scale, name, lanes = tangent
+        value = lanes[lane]
+        if name is None:  # a constant vector: its lane folded, times the factor
+            constant = coefficient * scale * cast(float, value)
+            return _product(constant, [factor]) if factor else constant
+        if value is None:
+            return _product(coefficient * scale, [factor, f"{name}_{lane}"])
+        if factor is None:
+            return coefficient * scale * value
+        return _product(coefficient * scale, [factor, c_number(value)])
+
+    @staticmethod
+    def _lane_sum(parts: list[str | float]) -> str | float:
+        """``parts`` summed in order: a float when they all are (Python's IEEE sums, as C's)."""
+        if all(isinstance(part, float) for part in parts):
+            total = cast(float, parts[0])
+            for part in parts[1:]:
+                total += cast(float, part)
+            return total
+        return " + ".join(part if isinstance(part, str) else c_number(part) for part in parts)
+
+    def _statement(self, target: str, terms: list[tuple[float, str | None, Tangent]]) -> Tangent:
+        """``Σ coefficient * factor * tangent`` as a tangent: an alias when it is one tangent
+        times a constant, else a vector statement and its lanes' statements (a lane that is
+        a constant is not a statement)."""
+        if len(terms) == 1 and terms[0][1] is None:
+            coefficient, _, (scale, name, lanes) = terms[0]
+            if name is not None:
+                return coefficient * scale, name, lanes
+            return 1.0, None, {k: coefficient * scale * cast(float, value) for k, value in lanes.items()}
+        self.vector_lines.append((target, terms))
+        result: dict[int, float | None] = {}
+        for k in sorted({k for _, _, tangent in terms for k in tangent[2]}):
+            lane = self._lane_sum([self._lane_term(c, factor, tangent, k) for c, factor, tangent in terms if k in tangent[2]])
+            if isinstance(lane, float):
+                result[k] = lane
+            else:
+                result[k] = None
+                self.lines.append(f"    const double {target}_{k} = {lane};")
+        return 1.0, target, result
+
+    def differentiate(self, symbol: sp.Symbol, expr: sp.Expr, name: str) -> None:
+        """The tangents of ``symbol = expr`` in both groups of directions that reach it."""
+        partials = []
+        for dependency in sorted(expr.free_symbols & self.tangents.keys(), key=str):
+            partial = self._partial(expr, dependency)
+            if partial is not None:
+                partials.append((partial, self.tangents[dependency]))
+        for group in GROUPS:
+            terms = [(c, factor, tangents[group]) for (c, factor), tangents in partials if group in tangents]
+            if terms:
+                self.tangents.setdefault(symbol, {})[group] = self._statement(f"d{group}_{name}", terms)
+
+    def source(self) -> str:
+        """The single call ``rdd_tau_derivatives`` and the batches' ``rdd_tau_derivatives2``
+        (``RDD_PAIRS``) and ``rdd<L>_tau_derivatives`` (``RDD_BLOCKS``)."""
+        tau = list(self.program.outputs["tau"])
+        values = needed(self.program.assignments, tau)
+        used = set().union(*(sp.sympify(e).free_symbols for e in tau), *(e.free_symbols for _, e in values))
+        inputs = {s for symbols in self.program.inputs.values() for s in symbols}
+        early = {s for s, e in values if isinstance(e, (sp.sin, sp.cos)) and e.free_symbols <= inputs}
+        for line in self.printer.statements([(s, e) for s, e in values if s in early]):
+            self._both(line)  # sin and cos first: a partial of one is the other
+        for symbol, expr in values:  # each value, then its derivatives (short live ranges)
+            if symbol not in early:
+                for line in self.printer.statements([(symbol, expr)]):
+                    self._both(line)
+            self.differentiate(symbol, expr, self.names[symbol])
+        outputs = [sp.Dummy(f"tau_body{b}") for b in range(self.bodies)]
+        for b, (symbol, expr) in enumerate(zip(outputs, tau, strict=True)):
+            self.names[symbol] = f"tb{b}"
+            self.differentiate(symbol, sp.sympify(expr), f"tb{b}")
+        results, stores = self._outputs(outputs)
+        single = self._single(used, stores)
+        return "\n".join(single + pair_function(self, used, results) + block_functions(self, used, results))
+
+    def _outputs(self, outputs: Sequence[sp.Symbol]) -> tuple[list[tuple[str, int, str]], list[Statement]]:
+        """``(array, index, C value)`` of every entry of ``dq`` and ``dv`` lane by lane, and
+        the single call's stores (``Sᵀ`` times the bodies' tangents)."""
+        n, S = self.nv, self.selection
+        results: list[tuple[str, int, str]] = []
+        stores: list[Statement] = []
+        for j in range(n):
+            for group, array in zip(GROUPS, ("dq", "dv"), strict=True):
+                terms: list[tuple[float, str | None, Tangent]] = [
+                    (float(S[b, j]), None, self.tangents[outputs[b]][group])
+                    for b in range(self.bodies)
+                    if S[b, j] != 0 and group in self.tangents.get(outputs[b], {})
+                ]
+                for k in range(n):
+                    parts = [self._lane_term(c, f, t, k) for c, f, t in terms if k in t[2]]
+                    lane = self._lane_sum(parts) if parts else 0.0
+                    results.append((array, j * n + k, c_number(lane) if isinstance(lane, float) else lane))
+                stores.append((f"b{group}[{j}]", terms))
+        return results, stores
+
+    def _vector_body(self, used: set[sp.Basic], stores: list[Statement], width: int) -> list[str]:
+        """``rdd_dirs_w<width>``: the single call's statements, each tangent in chunks of
+        ``width`` directions (a chunk no lane of which can be non-zero is not computed)."""
+        vector, chunks = f"rdd_w{width}", -(-self.nv // width)
+        lines = [
+            f"typedef double {vector} __attribute__((vector_size({8 * width})));",
+            _SOLVE.replace("TYPE", vector).replace("CHUNKS", str(chunks)),
+            f"static inline __attribute__((always_inline)) void rdd_dirs_w{width}("
+            f"const double *q, const double *v, const double *a, {vector} (*bq)[{chunks}], {vector} (*bv)[{chunks}]) {{",
+            *self._coordinates(used),
+        ]
+        for item in [*self.vector_lines, *stores]:
+            if isinstance(item, str):
+                lines.append(item)
+                continue
+            target, terms = item
+            for c in range(chunks):
+                lanes = range(c * width, (c + 1) * width)
+                present = [(k, f, t) for k, f, t in terms if any(lane in t[2] for lane in lanes)]
+                value = " + ".join(self._vector_term(k, f, t, lanes, vector) for k, f, t in present) or f"({vector}){{0.0}}"
+                if target.startswith("b"):
+                    lines.append(f"    {target}[{c}] = {value};")
+                elif present:
+                    lines.append(f"    const {vector} {target}_c{c} = {value};")
+        return [*lines, "}"]
+
+    def _single(self, used: set[sp.Basic], stores: list[Statement]) -> list[str]:
+        """``rdd_tau_derivatives`` and ``rdd_fd_derivatives`` (:data:`_SINGLE`): the vector
+        statements in chunks of the instruction set's width, compiled plainly (2 lanes, SSE2)
+        and once per SIMD variant of the build (its ``target``), the widest the CPU runs
+        chosen at the first call."""
+        variants = [("plain", 2, "")] + [(name, lanes, target) for name, lanes, target in self.variants if lanes > 2]
+        lines: list[str] = []
+        for width in sorted({lanes for _, lanes, _ in variants}):
+            lines += self._vector_body(used, stores, width)
+        choice = []
+        for name, lanes, target in variants:
+            attribute = f'__attribute__((target("{target}")))' if target else ""
+            text = (
+                _SINGLE.replace("NAME", name)
+                .replace("ATTR", attribute)
+                .replace("VZEROUPPER", "" if not target else "__builtin_ia32_vzeroupper();")
+            )
+            text = text.replace("TYPE", f"rdd_w{lanes}").replace("CHUNKS", str(-(-self.nv // lanes))).replace("WIDTH", str(lanes))
+            if target:
+                text = f"#if defined(__x86_64__) && defined(__GNUC__)\n{text}\n#endif"
+                choice.append(f'    if (__builtin_cpu_supports("{target}")) tau = rdd_tau_{name}, fd = rdd_fd_{name};')
+            lines.append(text)
+        choose = ["#if defined(__x86_64__) && defined(__GNUC__)", "    __builtin_cpu_init();", *choice, "#endif"]
+        return [*lines, _DISPATCH.replace("CHOOSE", "\n".join(choose if choice else [])), ""]
+
+
+#: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
+#: core.c's ``ldl_apply_columns``' operations, column ``c`` in lane ``c`` (the same bits).
+_SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
+    const int n = RD_NV;
+    RD_UNROLL for (int i = n - 1; i >= 0; --i)
+        RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
+            const int j = rd_ancestor[i][a];
+            RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[j][c] -= M[i * n + j] * b[i][c];
+        }
+    RD_UNROLL for (int i = 0; i < n; ++i)
+        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] /= M[i * n + i];
+    RD_UNROLL for (int i = 0; i < n; ++i)
+        RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
+            const int j = rd_ancestor[i][a];
+            RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] -= M[i * n + j] * b[j][c];
+        }
+}"""
+#: One variant's functions: the direction vectors, then ``∂τ`` stored, or ``∂q̈ = −M⁻¹ ∂τ``
+#: and ``M⁻¹`` (derivatives.c's ``rdd_fd_finish``: solved, then negated).
+_SINGLE = """static ATTR void rdd_dirs_NAME(const double *q, const double *v, const double *a, TYPE (*bq)[CHUNKS],
+                               TYPE (*bv)[CHUNKS]) {
+    rdd_dirs_wWIDTH(q, v, a, bq, bv);
+}
+static ATTR void rdd_tau_NAME(const double *q, const double *v, const double *a, double *dq, double *dv) {
+    TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS];
+    rdd_dirs_NAME(q, v, a, bq, bv);
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j) RD_UNROLL for (int c = 0; c < CHUNKS; ++c) {
+        const int size = 8 * (c + 1 < CHUNKS ? WIDTH : RD_NV - c * WIDTH);
+        memcpy(dq + j * RD_NV + c * WIDTH, &bq[j][c], size);
+        memcpy(dv + j * RD_NV + c * WIDTH, &bv[j][c], size);
+    }
+    VZEROUPPER
+}
+static ATTR void rdd_fd_NAME(const double *q, const double *v, const double *a, const double *M, double *dq,
+                             double *dv, double *minv) {
+    TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS], bi[RD_NV][CHUNKS];
+    rdd_dirs_NAME(q, v, a, bq, bv);
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j) {
+        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) bi[j][c] = (TYPE){0.0};
+        bi[j][j / WIDTH][j % WIDTH] = 1.0;
+    }
+    rdd_apply_TYPE(M, bq);
+    rdd_apply_TYPE(M, bv);
+    rdd_apply_TYPE(M, bi);
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j) RD_UNROLL for (int c = 0; c < CHUNKS; ++c) {
+        const int size = 8 * (c + 1 < CHUNKS ? WIDTH : RD_NV - c * WIDTH);
+        const TYPE nq = -bq[j][c], nv = -bv[j][c];
+        memcpy(dq + j * RD_NV + c * WIDTH, &nq, size);
+        memcpy(dv + j * RD_NV + c * WIDTH, &nv, size);
+        memcpy(minv + j * RD_NV + c * WIDTH, &bi[j][c], size);
+    }
+    VZEROUPPER
+}"""
+#: ``rdd_tau_derivatives`` (one state: ``∂τ/∂q``, ``∂τ/∂v``) and ``rdd_fd_derivatives`` (one
+#: state at ``a = q̈`` with ``M`` factored: ``∂q̈/∂q``, ``∂q̈/∂v``, ``M⁻¹``), each the widest
+#: variant the CPU runs.
+_DISPATCH = """typedef void (*rdd_tau_fn)(const double *, const double *, const double *, double *, double *);
+typedef void (*rdd_fd_fn)(const double *, const double *, const double *, const double *, double *, double *, double *);
+static rdd_tau_fn rdd_tau_current = NULL;
+static rdd_fd_fn rdd_fd_current = NULL;
+static void rdd_choose(void) {
+    rdd_tau_fn tau = rdd_tau_plain;
+    rdd_fd_fn fd = rdd_fd_plain;
+CHOOSE
+    rdd_fd_current = fd;
+    rdd_tau_current = tau;
+}
+static void rdd_tau_derivatives(const double *q, const double *v, const double *a, double *dq, double *dv) {
+    if (!rdd_tau_current) rdd_choose();
+    rdd_tau_current(q, v, a, dq, dv);
+}
+static void rdd_fd_derivatives(const double *q, const double *v, const double *a, const double *M, double *dq,
+                               double *dv, double *minv) {
+    if (!rdd_fd_current) rdd_choose();
+    rdd_fd_current(q, v, a, M, dq, dv, minv);
+}"""
