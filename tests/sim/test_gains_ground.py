@@ -61,3 +61,58 @@ def test_the_inertia_only_gains_let_solo12_fold_onto_the_floor(capsys):
     status = main(["simulate", "solo12", *flags])
     text = capsys.readouterr().out
     assert status == 0 and "that are no contact points went under the ground" in text
+
+
+# A planar walker as Gymnasium and dm_control write them: its base is root slides and a
+# hinge no actuator drives (not a floating base), two bent legs, spheres for feet.
+PLANAR_WALKER = """<mujoco model="planar_walker">
+  <default><geom contype="0" conaffinity="0"/></default>
+  <worldbody>
+    <geom name="floor" type="plane" size="5 5 .1" contype="1" conaffinity="1"/>
+    <body name="torso" pos="0 0 0.472">
+      <joint name="rootx" type="slide" axis="1 0 0"/>
+      <joint name="rootz" type="slide" axis="0 0 1"/>
+      <joint name="rooty" type="hinge" axis="0 1 0"/>
+      <geom type="box" size="0.3 0.05 0.05" mass="10"/>
+      <body name="back_thigh" pos="-0.25 0 0">
+        <joint name="back_hip" type="hinge" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.1 0 -0.2" size="0.02" mass="1"/>
+        <body name="back_shin" pos="0.1 0 -0.2">
+          <joint name="back_knee" type="hinge" axis="0 1 0"/>
+          <geom type="capsule" fromto="0 0 0 -0.1 0 -0.25" size="0.02" mass="1"/>
+          <geom name="back_foot" type="sphere" pos="-0.1 0 -0.25" size="0.02" mass="0.1" contype="1" conaffinity="1"/>
+        </body>
+      </body>
+      <body name="front_thigh" pos="0.25 0 0">
+        <joint name="front_hip" type="hinge" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.1 0 -0.2" size="0.02" mass="1"/>
+        <body name="front_shin" pos="0.1 0 -0.2">
+          <joint name="front_knee" type="hinge" axis="0 1 0"/>
+          <geom type="capsule" fromto="0 0 0 -0.1 0 -0.25" size="0.02" mass="1"/>
+          <geom name="front_foot" type="sphere" pos="-0.1 0 -0.25" size="0.02" mass="0.1" contype="1" conaffinity="1"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="back_hip"/><motor joint="back_knee"/><motor joint="front_hip"/><motor joint="front_knee"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_a_planar_walkers_root_slides_get_the_load_gains_and_it_stands(tmp_path, capsys):
+    path = tmp_path / "planar_walker.xml"
+    path.write_text(PLANAR_WALKER)
+    walker = robodyn.load(str(path))
+    q = walker.default_configuration()
+    jacobian = contact_kinematics(walker, q, Ground(), contact_points(walker, "collision").points)[1]
+    moment = joint_loads(walker, q, jacobian, carried=[0, 1, 2])[0]
+    weight, lean = walker.total_mass * 9.81, walker.center_of_mass(q)[0]
+    feet = weight * (0.5 - lean / 0.5), weight * (0.5 + lean / 0.5)  # statics: feet at x = -0.25, 0.25
+    lever = np.hypot(0.1, 0.25 + 0.02)  # the knee's axis to the sphere's lowest point
+    assert np.allclose(moment[[4, 6]], np.array(feet) * lever, rtol=1e-9)
+    status = main(["simulate", str(path), "--ground", "--controller", "pd", "--duration", "0.4", "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    # the knees sag at most LOAD_GIVE under their load (the inertia rule alone: 1.9 rad)
+    assert status == 0 and summary["final_joint_error"] < LOAD_GIVE
