@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from robodyn.common.text import counted
+from robodyn.common.text import counted, quoted
 from robodyn.constraints import PointContact
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
@@ -152,7 +152,9 @@ def stand_law(
 
     Raises:
         InputError: Naming ``ground`` (none), ``controller`` (a fixed base), ``friction`` (0),
-            or ``target`` (not 3 values, or outside the support polygon).
+            ``contacts`` (fewer than three feet off one line, or feet whose polygon does not
+            hold the start's centre of mass), or ``target`` (not 3 values, or outside the
+            support polygon).
     """
     if not robot.floating_base:
         raise InputError(
@@ -177,6 +179,13 @@ def stand_law(
     margin = support_margin(robot, start, feet, com)
     if not np.isfinite(margin):
         raise InputError("contacts", "feet spanning a support polygon (three points or more off one line)", f"{len(feet)} points")
+    if not margin > 0 and target is None:  # the feet do not hold the start: they are not the robot's feet
+        links = sorted({foot.frame for foot in feet})
+        raise InputError(
+            "contacts",
+            "feet whose support polygon holds the centre of mass at the start (name them)",
+            f"{-margin:.3g} m outside the polygon of {len(feet)} points on {', '.join(map(quoted, links[:4]))}",
+        )
     if not margin > 0:
         raise InputError(
             "target", "a centre of mass shift that stays over the support polygon of the feet", f"{-margin:.3g} m outside it"

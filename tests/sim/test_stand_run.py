@@ -8,8 +8,10 @@ An actuator without a limit (MJCF's motor without ctrlrange, a URDF's effort 0) 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import robodyn
+from robodyn.exceptions import InputError
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.ground import Ground
 
@@ -46,3 +48,11 @@ def test_a_collision_sphere_above_the_ground_is_no_foot_and_the_feet_carry_the_w
     commanded = summary.contact.commanded  # the QP's (N, 5, 3); the feet share the weight as it likes (one rigid body)
     assert np.allclose(commanded[-1, :, 2].sum(), table.total_mass * 9.81, rtol=1e-6)
     assert np.abs(commanded[:, 4]).max() == 0.0 and np.abs(forces[:, 4]).max() == 0.0  # the head: none
+
+
+def test_feet_that_do_not_hold_the_start_are_refused_naming_the_contacts_not_a_target(tmp_path):
+    path = tmp_path / "table.xml"
+    path.write_text(TABLE.replace('pos="-0.2 ', 'pos="0.25 '))  # every foot ahead of the centre of mass
+    with pytest.raises(InputError, match=r"contacts must be feet whose support polygon holds .* on 'body'") as caught:
+        run_simulation(robodyn.load(str(path)), controller="stand", ground=Ground(), duration=0.01)
+    assert caught.value.argument == "contacts"  # no target was given: the refusal names the feet
