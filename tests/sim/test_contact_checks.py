@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import robodyn
+from robodyn.exceptions import InputError
 from robodyn.sim.contact_checks import buried_line
+from robodyn.sim.experiment import run_simulation
 from robodyn.sim.ground import Ground, contact_points
 
 FEET = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
@@ -29,3 +32,29 @@ def test_a_run_that_stays_above_the_ground_has_no_buried_line():
     high = solo.neutral_configuration()
     high[2] = 0.6
     assert buried_line(solo, np.array([high]), np.array([0.0]), Ground(), contact_points(solo, FEET)) is None
+
+
+# A floating body whose only collision sphere is on its head, 0.4 m above its (meshless) legs.
+HEAD_ONLY = """<mujoco model="head_only">
+  <worldbody>
+    <body name="body" pos="0 0 0.5">
+      <freejoint/>
+      <geom type="box" size="0.2 0.1 0.02" mass="5" contype="0" conaffinity="0"/>
+      <body name="leg" pos="0 0 -0.2">
+        <joint name="knee" type="hinge" axis="0 1 0"/>
+        <geom type="box" size="0.02 0.02 0.2" mass="1" contype="0" conaffinity="0"/>
+      </body>
+      <geom name="head" type="sphere" pos="0.2 0 0.2" size="0.05" mass="1"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_a_start_that_puts_links_under_the_ground_is_refused_naming_the_contacts(tmp_path):
+    path = tmp_path / "head_only.xml"
+    path.write_text(HEAD_ONLY)
+    robot = robodyn.load(str(path))
+    with pytest.raises(InputError, match=r"contacts must be contact points that hold the robot .* 'leg' 0\.\d+ m") as caught:
+        run_simulation(robot, controller="pd", ground=Ground(), duration=0.01)  # set down 5 cm under its head
+    assert "\n" not in str(caught.value)
