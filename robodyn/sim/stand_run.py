@@ -23,7 +23,7 @@ import pinocchio as pin
 from robodyn.common.text import counted, quoted
 from robodyn.constraints import PointContact
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError
+from robodyn.exceptions import ControllerFailedError, InputError
 from robodyn.sim.contact import contact_kinematics
 from robodyn.sim.contact_checks import start_above
 from robodyn.sim.drawings import MovingPoint, PlotPanel, Polygon
@@ -50,7 +50,14 @@ class RecordedStand:
         self.times: list[float] = []
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        tau = self.law(t, q, v)
+        try:
+            tau = self.law(t, q, v)
+        except InputError as error:  # no QP solution mid-run: say when, not the state's parameter name
+            fastest = int(np.argmax(np.abs(v)))
+            reason = f"the whole-body QP: {error.received}, {error.expected}"
+            raise ControllerFailedError(
+                float(t), len(self.times), self.law.model.dofs[fastest].joint, float(v[fastest]), reason
+            ) from None
         forces = np.zeros((self.count, 3))
         forces[self.feet] = self.law.last_forces.reshape(-1, 3)
         self.forces.append(forces.reshape(-1))

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.exceptions import InputError
+from robodyn.exceptions import ControllerFailedError, InputError
 from robodyn.sim.experiment import run_simulation
 from robodyn.sim.ground import Ground
 
@@ -56,3 +56,13 @@ def test_feet_that_do_not_hold_the_start_are_refused_naming_the_contacts_not_a_t
     with pytest.raises(InputError, match=r"contacts must be feet whose support polygon holds .* on 'body'") as caught:
         run_simulation(robodyn.load(str(path)), controller="stand", ground=Ground(), duration=0.01)
     assert caught.value.argument == "contacts"  # no target was given: the refusal names the feet
+
+
+def test_a_qp_without_solution_stops_the_run_saying_when(tmp_path):
+    path = tmp_path / "table.xml"
+    path.write_text(TABLE)
+    table = robodyn.load(str(path))
+    q0 = list(table.floating_configuration([0.0, 0.0, 0.5], [0.0, 0.5, 0.0], [0.0]))  # its feet on the slope
+    slope = Ground.tilted(0.5, friction=0.1)  # μ = 0.1 < tan 0.5: no force in the cones holds it
+    with pytest.raises(ControllerFailedError, match=r"stopped at t = 0 s \(step 0\): the controller failed \(the whole-body QP"):
+        run_simulation(table, controller="stand", ground=slope, q0=q0, duration=0.01)
