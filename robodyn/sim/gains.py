@@ -152,45 +152,35 @@ def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = Non
 LOAD_GIVE = 0.05
 
 
-def joint_loads(
-    robot: Robot, q: np.ndarray, jacobian: np.ndarray, carried: Sequence[int] | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """The load moment and the carried inertia of each joint of a robot standing at ``q``
-    on the contact points of ``jacobian`` (3k, nv, rows of a contact in any orthonormal
-    axes), shapes (n,) each (the joints: a floating base's six left out).
+def joint_loads(robot: Robot, q: np.ndarray, jacobian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The load moment and the carried inertia of each joint of a floating robot standing
+    at ``q`` on the contact points of ``jacobian`` (3k, nv, rows of a contact in any
+    orthonormal axes), shapes (n,) each (the joints).
 
     The contact forces ``f`` that hold the robot still are the minimum-norm solution of
-    the ``carried`` rows of ``G(q) = Jᵀ f`` (those no actuator holds: a floating base's six,
-    or a planar robot's root joints); joint ``j`` carries the load moment
+    the base's rows of ``G(q) = Jᵀ f``; joint ``j`` carries the load moment
     ``L_j = Σ_c ‖f_c‖ ‖∂p_c/∂q_j‖`` (each force times its lever about the joint, ``‖J_c,j‖``
     the distance of the contact from the joint's axis) in [N m] ([N]) and the inertia
     ``Σ_c ‖f_c‖ / g ‖∂p_c/∂q_j‖²`` in [kg m²] ([kg]) of the weight it lifts.
 
     Args:
-        robot: The robot.
+        robot: A floating robot.
         q: Its configuration, shape (nq,).
         jacobian: The contact points' Jacobians, shape (3k, nv).
-        carried: The coordinates the contacts carry; ``None``: a floating base's six.
     """
-    rows = list(range(6)) if carried is None else list(carried)
     gravity = robot.gravity(q)
-    forces = np.linalg.lstsq(jacobian[:, rows].T, gravity[rows], rcond=None)[0].reshape(-1, 3)
+    forces = np.linalg.lstsq(jacobian[:, :6].T, gravity[:6], rcond=None)[0].reshape(-1, 3)
     magnitude = np.linalg.norm(forces, axis=1)
-    joints = jacobian[:, 6:] if robot.floating_base else jacobian
-    levers = np.linalg.norm(joints.reshape(len(magnitude), 3, -1), axis=1)  # (k, n)
+    levers = np.linalg.norm(jacobian[:, 6:].reshape(len(magnitude), 3, -1), axis=1)  # (k, n)
     g = max(float(np.linalg.norm(robot.model.gravity.linear)), 1e-300)
     return magnitude @ levers, (magnitude / g) @ levers**2
 
 
 def load_gains(
-    robot: Robot,
-    q: np.ndarray,
-    jacobian: np.ndarray,
-    driven: np.ndarray | None = None,
-    carried: Sequence[int] | None = None,
+    robot: Robot, q: np.ndarray, jacobian: np.ndarray, driven: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Default PD gains of a robot standing at ``q`` on the contacts of ``jacobian``
-    (3k, nv), shape (n,) each (the joints).
+    """Default PD gains of a floating robot standing at ``q`` on the contacts of
+    ``jacobian`` (3k, nv), shape (n,) each (the joints).
 
     ``kp = ω² m + L / θ``: the inertia rule (:func:`pd_gains`, ``m`` the joint's inertia
     with the base free) plus the load moment ``L`` (:func:`joint_loads`) over
@@ -205,23 +195,10 @@ def load_gains(
         jacobian: The contact points' Jacobians, shape (3k, nv).
         driven: Which degrees of freedom an actuator drives, shape (nv,) (as
             :func:`joint_inertia`); ``None``: every joint.
-        carried: The coordinates the contacts carry (as :func:`joint_loads`); ``None``:
-            a floating base's six.
     """
     inertia = joint_inertia(robot, q, driven)
-    stiffness = PD_FREQUENCY**2 * inertia + joint_loads(robot, q, jacobian, carried)[0] / LOAD_GIVE
+    stiffness = PD_FREQUENCY**2 * inertia + joint_loads(robot, q, jacobian)[0] / LOAD_GIVE
     return stiffness, 2.0 * np.sqrt(stiffness * inertia)
-
-
-def _root_slides(robot: Robot) -> list[int]:
-    """A fixed-base robot's leading coordinates that no actuator drives when one of them
-    slides (a planar walker's base: root slides and a hinge), else none."""
-    roots = []
-    for dof in robot.dofs:
-        if dof.actuated or dof.is_base:
-            break
-        roots.append(dof)
-    return [dof.index for dof in roots] if any(dof.linear for dof in roots) else []
 
 
 def pd_defaults(
@@ -231,10 +208,7 @@ def pd_defaults(
     """The pd controller's defaults: without a ``target``, the start's joints (held); a
     floating robot on a ``ground`` with neither ``kp`` nor ``kd`` in ``gains``: the gains
     of :func:`load_gains` at the target pose set on the ground, on its contact points that
-    touch it (those within 1 mm of the lowest). A robot whose root joints no actuator
-    drives, one of them a slide (a planar walker: Gymnasium's hopper, dm_control's
-    cheetah), gets them too, at the target pose as it is (it cannot be set on the ground).
-    Other controllers: unchanged.
+    touch it (those within 1 mm of the lowest). Other controllers: unchanged.
 
     Args:
         robot: The plant.
@@ -249,18 +223,12 @@ def pd_defaults(
         return target, gains
     if target is None:
         target = list(start[7:] if robot.floating_base else start)
-    roots = _root_slides(robot)
-    if ground is None or not (robot.floating_base or roots) or gains.get("kp") is not None or gains.get("kd") is not None:
+    if ground is None or not robot.floating_base or gains.get("kp") is not None or gains.get("kd") is not None:
         return target, gains
-    standing, joints = np.array(start, dtype=float), joint_target(robot, target, "pd")
-    standing[robot.nq - joints.size :] = joints
-    if robot.floating_base:
-        standing = start_above(robot, standing, ground, contacts, clearance=0.0)[0]
+    goal = np.array(start, dtype=float)
+    goal[7:] = joint_target(robot, target, "pd")
+    standing = start_above(robot, goal, ground, contacts, clearance=0.0)[0]
     gaps, jacobian = contact_kinematics(robot, standing, ground, contact_points(robot, contacts).points)
     support = np.repeat(gaps <= gaps.min() + 1e-3, 3)
-    if robot.floating_base:
-        kp, kd = load_gains(robot, standing, jacobian[support])
-    else:  # a planar robot's root joints (slides and a hinge, no actuator): its contacts carry them
-        driven = np.array([dof.actuated for dof in robot.dofs])
-        kp, kd = load_gains(robot, standing, jacobian[support], driven=driven, carried=roots)
+    kp, kd = load_gains(robot, standing, jacobian[support])
     return target, {**gains, "kp": kp, "kd": kd}
