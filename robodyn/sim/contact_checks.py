@@ -103,16 +103,18 @@ BURIED_DEPTH = 1e-3
 
 def buried_links(robot: Robot, q: np.ndarray, ground: Ground, contacts: Contacts) -> list[tuple[str, float, int]]:
     """The links that are not contact points and lie deeper than :data:`BURIED_DEPTH` under
-    the ground at some row of ``q`` (k, nq): their origins and collision spheres, boxes and
-    capsules; each link with its depth in [m] and the first row, deepest first."""
+    the ground at some row of ``q`` (k, nq): their origins (links with mass: not the massless
+    frames between a planar root's slides) and collision spheres, boxes and capsules; each
+    link with its depth in [m] and the first row, deepest first."""
     model, data, frames = robot.model, robot.handle.data, robot.handle.frames
     moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
     links = sorted(moving - {point.link for point in contacts.points})
     shapes = [point for point in collision_points(robot).points if point.link in links]
+    bodies = [link for link in links if getattr(robot.spec.links[link], "mass", 0.0) > 0]  # not a joint's massless frame
     depth: dict[str, tuple[float, int]] = {}
     for row, configuration in enumerate(q):
         pin.framesForwardKinematics(model, data, configuration)
-        points = [(link, data.oMf[frames[link]].translation) for link in links]
+        points = [(link, data.oMf[frames[link]].translation) for link in bodies]
         points += [
             (p.link, data.oMf[frames[p.link]].act(np.array(p.position)) - p.radius * np.array(ground.normal)) for p in shapes
         ]
