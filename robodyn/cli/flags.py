@@ -35,6 +35,7 @@ FLAGS: dict[str, str] = {
     "urdf_out": "--urdf-out",
     "method": "--method",
     "data": "DATA",
+    "source": "MODEL",
     "posture": "--posture",
     "stiffness": "--stiffness",
     "damping": "--damping",

@@ -24,7 +24,7 @@ YAML because its parser (PyYAML, which xacro needs) is already a dependency on e
 Python robodyn supports, and ROS users write it. :func:`read_constraints` reads it (a path,
 or the text itself) into constraint values (anchors, then welds, then contacts, each in the
 file's order). Anything else is refused in one :class:`~robodyn.exceptions.InputError`
-naming the list, entry and key: a file that is not YAML (or uses aliases), an unknown list
+naming the list, entry and key: a file that is not YAML (or uses aliases, or gives a key twice), an unknown list
 or key (nothing in the file is silently ignored), a coordinate that is not a finite number
 within :data:`MAX_COORDINATE`, more than :data:`MAX_CONSTRAINTS` entries.
 Link names are checked against the robot when the constraints are bound to it
@@ -65,12 +65,27 @@ _EXPECTED = "a YAML file of anchor, weld and contact lists (docs/constraints.md)
 
 
 class _Loader(yaml.SafeLoader):
-    """YAML's safe loader (plain data only), refusing aliases (``*name``: no expansion bombs)."""
+    """YAML's safe loader (plain data only), refusing aliases (``*name``: no expansion bombs)
+    and a key given twice in one mapping."""
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         if self.check_event(yaml.AliasEvent):
             raise yaml.YAMLError("aliases (*name) are not accepted")
         return super().compose_node(parent, index)
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+        """A mapping, refusing a key given twice (YAML would keep the last, silently dropping the first)."""
+        mapping = super().construct_mapping(node, deep=deep)
+        if len(mapping) < len(node.value):
+            seen: set[Any] = set()
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=True)
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"the key {printable(repr(key))[:40]} is given twice", key_node.start_mark
+                    )
+                seen.add(key)
+        return mapping
 
 
 # YAML 1.2's floats (1e-3, 2E+1), which YAML 1.1's resolver reads as strings

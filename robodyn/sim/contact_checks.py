@@ -5,7 +5,9 @@ with the controller sampled once a step; it has no momentum observer. Enforced j
 are rows of its contact problem (:mod:`robodyn.sim.contact_limits`). A plan asking for
 another integrator, a control period or an observer with a ground is refused, naming the
 parameter, as is a start with a contact point deeper than :data:`START_PENETRATION` below
-the ground or a joint further than that past an enforced limit.
+the ground, a link that is no contact point deeper than :data:`BURIED_DEPTH` (the contact
+points are not the robot's lowest: talos's only collision box is its head camera) or a joint
+further than that past an enforced limit.
 """
 
 from __future__ import annotations
@@ -65,6 +67,16 @@ def check_contact_run(
             f"a configuration with every contact point above the ground (at most {START_PENETRATION} m below)",
             f"{found.names[deepest]!r} {-gaps[deepest]:.3g} m below",
         )
+    buried = buried_links(robot, np.asarray(q0, dtype=float)[None], ground, found)
+    if buried:
+        shown = ", ".join(f"{printable(link)!r} {depth:.3g} m" for link, depth, _ in buried[:4]) + (
+            ", …" if len(buried) > 4 else ""
+        )
+        raise InputError(
+            "contacts",
+            f"contact points that hold the robot above the ground at the start (no other link more than {BURIED_DEPTH} m below it)",
+            f"{len(buried)} links under it: {shown}",
+        )
     return found
 
 
@@ -89,11 +101,35 @@ BURIED_SAMPLES = 200
 BURIED_DEPTH = 1e-3
 
 
+def buried_links(robot: Robot, q: np.ndarray, ground: Ground, contacts: Contacts) -> list[tuple[str, float, int]]:
+    """The links that are not contact points and lie deeper than :data:`BURIED_DEPTH` under
+    the ground at some row of ``q`` (k, nq): their origins (links with mass: not the massless
+    frames between a planar root's slides) and collision spheres, boxes and capsules; each
+    link with its depth in [m] and the first row, deepest first."""
+    model, data, frames = robot.model, robot.handle.data, robot.handle.frames
+    moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
+    links = sorted(moving - {point.link for point in contacts.points})
+    shapes = [point for point in collision_points(robot).points if point.link in links]
+    bodies = [link for link in links if getattr(robot.spec.links[link], "mass", 0.0) > 0]  # not a joint's massless frame
+    depth: dict[str, tuple[float, int]] = {}
+    for row, configuration in enumerate(q):
+        pin.framesForwardKinematics(model, data, configuration)
+        points = [(link, data.oMf[frames[link]].translation) for link in bodies]
+        points += [
+            (p.link, data.oMf[frames[p.link]].act(np.array(p.position)) - p.radius * np.array(ground.normal)) for p in shapes
+        ]
+        for link, where in points:
+            below = -float(ground.gap(where))
+            if below > BURIED_DEPTH:
+                depth[link] = (max(depth.get(link, (0.0, row))[0], below), depth.get(link, (0.0, row))[1])
+    return sorted(((link, value, row) for link, (value, row) in depth.items()), key=lambda item: -item[1])
+
+
 def buried_line(robot: Robot, q: np.ndarray, t: np.ndarray, ground: Ground, contacts: Contacts) -> str | None:
     """One warning line naming the links that are not contact points and went under the
-    ground in a run (``q`` (N, nq) at times ``t`` (N,) [s]): their origins and collision
-    spheres, boxes and capsules checked at :data:`BURIED_SAMPLES` samples, each link with
-    its deepest point in [m]; ``None`` when none went deeper than :data:`BURIED_DEPTH`.
+    ground in a run (``q`` (N, nq) at times ``t`` (N,) [s]): :func:`buried_links` at
+    :data:`BURIED_SAMPLES` samples, each link with its deepest point in [m]; ``None`` when
+    none went deeper than :data:`BURIED_DEPTH`.
 
     Args:
         robot: The simulated robot.
@@ -102,27 +138,14 @@ def buried_line(robot: Robot, q: np.ndarray, t: np.ndarray, ground: Ground, cont
         ground: The ground plane.
         contacts: The run's contact points (their links are left out).
     """
-    model, data, frames = robot.model, robot.handle.data, robot.handle.frames
-    moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
-    links = sorted(moving - {point.link for point in contacts.points})
-    shapes = [point for point in collision_points(robot).points if point.link in links]
-    depth: dict[str, float] = {}
-    first = np.inf
-    for index in np.unique(np.linspace(0, len(q) - 1, min(len(q), BURIED_SAMPLES)).round().astype(int)):
-        pin.framesForwardKinematics(model, data, q[index])
-        points = [(link, data.oMf[frames[link]].translation) for link in links]
-        points += [
-            (p.link, data.oMf[frames[p.link]].act(np.array(p.position)) - p.radius * np.array(ground.normal)) for p in shapes
-        ]
-        for link, where in points:
-            below = -float(ground.gap(where))
-            if below > BURIED_DEPTH:
-                depth[link] = max(depth.get(link, 0.0), below)
-                first = min(first, float(t[index]))
-    if not depth:
+    samples = np.unique(np.linspace(0, len(q) - 1, min(len(q), BURIED_SAMPLES)).round().astype(int))
+    deepest = buried_links(robot, q[samples], ground, contacts)
+    if not deepest:
         return None
-    deepest = sorted(depth.items(), key=lambda item: -item[1])
-    shown = ", ".join(f"{printable(link)!r} {value:.3g} m" for link, value in deepest[:4]) + (", …" if len(deepest) > 4 else "")
+    first = float(t[samples[min(row for _, _, row in deepest)]])
+    shown = ", ".join(f"{printable(link)!r} {value:.3g} m" for link, value, _ in deepest[:4]) + (
+        ", …" if len(deepest) > 4 else ""
+    )
     return (
         f"warning: {len(deepest)} link{'s' if len(deepest) > 1 else ''} that are no contact points went under the ground "
         f"(from t = {first:.6g} s; deepest): {shown}: name them as contacts or hold the robot up"
@@ -141,4 +164,12 @@ def start_above(
     return moved, lift
 
 
-__all__ = ["BURIED_DEPTH", "BURIED_SAMPLES", "START_PENETRATION", "buried_line", "check_contact_run", "start_above"]
+__all__ = [
+    "BURIED_DEPTH",
+    "BURIED_SAMPLES",
+    "START_PENETRATION",
+    "buried_line",
+    "buried_links",
+    "check_contact_run",
+    "start_above",
+]

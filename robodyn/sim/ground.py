@@ -278,7 +278,7 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
 
     Raises:
         FrameError: For a frame the robot does not have (with close names).
-        InputError: For no points at all, or a duplicated name.
+        InputError: For no points at all, an empty name or a duplicated name.
     """
     if isinstance(contacts, str) and contacts == "collision":
         found = _feet(robot, _moving(robot, collision_points(robot)))
@@ -288,6 +288,8 @@ def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -
         frames = robot.frame_ids
         chosen = []
         for item in contacts:
+            if not isinstance(item, ContactPoint) and not str(item):
+                raise InputError("contacts", "frame names, none empty", repr(list(map(str, contacts)))[:80])
             point = item if isinstance(item, ContactPoint) else ContactPoint(str(item), str(item))
             if point.link not in frames:
                 close = [name for name in frames if point.link.lower() in name.lower()][:5]

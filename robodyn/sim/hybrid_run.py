@@ -30,7 +30,7 @@ from robodyn.constraints import PointContact
 from robodyn.dynamics import constrained
 from robodyn.dynamics.loading import rebuild
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, NonFiniteResultError
 from robodyn.sim.constrained import project, simulate_constrained
 from robodyn.sim.drawings import Polygon
 from robodyn.sim.experiment import run_simulation
@@ -90,7 +90,7 @@ def _start(robot: Robot, contact: PointContact, q0: Sequence[float] | None) -> t
         )
     try:
         placed, _ = project(robot, start, np.zeros(robot.nv), constrained.bound(robot, [contact]))
-    except InputError:
+    except (InputError, NonFiniteResultError):  # Newton's steps toward a plane out of reach overflow
         raise InputError(
             "surface", f"a plane {contact.frame} can reach from the default configuration", f"{gap:.3g} m away"
         ) from None

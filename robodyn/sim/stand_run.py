@@ -3,7 +3,7 @@ the ground held by the whole-body QP (:class:`robodyn.sim.whole_body.Stand`).
 
 The robot starts with its lowest contact point on the ground (gap 0, not the 5 cm drop of
 the other controllers: the QP assumes feet that do not move), its feet (the run's contact
-points) become sticking :class:`~robodyn.constraints.PointContact` s of the ground's normal
+points within 1 mm of the ground there; the others, a hand or a knee, are no feet) become sticking :class:`~robodyn.constraints.PointContact` s of the ground's normal
 and friction, and the controller holds the base attitude and the centre of mass at its
 start shifted by ``target`` (DX, DY, DZ in [m]; refused outside the support polygon). The
 summary gains the centre of mass's final error, the largest difference between the QP's
@@ -20,10 +20,11 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from robodyn.common.text import counted
+from robodyn.common.text import counted, quoted
 from robodyn.constraints import PointContact
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import InputError
+from robodyn.exceptions import ControllerFailedError, InputError
+from robodyn.sim.contact import contact_kinematics
 from robodyn.sim.contact_checks import start_above
 from robodyn.sim.drawings import MovingPoint, PlotPanel, Polygon
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
@@ -32,19 +33,34 @@ from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import commanded_header, contact_header
 from robodyn.trajectory.io import write_csv
 
+#: A contact point is a foot when it lies within this gap [m] of the ground at the start.
+FOOT_GAP = 1e-3
+
 
 class RecordedStand:
-    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N],
-    and the call's time in [s]."""
+    """A :class:`Stand` that keeps the QP's contact forces of every call, (3 k,) each in [N]
+    for the run's ``k`` contact points (zero at a point that is no foot), and the call's
+    time in [s]."""
 
-    def __init__(self, law: Stand) -> None:
+    def __init__(self, law: Stand, feet: Sequence[int] | None = None, count: int | None = None) -> None:
         self.law = law
+        self.feet = list(range(len(law.contacts))) if feet is None else list(feet)
+        self.count = len(self.feet) if count is None else count
         self.forces: list[np.ndarray] = []
         self.times: list[float] = []
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        tau = self.law(t, q, v)
-        self.forces.append(self.law.last_forces.copy())
+        try:
+            tau = self.law(t, q, v)
+        except InputError as error:  # no QP solution mid-run: say when, not the state's parameter name
+            fastest = int(np.argmax(np.abs(v)))
+            reason = f"the whole-body QP: {error.received}, {error.expected}"
+            raise ControllerFailedError(
+                float(t), len(self.times), self.law.model.dofs[fastest].joint, float(v[fastest]), reason
+            ) from None
+        forces = np.zeros((self.count, 3))
+        forces[self.feet] = self.law.last_forces.reshape(-1, 3)
+        self.forces.append(forces.reshape(-1))
         self.times.append(float(t))
         return tau
 
@@ -143,7 +159,9 @@ def stand_law(
 
     Raises:
         InputError: Naming ``ground`` (none), ``controller`` (a fixed base), ``friction`` (0),
-            or ``target`` (not 3 values, or outside the support polygon).
+            ``contacts`` (fewer than three feet off one line, or feet whose polygon does not
+            hold the start's centre of mass), or ``target`` (not 3 values, or outside the
+            support polygon).
     """
     if not robot.floating_base:
         raise InputError(
@@ -161,11 +179,20 @@ def stand_law(
             "target", "DX,DY,DZ in [m] (the centre of mass's shift) for the stand controller", counted(shift.size, "value")
         )
     start, lift = start_above(robot, start, ground, contacts, clearance=0.0)
-    feet = _feet(robot, start, ground, contact_points(robot, contacts).points)
+    points = contact_points(robot, contacts).points
+    touching = _touching(robot, start, ground, points)
+    feet = _feet(robot, start, ground, [points[index] for index in touching])
     com = robot.center_of_mass(start) + shift
     margin = support_margin(robot, start, feet, com)
     if not np.isfinite(margin):
         raise InputError("contacts", "feet spanning a support polygon (three points or more off one line)", f"{len(feet)} points")
+    if not margin > 0 and target is None:  # the feet do not hold the start: they are not the robot's feet
+        links = sorted({foot.frame for foot in feet})
+        raise InputError(
+            "contacts",
+            "feet whose support polygon holds the centre of mass at the start (name them)",
+            f"{-margin:.3g} m outside the polygon of {len(feet)} points on {', '.join(map(quoted, links[:4]))}",
+        )
     if not margin > 0:
         raise InputError(
             "target", "a centre of mass shift that stays over the support polygon of the feet", f"{-margin:.3g} m outside it"
@@ -174,7 +201,16 @@ def stand_law(
     line = (
         f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point on it: stand's feet do not move)"
     )
-    return RecordedStand(Stand(model, feet, com, rotation, start)), start, line
+    if len(feet) < len(points):
+        line += f"; feet: the {len(feet)} of {len(points)} contact points within {FOOT_GAP:g} m of the ground at the start"
+    return RecordedStand(Stand(model, feet, com, rotation, start), touching, len(points)), start, line
+
+
+def _touching(robot: Robot, q: np.ndarray, ground: Ground, points: Sequence[ContactPoint]) -> list[int]:
+    """The indices of the contact points within :data:`FOOT_GAP` of ``ground`` at ``q``: the
+    feet (a hand or a knee above the ground is no foot the QP may push on)."""
+    gaps = contact_kinematics(robot, q, ground, tuple(points))[0]
+    return [index for index, gap in enumerate(gaps) if gap <= FOOT_GAP]
 
 
 def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, Any]:
@@ -190,7 +226,7 @@ def stand_outcome(robot: Robot, law: RecordedStand, contact: Any) -> dict[str, A
     """
     final = contact.trajectory.q[-1]
     feet = law.law.contacts
-    commanded = np.array(law.forces).reshape(len(law.forces), len(feet), 3)
+    commanded = np.array(law.forces).reshape(len(law.forces), -1, 3)
     count, held = min(len(commanded), len(contact.forces)), law.held(contact.trajectory.t)
     return {
         "com_error": float(np.linalg.norm(robot.center_of_mass(final) - law.law.com)),

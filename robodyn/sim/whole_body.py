@@ -163,7 +163,8 @@ class Stand:
         kp: Centre of mass and attitude stiffness [1/s²]. kd: damping [1/s].
         posture_kp, posture_kd: The posture's, [1/s²] and [1/s].
         weights: Of the centre of mass, attitude and posture tasks.
-        torque_limit: ``τ_max`` of each actuated joint (nv − 6,), default the model's effort limits.
+        torque_limit: ``τ_max`` of each actuated joint (nv − 6,), default the model's effort limits
+            (a joint without one, or a limit of 0 as URDF and MJCF write none: no limit).
         margin: ``μ_c / μ`` (:data:`CONE_MARGIN`); ``None`` drops the cone (a negative control).
         last_forces: The QP's contact forces at the last call, (3 k,) in [N], world axes.
 
@@ -210,7 +211,8 @@ class Stand:
         if batch:
             raise InputError("posture", f"one configuration ({model.nq} values)", f"shape {self.posture.shape}")
         self._actuated = np.array([dof.index for dof in model.dofs if dof.actuated])
-        limits = model.model.effortLimit[self._actuated] if self.torque_limit is None else self.torque_limit
+        efforts = np.array([dof.effort_limit for dof in model.dofs if dof.actuated], dtype=float)
+        limits = np.where(efforts > 0, efforts, np.inf) if self.torque_limit is None else self.torque_limit  # 0: none
         try:
             self.torque_limit = np.broadcast_to(np.asarray(limits, float), (len(self._actuated),)).copy()
         except (TypeError, ValueError):
@@ -267,11 +269,14 @@ class Stand:
         selection[np.arange(nt), self._actuated] = 1.0
         dynamics = np.hstack([mass, -selection.T, -jacobian.T])
         fixed = np.hstack([jacobian, np.zeros((len(jacobian), nt + nf))])
-        limits = np.zeros((2 * nt, nv + nt + nf))
-        limits[:nt, nv : nv + nt], limits[nt:, nv : nv + nt] = np.eye(nt), -np.eye(nt)
+        bound = np.asarray(self.torque_limit, dtype=float)  # set by __post_init__
+        limited = np.flatnonzero(np.isfinite(bound))  # an unlimited joint has no row
+        limits = np.zeros((2 * limited.size, nv + nt + nf))
+        limits[np.arange(limited.size), nv + limited] = 1.0
+        limits[limited.size + np.arange(limited.size), nv + limited] = -1.0
         rows = [dynamics, fixed, limits]
-        right = [-bias, -drift, np.concatenate([self.torque_limit, self.torque_limit])]
-        cones = [clarabel.ZeroConeT(nv + len(jacobian)), clarabel.NonnegativeConeT(2 * nt)]
+        right = [-bias, -drift, np.tile(bound[limited], 2)]
+        cones = [clarabel.ZeroConeT(nv + len(jacobian)), clarabel.NonnegativeConeT(2 * limited.size)]
         if self.margin is not None:
             for index, (contact, tangents) in enumerate(zip(self.contacts, self._tangent_rows, strict=True)):
                 cone = np.zeros((3, nv + nt + nf))

@@ -121,3 +121,11 @@ def test_a_suggested_boolean_keyword_becomes_its_switch_on_the_command_line(caps
     assert main(["equations", "solo12", "--symbolic"]) == 2
     err = capsys.readouterr().err
     assert "(--fixed-base)" in err and "floating_base=" not in err
+
+
+def test_a_refused_robot_is_named_as_the_model_argument_the_user_typed(capsys):
+    from robodyn.cli.app import main
+
+    assert main(["equations", "ur5", "--derivation"]) == 2  # 6 moving joints: too many to work step by step
+    err = capsys.readouterr().err
+    assert "MODEL must be a robot of at most 4 moving joints" in err and "source" not in err

@@ -103,3 +103,16 @@ def test_a_link_the_robot_does_not_have_is_refused_listing_its_links():
     (anchor,) = read_constraints("anchor:\n  - frame1: crank\n    frame2: nowhere\n")
     with pytest.raises(InputError, match=r"frame2 must be a link of robot 'four_bar' \('world', 'ground', 'crank'"):
         robodyn.load(str(EXAMPLES / "four_bar.urdf"), constraints=[anchor])
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "anchor:\n  - frame1: crank\nanchor:\n  - frame1: rocker\n",  # a list given twice: YAML keeps the last
+        "anchor:\n  - frame1: crank\n    point1: [0, 0, 0]\n    point1: [0.1, 0, 0]\n",  # a key twice in an entry
+    ],
+)
+def test_a_key_given_twice_is_refused_not_overwritten(text):
+    with pytest.raises(InputError, match=r"given twice.*line [34]") as caught:
+        read_constraints(text)
+    assert "\n" not in str(caught.value)

@@ -142,3 +142,9 @@ def test_a_robot_with_no_simple_collision_geometry_and_no_feet_is_refused_naming
     </robot>"""
     with pytest.raises(InputError, match=r"contacts.*no collision sphere or box"):
         contact_points(robodyn.load(urdf), "collision")
+
+
+def test_an_empty_contact_frame_name_is_refused_naming_the_contacts():
+    with pytest.raises(InputError, match=r"^contacts must be frame names, none empty") as caught:
+        contact_points(robodyn.load("rp_arm"), ["end_effector", ""])  # `--contact end_effector,` on the command line
+    assert caught.value.argument == "contacts"

@@ -83,6 +83,7 @@ def test_a_surface_that_pulls_is_said():
         ({"gravity": 1.0}, "gravity"),
         ({"surface": (1.0, 0.0, 0.0)}, "surface"),
         ({"surface": None}, "surface"),
+        ({"surface": ((1e300, 0.0, 0.0), (-1.0, 0.0, 0.0))}, "surface"),  # out of reach: the projection overflowed
         ({"force": None}, "force"),
     ],
 )
