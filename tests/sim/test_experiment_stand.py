@@ -83,3 +83,18 @@ def test_a_stand_it_cannot_do_is_refused_naming_the_parameter(robot, options, ar
     with pytest.raises(InputError) as error:
         run_simulation(robodyn.load(robot), controller="stand", duration=0.01, **options)
     assert error.value.argument == argument
+
+
+@pytest.mark.parametrize("joint_friction", [True, False])
+def test_the_stand_run_compensates_the_joints_damping_exactly_when_it_applies_it(joint_friction, monkeypatch):
+    """The QP the run builds (caught on its way to the plant) adds ``b ∘ v`` to its
+    equations of motion when the run's damping acts, as the other model-based laws do."""
+    from robodyn.sim import experiment
+
+    built = []
+    monkeypatch.setattr(experiment, "simulate_run", lambda *args, **kwargs: built.append(kwargs["controller"]) or 1 / 0)
+    robot = solo()
+    q0 = list(robot.floating_configuration([0.0, 0.0, 0.4], [0.0, 0.0, 0.0], LEGS))
+    with pytest.raises(ZeroDivisionError):
+        run_simulation(robot, controller="stand", ground=Ground(), q0=q0, duration=0.01, joint_friction=joint_friction)
+    assert built[0].compensate_damping is joint_friction and built[0].law.compensate_damping is joint_friction
