@@ -10,7 +10,7 @@ in the surface's frame: ``Ω = I − n nᵀ`` picks the motion directions (along
 ``Ω̃ = n nᵀ`` the force direction. With the frame's position Jacobian ``J`` (3 × nv), the
 task inertia ``Λ = (J M⁻¹ Jᵀ)⁻¹`` and ``J̄ = M⁻¹ Jᵀ Λ``::
 
-    tau = Jᵀ (Λ (Ω ẍ* − J̇ v) − F n) + C v + G + (I − J̄ J)ᵀ τ₀
+    tau = Jᵀ (Λ (Ω ẍ* − J̇ v) − F n) + C v + G + b ∘ v + (I − J̄ J)ᵀ τ₀
 
 with ``ẍ* = ẍ_d + Kd ė + Kp e`` (``e = x_d − x``) and ``F`` the commanded normal force in
 [N] (the frame pushes the surface with ``F``; the surface pushes back ``λ n``). With the
@@ -20,6 +20,10 @@ motion error obeys ``ë + Kd ė + Kp e = 0`` along the surface, undisturbed by t
 (the decoupling). The commanded force ``−F n`` has no component along the surface
 (``Ω n = 0``): it does no work on the motion. ``τ₀ = M (Kp₀ (q₀ − q) − Kd₀ v)`` is a
 posture for a redundant arm, kept out of the task by the dynamically consistent null space.
+``b ∘ v`` cancels the joints' viscous damping (the model's :attr:`~robodyn.Robot.joint_damping`)
+when ``compensate_damping`` is on (what a run that applies it sets,
+:func:`robodyn.sim.twin.compensate`), else 0: uncancelled, the damping of the sliding
+motion biases the force by ``nᵀ J M⁻¹ b v / nᵀ Λ⁻¹ n``.
 
 ``decoupled=False`` replaces ``Λ`` by a scalar mass (the mean of its eigenvalues over the
 directions the frame can move in): the classical law without dynamic decoupling, whose
@@ -37,6 +41,7 @@ import pinocchio as pin
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.operational_space import TASK_DAMPING, TaskReference, damped_task_inertia
+from robodyn.sim.twin import viscous_compensation
 
 #: Eigenvalues of ``Λ`` below this times the largest are directions the frame cannot move in.
 DIRECTION_TOLERANCE = 1e-6
@@ -131,6 +136,7 @@ class HybridForceMotion:
             (``None``: damping alone). posture_kp [1/s²], posture_kd [1/s].
         decoupled: ``False`` for the law without dynamic decoupling (module docstring).
         damping: Damping of ``Λ`` relative to the largest eigenvalue of ``J M⁻¹ Jᵀ``.
+        compensate_damping: Add ``b ∘ v`` (the model's joint damping; module docstring).
 
     Raises:
         FrameError: Unknown frame. InputError: A bad normal, force, motion or posture.
@@ -149,6 +155,7 @@ class HybridForceMotion:
     posture_kd: float = 10.0
     decoupled: bool = True
     damping: float = TASK_DAMPING
+    compensate_damping: bool = False
     _frame_id: int = field(init=False, repr=False)
     _normal: np.ndarray = field(init=False, repr=False)
 
@@ -208,7 +215,8 @@ class HybridForceMotion:
         posture_error = np.zeros(model.nv) if self.posture is None else pin.difference(model.model, q, self.posture)
         posture = mass @ (self.posture_kp * posture_error - self.posture_kd * v)
         task = self._task_inertia(inertia) @ (self.motion_selection @ command - bias) + self.force_command
-        return jacobian.T @ task + model.nonlinear_effects(q, v) + null_space.T @ posture
+        compensation = viscous_compensation(model, self.compensate_damping, v)
+        return jacobian.T @ task + model.nonlinear_effects(q, v) + compensation + null_space.T @ posture
 
 
 def circle(

@@ -37,6 +37,7 @@ from robodyn.sim.experiment import run_simulation
 from robodyn.sim.force_control import HybridForceMotion, scalar, unit_normal, vector
 from robodyn.sim.limits import limit_violations
 from robodyn.sim.surface_run import ForceOutcome, SurfaceRun, refuse_options, summary_of, timed
+from robodyn.sim.twin import compensate
 from robodyn.trajectory import Trajectory
 
 #: Largest distance in [m] a given ``q0`` (or ``target``) may leave the frame off the surface
@@ -244,7 +245,8 @@ def run_hybrid(
         posture=held,
         **gains,
     )
-    plant = _plant(robot, model, law, joint_friction)
+    compensate(law, joint_friction)
+    plant = _plant(robot, law, joint_friction)
     run, loop_time = timed(lambda: simulate_constrained(robot, start, constraints=[contact], duration=duration, dt=dt, tau=plant))
     surface_run = SurfaceRun(
         run.trajectory, SURFACE, frame, normal, run.multipliers[:, 0], np.full(len(run.trajectory), law.force)
@@ -257,12 +259,12 @@ def run_hybrid(
     return run.trajectory, replace(summary, panels=surface_run.panels(), drawings=(surface_patch(reference, normal),))
 
 
-def _plant(robot: Robot, model: Robot, law: HybridForceMotion, joint_friction: bool) -> Callable:
-    """The torques the plant feels: the law, plus its compensation of the joints' viscous
-    damping (its own model's), minus that damping (the plant's) when ``joint_friction``."""
+def _plant(robot: Robot, law: HybridForceMotion, joint_friction: bool) -> Callable:
+    """The torques the plant feels: the law (which compensates the joints' viscous damping
+    when the run applies it), minus that damping (the plant's) when ``joint_friction``."""
     if not joint_friction or not np.any(robot.joint_damping):
         return law
-    return lambda t, q, v: law(t, q, v) + model.joint_damping * v - robot.joint_damping * v
+    return lambda t, q, v: law(t, q, v) - robot.joint_damping * v
 
 
 def _notes(robot: Robot, joint_friction: bool) -> tuple[str, ...]:

@@ -64,6 +64,15 @@ class RecordedStand:
         self.times.append(float(t))
         return tau
 
+    @property
+    def compensate_damping(self) -> bool:
+        """The recorded law's ``compensate_damping`` (what the run sets from ``joint_friction``)."""
+        return self.law.compensate_damping
+
+    @compensate_damping.setter
+    def compensate_damping(self, value: bool) -> None:
+        self.law.compensate_damping = value
+
     def held(self, times: np.ndarray) -> np.ndarray:
         """The QP's forces in force at ``times`` (its last call at or before each), (N, k, 3) [N].
 

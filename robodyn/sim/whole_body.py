@@ -4,13 +4,17 @@
 state ``(q, v)`` it solves, for ``x = (v̇, τ, f)`` (``f``: 3 per contact, world axes)::
 
     minimise   Σ_k w_k |A_k v̇ − b_k|²  +  ε (|τ|² + |f|²)
-    subject to M v̇ + h = Sᵀ τ + Jcᵀ f          (the equations of motion)
+    subject to M v̇ + h + b∘v = Sᵀ τ + Jcᵀ f    (the equations of motion)
                Jc v̇ + J̇c v = 0                 (the feet do not move)
                ‖f_t‖ ≤ μ_c n·f, one cone a foot (second-order cones: the exact cone,
                                                  not a linearised pyramid)
                |τ| ≤ τ_max                      (the joints' effort limits)
 
-and returns ``τ``. The tasks (``A_k v̇ = b_k``, each a PD law of its error):
+and returns ``τ``. ``b ∘ v`` is the joints' viscous damping (the model's
+:attr:`~robodyn.Robot.joint_damping`; never the Coulomb term) when ``compensate_damping``
+is on (what a run that applies the damping sets, :func:`robodyn.sim.twin.compensate`),
+else 0: the QP's accelerations are those of the plant that applies it, or of the rigid
+plant. The tasks (``A_k v̇ = b_k``, each a PD law of its error):
 
 - centre of mass: ``J_c v̇ + J̇_c v = Kp (c_d − c) − Kd ċ`` (``J_c = A_G[:3] / m``, the
   centroidal momentum matrix's linear rows, :mod:`robodyn.dynamics.centroidal`);
@@ -40,6 +44,7 @@ from robodyn.dynamics import constrained
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
 from robodyn.sim.force_control import scalar, vector
+from robodyn.sim.twin import viscous_compensation
 
 #: The controller's cone is this fraction of each contact's friction coefficient.
 CONE_MARGIN = 0.9
@@ -166,6 +171,8 @@ class Stand:
         torque_limit: ``τ_max`` of each actuated joint (nv − 6,), default the model's effort limits
             (a joint without one, or a limit of 0 as URDF and MJCF write none: no limit).
         margin: ``μ_c / μ`` (:data:`CONE_MARGIN`); ``None`` drops the cone (a negative control).
+        compensate_damping: Add ``b ∘ v`` (the model's joint damping) to the equations of
+            motion, so that the QP plans for the plant that applies it (never the Coulomb term).
         last_forces: The QP's contact forces at the last call, (3 k,) in [N], world axes.
 
     Raises:
@@ -185,6 +192,7 @@ class Stand:
     weights: tuple[float, float, float] = (1.0, 1.0, 1e-6)
     torque_limit: np.ndarray | None = None
     margin: float | None = CONE_MARGIN
+    compensate_damping: bool = False
     last_forces: np.ndarray = field(init=False, repr=False)
     _actuated: np.ndarray = field(init=False, repr=False)
     _tangent_rows: list[np.ndarray] = field(init=False, repr=False)
@@ -275,7 +283,8 @@ class Stand:
         limits[np.arange(limited.size), nv + limited] = 1.0
         limits[limited.size + np.arange(limited.size), nv + limited] = -1.0
         rows = [dynamics, fixed, limits]
-        right = [-bias, -drift, np.tile(bound[limited], 2)]
+        damping = viscous_compensation(model, self.compensate_damping, v)
+        right = [-bias - damping, -drift, np.tile(bound[limited], 2)]
         cones = [clarabel.ZeroConeT(nv + len(jacobian)), clarabel.NonnegativeConeT(2 * limited.size)]
         if self.margin is not None:
             for index, (contact, tangents) in enumerate(zip(self.contacts, self._tangent_rows, strict=True)):

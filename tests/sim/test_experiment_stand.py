@@ -83,3 +83,39 @@ def test_a_stand_it_cannot_do_is_refused_naming_the_parameter(robot, options, ar
     with pytest.raises(InputError) as error:
         run_simulation(robodyn.load(robot), controller="stand", duration=0.01, **options)
     assert error.value.argument == argument
+
+
+@pytest.mark.parametrize("joint_friction", [True, False])
+def test_the_stand_run_compensates_the_joints_damping_exactly_when_it_applies_it(joint_friction, monkeypatch):
+    """The QP the run builds (caught on its way to the plant) adds ``b ∘ v`` to its
+    equations of motion when the run's damping acts, as the other model-based laws do."""
+    from robodyn.sim import experiment
+
+    built = []
+    monkeypatch.setattr(experiment, "simulate_run", lambda *args, **kwargs: built.append(kwargs["controller"]) or 1 / 0)
+    robot = solo()
+    q0 = list(robot.floating_configuration([0.0, 0.0, 0.4], [0.0, 0.0, 0.0], LEGS))
+    with pytest.raises(ZeroDivisionError):
+        run_simulation(robot, controller="stand", ground=Ground(), q0=q0, duration=0.01, joint_friction=joint_friction)
+    assert built[0].compensate_damping is joint_friction and built[0].law.compensate_damping is joint_friction
+
+
+def shifted_centre(robot: robodyn.Robot) -> np.ndarray:
+    """The centre of mass over a 0.3 s stand run shifting it 2 cm, (N, 3) in [m]."""
+    q0 = list(robot.floating_configuration([0.0, 0.0, 0.4], [0.0, 0.0, 0.0], LEGS))
+    trajectory, _ = run_simulation(robot, controller="stand", ground=Ground(), q0=q0, duration=0.3, target=list(SHIFT))
+    return np.atleast_2d(robot.center_of_mass(trajectory.q))
+
+
+@pytest.mark.slow  # three 0.3 s contact runs, about 3 s
+def test_on_damped_joints_the_stand_run_moves_as_on_rigid_ones_and_without_the_compensation_it_does_not(monkeypatch):
+    """The contact step applies the joints' damping (solo12 with 0.02 to 0.06 N m s/rad
+    written in): the centre of mass moves as the rigid robot's does; the negative control
+    leaves the QP rigid (the run's ``compensate`` disabled)."""
+    from robodyn.sim import experiment
+    from tests.sim.test_whole_body_damping import damped_solo
+
+    rigid = shifted_centre(solo())
+    assert np.abs(shifted_centre(damped_solo()) - rigid).max() <= 1e-9  # [m]
+    monkeypatch.setattr(experiment, "compensate", lambda law, joint_friction: None)
+    assert np.abs(shifted_centre(damped_solo()) - rigid).max() > 1e-4

@@ -126,3 +126,40 @@ def test_hostile_values_are_refused_in_one_sentence(field, value):
         options[field] = value
     with pytest.raises(InputError, match=field):
         HybridForceMotion(robot, None, arguments["normal"], arguments["force"], arguments["motion"], **options)
+
+
+@pytest.mark.parametrize("compensate", [True, False], ids=["compensated", "negative_control_rigid_law"])
+def test_on_damped_joints_the_sliding_force_is_the_command_only_when_the_law_compensates(compensate):
+    """The RP arm's joints damped (``b`` 3 N m s/rad, the plant's torque ``τ − b v``),
+    gravity tilted: compensated, the wall force is the command at every instant and the
+    motion keeps its law; the rigid-body law's force is off by the sliding's damping,
+    ``nᵀ J M⁻¹ b v / nᵀ Λ⁻¹ n`` (computed here from the run's states, not by the law)."""
+    from robodyn.urdf.models.rp_arm import rp_arm_urdf
+
+    robot = robodyn.load(rp_arm_urdf().replace("</joint>", '<dynamics damping="3.0"/></joint>', 2), gravity=(0.4, 0, -9.7))
+    wall = PointContact("end_effector", normal=(-1, 0, 0), friction=0, plane_point=(WALL_X, 0, 0))
+    q0 = np.array([np.arctan2(START_Z, WALL_X), np.hypot(WALL_X, START_Z) - 0.9])
+    control = HybridForceMotion(robot, None, (-1, 0, 0), FORCE, wall_reference, kp=KP, kd=KD, compensate_damping=compensate)
+    damping = robot.joint_damping
+
+    def plant(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return control(t, q, v) - damping * v
+
+    run = simulate_constrained(robot, q0, constraints=[wall], duration=0.4, dt=4e-3, tau=plant)
+    trajectory, normal = run.trajectory, np.array([-1.0, 0.0, 0.0])
+    bias = []
+    for q, v in zip(trajectory.q, trajectory.v, strict=True):
+        jacobian, mass = robot.frame_jacobian(q, "end_effector")[:3], robot.mass_matrix(q)
+        bias.append(
+            normal
+            @ jacobian
+            @ np.linalg.solve(mass, damping * v)
+            / (normal @ jacobian @ np.linalg.solve(mass, jacobian.T) @ normal)
+        )
+    error = run.multipliers[:, 0] - FORCE
+    assert np.abs(bias).max() > 1e-2 * FORCE  # the sliding's damping is large enough to show
+    if compensate:
+        assert np.abs(error).max() <= 1e-6 * FORCE
+        assert np.abs(motion_errors(control, trajectory)[:, 2] - law(trajectory.t)).max() <= 1e-3 * OFFSET
+    else:
+        np.testing.assert_allclose(error, bias, atol=1e-9 * FORCE)

@@ -42,9 +42,7 @@ def test_the_damped_arm_presses_and_slides_by_the_law_its_controller_compensatin
 
 def test_without_the_compensation_the_damping_shows(monkeypatch):  # negative control
     robot = _damped_arm()
-    monkeypatch.setattr(
-        hybrid_run, "_plant", lambda robot, model, law, friction: lambda t, q, v: law(t, q, v) - robot.joint_damping * v
-    )
+    monkeypatch.setattr(hybrid_run, "compensate", lambda law, joint_friction: None)  # the rigid-body law
     trajectory, _ = run_hybrid(robot, force=10.0, surface=WALL, along=(0, 0, 0.1), duration=0.2, dt=0.02)
     plain_trajectory, _ = run_hybrid(
         robodyn.load(rp_arm_urdf()), force=10.0, surface=WALL, along=(0, 0, 0.1), duration=0.2, dt=0.02
