@@ -127,7 +127,7 @@ def test_a_run_that_stays_above_the_ground_has_no_buried_line():
 # A floating body whose only collision sphere is on its head, 0.4 m above its (meshless) legs.
 HEAD_ONLY = """<mujoco model="head_only">
   <worldbody>
-    <body name="body" pos="0 0 0.5">
+    <body name="body" pos="0 0 0.1">
       <freejoint/>
       <geom type="box" size="0.2 0.1 0.02" mass="5" contype="0" conaffinity="0"/>
       <body name="leg" pos="0 0 -0.2">
@@ -146,7 +146,7 @@ def test_a_start_that_puts_links_under_the_ground_is_refused_naming_the_contacts
     path.write_text(HEAD_ONLY)
     robot = robodyn.load(str(path))
     with pytest.raises(InputError, match=r"contacts must be contact points that hold the robot .* 'leg' 0\.\d+ m") as caught:
-        run_simulation(robot, controller="pd", ground=Ground(), duration=0.01)  # set down 5 cm under its head
+        run_simulation(robot, controller="pd", ground=Ground(), duration=0.01)  # the file puts the leg through the floor, the head above it
     assert "\n" not in str(caught.value)
 
 
