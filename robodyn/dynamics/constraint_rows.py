@@ -82,7 +82,7 @@ class EndFrames:
             positions[index] = placement.translation
             if self.layout.welds:
                 rotations.append(placement.rotation)
-            jacobians[index] = pin.getFrameJacobian(model, data, frame, world)
+            jacobians[index] = pin.getFrameJacobian(model, data, frame, world).reshape(6, -1)  # eigenpy: (6,) at nv = 1
             drifts[index] = pin.getFrameClassicalAcceleration(model, data, frame, world).vector
         return self.layout.assemble(positions, rotations, jacobians, drifts)  # new arrays: the buffers stay here
 
