@@ -105,7 +105,14 @@ def buried_links(robot: Robot, q: np.ndarray, ground: Ground, contacts: Contacts
     """The links that are not contact points and lie deeper than :data:`BURIED_DEPTH` under
     the ground at some row of ``q`` (k, nq): their origins (links with mass: not the massless
     frames between a planar root's slides) and collision spheres, boxes and capsules; each
-    link with its depth in [m] and the first row, deepest first."""
+    link with its depth in [m] and the first row, deepest first.
+
+    Args:
+        robot: The simulated robot.
+        q: Configurations, shape (k, nq).
+        ground: The ground plane.
+        contacts: The run's contact points (their links are left out).
+    """
     model, data, frames = robot.model, robot.handle.data, robot.handle.frames
     moving = {name for name in robot.spec.links if name in frames and model.frames[frames[name]].parentJoint != 0}
     links = sorted(moving - {point.link for point in contacts.points})
