@@ -20,7 +20,11 @@ from robodyn.exceptions import InputError
 
 
 def vector(text: str) -> list[float]:
-    """Parse ``"0.5,0.2"`` or ``"0.5 0.2"`` into floats."""
+    """Parse ``"0.5,0.2"`` or ``"0.5 0.2"`` into floats.
+
+    Args:
+        text: The option's value, numbers separated by commas or whitespace.
+    """
     tokens = text.replace(",", " ").split()
     try:
         return [float(token) for token in tokens]
@@ -33,7 +37,11 @@ MODEL_HELP = "a URDF, .xacro or MJCF file path, a robot name (see 'robodyn list'
 
 
 def add_model_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add the robot-file arguments every command shares (the model and how to read it) to ``parser``."""
+    """Add the robot-file arguments every command shares (the model and how to read it) to ``parser``.
+
+    Args:
+        parser: The command's parser.
+    """
     parser.add_argument("model", help=MODEL_HELP)
     base = parser.add_mutually_exclusive_group()
     base.add_argument(
@@ -62,7 +70,11 @@ def add_model_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_file_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable), ``--xacro-env``."""
+    """``--xacro-arg NAME:=VALUE`` and ``--package NAME=DIR`` (each repeatable), ``--xacro-env``.
+
+    Args:
+        parser: The command's parser.
+    """
     parser.add_argument(
         "--xacro-arg",
         dest="xacro_arg",
@@ -89,6 +101,9 @@ def add_file_arguments(parser: argparse.ArgumentParser) -> None:
 def xacro_arguments(values: Sequence[str] | None) -> dict[str, str]:
     """Parse ``--xacro-arg NAME:=VALUE`` options into ``{NAME: VALUE}``.
 
+    Args:
+        values: The repeated option's values (``None`` when not given).
+
     Raises:
         InputError: For a value without ``:=`` or with an empty name.
     """
@@ -103,6 +118,9 @@ def xacro_arguments(values: Sequence[str] | None) -> dict[str, str]:
 
 def package_arguments(values: Sequence[str] | None) -> dict[str, str]:
     """Parse ``--package NAME=DIR`` options into ``{NAME: DIR}``.
+
+    Args:
+        values: The repeated option's values (``None`` when not given).
 
     Raises:
         InputError: For a value without ``=``, with an empty name or folder.
@@ -145,7 +163,11 @@ def constraints_file(arguments: argparse.Namespace) -> tuple | None:
 
 
 def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
-    """The robot of a command's model arguments (and its ``--lock`` and ``--constraints``, where it has them)."""
+    """The robot of a command's model arguments (and its ``--lock`` and ``--constraints``, where it has them).
+
+    Args:
+        arguments: The parsed arguments of a command that called :func:`add_model_arguments`.
+    """
     return robodyn.load(
         arguments.model,
         floating_base=arguments.floating_base,
@@ -164,6 +186,13 @@ def load_robot(arguments: argparse.Namespace) -> robodyn.Robot:
 def state(robot: robodyn.Robot, values: list[float] | None, name: str, size: int, default: np.ndarray) -> np.ndarray:
     """The values of flag ``--name`` as an array of ``size`` (``default`` when not given).
 
+    Args:
+        robot: The loaded robot (its joint names go into the error).
+        values: The flag's numbers (``None`` when not given).
+        name: The flag's name without ``--``, e.g. ``"q"``.
+        size: How many values the flag takes (e.g. ``robot.nq`` or ``robot.nv``).
+        default: The array returned when the flag is not given.
+
     Raises:
         InputError: Naming the flag and the joints, when the count is not ``size``.
     """
@@ -175,7 +204,11 @@ def state(robot: robodyn.Robot, values: list[float] | None, name: str, size: int
 
 
 def lock_values(text: str | None) -> dict[str, float] | None:
-    """Parse ``--lock name=value,name2=value2`` (a bare name locks at 0)."""
+    """Parse ``--lock name=value,name2=value2`` (a bare name locks at 0).
+
+    Args:
+        text: The option's value (``None`` or empty when not given).
+    """
     if not text:
         return None
     locked = {}
@@ -189,7 +222,11 @@ def lock_values(text: str | None) -> dict[str, float] | None:
 
 
 def warn(lines: Sequence[str]) -> None:
-    """Each line as ``robodyn: warning: <line>`` on stderr."""
+    """Each line as ``robodyn: warning: <line>`` on stderr.
+
+    Args:
+        lines: The warnings, one a line.
+    """
     for line in lines:
         print(f"robodyn: warning: {line}", file=sys.stderr)
 
@@ -238,6 +275,10 @@ def attach_negative_values(parser: argparse.ArgumentParser, argv: Sequence[str])
     argparse reads a token starting with ``-`` as an option unless it is a single plain
     number; a list like ``-0.5,0.1`` (or ``-9.81,0,0``) must be attached to its option
     with ``=``, which this does for every option of any command that takes one value.
+
+    Args:
+        parser: The ``robodyn`` parser (its subcommands' options are seen too).
+        argv: The command line without the program name.
     """
     takes_value = _value_options(parser)
     result: list[str] = []
@@ -316,6 +357,9 @@ def check_ranges(arguments: argparse.Namespace) -> None:
     """Refuse any numeric option outside its range (:data:`RANGES`), one line.
 
     Also ``--dt`` ≤ ``--duration`` where a command has both.
+
+    Args:
+        arguments: The parsed arguments.
 
     Raises:
         InputError: Naming the option, its range and the value given.

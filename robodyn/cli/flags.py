@@ -85,7 +85,11 @@ _KEYWORD = re.compile(r"\b(" + "|".join(map(re.escape, FLAGS)) + r")=(?:'(\w+)'(
 
 
 def flag(parameter: str) -> str:
-    """The flag of a library parameter (``"target"`` -> ``"--target"``); others unchanged."""
+    """The flag of a library parameter (``"target"`` -> ``"--target"``); others unchanged.
+
+    Args:
+        parameter: The name of a library function's parameter.
+    """
     return FLAGS.get(parameter, parameter)
 
 
@@ -95,6 +99,9 @@ def error_text(error: RobodynError) -> str:
     An :class:`InputError` about a parameter in :data:`FLAGS` names its flag; a keyword
     argument the message suggests (``form='compact'``) becomes the flag (``--form compact``),
     a boolean one (``floating_base=False``) its switch (``--fixed-base``).
+
+    Args:
+        error: The library's error.
     """
     text = str(error)
     if isinstance(error, InputError) and error.argument in FLAGS:
@@ -108,7 +115,11 @@ def error_text(error: RobodynError) -> str:
 def command_line_text(text: str) -> str:
     """A library sentence as the command line says it: a keyword argument it suggests
     (``engine='compiled'``) becomes the flag (``--engine compiled``), a boolean one
-    (``joint_friction=False``) its switch (``--no-joint-friction``)."""
+    (``joint_friction=False``) its switch (``--no-joint-friction``).
+
+    Args:
+        text: The library's sentence (a warning, a note).
+    """
     for keyword, switch in SWITCHES.items():
         text = text.replace(keyword, switch)
     return _KEYWORD.sub(_keyword_flag, text)

@@ -15,7 +15,11 @@ from robodyn.dynamics.robot import Robot
 
 
 def end_effector_text(robot: Robot) -> tuple[str | None, str]:
-    """The default end effector, or ``None`` and why there is none."""
+    """The default end effector, or ``None`` and why there is none.
+
+    Args:
+        robot: The loaded robot.
+    """
     from robodyn.exceptions import AmbiguousEndEffectorError
 
     try:
@@ -27,7 +31,11 @@ def end_effector_text(robot: Robot) -> tuple[str | None, str]:
 
 def info_dict(robot: Robot) -> dict:
     """A JSON-ready description of a robot: joints, limits, masses, default end effector
-    (``null`` with ``end_effector_candidates`` when it has several chains)."""
+    (``null`` with ``end_effector_candidates`` when it has several chains).
+
+    Args:
+        robot: The loaded robot.
+    """
 
     def finite(value: float) -> float | None:
         return float(value) if np.isfinite(value) else None
@@ -76,7 +84,11 @@ def info_dict(robot: Robot) -> dict:
 
 
 def mimic_joints(robot: Robot) -> list[dict]:
-    """The robot's mimic joints: ``q = multiplier * q_source + offset``, in document order."""
+    """The robot's mimic joints: ``q = multiplier * q_source + offset``, in document order.
+
+    Args:
+        robot: The loaded robot.
+    """
     return [
         {"joint": joint.name, "source": joint.mimic.joint, "multiplier": joint.mimic.multiplier, "offset": joint.mimic.offset}
         for joint in robot.spec.joints.values()
@@ -85,7 +97,11 @@ def mimic_joints(robot: Robot) -> list[dict]:
 
 
 def package_paths(robot: Robot) -> dict[str, list[str]]:
-    """Where the robot's ``package://`` paths resolve: ``packages=``, ``$ROS_PACKAGE_PATH``, the zoo."""
+    """Where the robot's ``package://`` paths resolve: ``packages=``, ``$ROS_PACKAGE_PATH``, the zoo.
+
+    Args:
+        robot: The loaded robot.
+    """
     from robodyn.urdf.packages import PackageLookup
 
     dirs = robot.source.package_dirs
@@ -95,7 +111,11 @@ def package_paths(robot: Robot) -> dict[str, list[str]]:
 
 
 def info_text(robot: Robot) -> str:
-    """A readable description of a robot: joints with types and limits, link masses."""
+    """A readable description of a robot: joints with types and limits, link masses.
+
+    Args:
+        robot: The loaded robot.
+    """
     end_effector, reason = end_effector_text(robot)
     also = f' ("{printable(robot.name)}")' if robot.name != robot.spec.name else ""
     kind = {"xacro": ", expanded from xacro", "mjcf": ", read from MJCF"}.get(robot.source.file_format, "")

@@ -68,12 +68,21 @@ class OutputSet:
             self.discard()
 
     def write_text(self, path: str | os.PathLike, text: str) -> Path | None:
-        """Stage UTF-8 text for ``path`` (see :meth:`write_bytes`)."""
+        """Stage UTF-8 text for ``path`` (see :meth:`write_bytes`).
+
+        Args:
+            path: The file to write, or ``"-"`` for standard output.
+            text: The file's contents.
+        """
         return self.write_bytes(path, text.encode("utf-8"))
 
     def write_bytes(self, path: str | os.PathLike, data: bytes) -> Path | None:
         """Stage ``data`` for ``path``: checked and written to a temporary file now, renamed
         at :meth:`commit`.
+
+        Args:
+            path: The file to write, or ``"-"`` for standard output.
+            data: The file's contents.
 
         Returns:
             The file that will be replaced, or ``None`` for standard output (``-``).
@@ -126,6 +135,9 @@ class OutputSet:
 
 def output_target(path: str | os.PathLike) -> Path:
     """The file an output path will replace, after the checks of the module docstring.
+
+    Args:
+        path: The output path as given.
 
     Raises:
         OutputError: If the path is refused (special file, directory, missing folder).
@@ -202,6 +214,10 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path | None:
     """Write ``data`` to ``path`` atomically: a one-output :class:`OutputSet`, or staged in
     the enclosing :func:`outputs_together` block (then written when that block ends).
 
+    Args:
+        path: The file to write, or ``"-"`` for standard output.
+        data: The file's contents.
+
     Returns:
         The file written (or to be written), or ``None`` for standard output (``-``).
 
@@ -217,12 +233,21 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path | None:
 
 
 def atomic_write_text(path: str | os.PathLike, text: str) -> Path | None:
-    """Write UTF-8 text atomically (see :func:`atomic_write_bytes`)."""
+    """Write UTF-8 text atomically (see :func:`atomic_write_bytes`).
+
+    Args:
+        path: The file to write, or ``"-"`` for standard output.
+        text: The file's contents.
+    """
     return atomic_write_bytes(path, text.encode("utf-8"))
 
 
 def temporary_prefix(target: Path) -> str:
-    """Start of the names of the temporary files for ``target`` (in its folder)."""
+    """Start of the names of the temporary files for ``target`` (in its folder).
+
+    Args:
+        target: The file to be replaced.
+    """
     return f".{target.name[:_NAME_PART]}{_TEMPORARY_TAG}"
 
 

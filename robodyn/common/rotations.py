@@ -62,7 +62,12 @@ def skew(vectors: np.ndarray) -> np.ndarray:
 
 
 def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rodrigues' rotation by ``angle`` in [rad] about a unit ``axis`` (shape (3,)); shape (3, 3)."""
+    """Rodrigues' rotation by ``angle`` in [rad] about a unit ``axis`` (shape (3,)); shape (3, 3).
+
+    Args:
+        axis: Unit axis, shape (3,).
+        angle: Angle in [rad].
+    """
     cross = skew(np.asarray(axis, dtype=float))
     return np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
 

@@ -93,7 +93,11 @@ def is_printable(text: str) -> bool:
 
 
 def quoted(name: object) -> str:
-    """A name from a URDF for a message: in single quotes, escaped like ``repr`` of a str."""
+    """A name from a URDF for a message: in single quotes, escaped like ``repr`` of a str.
+
+    Args:
+        name: The name (anything ``str`` takes).
+    """
     return "'" + printable(str(name).replace("\\", "\\\\").replace("'", "\\'")) + "'"
 
 
@@ -114,6 +118,9 @@ def latex_text(text: str) -> str:
     ``\\textbackslash{}``, ...); every character outside printable ASCII (control
     characters, line breaks, non-ASCII letters) as ``<U+XXXX>``, so the result is ASCII and
     one line whatever the engine and input encoding.
+
+    Args:
+        text: Any text (a name from a file).
     """
     out = []
     for character in str(text):
@@ -158,6 +165,9 @@ def comment_text(text: str) -> str:
     character (quotes, backslashes, ``*``, ``/``, ``?``, newlines, control characters,
     non-ASCII) is written as ``<U+XXXX>``, so no ``\"\"\"``, ``*/``, ``/*``, trigraph or line
     break can appear.
+
+    Args:
+        text: Any text (a name from a file).
     """
     return "".join(c if _SAFE_COMMENT.fullmatch(c) else _code_point(c) for c in str(text))
 

@@ -131,13 +131,22 @@ def bind(constraints: Sequence[Constraint], pose: NeutralPose) -> tuple[Bound, .
 
 
 def world_end(end: End, nv: int) -> EndKinematics:
-    """The kinematics of an end fixed in the world: it never moves."""
+    """The kinematics of an end fixed in the world: it never moves.
+
+    Args:
+        end: The end (its pose in the world frame).
+        nv: Number of velocity coordinates.
+    """
     zeros = np.zeros((3, nv))
     return EndKinematics(end.position, end.rotation, zeros, zeros, np.zeros(3), np.zeros(3))
 
 
 def rotation_log(rotation: np.ndarray) -> np.ndarray:
-    """The rotation vector (axis × angle in [rad], angle in [0, π]) of a rotation matrix."""
+    """The rotation vector (axis × angle in [rad], angle in [0, π]) of a rotation matrix.
+
+    Args:
+        rotation: A rotation matrix, shape (3, 3).
+    """
     vector = 0.5 * np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0], rotation[1, 0] - rotation[0, 1]])
     sine = float(np.linalg.norm(vector))  # sin(angle) a; atan2 keeps the angle exact near π (acos does not)
     angle = math.atan2(sine, (float(np.trace(rotation)) - 1.0) / 2.0)
@@ -153,6 +162,11 @@ def rotation_log(rotation: np.ndarray) -> np.ndarray:
 
 def rows(bound: Bound, first: EndKinematics, second: EndKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``Φ``, ``J`` and ``J̇ v`` of one bound constraint from its ends' kinematics.
+
+    Args:
+        bound: The constraint with both ends resolved.
+        first: Kinematics of its first end.
+        second: Kinematics of its second end.
 
     Returns:
         Shapes (rows,), (rows, nv), (rows,).

@@ -36,7 +36,11 @@ def _wxyz_matrix(w: float, x: float, y: float, z: float) -> np.ndarray:
 
 
 def from_equality(record: EqualityRecord) -> Constraint | None:
-    """The constraint of one equality record, or ``None`` when it is inactive at the start."""
+    """The constraint of one equality record, or ``None`` when it is inactive at the start.
+
+    Args:
+        record: An MJCF ``connect`` or ``weld`` equality as read from the file.
+    """
     if not record.active:
         return None
     if record.kind == "connect":

@@ -30,6 +30,9 @@ def available_cores() -> int:
 def check_threads(threads: int | None) -> int:
     """A thread count: ``None`` means every available core; else a whole number ≥ 1.
 
+    Args:
+        threads: The thread count asked for, or ``None``.
+
     Raises:
         InputError: For anything else.
     """
@@ -84,6 +87,12 @@ class ParallelRunner:
 
         A pool's data is shared by its calls, so concurrent batches of one runner are
         serialised.
+
+        Args:
+            algorithm: A Pinocchio parallel algorithm (e.g. ``rneaInParallel``), called with column-major stacks.
+            q: Configurations, shape (N, nq).
+            v: Velocities, shape (N, nv).
+            third: The algorithm's third argument (accelerations or torques), shape (N, nv).
         """
         nv = self._model.nv
         if q.shape[0] == 0:

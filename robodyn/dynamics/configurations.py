@@ -32,12 +32,19 @@ def lower_limits(dofs: Sequence[Dof]) -> np.ndarray:
     """Lower position limits per degree of freedom, shape (nv,), in [rad] or [m].
 
     The six base coordinates of a floating base are unlimited (-inf).
+
+    Args:
+        dofs: The degrees of freedom (:attr:`robodyn.Robot.dofs`).
     """
     return np.array([dof.lower for dof in dofs])
 
 
 def upper_limits(dofs: Sequence[Dof]) -> np.ndarray:
-    """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m]."""
+    """Upper position limits per degree of freedom, shape (nv,), in [rad] or [m].
+
+    Args:
+        dofs: The degrees of freedom (:attr:`robodyn.Robot.dofs`).
+    """
     return np.array([dof.upper for dof in dofs])
 
 
@@ -85,6 +92,9 @@ def physical_limits(dofs: Sequence[Dof]) -> tuple[np.ndarray, np.ndarray]:
     ridgeback's ±999 999 m) stands for "unlimited" and becomes ±inf, and so does an
     empty range ``lower == upper`` of a joint that is not fixed (example-robot-data's
     double pendulums write ``lower="0" upper="0"`` on joints that swing freely).
+
+    Args:
+        dofs: The degrees of freedom (:attr:`robodyn.Robot.dofs`).
 
     Returns:
         ``(lower, upper)``, each of shape (nv,), or (nv − 6,) with a floating base.

@@ -62,6 +62,12 @@ _BOUND: weakref.WeakKeyDictionary[Any, dict[tuple[Constraint, ...], tuple[Bound,
 def bound(robot: Robot, constraints: object) -> tuple[Bound, ...]:
     """The robot's constraints (``None``: :attr:`Robot.constraints`) with both ends resolved.
 
+    Args:
+        robot: The robot the constraints act on.
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
+
     Raises:
         InputError: For anything that is not a constraint, or a link the robot does not have.
     """
@@ -139,7 +145,15 @@ def _finite(robot: Robot, what: str, compute: Callable[[], tuple[np.ndarray, ...
 
 
 def constraint_residual(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
-    """``Φ(q)``, shape (m,) or (N, m) (see :mod:`robodyn.constraints.algebra`), in [m] / [rad]."""
+    """``Φ(q)``, shape (m,) or (N, m) (see :mod:`robodyn.constraints.algebra`), in [m] / [rad].
+
+    Args:
+        robot: The robot the constraints act on.
+        q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit quaternion).
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
+    """
     bounds = bound(robot, constraints)
     (q,), batch = robot.validate(q=q)
     zeros = np.zeros(robot.nv)
@@ -147,7 +161,15 @@ def constraint_residual(robot: Robot, q: np.ndarray, constraints: object = None)
 
 
 def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None) -> np.ndarray:
-    """``J(q)``, shape (m, nv) or (N, m, nv): the rows' velocities are ``J v``."""
+    """``J(q)``, shape (m, nv) or (N, m, nv): the rows' velocities are ``J v``.
+
+    Args:
+        robot: The robot the constraints act on.
+        q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit quaternion).
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
+    """
     bounds = bound(robot, constraints)
     (q,), batch = robot.validate(q=q)
     zeros = np.zeros(robot.nv)
@@ -155,7 +177,16 @@ def constraint_jacobian(robot: Robot, q: np.ndarray, constraints: object = None)
 
 
 def constraint_drift(robot: Robot, q: np.ndarray, v: np.ndarray, constraints: object = None) -> np.ndarray:
-    """``J̇(q, v) v``, shape (m,) or (N, m): the rows' accelerations at ``v̇ = 0``."""
+    """``J̇(q, v) v``, shape (m,) or (N, m): the rows' accelerations at ``v̇ = 0``.
+
+    Args:
+        robot: The robot the constraints act on.
+        q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit quaternion).
+        v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
+    """
     bounds = bound(robot, constraints)
     (q, v), batch = robot.validate(q=q, v=v)
     return _per_state(robot, lambda qi, vi: end_frames(robot, bounds).compute(qi, vi)[2:], batch, q, v)[0]
@@ -163,7 +194,15 @@ def constraint_drift(robot: Robot, q: np.ndarray, v: np.ndarray, constraints: ob
 
 def constraint_rank(robot: Robot, q: np.ndarray, constraints: object = None) -> int:
     """How many rows of the constraints are independent at one configuration (rank of ``J``;
-    rows minus rank are redundant)."""
+    rows minus rank are redundant).
+
+    Args:
+        robot: The robot the constraints act on.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
+    """
     jacobian = constraint_jacobian(robot, np.asarray(q, float).reshape(-1), constraints)
     if not jacobian.size:
         return 0
@@ -175,6 +214,13 @@ def solve_kkt(
     mass: np.ndarray, force: np.ndarray, jacobian: np.ndarray, drift: np.ndarray, name: str = "robot"
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(v̇, λ)`` of ``M v̇ = force + Jᵀ λ``, ``J v̇ = −drift`` (λ least-norm; module docstring).
+
+    Args:
+        mass: The mass matrix ``M``, shape (nv, nv), positive definite.
+        force: ``tau − C v − G``, shape (nv,), in [N m] / [N].
+        jacobian: The constraints' Jacobian ``J``, shape (m, nv).
+        drift: ``J̇ v``, shape (m,).
+        name: The robot's name, for the error.
 
     Raises:
         SingularMassMatrixError: If ``M`` is not positive definite.
@@ -222,7 +268,17 @@ def _least_norm(delassus: np.ndarray, target: np.ndarray) -> np.ndarray:
 def forward_dynamics(
     robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, constraints: object = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(v̇, λ)`` under bilateral constraints: shapes (nv,), (m,) or (N, nv), (N, m)."""
+    """``(v̇, λ)`` under bilateral constraints: shapes (nv,), (m,) or (N, nv), (N, m).
+
+    Args:
+        robot: The robot the constraints act on.
+        q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit quaternion).
+        v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        tau: Joint torques / forces, shape (nv,) or (N, nv), in [N m] / [N].
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
+    """
     bounds = bound(robot, constraints)
     (q, v, tau), batch = robot.validate(q=q, v=v, tau=tau)
     if robot.massless_joints:
@@ -240,7 +296,15 @@ def forward_dynamics_unchecked(
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`forward_dynamics` of one checked state (float64 1-D arrays of the right sizes)
     and bound constraints (:func:`bound`), for inner loops (simulation): the arrays are
-    read-only, and shared with the next call at the same state and torques."""
+    read-only, and shared with the next call at the same state and torques.
+
+    Args:
+        robot: The robot the constraints act on.
+        bounds: Its constraints bound to its frames (:func:`bound`).
+        q: Configuration, float64, shape (nq,).
+        v: Velocity, float64, shape (nv,).
+        tau: Torques, float64, shape (nv,), in [N m] / [N].
+    """
     return end_frames(robot, bounds).remember("dynamics", (q, v, tau), lambda: _dynamics(robot, bounds, q, v, tau))
 
 
@@ -261,6 +325,15 @@ def contact_inverse_dynamics(
     ``λ`` is the least-norm solution of the unactuated rows ``Sᵤ Jᵀ λ = Sᵤ (M a + C v + G)``
     (a floating base's six: the constraints carry the base); ``τ`` is what remains for the
     actuated coordinates. When every coordinate is actuated, ``λ = 0``.
+
+    Args:
+        robot: The robot the constraints act on.
+        q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit quaternion).
+        v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        constraints: The constraints: one :class:`~robodyn.constraints.values.PointAnchor`,
+            :class:`~robodyn.constraints.values.FrameAnchor` or :class:`~robodyn.constraints.values.PointContact`, an iterable
+            of them, or ``None`` for the robot's own (:attr:`robodyn.Robot.constraints`).
 
     Raises:
         InputError: If no multipliers balance the unactuated rows (``a`` is not reachable

@@ -90,7 +90,11 @@ def forward_dynamics_derivatives(handle: ModelHandle, q: np.ndarray, v: np.ndarr
 
 def rnea_derivatives(handle: ModelHandle) -> Callable[[np.ndarray, np.ndarray, np.ndarray], Derivatives]:
     """The unchecked one-state function ``(q, v, a) -> (∂τ/∂q, ∂τ/∂v, M)`` of a handle
-    (float64 1-D arrays of the right sizes)."""
+    (float64 1-D arrays of the right sizes).
+
+    Args:
+        handle: The robot's model handle.
+    """
     mimic = handle.mimic
     if mimic is None:
         model = handle.model
@@ -117,6 +121,9 @@ def aba_derivatives(handle: ModelHandle) -> Callable[[np.ndarray, np.ndarray, np
     Pinocchio's ABA derivatives, or for mimic joints the reduced equations (module
     docstring): ``q̈`` by a linear solve, then ``−M⁻¹ ∂τ/∂(q, v)`` at ``a = q̈``.
     A singular ``M`` gives non-finite values.
+
+    Args:
+        handle: The robot's model handle.
     """
     if handle.mimic is None:
         model = handle.model

@@ -106,7 +106,11 @@ class Dof:
 
     def unit(self, quantity: str) -> str:
         """The unit of ``quantity``: ``"q"``/``"position"``, ``"v"``/``"velocity"``,
-        ``"a"``/``"acceleration"`` or ``"tau"``/``"effort"``."""
+        ``"a"``/``"acceleration"`` or ``"tau"``/``"effort"``.
+
+        Args:
+            quantity: ``"q"``/``"position"``, ``"v"``/``"velocity"``, ``"a"``/``"acceleration"`` or ``"tau"``/``"effort"``.
+        """
         aliases = {"q": "position", "v": "velocity", "a": "acceleration", "tau": "effort"}
         return _UNITS[self.kind][aliases.get(quantity, quantity)]
 
@@ -172,7 +176,11 @@ def _with_dynamics(
 
 def configuration_names(joints: Sequence[JointInfo]) -> list[str]:
     """A name for each entry of ``q`` (nq of them): :data:`BASE_Q_NAMES` for a floating
-    base's seven, then the joints' names."""
+    base's seven, then the joints' names.
+
+    Args:
+        joints: The joints with coordinates, in order (:func:`robodyn.dynamics.robot.joint_infos`).
+    """
     names: list[str] = []
     for joint in joints:
         names.extend(BASE_Q_NAMES if joint.type == "floating" else (joint.name,))

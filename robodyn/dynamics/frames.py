@@ -32,17 +32,33 @@ GRIPPER_JOINTS = 2
 
 
 def moves(model: pin.Model, frame_id: int) -> bool:
-    """Whether some joint moves a frame (its parent joint is not the universe)."""
+    """Whether some joint moves a frame (its parent joint is not the universe).
+
+    Args:
+        model: The Pinocchio model.
+        frame_id: The frame's index in ``model.frames``.
+    """
     return model.frames[frame_id].parentJoint != 0
 
 
 def moving_frames(model: pin.Model) -> list[str]:
-    """Names of the link frames some joint moves, in model order."""
+    """Names of the link frames some joint moves, in model order.
+
+    Args:
+        model: The Pinocchio model.
+    """
     return [f.name for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY and moves(model, i)]
 
 
 def require_moving(model: pin.Model, robot: str, frame: str, frame_id: int, purpose: str) -> None:
     """Refuse a frame no joint moves for a task (``purpose``: what it is used for).
+
+    Args:
+        model: The Pinocchio model.
+        robot: The robot's name, for the error.
+        frame: The frame's name.
+        frame_id: The frame's index in ``model.frames``.
+        purpose: What the frame is used for, for the error.
 
     Raises:
         StaticFrameError: With the default end effector or some moving links as hints.
@@ -84,7 +100,11 @@ def _follow_fixed(model: pin.Model, body: int) -> int:
 
 
 def end_effector_candidates(model: pin.Model) -> list[str]:
-    """The tips of every chain of moving joints (one name a leaf joint)."""
+    """The tips of every chain of moving joints (one name a leaf joint).
+
+    Args:
+        model: The Pinocchio model.
+    """
     children = _children(model)
     leaves = [joint for joint in range(1, model.njoints) if not children[joint]]
     return [model.frames[_follow_fixed(model, _body_of_joint(model, leaf))].name for leaf in leaves]

@@ -138,6 +138,10 @@ class ModelHandle:
         product; ``q`` is checked too since some algorithms do not propagate it), and a
         floating base needs a unit quaternion. Anything else is re-done through
         :meth:`validate`, which names the offending argument.
+
+        Args:
+            result: The fast path's result.
+            q: The configuration it was computed at, as given.
         """
         if not (_all_finite(result) and _all_finite(q)):
             return False
@@ -147,7 +151,12 @@ class ModelHandle:
         return True
 
     def finite(self, result: np.ndarray, what: str) -> np.ndarray:
-        """Refuse a non-finite result of finite inputs (an overflow), never return it."""
+        """Refuse a non-finite result of finite inputs (an overflow), never return it.
+
+        Args:
+            result: The result.
+            what: The quantity's name, for the error.
+        """
         if not np.isfinite(result).all():
             raise NonFiniteResultError(self.name, what)
         return result
@@ -190,6 +199,9 @@ class ModelHandle:
         messages) go through :meth:`validate` and one state goes to the one-state function,
         a batch to the batch function (or to the one-state function row by row when there
         is none).
+
+        Args:
+            kernel: The quantity's kernel (its one-state and batch functions, its arguments' names).
 
         Raises:
             InputError: For arguments :meth:`validate` refuses.
@@ -236,6 +248,9 @@ def bounded_for_finite_q(model: pin.Model) -> bool:
     a few such constants and rotation entries, far from overflow. A prismatic joint (a
     translation by ``q``) or a continuous joint's (cos, sin) pair can overflow for large
     finite ``q``, so their results are checked.
+
+    Args:
+        model: The Pinocchio model.
     """
     if any(joint.shortname() not in _ANGLE_JOINTS for joint in list(model.joints)[1:]):
         return False
@@ -366,7 +381,11 @@ def _all_finite(array: np.ndarray) -> bool:
 
 
 def per_state(function: Callable[..., np.ndarray], *states: np.ndarray) -> np.ndarray:
-    """Apply a one-state function to 1-D states, or to each row of 2-D stacks (stacked)."""
+    """Apply a one-state function to 1-D states, or to each row of 2-D stacks (stacked).
+
+    Args:
+        function: The one-state function, of 1-D arrays.
+    """
     if states[0].ndim == 1:
         return function(*states)
     results = [function(*row) for row in zip(*states, strict=True)]

@@ -87,6 +87,12 @@ def with_armature(
 ) -> URDFSpec:
     """``spec`` with ``armature`` (``(joint name, value)`` pairs) added to its joints' armature.
 
+    Args:
+        spec: The validated URDF.
+        armature: ``(joint name, value)`` pairs, values in [kg m²] / [kg].
+        locked: Names of the locked joints.
+        label: The file or robot name, for the error.
+
     Raises:
         InputError: For a name that is no moving joint (nor a locked one, whose armature
             goes with the lock) or a value that is not a finite number >= 0.
@@ -111,7 +117,12 @@ def with_armature(
 
 def dof_values(spec: URDFSpec, model: pin.Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Damping, friction and armature per degree of freedom of ``model`` (mimic joints
-    folded onto their sources, see the module docstring), each shape (nv,)."""
+    folded onto their sources, see the module docstring), each shape (nv,).
+
+    Args:
+        spec: The validated URDF (``<dynamics>`` and armature of its joints).
+        model: Its Pinocchio model.
+    """
     values = {quantity: np.zeros(model.nv) for quantity in QUANTITIES}
     for name, joint in spec.joints.items():
         if joint.type == "fixed":
@@ -128,7 +139,13 @@ def dof_values(spec: URDFSpec, model: pin.Model) -> tuple[np.ndarray, np.ndarray
 
 def friction_torque(damping: np.ndarray, friction: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The joints' friction torque ``−b q̇ − f sign(q̇)`` (``sign(0) = 0``), shape of ``v``
-    ((nv,) or (N, nv)), in [N m] or [N]."""
+    ((nv,) or (N, nv)), in [N m] or [N].
+
+    Args:
+        damping: Viscous coefficients ``b``, shape (nv,), in [N m s/rad] / [N s/m].
+        friction: Coulomb friction ``f``, shape (nv,), in [N m] / [N].
+        v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+    """
     return -damping * v - friction * np.sign(v)
 
 

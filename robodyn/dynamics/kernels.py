@@ -59,7 +59,11 @@ class DynamicsKernels(NamedTuple):
 
 def massless_joints(model: pin.Model) -> list[str]:
     """Joints of ``model`` whose whole subtree has no mass, and :func:`redundant_free_flyers`:
-    they make ``M(q)`` singular."""
+    they make ``M(q)`` singular.
+
+    Args:
+        model: The Pinocchio model.
+    """
     subtree_mass = [model.inertias[i].mass for i in range(model.njoints)]
     for joint_id in range(model.njoints - 1, 0, -1):
         subtree_mass[model.parents[joint_id]] += subtree_mass[joint_id]
@@ -71,7 +75,11 @@ def redundant_free_flyers(model: pin.Model) -> list[str]:
     """Free-flyer joints whose body has no mass and carries one moving joint: the body's six
     motions move that joint's whole subtree rigidly, as the joint does, so ``M(q)`` is
     singular (a massless floating root with one child link). Not claimed with mimic joints
-    (``nv = 0`` here): a mimic in the subtree breaks the rigid motion."""
+    (``nv = 0`` here): a mimic in the subtree breaks the rigid motion.
+
+    Args:
+        model: The Pinocchio model.
+    """
     if any(model.joints[j].nv == 0 for j in range(1, model.njoints)):
         return []
     out = []
@@ -140,7 +148,13 @@ def dynamics_kernels(
 def mass_matrix_function(
     model: pin.Model, data: Callable[[], pin.Data], mimic: MimicExpansion | None
 ) -> Callable[[np.ndarray], np.ndarray]:
-    """``M(q)`` of one state (CRBA), both triangles filled."""
+    """``M(q)`` of one state (CRBA), both triangles filled.
+
+    Args:
+        model: The Pinocchio model.
+        data: Returns the Pinocchio data to compute in (this thread's).
+        mimic: The expansion of a model with mimic joints, or ``None``.
+    """
     lower_triangle = np.tri(model.nv, model.nv, -1, dtype=bool)
     # With a mimic joint between two free joints, Pinocchio 4.1's crba in its default LOCAL
     # convention accumulates into data from call to call; the WORLD convention does not
@@ -159,7 +173,13 @@ def coriolis_function(
     model: pin.Model, data: Callable[[], pin.Data], mimic: MimicExpansion | None
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """``C(q, v)`` of one state (computeCoriolisMatrix mishandles mimic joints: those go
-    through the expanded model, ``C = Sᵀ C_full S``)."""
+    through the expanded model, ``C = Sᵀ C_full S``).
+
+    Args:
+        model: The Pinocchio model.
+        data: Returns the Pinocchio data to compute in (this thread's).
+        mimic: The expansion of a model with mimic joints, or ``None``.
+    """
     if mimic is None:
         return lambda q, v: pin.computeCoriolisMatrix(model, data(), q, v)
 

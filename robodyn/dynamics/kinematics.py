@@ -22,6 +22,10 @@ from robodyn.exceptions import FrameError, InputError
 def frame_id(handle: ModelHandle, frame: str) -> int:
     """Pinocchio index of a frame (link, joint or fixed frame) by name.
 
+    Args:
+        handle: The robot's model handle.
+        frame: The frame's name.
+
     Raises:
         FrameError: If the robot has no such frame (with the closest names).
     """
@@ -130,6 +134,11 @@ def integrate(handle: ModelHandle, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
 
     ``q + dq`` for joints; the floating base's pose moves on SE(3) (Pinocchio's
     ``integrate``), keeping its quaternion unit.
+
+    Args:
+        handle: The robot's model handle.
+        q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit quaternion).
+        dq: The displacement, a velocity applied for unit time, shape (nv,) or (N, nv), in [rad] / [m].
 
     Raises:
         InputError: For states of the wrong size, non-finite values or a base

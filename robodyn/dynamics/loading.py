@@ -47,7 +47,11 @@ from robodyn.urdf.validation import URDFSpec, parse_urdf
 
 
 def pinocchio_xml(spec: URDFSpec) -> str:
-    """The URDF text Pinocchio builds the model from (see :mod:`robodyn.urdf.normalised`)."""
+    """The URDF text Pinocchio builds the model from (see :mod:`robodyn.urdf.normalised`).
+
+    Args:
+        spec: The validated URDF.
+    """
     return normalised_urdf(spec)[0]
 
 
@@ -59,6 +63,10 @@ def data_memory_estimate(nv: int, njoints: int) -> int:
     and stars of 25, 40, 50, 100 and 150 joints took 5.0, 8.9, 13.5, 74.6 and 234 MB (chains
     and stars alike; measured in a process that imports Pinocchio only); the fit gives 4.0 GB
     for a 400-joint star (measured: 4.1 GB).
+
+    Args:
+        nv: Number of velocity coordinates.
+        njoints: Number of joints, the universe included.
     """
     return int(60 * njoints * nv * nv + 1600 * nv * nv + 3_500_000)
 
@@ -183,7 +191,13 @@ def _report_equalities(resolved: URDFSource, strict: bool) -> None:
 
 def rebuild(robot: Robot, *, urdf: str | None = None, label: str | None = None) -> Robot:
     """A new robot from ``robot``'s source and options: an independent copy, or (with
-    ``urdf``) the same robot edited (a payload welded on, ...), named ``label``."""
+    ``urdf``) the same robot edited (a payload welded on, ...), named ``label``.
+
+    Args:
+        robot: The robot to copy.
+        urdf: The edited URDF text, or ``None`` for an unchanged copy.
+        label: The new robot's name (``None``: the source's).
+    """
     source = (
         robot.source
         if urdf is None
@@ -216,6 +230,12 @@ copyreg.pickle(Robot, _reduce)
 
 def build_model(spec: URDFSpec, label: str, *, floating: bool, mimic: bool) -> pin.Model:
     """The Pinocchio model of a validated spec, with the URDF's joint names.
+
+    Args:
+        spec: The validated URDF.
+        label: The file or robot name, for the error.
+        floating: Give the root a free-flyer joint.
+        mimic: Build mimic joints as Pinocchio mimic joints (else every joint is free).
 
     Raises:
         URDFError: If Pinocchio refuses the model (with Pinocchio's reason).

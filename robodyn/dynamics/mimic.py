@@ -44,19 +44,35 @@ class MimicExpansion:
         return self._data.get()
 
     def q(self, q: np.ndarray) -> np.ndarray:
-        """Configuration of the expanded model, shape (nq_full,)."""
+        """Configuration of the expanded model, shape (nq_full,).
+
+        Args:
+            q: Configuration of the model with mimic joints folded, shape (nq,).
+        """
         return self.q_selection @ q + self.offset
 
 
 def has_mimic(model: pin.Model, spec: URDFSpec, floating: bool) -> bool:
-    """Whether Pinocchio folded mimic joints into ``model`` (fewer coordinates than joints)."""
+    """Whether Pinocchio folded mimic joints into ``model`` (fewer coordinates than joints).
+
+    Args:
+        model: The Pinocchio model.
+        spec: The URDF it was built from.
+        floating: Whether the model has a free-flyer root.
+    """
     free = (7 if floating else 0) + sum(joint.type != "fixed" for joint in spec.joints.values())
     return model.nq != free
 
 
 def mimic_expansion(model: pin.Model, spec: URDFSpec, full: pin.Model) -> MimicExpansion:
     """The map from ``model`` (mimic joints folded) to ``full``, the model of the same
-    spec with every joint free (built by :func:`robodyn.dynamics.loading.build_model`)."""
+    spec with every joint free (built by :func:`robodyn.dynamics.loading.build_model`).
+
+    Args:
+        model: The model with mimic joints folded.
+        spec: The URDF both were built from.
+        full: The model with every joint free.
+    """
     selection = np.zeros((full.nv, model.nv))
     q_selection = np.zeros((full.nq, model.nq))
     offset = np.zeros(full.nq)

@@ -40,48 +40,111 @@ class Dynamics(Protocol):
 
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *, joint_friction: bool = False) -> np.ndarray:
         """Joint torques ``tau = M a + C v + G`` (plus the joints' friction torques with
-        ``joint_friction``), shape (nv,) or (N, nv), in [N m] / [N]."""
+        ``joint_friction``), shape (nv,) or (N, nv), in [N m] / [N].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+            joint_friction: Add the joints' friction torques ``b v + f sign(v)`` (``sign(0) = 0``).
+        """
         ...
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """Joint accelerations ``a = M⁻¹ (tau − C v − G)``, shape (nv,) or (N, nv)."""
+        """Joint accelerations ``a = M⁻¹ (tau − C v − G)``, shape (nv,) or (N, nv).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            tau: Joint torques / forces, shape (nv,) or (N, nv), in [N m] / [N].
+        """
         ...
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """``M(q)``, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg]."""
+        """``M(q)``, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+        """
         ...
 
     def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``C(q, v)`` with ``dM/dt = C + Cᵀ``, shape (nv, nv) or (N, nv, nv)."""
+        """``C(q, v)`` with ``dM/dt = C + Cᵀ``, shape (nv, nv) or (N, nv, nv).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        """
         ...
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``C(q, v) v + G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
+        """``C(q, v) v + G(q)``, shape (nv,) or (N, nv), in [N m] / [N].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        """
         ...
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
-        """``G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
+        """``G(q)``, shape (nv,) or (N, nv), in [N m] / [N].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+        """
         ...
 
     def inverse_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, a: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(∂τ/∂q, ∂τ/∂v, M)``, each (nv, nv) or (N, nv, nv)."""
+        """``(∂τ/∂q, ∂τ/∂v, M)``, each (nv, nv) or (N, nv, nv).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        """
         ...
 
     def forward_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(∂q̈/∂q, ∂q̈/∂v, M⁻¹)``, each (nv, nv) or (N, nv, nv)."""
+        """``(∂q̈/∂q, ∂q̈/∂v, M⁻¹)``, each (nv, nv) or (N, nv, nv).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            tau: Joint torques / forces, shape (nv,) or (N, nv), in [N m] / [N].
+        """
         ...
 
     def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """A frame's origin in the world frame, shape (3,) or (N, 3), in [m]."""
+        """A frame's origin in the world frame, shape (3,) or (N, 3), in [m].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+        """
         ...
 
     def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
         """A frame's Jacobian (linear rows then angular, world-aligned axes at its origin),
-        shape (6, nv) or (N, 6, nv)."""
+        shape (6, nv) or (N, 6, nv).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+        """
         ...
 
 

@@ -70,7 +70,11 @@ def _handle(model: ModelHandle | DescribedModel) -> ModelHandle:
 
 
 def body_links(robot: DescribedModel) -> list[str]:
-    """The URDF link that names each body (the moving joint's child link), in order."""
+    """The URDF link that names each body (the moving joint's child link), in order.
+
+    Args:
+        robot: The robot (its handle and URDF).
+    """
     handle, spec = robot.handle, robot.spec
     model = handle.model if handle.mimic is None else handle.mimic.model
     links = []
@@ -84,7 +88,11 @@ def parameter_names(robot: DescribedModel, *, friction: bool = False) -> list[st
     """Names of the standard parameters, ``"kind[link]"`` (e.g. ``"Izz[link1]"``), in the
     order of :func:`regressor`'s columns (friction: ``"fv[dof]"``, ``"fc[dof]"`` with the
     degrees of freedom's names, :attr:`robodyn.Robot.dofs`: a floating base's six are
-    ``base.x`` … ``base.rz``)."""
+    ``base.x`` … ``base.rz``).
+
+    Args:
+        robot: The robot (its handle, URDF and degrees of freedom).
+    """
     names = [f"{kind}[{link}]" for link in body_links(robot) for kind in PARAMETER_KINDS]
     if friction:
         names += [f"{kind}[{dof.name}]" for kind in FRICTION_KINDS for dof in robot.dofs]

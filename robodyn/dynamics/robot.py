@@ -292,6 +292,11 @@ class Robot(RobotDerivatives, RobotKinematics, RobotConstraints, RobotExchange):
         For inner loops (simulation) whose inputs were checked once: float64 1-D arrays of
         the right sizes. A singular mass matrix gives non-finite values here (ABA), or a
         :class:`SingularMassMatrixError` for robots with mimic joints.
+
+        Args:
+            q: Configuration, float64, shape (nq,), in [rad] / [m].
+            v: Velocity, float64, shape (nv,), in [rad/s] / [m/s].
+            tau: Torques, float64, shape (nv,), in [N m] / [N].
         """
         return self.handle.kernels.a.single(q, v, tau)
 
@@ -346,7 +351,12 @@ class Robot(RobotDerivatives, RobotKinematics, RobotConstraints, RobotExchange):
 def joint_infos(model: pin.Model, spec: URDFSpec) -> list[JointInfo]:
     """The joints of ``model`` that have coordinates (mimic joints follow another joint and
     have none), in Pinocchio's order, with their URDF limits; a floating root joint is
-    unlimited."""
+    unlimited.
+
+    Args:
+        model: The robot's Pinocchio model.
+        spec: The validated URDF the model was built from (its joints' limits).
+    """
     infos = []
     for joint_id in range(1, model.njoints):
         if model.joints[joint_id].nv == 0:  # mimic joints follow another joint

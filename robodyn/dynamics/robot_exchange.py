@@ -38,7 +38,12 @@ class RobotExchange:
         return identification.regressor(self.handle, q, v, a, friction=friction)
 
     def inertial_parameters(self, *, friction: bool = False) -> np.ndarray:
-        """The URDF's standard inertial parameters π, in :meth:`regressor`'s order."""
+        """The URDF's standard inertial parameters π, in :meth:`regressor`'s order.
+
+        Args:
+            friction: Append the joints' viscous then Coulomb friction coefficients (:attr:`joint_damping`,
+                :attr:`joint_friction`).
+        """
         return identification.inertial_parameters(self.handle, friction=friction)
 
     # ----------------------------------------------------------------------------------
@@ -48,9 +53,22 @@ class RobotExchange:
         """MuJoCo's ``(qpos, qvel)`` of ``(q, v)``: joints by name in MuJoCo's order, ``ref``
         offsets, the free joint's w-first quaternion and world linear velocity. See
         :mod:`robodyn.dynamics.mujoco_state` (``joint_names``: MuJoCo's order, needed
-        unless the robot was read from MJCF)."""
+        unless the robot was read from MJCF).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), or ``None`` (then ``qvel`` is ``None``).
+            joint_names: MuJoCo's joint names in its order (needed unless the robot was read from MJCF).
+        """
         return mujoco_state.to_mujoco(cast("Robot", self), q, v, joint_names=joint_names)
 
     def from_mujoco(self, qpos: np.ndarray, qvel: np.ndarray | None = None, *, joint_names: Sequence[str] | None = None) -> tuple:
-        """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`)."""
+        """robodyn's ``(q, v)`` of MuJoCo's ``(qpos, qvel)`` (the inverse of :meth:`to_mujoco`).
+
+        Args:
+            qpos: MuJoCo's positions, shape (nq,) or (N, nq).
+            qvel: MuJoCo's velocities, shape (nv,) or (N, nv), or ``None``.
+            joint_names: MuJoCo's joint names in its order (needed unless the robot was read from MJCF).
+        """
         return mujoco_state.from_mujoco(cast("Robot", self), qpos, qvel, joint_names=joint_names)

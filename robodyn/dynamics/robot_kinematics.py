@@ -32,13 +32,23 @@ class RobotKinematics:
     # Energies (robodyn.dynamics.energies)
     # ----------------------------------------------------------------------------------
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
-        """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch."""
+        """Kinetic energy ``½ vᵀ M(q) v`` in [J]: a float, or shape (N,) for a batch.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        """
         return energies.kinetic_energy(self.handle, q, v)
 
     def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
         """Gravitational potential energy ``−Σ m_i gᵀ p_i`` in [J]: a float, or shape (N,).
 
         Zero when every centre of mass is at height zero (for the default gravity).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
         """
         return energies.potential_energy(self.handle, q)
 
@@ -57,6 +67,9 @@ class RobotKinematics:
 
     def frame_id(self, frame: str) -> int:
         """Pinocchio index of a frame (link, joint or fixed frame) by name.
+
+        Args:
+            frame: The frame's name.
 
         Raises:
             FrameError: If the robot has no such frame (with the closest names).
@@ -85,7 +98,13 @@ class RobotKinematics:
 
     def integrate(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
         """The configuration reached from ``q`` along the velocity ``dq`` in unit time
-        (:func:`robodyn.dynamics.kinematics.integrate`: SE(3) for a floating base)."""
+        (:func:`robodyn.dynamics.kinematics.integrate`: SE(3) for a floating base).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position in [m], then its unit
+                quaternion).
+            dq: The displacement, a velocity applied for unit time, shape (nv,) or (N, nv), in [rad] / [m].
+        """
         return kinematics.integrate(self.handle, q, dq)
 
     # ----------------------------------------------------------------------------------

@@ -66,7 +66,11 @@ class DynamicsTerms:
         }
 
     def text(self, *, precision: int = 6) -> str:
-        """Readable text, one block a term, with units (``precision`` significant digits)."""
+        """Readable text, one block a term, with units (``precision`` significant digits).
+
+        Args:
+            precision: Significant digits of each number.
+        """
         lines = [f"{self.robot}: {EQUATION}", ""]
         lines.append(f"{'joint':26s} {'q':>14s} {'v':>16s} {'a':>18s} {'tau':>16s} {'G':>16s}")
         q_offset = len(self.q) - len(self.v)  # a floating base has one more q than v entries
@@ -87,7 +91,14 @@ class DynamicsTerms:
 
 
 def dynamics_terms(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> DynamicsTerms:
-    """Evaluate ``tau``, ``M``, ``C`` and ``G`` at one state (1-D arrays: q (nq,), v and a (nv,))."""
+    """Evaluate ``tau``, ``M``, ``C`` and ``G`` at one state (1-D arrays: q (nq,), v and a (nv,)).
+
+    Args:
+        robot: The robot.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        a: Acceleration, shape (nv,), in [rad/s²] / [m/s²].
+    """
     return DynamicsTerms(
         robot.name, tuple(robot.joint_names), robot.dofs,
         np.asarray(q, float), np.asarray(v, float), np.asarray(a, float),

@@ -31,12 +31,20 @@ from robodyn.equations.program import Assignment
 
 
 def c_number(value: float) -> str:
-    """A double literal that reads back to exactly ``value``."""
+    """A double literal that reads back to exactly ``value``.
+
+    Args:
+        value: The number.
+    """
     return repr(float(value))
 
 
 def c_combination(terms: Iterable[tuple[float, str]]) -> str:
-    """``c0*x0 + c1*x1 + ...`` with unit coefficients left out; ``0.0`` for no terms."""
+    """``c0*x0 + c1*x1 + ...`` with unit coefficients left out; ``0.0`` for no terms.
+
+    Args:
+        terms: ``(coefficient, C name)`` pairs.
+    """
     parts = [name if coefficient == 1.0 else f"{c_number(coefficient)}*{name}" for coefficient, name in terms]
     return " + ".join(parts) if parts else "0.0"
 
@@ -61,7 +69,11 @@ class CPrinter:
         self._printed: dict[sp.Symbol, str] = {}
 
     def expression(self, expr: sp.Expr) -> str:
-        """C for one expression."""
+        """C for one expression.
+
+        Args:
+            expr: The expression (anything :func:`sympy.sympify` takes).
+        """
         return self._print(sp.sympify(expr))[0]
 
     def _print(self, expr: sp.Expr) -> tuple[str, int]:
@@ -120,13 +132,23 @@ class CPrinter:
         return "*".join(self._operand(factor, _MUL) for factor in factors), _MUL
 
     def assignment(self, symbol: sp.Symbol, expr: sp.Expr) -> str:
-        """``const double <name> = <expr>;`` (printed once per symbol, then reused)."""
+        """``const double <name> = <expr>;`` (printed once per symbol, then reused).
+
+        Args:
+            symbol: The symbol assigned (named by :attr:`names`).
+            expr: Its expression.
+        """
         if symbol not in self._printed:
             self._printed[symbol] = self.expression(expr)
         return f"const double {self.names[symbol]} = {self._printed[symbol]};"
 
     def statements(self, assignments: Iterable[Assignment], *, indent: str = "    ") -> list[str]:
-        """A straight-line program's assignments as C declarations, one a line."""
+        """A straight-line program's assignments as C declarations, one a line.
+
+        Args:
+            assignments: ``(symbol, expression)`` pairs, in the program's order.
+            indent: Text before each line.
+        """
         return [indent + self.assignment(symbol, expr) for symbol, expr in assignments]
 
 
@@ -151,6 +173,12 @@ def vector_lines(lines: Iterable[str], *, vector: str, prefix: str, kernels: Ite
     ``rd_cos`` (:data:`OWN_CALLS`) become ``{prefix}sin`` and ``{prefix}cos``; a call of one
     of ``kernels`` (``rd_mass``) becomes the vector kernel (``{prefix}mass``); a constant
     right-hand side becomes ``{prefix}splat(c)``.
+
+    Args:
+        lines: The scalar C lines.
+        vector: The name of the vector type (e.g. ``"rds4"``).
+        prefix: Prefix of the lane-wise functions the caller defines (e.g. ``"rds4_"``).
+        kernels: Names of the scalar kernels called (``"rd_mass"``), renamed to their vector forms.
 
     Returns:
         The lines, or None if one has a call or an operator (``?:``) the vector form does not take.

@@ -23,6 +23,9 @@ from robodyn.exceptions import InputError
 def christoffel_symbols(equations: EquationsData) -> dict[tuple[int, int, int], sp.Expr]:
     """Non-zero ``Γ_ijk`` (0-based ``i, j ≤ k``) of a closed form's ``M``.
 
+    Args:
+        equations: The derived equations of motion (closed form).
+
     Raises:
         InputError: For the compact form (its ``M`` is a program, not expressions in ``q``).
     """
@@ -42,7 +45,13 @@ def christoffel_symbols(equations: EquationsData) -> dict[tuple[int, int, int], 
 
 
 def render_christoffel(equations: EquationsData, format: Literal["text", "json"] = "text", *, precision: int = 6) -> str:
-    """The symbols as ``text`` (``Gamma[i,j,k] = ...``, 1-based) or ``json``."""
+    """The symbols as ``text`` (``Gamma[i,j,k] = ...``, 1-based) or ``json``.
+
+    Args:
+        equations: The derived equations of motion (closed form).
+        format: ``"text"`` or ``"json"``.
+        precision: Significant digits of the numbers printed, 1 to 17.
+    """
     check_precision(precision)
     symbols = christoffel_symbols(equations)
     if format == "json":

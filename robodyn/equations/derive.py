@@ -90,6 +90,10 @@ def estimate_closed_form_seconds(robot: ReferenceRobot, *, keep_params: bool = F
     turned by 0.3 rad 30 s (45), a two-joint arm with one origin turned by 0.3 rad 1.1 s
     (1.0), the oblique robot's first joint 0.28 s (0.35) and first two 28 s (24.5), ur5's
     first four joints 52 s. Kept parameters cost about as much again.
+
+    Args:
+        robot: The reference model of the robot.
+        keep_params: Estimate for symbolic parameters (slower) instead of numbers.
     """
     bodies = [body for body in robot.tree.bodies if not body.rotor]  # a rotor adds one term, not a level
     revolute = sum(body.revolute for body in bodies)
@@ -249,7 +253,11 @@ def derive_equations(
 
 
 def substitute_parameters(equations: EquationsData) -> EquationsData:
-    """The equations with every kept parameter replaced by its (exact) value."""
+    """The equations with every kept parameter replaced by its (exact) value.
+
+    Args:
+        equations: Equations derived with kept (symbolic) parameters.
+    """
     values = {s: exact_number(v) for s, v in equations.parameters.items()}
     matrices: dict[str, Any] = {
         name: getattr(equations, name).xreplace(values) if getattr(equations, name) is not None else None

@@ -103,6 +103,11 @@ def render_kinematics(kinematics: Kinematics, format: KinematicsFormat = "text",
     (the same two functions, one state, arrays of doubles): one renderer a format, as for
     the equations (:func:`robodyn.equations.output.render`).
 
+    Args:
+        kinematics: The derived frame kinematics (:func:`robodyn.equations.kinematics.derive_kinematics`).
+        format: ``"text"``, ``"latex"``, ``"json"``, ``"python"`` or ``"c"``.
+        precision: Significant digits of the numbers printed, 1 to 17.
+
     Raises:
         InputError: For an unknown format or precision.
     """
@@ -145,7 +150,8 @@ def frame_program(
     Args:
         robot: A fixed-base reference robot (mimic joints as bodies of their own).
         body: Index of the carrying body in ``robot.tree.bodies``, or -1.
-        rotation: Body frame <- frame, shape (3, 3); translation: shape (3,), in [m].
+        rotation: Body frame <- frame, shape (3, 3).
+        translation: The frame's origin in the body frame, shape (3,), in [m].
         snap: Tolerance for exact rotation and axis entries.
         symbols: ``(q, qd)`` to use instead of the reference's joint symbols.
     """

@@ -75,7 +75,11 @@ def rigid() -> SymbolicDynamics:
 
 
 def split(tau: sp.Matrix) -> dict[str, sp.Matrix]:
-    """Split ``tau`` into its ``M q̈``, ``C q̇`` (velocity products) and ``G`` parts."""
+    """Split ``tau`` into its ``M q̈``, ``C q̇`` (velocity products) and ``G`` parts.
+
+    Args:
+        tau: The RP arm's torques, a (2, 1) matrix in the lecture's symbols.
+    """
     expanded = sp.expand(tau)
     at_rest = expanded.subs({qd1: 0, qd2: 0, qdd1: 0, qdd2: 0})
     inertial = expanded.subs({qd1: 0, qd2: 0}) - at_rest

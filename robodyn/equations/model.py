@@ -57,7 +57,12 @@ class EquationsData:
 
 def numeric(expr: sp.Expr, digits: int = 17) -> sp.Expr:
     """``expr`` with its exact numbers (rationals, ``π``, ``√2``...) as floats of ``digits``
-    significant digits; symbols and integers stay."""
+    significant digits; symbols and integers stay.
+
+    Args:
+        expr: The expression.
+        digits: Significant digits of the floats.
+    """
     return expr.evalf(digits) if expr.free_symbols or not expr.is_Integer else expr
 
 

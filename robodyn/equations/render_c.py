@@ -72,7 +72,11 @@ def _terms(equations: EquationsData) -> list[str]:
 
 def to_c(equations: EquationsData) -> str:
     """``mass_matrix``, ``coriolis_forces``, ``coriolis_matrix``, ``gravity`` and
-    ``inverse_dynamics`` (one state; arrays of doubles, row-major)."""
+    ``inverse_dynamics`` (one state; arrays of doubles, row-major).
+
+    Args:
+        equations: The derived equations of motion (numbers only: no kept parameters).
+    """
     code_ready(equations)
     n = len(equations.q)
     lines = [
@@ -88,7 +92,11 @@ def to_c(equations: EquationsData) -> str:
 
 
 def kinematics_c(kinematics: Kinematics) -> str:
-    """``frame_position(q, p)`` and ``frame_jacobian(q, J)`` (one state, arrays of doubles)."""
+    """``frame_position(q, p)`` and ``frame_jacobian(q, J)`` (one state, arrays of doubles).
+
+    Args:
+        kinematics: The derived frame kinematics (:func:`robodyn.equations.kinematics.derive_kinematics`).
+    """
     k = kinematics
     n = len(k.q)
     printer = _printer(k.q)

@@ -8,7 +8,11 @@ from robodyn.equations.model import EquationsData, Kinematics, numeric
 
 
 def to_json(equations: EquationsData) -> str:
-    """Symbols, assignments and entries (see the module)."""
+    """Symbols, assignments and entries (see the module).
+
+    Args:
+        equations: The derived equations of motion.
+    """
     n = len(equations.q)
 
     def text(expr) -> str:
@@ -35,7 +39,11 @@ def to_json(equations: EquationsData) -> str:
 
 
 def kinematics_json(kinematics: Kinematics) -> str:
-    """The frame's names, ``q``, position, rotation and Jacobian (entries as sympy strings)."""
+    """The frame's names, ``q``, position, rotation and Jacobian (entries as sympy strings).
+
+    Args:
+        kinematics: The derived frame kinematics (:func:`robodyn.equations.kinematics.derive_kinematics`).
+    """
     k = kinematics
     n = len(k.q)
     data = {

@@ -69,7 +69,11 @@ def _symbol_names(equations: EquationsData) -> dict[sp.Symbol, str]:
 
 
 def latex_width(tex: str) -> float:
-    """Roughly how many characters wide ``tex`` typesets."""
+    """Roughly how many characters wide ``tex`` typesets.
+
+    Args:
+        tex: The LaTeX math.
+    """
     text = re.sub(r"\\(left|right|bigl|bigr|mathit|text|operatorname)\b", "", tex)
     text = re.sub(r"\\(dot|ddot)\b", "", text)
     text = re.sub(r"\\[A-Za-z]+", "xx", text)
@@ -119,14 +123,25 @@ def _lines(printer: EquationPrinter, expr: sp.Expr, width: float) -> list[str]:
 
 
 def latex_equation(printer: EquationPrinter, left: str, expr: sp.Expr) -> str:
-    """One ``align*`` row, continued with ``&\\quad`` lines where long."""
+    """One ``align*`` row, continued with ``&\\quad`` lines where long.
+
+    Args:
+        printer: The printer (its precision and symbol names).
+        left: The LaTeX of the left-hand side.
+        expr: The right-hand side.
+    """
     lines = _lines(printer, numeric(expr), LINE_WIDTH - latex_width(left))
     rows = [f"{left} &= {lines[0]}"] + [rf"&\quad {line}" for line in lines[1:]]
     return " \\\\\n".join(rows)
 
 
 def latex_math(equations: EquationsData, *, precision: int = 6) -> str:
-    """The equations as ``align*`` environments (for a document or a notebook)."""
+    """The equations as ``align*`` environments (for a document or a notebook).
+
+    Args:
+        equations: The derived equations of motion.
+        precision: Significant digits of the numbers printed.
+    """
     printer = EquationPrinter(precision, _symbol_names(equations))
     n = len(equations.q)
     rows = []
@@ -144,7 +159,12 @@ def latex_math(equations: EquationsData, *, precision: int = 6) -> str:
 
 
 def to_latex(equations: EquationsData, *, precision: int = 6) -> str:
-    """A complete LaTeX document (amsmath): the joints' legend, parameters, equations."""
+    """A complete LaTeX document (amsmath): the joints' legend, parameters, equations.
+
+    Args:
+        equations: The derived equations of motion.
+        precision: Significant digits of the numbers printed.
+    """
     names = _symbol_names(equations)
     legend = [
         rf"${names[q]}$ & \texttt{{{latex_text(name)}}} \\" for q, name in zip(equations.q, equations.joint_names, strict=True)
@@ -174,7 +194,12 @@ def to_latex(equations: EquationsData, *, precision: int = 6) -> str:
 
 
 def kinematics_latex(kinematics: Kinematics, *, precision: int = 6) -> str:
-    """The frame's position and Jacobian as an ``align*`` fragment, with the joints' legend."""
+    """The frame's position and Jacobian as an ``align*`` fragment, with the joints' legend.
+
+    Args:
+        kinematics: The derived frame kinematics.
+        precision: Significant digits of the numbers printed.
+    """
     k = kinematics
     n = len(k.q)
     printer = EquationPrinter(precision, {s: rf"q_{{{i + 1}}}" for i, s in enumerate(k.q)})
@@ -196,6 +221,10 @@ def tex_engine() -> str | None:
 
 def compile_latex(tex: str, folder: Path) -> tuple[Path, str]:
     """Compile a document with pdflatex in ``folder``; the PDF and the log.
+
+    Args:
+        tex: The LaTeX document.
+        folder: A folder to write ``equations.tex`` and pdflatex's output in.
 
     Raises:
         MissingToolError: Without pdflatex.
@@ -221,7 +250,12 @@ def compile_latex(tex: str, folder: Path) -> tuple[Path, str]:
 
 
 def to_pdf(equations: EquationsData, *, precision: int = 6) -> bytes:
-    """The document of :func:`to_latex`, compiled with pdflatex."""
+    """The document of :func:`to_latex`, compiled with pdflatex.
+
+    Args:
+        equations: The derived equations of motion.
+        precision: Significant digits of the numbers printed.
+    """
     with tempfile.TemporaryDirectory(prefix="robodyn-tex-") as folder:
         pdf, _ = compile_latex(to_latex(equations, precision=precision), Path(folder))
         return pdf.read_bytes()

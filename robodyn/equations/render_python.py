@@ -70,7 +70,11 @@ def inverse_dynamics(q, v, a):
 def to_python(equations: EquationsData) -> str:
     """A module with ``mass_matrix``, ``coriolis_matrix``, ``coriolis_forces``, ``gravity``,
     ``inverse_dynamics``, with :class:`robodyn.Robot`'s conventions (1-D state, or 2-D
-    with one state a row)."""
+    with one state a row).
+
+    Args:
+        equations: The derived equations of motion (numbers only: no kept parameters).
+    """
     code_ready(equations)
     substitutions, assignments = numbered(equations)
     printer = NumPyPrinter({"fully_qualified_modules": True})
@@ -107,7 +111,11 @@ def to_python(equations: EquationsData) -> str:
 
 
 def kinematics_python(kinematics: Kinematics) -> str:
-    """A module with ``frame_position(q)`` and ``frame_jacobian(q)`` (1-D or 2-D ``q``)."""
+    """A module with ``frame_position(q)`` and ``frame_jacobian(q)`` (1-D or 2-D ``q``).
+
+    Args:
+        kinematics: The derived frame kinematics (:func:`robodyn.equations.kinematics.derive_kinematics`).
+    """
     k = kinematics
     n = len(k.q)
     printer = NumPyPrinter({"fully_qualified_modules": True})

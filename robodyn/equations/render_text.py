@@ -9,7 +9,12 @@ from robodyn.equations.printing import format_float, to_text_expr
 
 
 def header(equations: EquationsData, precision: int) -> list[str]:
-    """The title, the joints and the kept parameters' values."""
+    """The title, the joints and the kept parameters' values.
+
+    Args:
+        equations: The derived equations of motion.
+        precision: Significant digits of the parameters' values.
+    """
     lines = [
         f"{terminal_text(equations.robot)}: tau = M(q) qdd + C(q, qd) qd + G(q)   "
         f"({equations.form} form, {equations.operation_count()} operations)",
@@ -24,7 +29,12 @@ def header(equations: EquationsData, precision: int) -> list[str]:
 
 
 def to_text(equations: EquationsData, *, precision: int = 6) -> str:
-    """Assignments (compact form), then every entry of M, C (closed form), C q̇ and G."""
+    """Assignments (compact form), then every entry of M, C (closed form), C q̇ and G.
+
+    Args:
+        equations: The derived equations of motion.
+        precision: Significant digits of the numbers printed, 1 to 17.
+    """
 
     def text(expr) -> str:
         return to_text_expr(expr, precision)
@@ -44,7 +54,12 @@ def to_text(equations: EquationsData, *, precision: int = 6) -> str:
 
 
 def kinematics_text(kinematics: Kinematics, *, precision: int = 6) -> str:
-    """The frame, its joints, then every entry of ``p`` and ``J`` (1-based)."""
+    """The frame, its joints, then every entry of ``p`` and ``J`` (1-based).
+
+    Args:
+        kinematics: The derived frame kinematics (:func:`robodyn.equations.kinematics.derive_kinematics`).
+        precision: Significant digits of the numbers printed, 1 to 17.
+    """
     k = kinematics
     n = len(k.q)
     lines = [

@@ -19,7 +19,11 @@ from robodyn.equations.program import Assignment, Program, in_order
 
 def share_subexpressions(program: Program) -> Program:
     """Share repeated subexpressions (new symbols ``t0``, ``t1``, ...) and keep only what the
-    outputs need, in dependency order."""
+    outputs need, in dependency order.
+
+    Args:
+        program: The straight-line program (assignments and outputs).
+    """
     names = [name for name, _ in program.assignments]
     outputs = program.output_expressions()
     taken = {s for _, e in program.assignments for s in e.free_symbols} | set(names)
@@ -95,7 +99,11 @@ def _collected(expr: sp.Expr) -> sp.Expr:
 
 
 def reuse_products(program: Program) -> Program:
-    """See the module: assigned products reused, expressions collected."""
+    """See the module: assigned products reused, expressions collected.
+
+    Args:
+        program: The straight-line program (assignments and outputs).
+    """
     pairs: dict[frozenset, sp.Symbol] = {}
 
     def tidy(expr: sp.Expr) -> sp.Expr:
@@ -114,7 +122,11 @@ def reuse_products(program: Program) -> Program:
 
 def without_copies(program: Program) -> Program:
     """Substitute away assignments of a bare symbol or number (``a = b``) and repeats of an
-    expression already assigned."""
+    expression already assigned.
+
+    Args:
+        program: The straight-line program (assignments and outputs).
+    """
     copies: dict[sp.Symbol, sp.Expr] = {}
     seen: dict[sp.Expr, sp.Symbol] = {}
     kept: list[Assignment] = []
@@ -132,5 +144,9 @@ def without_copies(program: Program) -> Program:
 
 def shortened(program: Program) -> Program:
     """All three, in the order that works best: shared, copies removed, products reused,
-    copies removed again."""
+    copies removed again.
+
+    Args:
+        program: The straight-line program (assignments and outputs).
+    """
     return without_copies(reuse_products(without_copies(share_subexpressions(program))))

@@ -47,7 +47,11 @@ SYMBOLIC_MAX_JOINTS = 7
 def joint_ranges(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     """Position ranges of the joints (a floating base's six coordinates left out), in [rad]
     or [m]: the URDF's limits, except that unlimited joints and joints whose limits are
-    equal (``lower = upper``, which published URDFs write for "no limit") get [−π, π]."""
+    equal (``lower = upper``, which published URDFs write for "no limit") get [−π, π].
+
+    Args:
+        robot: The robot.
+    """
     lower, upper = robot.lower_limits.copy(), robot.upper_limits.copy()
     if robot.floating_base:
         lower, upper = lower[6:], upper[6:]
@@ -57,7 +61,13 @@ def joint_ranges(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
 
 def random_states(robot: Robot, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``count`` random states: q uniform in :func:`joint_ranges` (a floating base's pose
-    as :meth:`Robot.random_configuration`), v and a standard normal."""
+    as :meth:`Robot.random_configuration`), v and a standard normal.
+
+    Args:
+        robot: The robot.
+        count: Number of states.
+        rng: The random generator.
+    """
     q = robot.random_configuration(rng, count)
     lower, upper = joint_ranges(robot)
     q[:, q.shape[1] - lower.size :] = rng.uniform(lower, upper, size=(count, lower.size))
@@ -99,7 +109,13 @@ class BaseParameters:
     _standard: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
 
     def standard_regressor(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        """The full standard regressor (friction columns if :attr:`friction`)."""
+        """The full standard regressor (friction columns if :attr:`friction`).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        """
         return regressor(self.robot, q, v, a, friction=self.friction)
 
     def regressor(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -116,13 +132,23 @@ class BaseParameters:
     def known_torque(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """Torque of the parameters outside :attr:`columns` (held at the URDF's values) and
         of the joints' armature (``armature ⊙ a``, no parameter of the regressor), shape
-        (nv,) or (N, nv); zero when every parameter is included and there is no armature."""
+        (nv,) or (N, nv); zero when every parameter is included and there is no armature.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        """
         full = self.standard_regressor(q, v, a)
         rest = np.setdiff1d(np.arange(full.shape[-1]), self.columns)
         return full[..., rest] @ self._standard[rest] + self.robot.joint_armature * np.asarray(a, dtype=float)
 
     def to_base(self, standard: np.ndarray) -> np.ndarray:
-        """Base values of a standard parameter vector over :attr:`columns`, (p,) -> (r,)."""
+        """Base values of a standard parameter vector over :attr:`columns`, (p,) -> (r,).
+
+        Args:
+            standard: Standard parameters, shape (p,), in the order of :attr:`standard_names`, their units.
+        """
         return self.mapping @ np.asarray(standard, dtype=float)
 
     def expressions(self) -> list:

@@ -83,14 +83,24 @@ class Excitation:
     improved: bool = True
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``q, v, a`` at times ``t`` (M,), each (M, nv)."""
+        """``q, v, a`` at times ``t`` (M,), each (M, nv).
+
+        Args:
+            t: Times in [s], shape (M,).
+        """
         return _series(self.offset, self.sine, self.cosine, 2 * np.pi / self.period, np.asarray(t, dtype=float))
 
     def sample(self, robot: Robot, *, rate: float = 100.0, periods: int = 1) -> tuple[np.ndarray, ...]:
         """``t, q, v, a, tau`` sampled at ``rate`` [Hz] over ``periods`` periods, with
         ``tau`` the robot's inverse dynamics along it, its joints' damping and friction
         included (``joint_friction=True``: what the robot needs to follow it), shapes (M,)
-        and (M, nv); the columns of :class:`robodyn.trajectory.Trajectory`."""
+        and (M, nv); the columns of :class:`robodyn.trajectory.Trajectory`.
+
+        Args:
+            robot: The robot that follows the motion.
+            rate: Samples per second in [Hz].
+            periods: Number of periods sampled, at least 1.
+        """
         if not (np.isfinite(rate) and rate > 0) or periods < 1:
             raise InputError("rate and periods", "a positive rate in [Hz] and at least one period", f"{rate!r}, {periods!r}")
         t = np.arange(0.0, periods * self.period, 1.0 / rate)

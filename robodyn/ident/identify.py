@@ -79,11 +79,22 @@ class Identification:
     solver: str | None = field(default=None)
 
     def predict(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        """Predicted torques ``Y_b β + known``, shape (nv,) or (N, nv)."""
+        """Predicted torques ``Y_b β + known``, shape (nv,) or (N, nv).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        """
         return self.base.regressor(q, v, a) @ self.values + self.base.known_torque(q, v, a)
 
     def prediction_error(self, trajectory: Samples, tau: np.ndarray | None = None) -> float:
-        """Relative torque prediction error on other data (a validation trajectory)."""
+        """Relative torque prediction error on other data (a validation trajectory).
+
+        Args:
+            trajectory: Validation data with ``q``, ``v``, ``a`` and ``tau`` (e.g. a :class:`robodyn.trajectory.Trajectory`).
+            tau: Measured torques in [N m] / [N], shape (N, nv), instead of ``trajectory.tau`` (``None``: those).
+        """
         measured = trajectory.tau if tau is None else np.asarray(tau, dtype=float)
         predicted = self.predict(trajectory.q, trajectory.v, trajectory.a)
         return float(np.linalg.norm(measured - predicted) / np.linalg.norm(measured))

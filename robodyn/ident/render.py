@@ -28,6 +28,10 @@ def render_base_parameters(base: BaseParameters, format: str = "text") -> str:
     """The base parameters: count, how they were found, each name, URDF value and (up to
     ``SYMBOLIC_MAX_JOINTS`` joints) its expression in the standard parameters.
 
+    Args:
+        base: The base parameters.
+        format: ``"text"``, ``"latex"`` or ``"json"``.
+
     Raises:
         InputError: For an unknown format.
     """

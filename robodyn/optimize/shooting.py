@@ -48,6 +48,11 @@ class Plant:
 def planned_plant(robot: Robot, actuated: Sequence[str] | None, joint_friction: bool) -> Plant:
     """The actuation (default: the joints whose ``Dof.actuated``) and the damping planned with.
 
+    Args:
+        robot: The robot (fixed base).
+        actuated: Names of the joints the motors drive; ``None``: those whose ``Dof.actuated`` is true.
+        joint_friction: Plan with the joints' viscous damping (``False``: none).
+
     Raises:
         InputError: ``actuated`` naming unknown joints or none; ``joint_friction`` with a
             joint that has Coulomb friction (a rest-to-rest motion starts and ends stuck:
@@ -104,7 +109,17 @@ class Problem:
 def shooting_problem(
     ca: Any, robot: Robot, plant: Plant, ends: tuple[np.ndarray, np.ndarray], duration: float, intervals: int, cost: Cost
 ) -> Problem:
-    """Multiple shooting with limits and boundary conditions (see the module); ``ends``: start and goal."""
+    """Multiple shooting with limits and boundary conditions (see the module); ``ends``: start and goal.
+
+    Args:
+        ca: The ``casadi`` module.
+        robot: The robot (fixed base).
+        plant: The actuation and the damping planned with (:func:`planned_plant`).
+        ends: Start and goal configurations, each shape (nq,), in [rad] / [m].
+        duration: The motion's duration in [s] (``cost="time"``: its upper bound).
+        intervals: Shooting intervals (``intervals + 1`` samples).
+        cost: ``"effort"`` or ``"time"``.
+    """
     (nv, nu), limits = plant.selection.shape, JointLimits(robot)
     opti = ca.Opti()
     X, U = opti.variable(2 * nv, intervals + 1), opti.variable(nu, intervals)
@@ -138,7 +153,15 @@ def shooting_problem(
 
 def initial_guess(problem: Problem, robot: Robot, plant: Plant, ends: tuple[np.ndarray, np.ndarray], duration: float) -> None:
     """Straight from start to goal at constant speed, the inputs holding gravity as far as
-    the actuated joints can (least squares, within the effort limits)."""
+    the actuated joints can (least squares, within the effort limits).
+
+    Args:
+        problem: The shooting problem (its CasADi ``Opti`` and decision variables).
+        robot: The robot (fixed base).
+        plant: The actuation and the damping planned with (:func:`planned_plant`).
+        ends: Start and goal configurations, each shape (nq,), in [rad] / [m].
+        duration: The motion's duration in [s].
+    """
     start, goal = ends
     intervals = problem.X.shape[1] - 1
     s = np.linspace(0.0, 1.0, intervals + 1)
@@ -154,7 +177,14 @@ def initial_guess(problem: Problem, robot: Robot, plant: Plant, ends: tuple[np.n
 def scaled_guess(problem: Problem, plant: Plant, trajectory: Trajectory, duration: float) -> None:
     """A motion found over another duration as the start over ``duration``: a shorter one
     delayed (held at rest at the start first, which is the same motion), a longer one
-    time-scaled (the same path, faster); either resampled on this problem's grid."""
+    time-scaled (the same path, faster); either resampled on this problem's grid.
+
+    Args:
+        problem: The shooting problem (its CasADi ``Opti`` and decision variables).
+        plant: The actuation and the damping planned with (:func:`planned_plant`).
+        trajectory: The motion found over another duration (with ``tau``).
+        duration: This problem's duration in [s].
+    """
     intervals = problem.X.shape[1] - 1
     length = float(trajectory.t[-1])
     ratio = max(length / duration, 1.0)
@@ -173,7 +203,11 @@ def scaled_guess(problem: Problem, plant: Plant, trajectory: Trajectory, duratio
 
 
 def limiting(problem: Problem) -> str:
-    """The bound with the largest multiplier at the last iterate ("" when none is active)."""
+    """The bound with the largest multiplier at the last iterate ("" when none is active).
+
+    Args:
+        problem: The shooting problem (its CasADi ``Opti`` and decision variables). after a solve
+    """
     worst, name = 0.0, ""
     for label, (constraint, _) in problem.bounds.items():
         dual = float(np.max(np.abs(problem.opti.debug.value(problem.opti.dual(constraint)))))

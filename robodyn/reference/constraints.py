@@ -40,7 +40,11 @@ RCOND = 1e-11
 
 
 def link_frames(model: ReferenceRobot) -> dict[str, tuple[int, np.ndarray]]:
-    """Every link: the body carrying it (−1: the fixed root) and its 4×4 pose in that body's frame."""
+    """Every link: the body carrying it (−1: the fixed root) and its 4×4 pose in that body's frame.
+
+    Args:
+        model: The reference model of the robot.
+    """
     body_of = {body.link: index for index, body in enumerate(model.tree.bodies) if not body.rotor}
     if model.floating_base:
         body_of[model.spec.root] = 5
@@ -122,7 +126,12 @@ class _State:
 
 
 def bound(model: ReferenceRobot, constraints: Sequence[Constraint] | object) -> tuple[tuple[Bound, ...], dict]:
-    """The constraints with both ends resolved on the reference, and its link frames."""
+    """The constraints with both ends resolved on the reference, and its link frames.
+
+    Args:
+        model: The reference model of the robot.
+        constraints: One constraint (a ``PointAnchor``, ``FrameAnchor`` or ``PointContact``) or a sequence of them.
+    """
     given = as_constraints(constraints)
     check_frames(given, list(model.spec.links), model.name)
     frames = link_frames(model)
@@ -143,7 +152,15 @@ def bound(model: ReferenceRobot, constraints: Sequence[Constraint] | object) -> 
 def state_rows(
     model: ReferenceRobot, bounds: Sequence[Bound], frames: dict, q: np.ndarray, v: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one state (the reference's coordinate order)."""
+    """``Φ`` (m,), ``J`` (m, nv), ``J̇ v`` (m,) at one state (the reference's coordinate order).
+
+    Args:
+        model: The reference model of the robot.
+        bounds: The constraints bound to the model (:func:`bound`).
+        frames: The link frames (:func:`link_frames`).
+        q: Configuration, shape (nq,).
+        v: Velocity, shape (nv,).
+    """
     state = _State(model, q, v)
 
     def kinematics(end: End) -> EndKinematics:
@@ -161,7 +178,14 @@ def state_rows(
 
 
 def constraint_terms(model: ReferenceRobot, q, v, constraints) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(Φ, J, J̇ v)``: shapes (m,), (m, nv), (m,) or stacked for a batch."""
+    """``(Φ, J, J̇ v)``: shapes (m,), (m, nv), (m,) or stacked for a batch.
+
+    Args:
+        model: The reference model of the robot.
+        q: Configuration, shape (nq,) or (N, nq), in the reference's joint order, in [rad] / [m].
+        v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        constraints: One constraint (a ``PointAnchor``, ``FrameAnchor`` or ``PointContact``) or a sequence of them.
+    """
     bounds, frames = bound(model, constraints)
     (q, v), batch = as_states({"q": (q, model.nq), "v": (v, model.nv)})
     if not batch:
@@ -174,7 +198,14 @@ def constraint_terms(model: ReferenceRobot, q, v, constraints) -> tuple[np.ndarr
 
 
 def solve_kkt(mass: np.ndarray, force: np.ndarray, jacobian: np.ndarray, drift: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(a, λ)`` of ``[[M, −Jᵀ], [J, 0]] (a, λ) = (force, −J̇ v)`` by least squares."""
+    """``(a, λ)`` of ``[[M, −Jᵀ], [J, 0]] (a, λ) = (force, −J̇ v)`` by least squares.
+
+    Args:
+        mass: ``M``, shape (nv, nv).
+        force: ``τ − C v − G``, shape (nv,), in [N m] / [N].
+        jacobian: ``J``, shape (m, nv).
+        drift: ``J̇ v``, shape (m,).
+    """
     n, m = len(force), len(drift)
     kkt = np.block([[mass, -jacobian.T], [jacobian, np.zeros((m, m))]])
     solution = np.linalg.lstsq(kkt, np.concatenate([force, -drift]), rcond=RCOND)[0]
@@ -185,6 +216,13 @@ def constrained_forward_dynamics(model: ReferenceRobot, q, v, tau, constraints) 
     """``(a, λ)`` of ``M a + C v + G = τ + Jᵀ λ``, ``J a + J̇ v = 0`` (the reference's order).
 
     Shapes (nv,), (m,), or stacked for a batch (one state a row).
+
+    Args:
+        model: The reference model of the robot.
+        q: Configuration, shape (nq,) or (N, nq), in the reference's joint order, in [rad] / [m].
+        v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        tau: Torques, shape (nv,) or (N, nv), in [N m] / [N].
+        constraints: One constraint (a ``PointAnchor``, ``FrameAnchor`` or ``PointContact``) or a sequence of them.
     """
     bounds, frames = bound(model, constraints)
     (q, v, tau), batch = as_states({"q": (q, model.nq), "v": (v, model.nv), "tau": (tau, model.nv)})

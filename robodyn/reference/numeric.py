@@ -291,53 +291,108 @@ class ReferenceRobot:
     def terms(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
         """Every term at once, for stacks of states (one a row): ``tau``, ``M``, ``Cv``, ``G``
         and, on a fixed base, ``C`` and ``Mdot`` (shapes as their methods give for a stack),
-        in one pass: ``∂M/∂q`` is computed once, not once a method."""
+        in one pass: ``∂M/∂q`` is computed once, not once a method.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        """
         (q, v, a), _ = as_states({"q": (q, self.nq), "v": (v, self.nv), "a": (a, self.nv)})
         values = self._evaluate(np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a))
         names = ("tau", "M", "Cv", "G") if self.floating_base else ("tau", "M", "Cv", "G", "C", "Mdot")
         return {name: values[name] for name in names}
 
     def inverse_dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        """``tau = M a + C v + G``, shape (n,) or (N, n)."""
+        """``tau = M a + C v + G``, shape (n,) or (N, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+            a: Acceleration, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        """
         return self._call("tau", q=q, v=v, a=a)
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """``M(q)``, shape (n, n) or (N, n, n)."""
+        """``M(q)``, shape (n, n) or (N, n, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+        """
         return self._call("M", q=q)
 
     def mass_matrix_derivative(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``dM/dt = Σ_k ∂M/∂q_k v_k`` (analytic), shape (n, n) or (N, n, n)."""
+        """``dM/dt = Σ_k ∂M/∂q_k v_k`` (analytic), shape (n, n) or (N, n, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        """
         return self._call("Mdot", q=q, v=v)
 
     def coriolis_matrix(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``C(q, v)`` from the Christoffel symbols of ``M``, shape (n, n) or (N, n, n)."""
+        """``C(q, v)`` from the Christoffel symbols of ``M``, shape (n, n) or (N, n, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        """
         return self._call("C", q=q, v=v)
 
     def coriolis_forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``C(q, v) v``, shape (n,) or (N, n)."""
+        """``C(q, v) v``, shape (n,) or (N, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        """
         return self._call("Cv", q=q, v=v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
-        """``G(q) = ∂U/∂q``, shape (n,) or (N, n)."""
+        """``G(q) = ∂U/∂q``, shape (n,) or (N, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+        """
         return self._call("G", q=q)
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``C(q, v) v + G(q)``, shape (n,) or (N, n)."""
+        """``C(q, v) v + G(q)``, shape (n,) or (N, n).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        """
         return self._call("Cv", q=q, v=v) + self.gravity(q)
 
     def forward_dynamics(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """``a = M⁻¹ (tau − C v − G)``, shape (nv,) or (N, nv); ``q`` has nq entries a state."""
+        """``a = M⁻¹ (tau − C v − G)``, shape (nv,) or (N, nv); ``q`` has nq entries a state.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+            tau: Torques, shape (nv,) or (N, nv), in [N m] / [N].
+        """
         (q, v, tau), _ = as_states({"q": (q, self.nq), "v": (v, self.nv), "tau": (tau, self.nv)})
         return np.linalg.solve(self.mass_matrix(q), (tau - self.nonlinear_effects(q, v))[..., None])[..., 0]
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float | np.ndarray:
-        """``T = ½ vᵀ M v`` in [J]: a float or shape (N,); ``q`` has nq entries a state."""
+        """``T = ½ vᵀ M v`` in [J]: a float or shape (N,); ``q`` has nq entries a state.
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        """
         (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
         energy = 0.5 * np.einsum("...i,...ij,...j->...", v, self.mass_matrix(q), v)
         return energy if batch else float(energy)
 
     def potential_energy(self, q: np.ndarray) -> float | np.ndarray:
-        """``U = −Σ m_b gᵀ p_b`` in [J]: a float or shape (N,)."""
+        """``U = −Σ m_b gᵀ p_b`` in [J]: a float or shape (N,).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+        """
         energy = self._call("U", q=q)
         return energy if np.ndim(energy) else float(energy)
 
@@ -347,7 +402,12 @@ class ReferenceRobot:
     def body_motion(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
         """The robot's bodies (armature rotors left out) at stacked states: masses (B,),
         centres of mass (N, B, 3) [m], their velocities (N, B, 3) [m/s], inertias about
-        them in world axes (N, B, 3, 3) [kg m²], angular velocities (N, B, 3) [rad/s]."""
+        them in world axes (N, B, 3, 3) [kg m²], angular velocities (N, B, 3) [rad/s].
+
+        Args:
+            q: Configurations, shape (N, nq), in [rad] / [m].
+            v: Velocities, shape (N, nv), in [rad/s] / [m/s].
+        """
         coms, linear, angular, inertias, _ = self._bodies(q)
         rate = v @ self._selection.T  # θ̇: a floating base's virtual rates are its body-frame twist
         keep = np.array([not body.rotor for body in self.tree.bodies])
@@ -356,7 +416,11 @@ class ReferenceRobot:
         return self._masses[keep], coms[:, keep], velocities[:, keep], inertias[:, keep], omegas[:, keep]
 
     def center_of_mass(self, q: np.ndarray) -> np.ndarray:
-        """``Σ mᵢ pᵢ / m`` in [m], world axes, shape (3,) or (N, 3)."""
+        """``Σ mᵢ pᵢ / m`` in [m], world axes, shape (3,) or (N, 3).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+        """
         (q,), batch = as_states({"q": (q, self.nq)})
         stacked = q if batch else q[None]
         masses, coms, *_ = self.body_motion(stacked, np.zeros((len(stacked), self.nv)))
@@ -365,7 +429,12 @@ class ReferenceRobot:
 
     def centroidal_momentum(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``(Σ mᵢ vᵢ, Σ (pᵢ − c) × mᵢ vᵢ + Iᵢ ωᵢ)``: linear [kg m/s] then angular
-        [kg m²/s] momentum about the centre of mass, world axes, shape (6,) or (N, 6)."""
+        [kg m²/s] momentum about the centre of mass, world axes, shape (6,) or (N, 6).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in the reference's joint order (:attr:`joint_names`), in [rad] / [m].
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s] (a floating base: its body-frame twist first).
+        """
         (q, v), batch = as_states({"q": (q, self.nq), "v": (v, self.nv)})
         stacked = [q, v] if batch else [q[None], v[None]]
         result = centroidal.centroidal_momentum(*self.body_motion(*stacked))

@@ -40,18 +40,30 @@ def _body_with(body: Body, parameters: np.ndarray) -> Body:
 
 
 def reference_bodies(reference: ReferenceRobot) -> list[int]:
-    """Indices of the tree's bodies that carry a link (the regressor's bodies, in order)."""
+    """Indices of the tree's bodies that carry a link (the regressor's bodies, in order).
+
+    Args:
+        reference: The reference model of the robot.
+    """
     bodies = reference.tree.bodies
     return [i for i, body in enumerate(bodies) if body.joint not in VIRTUAL_JOINTS[:5] and not body.rotor]
 
 
 def reference_body_links(reference: ReferenceRobot) -> list[str]:
-    """The link naming each regressor body."""
+    """The link naming each regressor body.
+
+    Args:
+        reference: The reference model of the robot.
+    """
     return [reference.tree.bodies[i].link for i in reference_bodies(reference)]
 
 
 def reference_parameters(reference: ReferenceRobot) -> np.ndarray:
-    """The reference's standard parameters π from the URDF, shape (10·n_bodies,)."""
+    """The reference's standard parameters π from the URDF, shape (10·n_bodies,).
+
+    Args:
+        reference: The reference model of the robot.
+    """
     values = []
     for index in reference_bodies(reference):
         body = reference.tree.bodies[index]

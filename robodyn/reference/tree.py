@@ -244,6 +244,11 @@ def spec_with_armature(spec: URDFSpec, armature: Mapping[str, float], *, locked:
     """``spec`` with ``armature`` (``{joint name: value}``) added to its joints' armature
     (a locked joint's is dropped with it).
 
+    Args:
+        spec: The validated URDF.
+        armature: Armature by joint name, in [kg m²] / [kg].
+        locked: Names of the locked joints.
+
     Raises:
         InputError: For a name that is no moving joint of ``spec``, or a value that is not a
             finite number >= 0.

@@ -18,6 +18,9 @@ MAX_LOCAL_WORKERS = 64
 def check_scheduler(text: str) -> str:
     """``local:N`` (1 ≤ N ≤ 64) or a scheduler address such as ``tcp://10.0.0.5:8786``.
 
+    Args:
+        text: The scheduler as given.
+
     Raises:
         InputError: For anything else.
     """
@@ -34,6 +37,10 @@ def check_scheduler(text: str) -> str:
 @contextlib.contextmanager
 def connect(scheduler: str, *, timeout: float = 20.0) -> Iterator:
     """A ``dask.distributed.Client`` for ``scheduler`` (see the module docstring).
+
+    Args:
+        scheduler: ``local:N`` (a local cluster of N workers) or a scheduler address.
+        timeout: How long to wait for the scheduler, in [s].
 
     Raises:
         RobodynError: If Dask is not installed or the scheduler cannot be reached.

@@ -22,6 +22,13 @@ USE_ARROW = importlib.util.find_spec("pyarrow") is not None
 def csv_tables(path: Path, source: str, *, width: int, rows: int, header_lines: int) -> Iterator[np.ndarray]:
     """The data rows of a CSV trajectory as float arrays of ``rows`` rows (the last fewer).
 
+    Args:
+        path: The CSV file.
+        source: The file's name, for the error.
+        width: Numbers a row.
+        rows: Rows a table.
+        header_lines: Lines before the data (skipped).
+
     Raises:
         TrajectoryError: For rows that are not ``width`` numbers, naming the rows.
     """
@@ -90,7 +97,12 @@ def _arrow_tables(path: Path, source: str, width: int, rows: int, header_lines: 
 
 
 def write_rows(stream, table: np.ndarray) -> None:
-    """Append rows to a CSV file opened in binary mode."""
+    """Append rows to a CSV file opened in binary mode.
+
+    Args:
+        stream: The file, opened for binary appending.
+        table: The rows, shape (n, columns).
+    """
     if USE_ARROW:
         import pyarrow as pa
         import pyarrow.csv as pc

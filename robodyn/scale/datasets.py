@@ -276,7 +276,11 @@ class DatasetWriter:
             self._schema = schema
 
     def write(self, table: np.ndarray) -> None:
-        """Append rows (shape (n, len(header)))."""
+        """Append rows (shape (n, len(header))).
+
+        Args:
+            table: The rows, shape (n, len(header)).
+        """
         if self.path.suffix == ".csv":
             write_rows(self._stream, table)
         elif self.path.suffix == ".npz":
@@ -291,7 +295,11 @@ class DatasetWriter:
         self._written += len(table)
 
     def close(self, *, small: dict[str, np.ndarray] | None = None) -> Path:
-        """Finish the file and put it in place; ``small`` adds arrays to an NPZ (names)."""
+        """Finish the file and put it in place; ``small`` adds arrays to an NPZ (names).
+
+        Args:
+            small: Arrays by name added to an NPZ file (``None``: none).
+        """
         try:
             if self.length is not None and self._written != self.length:
                 raise TrajectoryError(str(self.path), f"wrote {self._written} rows of {self.length}")
@@ -342,7 +350,12 @@ def _umask() -> int:
 
 
 def write_parquet(path: str | os.PathLike, trajectory: Trajectory) -> Path:
-    """Write a whole trajectory as Parquet (the columns of the CSV header), atomically."""
+    """Write a whole trajectory as Parquet (the columns of the CSV header), atomically.
+
+    Args:
+        path: The ``.parquet`` file to write.
+        trajectory: The trajectory.
+    """
     writer = DatasetWriter(path, trajectory.header(), length=len(trajectory), robot=trajectory.robot)
     try:
         writer.write(trajectory.table())

@@ -44,6 +44,9 @@ def what_if(model: str = "rp_arm", *, client, materials: tuple[str, ...] | None 
     """:func:`robodyn.sim.whatif.what_if` with one Dask task a row (same arguments, same table).
 
     The robot is loaded here once more (the first material's), for the table's names and units.
+
+    Args:
+        client: A ``dask.distributed.Client`` (:func:`robodyn.scale.cluster.connect`).
     """
     rows = sweep(model, client=client, materials=materials, **options)
     first = (materials or whatif.DEFAULT_MATERIALS)[:1] if model == "rp_arm" else None
@@ -52,7 +55,12 @@ def what_if(model: str = "rp_arm", *, client, materials: tuple[str, ...] | None 
 
 
 def zoo_statuses(client, names: list[str]) -> list[ZooStatus]:
-    """:func:`robodyn.verify.zoo_status.zoo_statuses` with one Dask task a robot, in ``names`` order."""
+    """:func:`robodyn.verify.zoo_status.zoo_statuses` with one Dask task a robot, in ``names`` order.
+
+    Args:
+        client: A ``dask.distributed.Client`` (:func:`robodyn.scale.cluster.connect`).
+        names: The zoo robots' names.
+    """
     return client.gather(client.map(zoo_status, names, pure=False))
 
 

@@ -87,6 +87,16 @@ def chunk_dynamics(
 ) -> dict[str, np.ndarray]:
     """``tau`` (and ``G``, ``M``) of one chunk; a refusal names the file and the first bad row.
 
+    Args:
+        robot: The robot.
+        q: Configurations, shape (n, nq), in [rad] / [m].
+        v: Velocities, shape (n, nv), in [rad/s] / [m/s].
+        a: Accelerations, shape (n, nv), in [rad/s²] / [m/s²].
+        source: The input file's name, for the error.
+        first_row: The chunk's first row in the file (1-based), for the error.
+        gravity: Also compute ``G``.
+        mass_matrix: Also compute ``M``.
+
     Returns:
         ``{"tau": (n, nv), "G": (n, nv), "M": (n, nv, nv)}`` (G and M when asked).
 
@@ -111,7 +121,13 @@ def chunk_dynamics(
 
 
 def output_header(robot: Robot, *, gravity: bool, mass_matrix: bool) -> tuple[list[str], dict]:
-    """Columns of the output file and, for NPZ, which columns make which array."""
+    """Columns of the output file and, for NPZ, which columns make which array.
+
+    Args:
+        robot: The robot.
+        gravity: The output has ``G`` columns.
+        mass_matrix: The output has ``M`` columns.
+    """
     q_names, v_names = list(robot.configuration_names), [dof.name for dof in robot.dofs]
     nq, nv = len(q_names), len(v_names)
     header = ["t"] + [f"q[{n}]" for n in q_names] + [f"{kind}[{n}]" for kind in ("v", "a", "tau") for n in v_names]
@@ -201,7 +217,11 @@ def torques_run(
     robot: Robot, source: str | os.PathLike, out: str | os.PathLike | None = None, *, scheduler: str | None = None, **options: Any
 ) -> TorquesRun:
     """:func:`torques_file` here, or on the Dask scheduler ``scheduler`` (an address or
-    ``local:N``, :func:`robodyn.scale.cluster.connect`); ``options`` as for it."""
+    ``local:N``, :func:`robodyn.scale.cluster.connect`); ``options`` as for it.
+
+    Args:
+        scheduler: ``local:N`` or a Dask scheduler's address (``None``: run here).
+    """
     if not scheduler:
         return torques_file(robot, source, out, **options)
     check_scheduler(scheduler)

@@ -51,7 +51,11 @@ class Reason(str):
 
 def unsupported(plan: RunPlan) -> list[str]:
     """What the compiled engine does not model in a plan, each one phrase (a :class:`Reason`
-    naming its parameter; empty: it runs it)."""
+    naming its parameter; empty: it runs it).
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+    """
     controller, robot = plan.controller, plan.robot
     reasons: list[str] = []
     if robot.floating_base and fixed_base_only(controller) and plan.every in (None, 1):
@@ -82,7 +86,11 @@ def unsupported(plan: RunPlan) -> list[str]:
 
 def twin_runs(plan: RunPlan) -> bool:
     """Whether the plan's controller runs in C: it owns a twin and is evaluated at every
-    stage or sampled once a step."""
+    stage or sampled once a step.
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+    """
     controller = plan.controller
     return (
         controller is not None
@@ -95,7 +103,11 @@ def twin_runs(plan: RunPlan) -> bool:
 def not_ready(plan: RunPlan) -> list[str]:
     """Why ``engine="auto"`` would not choose the compiled engine for a plan it can run:
     a Python controller (the same stage-by-stage calls in either engine), no C compiler, or
-    the robot not compiled before (a cache lookup: no code generator is loaded)."""
+    the robot not compiled before (a cache lookup: no code generator is loaded).
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+    """
     if plan.controller is not None and not twin_runs(plan):
         return ["a Python controller (called from Python at every stage in either engine)"]
     candidates = (os.environ["CC"],) if os.environ.get("CC") else ("cc", "gcc", "clang")
@@ -116,7 +128,11 @@ def _compiler_on_path(candidates: tuple[str, ...], path: str | None) -> bool:
 
 
 def ready_reason(plan: RunPlan) -> str:
-    """Why auto chose the compiled engine, one phrase."""
+    """Why auto chose the compiled engine, one phrase.
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+    """
     what = "passive" if plan.controller is None else f"{type(plan.controller).__name__} in C"
     return f"{'floating' if plan.robot.floating_base else 'fixed'} base, {what}, compiled before (cached)"
 
@@ -131,6 +147,9 @@ class Prepared:
 
 def prepare(plan: RunPlan) -> Prepared:
     """Compile (or load from the cache) the plant and the controller's twin.
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
 
     Raises:
         CompileError: If a build fails (``CompilerNotFoundError``: no C compiler).
@@ -154,6 +173,10 @@ def twin_torque(prepared: Prepared) -> Callable[[np.ndarray, np.ndarray], np.nda
 
 def run(plan: RunPlan, prepared: Prepared) -> Outcome:
     """Integrate the plan on the compiled kernels (prepared by :func:`prepare`).
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+        prepared: The compiled plant and twin (:func:`prepare`).
 
     Raises:
         SimulationError: If the state stops being finite.

@@ -80,12 +80,21 @@ class CompliantWall:
         self.damping = scalar(self.damping, "damping", "a finite damping >= 0 in [N s/m]")
 
     def penetration(self, q: np.ndarray) -> float:
-        """``p = −n·(x − c)`` in [m] (> 0: inside the wall)."""
+        """``p = −n·(x − c)`` in [m] (> 0: inside the wall).
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+        """
         position, _ = _frame(self.robot, self._frame_id, q)
         return float(-self._normal @ (position - self._point))
 
     def force(self, q: np.ndarray, v: np.ndarray) -> float:
-        """The wall's push ``f = max(0, k p + d ṗ)`` in [N] (zero outside the wall)."""
+        """The wall's push ``f = max(0, k p + d ṗ)`` in [N] (zero outside the wall).
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        """
         position, jacobian = _frame(self.robot, self._frame_id, q)
         depth = float(-self._normal @ (position - self._point))
         if depth <= 0:
@@ -93,7 +102,12 @@ class CompliantWall:
         return max(0.0, self.stiffness * depth - self.damping * float(self._normal @ (jacobian @ v)))
 
     def torques(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """The generalised force ``Jᵀ f n`` of the wall's push, (nv,)."""
+        """The generalised force ``Jᵀ f n`` of the wall's push, (nv,).
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        """
         _, jacobian = _frame(self.robot, self._frame_id, q)
         return jacobian.T @ (self.force(q, v) * self._normal)
 
@@ -139,11 +153,22 @@ class ExplicitForce:
             setattr(self, name, scalar(getattr(self, name), name, "a finite gain >= 0"))
 
     def integral_rate(self, q: np.ndarray, v: np.ndarray) -> float:
-        """``d∫/dt = F − f_m`` in [N]."""
+        """``d∫/dt = F − f_m`` in [N].
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        """
         return self.force - float(self.sensor(q, v))
 
     def torques(self, q: np.ndarray, v: np.ndarray, integral: float) -> np.ndarray:
-        """``tau`` (nv,) at a state and the integral ``∫ (F − f_m) dt`` in [N s]."""
+        """``tau`` (nv,) at a state and the integral ``∫ (F − f_m) dt`` in [N s].
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+            integral: The controller's state ``∫ (F − f_m) dt`` in [N s].
+        """
         position, jacobian = _frame(self.model, self._frame_id, q)
         velocity, n = jacobian @ v, self._normal
         command = self.force + self.force_gain * (self.force - float(self.sensor(q, v))) + self.integral_gain * integral
@@ -173,7 +198,8 @@ def simulate_compliant(
         q0: Initial configuration (nq,).
         torques: ``torques(t, q, v, integral) -> tau`` (nv,).
         wall: The compliant wall.
-        duration: In [s]. dt: Step in [s].
+        duration: Simulated time in [s].
+        dt: Step in [s].
         integral_rate: ``d∫/dt`` of the controller's state (``None``: no state).
 
     Returns:

@@ -144,6 +144,12 @@ def _correction(robot: Robot, bounds, q: np.ndarray, rows: np.ndarray, v: np.nda
 def project(robot: Robot, q: np.ndarray, v: np.ndarray, bounds) -> tuple[np.ndarray, np.ndarray]:
     """``(q, v)`` projected onto ``Φ(q) = 0`` and ``J(q) v = 0`` (the module docstring).
 
+    Args:
+        robot: The simulated robot.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        bounds: Its constraints bound to its frames (:func:`robodyn.dynamics.constrained.bound`).
+
     Raises:
         InputError: If the positions cannot be brought within :data:`POSITION_TOLERANCE`
             (constraints that no configuration near ``q`` satisfies).

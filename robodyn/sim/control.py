@@ -176,7 +176,11 @@ class TaskSpace:
             raise InputError("target", "3 finite values X, Y, Z in [m]", f"shape {self.target.shape}")
 
     def task_error(self, q: np.ndarray) -> np.ndarray:
-        """Target minus the frame's position, shape (3,), in [m]."""
+        """Target minus the frame's position, shape (3,), in [m].
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+        """
         return np.asarray(self.target, float) - self.model.frame_position(q, self._frame)
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -228,13 +232,24 @@ class QuinticReference:
 
 
 def quintic_reference(q_start: np.ndarray, q_end: np.ndarray, duration: float) -> QuinticReference:
-    """A rest-to-rest joint motion from ``q_start`` to ``q_end`` in ``duration`` [s] (:class:`QuinticReference`)."""
+    """A rest-to-rest joint motion from ``q_start`` to ``q_end`` in ``duration`` [s] (:class:`QuinticReference`).
+
+    Args:
+        q_start: Start joint positions, shape (n,), in [rad] / [m].
+        q_end: End joint positions, shape (n,), in [rad] / [m].
+        duration: Duration of the motion in [s].
+    """
     return QuinticReference(np.asarray(q_start, float), np.asarray(q_end, float), float(duration))
 
 
 def joint_target(robot: Robot, target: np.ndarray | list[float], controller: str = "joint-space") -> np.ndarray:
     """A joint-space target, checked: ``nq`` values, or for a floating base its joints'
     ``nq − 7`` (the base is not a target of joint-space control).
+
+    Args:
+        robot: The controlled robot.
+        target: The target joint positions in [rad] / [m]: ``nq`` values, or ``nq − 7`` for a floating base.
+        controller: The controller's name, for the error.
 
     Raises:
         InputError: For another number of values (naming the count and the joints) or
@@ -256,6 +271,12 @@ def free_base_torques(model: Robot, q: np.ndarray, v: np.ndarray, joint_accelera
 
     The base's acceleration is the one that motion causes: the base rows of
     ``M a + h = tau`` with ``tau_base = 0`` give ``a_base = −M_bb⁻¹ (M_bj a_j + h_b)``.
+
+    Args:
+        model: The controller's model of the robot (floating base).
+        q: Configuration, shape (nq,), in [rad] / [m].
+        v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        joint_accelerations: The joints' accelerations, shape (nv − 6,), in [rad/s²] / [m/s²].
     """
     mass, effects = model.mass_matrix(q), model.nonlinear_effects(q, v)
     base = -np.linalg.solve(mass[:6, :6], mass[:6, 6:] @ joint_accelerations + effects[:6])
@@ -351,7 +372,18 @@ def lqr_gain(
     integrator: StepIntegrator = "rk4",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The gain ``K`` (nu, 2 nv), the holding input ``u_eq`` (nu,) and ``S_act`` (nv, nu) of
-    :class:`LQR` (its attributes are the arguments; same errors)."""
+    :class:`LQR` (its attributes are the arguments; same errors).
+
+    Args:
+        model: The controller's model of the robot (fixed base).
+        q_eq: Equilibrium configuration, shape (nq,).
+        v_eq: Equilibrium velocity, shape (nv,): zeros (an equilibrium holds still).
+        Q: State weight: a scalar, the diagonal (2 nv,) or a matrix (2 nv, 2 nv), per [rad²] / [m²] and [rad²/s²] / [m²/s²].
+        R: Input weight: a scalar, (nu,) or (nu, nu), per [N² m²] / [N²].
+        dt: Step in [s] for a discrete design; ``None``: continuous.
+        actuated: Names of the actuated joints; ``None``: all.
+        integrator: With ``dt``: the integrator the step is taken with.
+    """
     import scipy.linalg
 
     if model.floating_base:

@@ -58,6 +58,9 @@ class EngineRun:
 def choose(plan: RunPlan) -> tuple[Literal["pinocchio", "compiled"], str]:
     """The engine a plan runs on, and why (one phrase).
 
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+
     Raises:
         InputError: With ``engine="compiled"``, for what the compiled engine does not
             model (:func:`robodyn.sim.compiled_backend.unsupported`'s first reason).
@@ -81,6 +84,9 @@ def choose(plan: RunPlan) -> tuple[Literal["pinocchio", "compiled"], str]:
 
 def run(plan: RunPlan) -> tuple[Trajectory, EngineRun]:
     """Run a plan on the engine :func:`choose` names: the trajectory and how it went.
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
 
     Raises:
         CompileError: With ``engine="compiled"``, if the build fails (with ``"auto"`` the

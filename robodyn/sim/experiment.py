@@ -62,7 +62,11 @@ REACHED = 1e-3
 
 
 def controller_model(robot: Robot) -> Robot:
-    """An independent copy of the robot for a controller (same URDF, its own data)."""
+    """An independent copy of the robot for a controller (same URDF, its own data).
+
+    Args:
+        robot: The simulated robot.
+    """
     return rebuild(robot)
 
 
@@ -365,7 +369,13 @@ def _task_outcome(robot: Robot, trajectory: Trajectory, frame: str, task: np.nda
 
 
 def frame_pose(robot: Robot, q: np.ndarray, frame: str) -> tuple[np.ndarray, np.ndarray]:
-    """A frame's position in [m] (3,) and attitude (3, 3), by the robot's forward kinematics."""
+    """A frame's position in [m] (3,) and attitude (3, 3), by the robot's forward kinematics.
+
+    Args:
+        robot: The robot.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        frame: The frame's name.
+    """
     model, data = robot.model, robot.data
     pin.framesForwardKinematics(model, data, np.asarray(q, dtype=float))
     placement = data.oMf[robot.frame_id(frame)]

@@ -102,13 +102,25 @@ def computed_torque_gains(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Computed torque's gains in [1/s²] and [1/s], shape (size,) each: as given (checked
     as :func:`gain_values`), else 400 and 40 (a critically damped 20 rad/s: the law
-    divides by the inertia itself, so one pair suits every joint)."""
+    divides by the inertia itself, so one pair suits every joint).
+
+    Args:
+        size: Number of joints.
+        kp: Stiffness in [1/s²]: one value or one a joint (``None``: 400).
+        kd: Damping in [1/s]: one value or one a joint (``None``: 40).
+    """
     stiffness = np.full(size, 400.0) if kp is None else gain_values(kp, "kp", size)
     return stiffness, (np.full(size, 40.0) if kd is None else gain_values(kd, "kd", size))
 
 
 def gain_values(value: float | list[float] | np.ndarray, name: str, size: int) -> np.ndarray:
-    """A gain as one value a joint: a scalar broadcast, or ``size`` values; finite and ≥ 0."""
+    """A gain as one value a joint: a scalar broadcast, or ``size`` values; finite and ≥ 0.
+
+    Args:
+        value: A scalar or one value a joint.
+        name: The parameter's name, for the error.
+        size: Number of joints.
+    """
     try:
         array = np.asarray(value, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -131,6 +143,11 @@ def lqr_weights(robot: Robot, q_eq: np.ndarray, actuated: list[str] | None = Non
     0.1 m/s); ``R`` with 1 / u_j² per actuated joint, ``u_j`` the smaller of its effort
     limit and ``M_jj(q_eq)`` × :data:`LQR_ACCELERATION` (so light distal joints are not
     given gains too stiff for a millisecond step).
+
+    Args:
+        robot: The controlled robot (fixed base).
+        q_eq: Equilibrium configuration, shape (nq,), in [rad] / [m].
+        actuated: Names of the actuated joints; ``None``: all.
     """
     positions = [1 / 0.03**2 if dof.linear else 1 / 0.3**2 for dof in robot.dofs]
     velocities = [100.0 if dof.linear else 1.0 for dof in robot.dofs]

@@ -44,7 +44,11 @@ _ITERATIONS = 80
 
 
 def has_joint_friction(robot: Robot) -> bool:
-    """Whether any joint of ``robot`` has damping or Coulomb friction."""
+    """Whether any joint of ``robot`` has damping or Coulomb friction.
+
+    Args:
+        robot: The robot.
+    """
     return bool(np.any(robot.joint_damping) or np.any(robot.joint_friction))
 
 
@@ -77,7 +81,11 @@ class JointFriction:
 
     def wrap(self, forward: Accelerate) -> Accelerate:
         """``forward`` (the rigid-body accelerations under a torque) with the joints'
-        damping and friction torques added and the stuck joints held."""
+        damping and friction torques added and the stuck joints held.
+
+        Args:
+            forward: The rigid-body accelerations ``a(t, q, v, tau)``.
+        """
         damping, friction = self.damping, self.friction
         damped = bool(damping.any())
 
@@ -108,7 +116,15 @@ class JointFriction:
 
     def start(self, accelerate: Accelerate, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
         """Decide the modes at the run's first state: joints at rest stick or slip, the
-        others slide the way they move."""
+        others slide the way they move.
+
+        Args:
+            accelerate: The accelerations ``a(t, q, v, tau)`` with the joints' friction (:meth:`wrap`).
+            t: Time in [s].
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+            tau: The applied torques, shape (nv,), in [N m] / [N].
+        """
         self.sign = np.where(self.coulomb, np.sign(v), 0.0)
         self._settle(accelerate, t, q, v, tau)
 
@@ -148,7 +164,18 @@ class JointFriction:
         a: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray]:
         """One step of ``dt`` from ``(q, v)`` at time ``t`` (``a``: the accelerations
-        there), cut at every stick–slip event inside it."""
+        there), cut at every stick–slip event inside it.
+
+        Args:
+            step: One integrator step ``step(t, dt, q, v, tau, a) -> (q, v)``.
+            accelerate: The accelerations ``a(t, q, v, tau)`` with the joints' friction (:meth:`wrap`).
+            t: Time in [s].
+            dt: Step in [s].
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+            tau: The applied torques, shape (nv,), in [N m] / [N].
+            a: Accelerations at ``(t, q, v)``, shape (nv,), in [rad/s²] / [m/s²].
+        """
         if not self.coulomb.any():
             return step(t, dt, q, v, tau, a)
         done = 0.0

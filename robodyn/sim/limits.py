@@ -44,7 +44,11 @@ TOLERANCE = 1e-9
 
 
 def check_mode(limits: str) -> str:
-    """Refuse an unknown limits mode."""
+    """Refuse an unknown limits mode.
+
+    Args:
+        limits: The limits mode, one of :data:`LIMIT_MODES`.
+    """
     if limits not in LIMIT_MODES:
         raise InputError("limits", f"one of {', '.join(LIMIT_MODES)}", repr(limits))
     return limits
@@ -116,11 +120,20 @@ class JointLimits:
         self._has_efforts = bool(np.isfinite(self.effort).any())
 
     def saturate(self, tau: np.ndarray) -> np.ndarray:
-        """Torques clipped at the effort limits, shape (nv,)."""
+        """Torques clipped at the effort limits, shape (nv,).
+
+        Args:
+            tau: Torques, shape (nv,), in [N m] / [N].
+        """
         return np.clip(tau, -self.effort, self.effort) if self._has_efforts else tau
 
     def stop(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Put joints beyond a position limit back on it, with no velocity into it."""
+        """Put joints beyond a position limit back on it, with no velocity into it.
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        """
         if not self._has_stops:
             return q, v
         joints = q[self._q_start :]
@@ -138,7 +151,11 @@ class JointLimits:
 
         Each column's comparisons, first times and worst samples come from whole-array
         operations (one per quantity, every joint at once); a violation is then read off its
-        column."""
+        column.
+
+        Args:
+            trajectory: A trajectory of the robot (its ``tau`` may be ``None``: efforts then unchecked).
+        """
         if len(trajectory.t) == 0:
             return []
         # one row a joint (contiguous: the reductions run along rows)
@@ -186,12 +203,22 @@ def limit_violations(robot: Robot, trajectory: Trajectory) -> list[LimitViolatio
     """Every position, velocity and effort limit a trajectory of ``robot`` broke.
 
     Each violation names the joint, the first time in [s], the worst value and the limit.
+
+    Args:
+        robot: The robot whose limits are checked.
+        trajectory: A trajectory of ``robot``.
     """
     return JointLimits(robot).violations(trajectory)
 
 
 def warning_text(robot: str, violations: list[LimitViolation], *, shown: int = 4) -> str:
-    """One line summarising the violations (the first ``shown`` in full)."""
+    """One line summarising the violations (the first ``shown`` in full).
+
+    Args:
+        robot: The robot's name.
+        violations: The violations (:func:`limit_violations`).
+        shown: How many are listed in full.
+    """
     listed = "; ".join(violation.text() for violation in violations[:shown])
     more = f"; and {len(violations) - shown} more" if len(violations) > shown else ""
     return f"{printable(robot)}: {len(violations)} joint limit violation{'s' if len(violations) != 1 else ''}: {listed}{more}"

@@ -121,7 +121,11 @@ class Linearization:
         }
 
     def text(self, *, precision: int = 6) -> str:
-        """Readable text: the state, the matrices with their row and column names."""
+        """Readable text: the state, the matrices with their row and column names.
+
+        Args:
+            precision: Significant digits of each number.
+        """
         if self.dt is None:
             head = f"{self.robot}: continuous time, d(dx)/dt = A dx + B du"
         else:
@@ -163,6 +167,10 @@ def _rows(names: list[str], matrix: np.ndarray, precision: int) -> list[str]:
 def actuation_matrix(robot: Robot, actuated: Sequence[str] | None) -> np.ndarray:
     """``S_act``, shape (nv, nu): one column a degree of freedom of the ``actuated`` joints
     (in the robot's order), or the identity for ``None``.
+
+    Args:
+        robot: The robot.
+        actuated: Names of the actuated joints (one name as a string too); ``None``: all.
 
     Raises:
         InputError: For an unknown joint name, a repeated one or none at all.

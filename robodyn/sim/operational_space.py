@@ -233,7 +233,13 @@ class OperationalSpace:
         return relative_singular_value(jacobian[:rows], self._length, self._rank)
 
     def task_error(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The task error ``e`` and its rate ``ė`` ([m], [m/s], then with an attitude [rad], [rad/s]), each (3,) or (6,)."""
+        """The task error ``e`` and its rate ``ė`` ([m], [m/s], then with an attitude [rad], [rad/s]), each (3,) or (6,).
+
+        Args:
+            t: Time in [s] (a moving target's).
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        """
         state = _frame_state(self.model, self._frame_id, q, v)
         error, rate, _ = self._error(t, state, v)
         return error, rate
@@ -359,7 +365,11 @@ class Impedance:
 
     def deflection(self, q: np.ndarray) -> np.ndarray:
         """The frame's displacement from rest, shape (3,) or (6,): position in [m], then (with an orientation)
-        the rotation from rest as a rotation vector in world axes in [rad]. A steady wrench ``F`` there gives ``K⁻¹ F``."""
+        the rotation from rest as a rotation vector in world axes in [rad]. A steady wrench ``F`` there gives ``K⁻¹ F``.
+
+        Args:
+            q: Configuration, shape (nq,), in [rad] / [m].
+        """
         state = _frame_state(self.model, self._frame_id, q, np.zeros(self.model.nv))
         shift = state.position - np.asarray(self.position)
         if self._rotation is None:

@@ -23,12 +23,19 @@ from robodyn.sim.python_loop import Forward, Stepper, integrate, singular
 
 
 def unsupported(plan: RunPlan) -> list[str]:
-    """What this backend cannot run of a plan, each reason one phrase: nothing."""
+    """What this backend cannot run of a plan, each reason one phrase: nothing.
+
+    Args:
+        plan: The checked simulation request.
+    """
     return []
 
 
 def run(plan: RunPlan) -> Outcome:
     """Integrate the plan over Pinocchio's ABA.
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
 
     Raises:
         SingularMassMatrixError: If the mass matrix is singular at the start (massless
@@ -71,6 +78,10 @@ def accelerator(robot: Robot, external: Sequence[ExternalWrench]) -> Forward:
 
     Calls Pinocchio without the boundary checks (the plan checked the state once, and the
     loop checks finiteness each step).
+
+    Args:
+        robot: The simulated robot.
+        external: The external wrenches.
     """
     forward = robot.forward_dynamics_unchecked
     if not external:

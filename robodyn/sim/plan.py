@@ -56,12 +56,23 @@ class ExternalWrench:
     wrench: np.ndarray | Sequence[float] | Callable[[float], np.ndarray]
 
     def value(self, time: float) -> np.ndarray:
-        """The wrench at a time, shape (6,) or (3,)."""
+        """The wrench at a time, shape (6,) or (3,).
+
+        Args:
+            time: Simulation time in [s].
+        """
         return np.asarray(self.wrench(time) if callable(self.wrench) else self.wrench, dtype=float)
 
 
 def external_torques(robot: Robot, q: np.ndarray, time: float, external: Sequence[ExternalWrench]) -> np.ndarray:
-    """Sum of ``J(q)ᵀ w`` over external wrenches at a time, shape (nv,)."""
+    """Sum of ``J(q)ᵀ w`` over external wrenches at a time, shape (nv,).
+
+    Args:
+        robot: The simulated robot.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        time: Simulation time in [s].
+        external: The external wrenches.
+    """
     total = np.zeros(robot.nv)
     for item in external:
         total += robot.wrench_torques(q, item.frame, item.value(time))

@@ -96,22 +96,53 @@ class Stepper:
         self.zero = np.zeros(robot.nv)
 
     def torque(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """The controller's torque at the step's start, shape (nv,) (zero when passive)."""
+        """The controller's torque at the step's start, shape (nv,) (zero when passive).
+
+        Args:
+            t: Time in [s].
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        """
         return self.zero if self.controller is None else np.asarray(self.controller(t, q, v), dtype=float)
 
     def observe(self, t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
-        """Feed the observer (if any) a sample and the torque applied there."""
+        """Feed the observer (if any) a sample and the torque applied there.
+
+        Args:
+            t: Time in [s].
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+            tau: The applied torques, shape (nv,), in [N m] / [N].
+        """
         if self.observer is not None:
             self.observer.update(t, q, v, tau)
 
     def advance(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
-        """:meth:`step`, cut at the joints' stick-slip events when there is joint friction."""
+        """:meth:`step`, cut at the joints' stick-slip events when there is joint friction.
+
+        Args:
+            t: Time in [s].
+            dt: Step in [s].
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+            tau: The torques held over the step, shape (nv,), in [N m] / [N].
+            a: Accelerations at ``(t, q, v)``, shape (nv,), in [rad/s²] / [m/s²].
+        """
         if self.friction is None:
             return self.step(t, dt, q, v, tau, a)
         return self.friction.step(self.step, self.accelerate, t, dt, q, v, tau, a)
 
     def step(self, t: float, dt: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray):
-        """``(q, v)`` after one step of ``dt`` from time ``t`` with acceleration ``a`` there."""
+        """``(q, v)`` after one step of ``dt`` from time ``t`` with acceleration ``a`` there.
+
+        Args:
+            t: Time in [s].
+            dt: Step in [s].
+            q: Configuration, shape (nq,), in [rad] / [m].
+            v: Velocity, shape (nv,), in [rad/s] / [m/s].
+            tau: The torques held over the step, shape (nv,), in [N m] / [N].
+            a: Accelerations at ``(t, q, v)``, shape (nv,), in [rad/s²] / [m/s²].
+        """
         if not self.rk4:
             v = v + dt * a
             return (q + dt * v if self.integrate is None else self.integrate(q, dt * v)), v
@@ -139,7 +170,17 @@ def integrate(
     robot: Robot, stepper: Stepper, q: np.ndarray, v: np.ndarray, steps: int, dt: float, stops: JointLimits | None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The samples of ``steps`` steps from ``(q, v)``: positions, velocities, accelerations,
-    torques, one row a sample (``stops``: joints stopped at their position limits after each step)."""
+    torques, one row a sample (``stops``: joints stopped at their position limits after each step).
+
+    Args:
+        robot: The simulated robot.
+        stepper: The integrator with the controller and forward dynamics.
+        q: Initial configuration, shape (nq,), in [rad] / [m].
+        v: Initial velocity, shape (nv,), in [rad/s] / [m/s].
+        steps: Number of steps.
+        dt: Step in [s].
+        stops: The joints' position stops (``None``: limits not enforced).
+    """
     qs: list[np.ndarray] = []
     vs: list[np.ndarray] = []
     accelerations: list[np.ndarray] = []
@@ -182,7 +223,16 @@ def integrate(
 
 
 def check_finite(robot: Robot, qs: list[np.ndarray], vs: list[np.ndarray], q: np.ndarray, v: np.ndarray, dt: float) -> None:
-    """Raise :class:`SimulationError` at the first non-finite state since the last check."""
+    """Raise :class:`SimulationError` at the first non-finite state since the last check.
+
+    Args:
+        robot: The simulated robot.
+        qs: The configurations sampled so far.
+        vs: The velocities sampled so far.
+        q: The newest configuration, shape (nq,).
+        v: The newest velocity, shape (nv,).
+        dt: Step in [s] (to name the failing time).
+    """
     if math.isfinite(v.dot(v)) and math.isfinite(q.dot(q)):
         return
     states = [*zip(qs[-CHECK_EVERY:], vs[-CHECK_EVERY:], strict=True), (q, v)]
@@ -208,6 +258,11 @@ def _moderate(q: np.ndarray, v: np.ndarray) -> bool:
 
 
 def singular(robot: Robot, q: np.ndarray) -> bool:
-    """Whether ``M(q)`` is singular to working precision (no finite acceleration)."""
+    """Whether ``M(q)`` is singular to working precision (no finite acceleration).
+
+    Args:
+        robot: The robot.
+        q: Configuration, shape (nq,), in [rad] / [m].
+    """
     eigenvalues = np.linalg.eigvalsh(robot.mass_matrix(q))
     return bool(eigenvalues[0] <= 1e-12 * max(abs(eigenvalues[-1]), np.finfo(float).tiny))

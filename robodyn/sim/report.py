@@ -223,11 +223,20 @@ class SimulationSummary:
     drawings: tuple = field(default=(), repr=False, compare=False)
 
     def with_startup(self, seconds: float | None) -> SimulationSummary:
-        """The same summary with the start-up time in [s] (process start to the run)."""
+        """The same summary with the start-up time in [s] (process start to the run).
+
+        Args:
+            seconds: The start-up time in [s] (``None``: not measured).
+        """
         return replace(self, startup_time=seconds)
 
     def with_file(self, kind: str, path: str) -> SimulationSummary:
-        """The same summary also naming a file written for the run."""
+        """The same summary also naming a file written for the run.
+
+        Args:
+            kind: What the file holds (e.g. ``"trajectory"``).
+            path: The file's path.
+        """
         return replace(self, files=(*self.files, (kind, str(path))))
 
     def to_dict(self) -> dict[str, Any]:
@@ -366,7 +375,12 @@ class SimulationSummary:
 
 
 def vector_text(values: Any, precision: int) -> str:
-    """``[v0, v1, ...]`` with ``precision`` significant digits."""
+    """``[v0, v1, ...]`` with ``precision`` significant digits.
+
+    Args:
+        values: The numbers, shape (n,).
+        precision: Significant digits.
+    """
     return "[" + ", ".join(f"{value:.{precision}g}" for value in np.asarray(values, dtype=float)) + "]"
 
 

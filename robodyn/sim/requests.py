@@ -25,7 +25,11 @@ from robodyn.trajectory import Trajectory
 
 
 def task_target(values: list[float] | np.ndarray) -> np.ndarray:
-    """A task-space target from ``X,Z`` (planar arms, ``Y = 0``) or ``X,Y,Z``, in [m]."""
+    """A task-space target from ``X,Z`` (planar arms, ``Y = 0``) or ``X,Y,Z``, in [m].
+
+    Args:
+        values: 2 (``X,Z``) or 3 (``X,Y,Z``) numbers, in [m].
+    """
     values = np.asarray(values, dtype=float)
     if values.shape == (2,):
         return np.array([values[0], 0.0, values[1]])
@@ -36,7 +40,14 @@ def task_target(values: list[float] | np.ndarray) -> np.ndarray:
 
 def check_planar(robot: Robot, frame: str, q: np.ndarray, size: int) -> None:
     """Refuse an ``X,Z`` target for a frame that does not stay in the plane ``Y = 0``
-    (a planar arm in the XY plane, or any 3-D arm): the target would leave ``Y`` at 0."""
+    (a planar arm in the XY plane, or any 3-D arm): the target would leave ``Y`` at 0.
+
+    Args:
+        robot: The controlled robot.
+        frame: The task frame's name.
+        q: The configuration the frame is checked at, shape (nq,).
+        size: How many target values were given (2: ``X,Z``).
+    """
     if size != 2:
         return
     sideways = np.abs(robot.frame_jacobian(q, frame)[1]).max(initial=0.0)
@@ -52,6 +63,9 @@ def check_planar(robot: Robot, frame: str, q: np.ndarray, size: int) -> None:
 def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """A pose target from ``X,Y,Z`` (position only) or ``X,Y,Z,ROLL,PITCH,YAW``.
 
+    Args:
+        values: 3 or 6 numbers: position in [m], then roll, pitch, yaw in [rad].
+
     Returns:
         The position in [m], shape (3,), and roll, pitch, yaw in [rad], shape (3,) (``None``
         for a position target).
@@ -63,7 +77,11 @@ def pose_target(values: list[float] | np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def parse_push(text: str) -> Push:
-    """A push from ``T:FX,FY,FZ`` or ``T:FX,FY,FZ@FRAME`` (time in [s], force in [N])."""
+    """A push from ``T:FX,FY,FZ`` or ``T:FX,FY,FZ@FRAME`` (time in [s], force in [N]).
+
+    Args:
+        text: The push, e.g. ``"0.5:0,0,-20@link2"``.
+    """
     head, _, frame = text.partition("@")
     start, _, force = head.partition(":")
     try:
@@ -90,7 +108,13 @@ def push_wrenches(
     robot: Robot, pushes: Sequence[str | Push], frame: str | None = None
 ) -> tuple[tuple[Push, ...], list[ExternalWrench]]:
     """The pushes (frames resolved: ``frame`` when a push names none, then the robot's end
-    effector) and their wrenches."""
+    effector) and their wrenches.
+
+    Args:
+        robot: The simulated robot.
+        pushes: Pushes, as :class:`Push` or as text for :func:`parse_push`.
+        frame: The frame of a push that names none (``None``: the robot's end effector).
+    """
     resolved = []
     for push in pushes:
         push = parse_push(push) if isinstance(push, str) else push
@@ -125,7 +149,15 @@ def tracked(
     robot: Robot, controller: str, reference: Trajectory, target: list[float] | None, q0: list[float] | None
 ) -> tuple[Trajectory, list[float], list[float]]:
     """The reference in the robot's joint order, its goal as the target and its start as ``q0``
-    (unless given); refused with another controller, a target, a floating base or one sample."""
+    (unless given); refused with another controller, a target, a floating base or one sample.
+
+    Args:
+        robot: The simulated robot.
+        controller: The controller's name (only ``"computed-torque"`` tracks a reference).
+        reference: The motion to track (a fixed-base robot's, at least two samples).
+        target: A target given besides (refused: the reference's last sample is the target).
+        q0: Initial configuration in [rad] / [m] (``None``: the reference's first sample).
+    """
     if controller != "computed-torque":
         raise InputError("reference", "given only with the computed-torque controller", repr(controller))
     if target is not None:

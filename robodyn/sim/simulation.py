@@ -129,8 +129,9 @@ def simulate(run_plan: RunPlan) -> Trajectory:
 @_from_plan(plan)
 def simulate_run(run_plan: RunPlan) -> tuple[Trajectory, EngineRun]:
     """:func:`simulate`, also saying which engine ran, why, and the loop's and the
-    compilation's wall-clock times (:class:`EngineRun`). Arguments, errors and warnings
-    are :func:`simulate`'s."""
+    compilation's wall-clock times (:class:`EngineRun`). Errors and warnings are
+    :func:`simulate`'s; the arguments, those of :func:`robodyn.sim.plan.plan`, which
+    documents each."""
     return _run(run_plan)
 
 

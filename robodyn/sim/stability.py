@@ -63,7 +63,11 @@ class _Start(NamedTuple):
 def largest_stable_step(plan: RunPlan) -> tuple[float, str, str] | None:
     """The largest stable step in [s] at the plan's start, the joint its fastest mode moves
     most and that mode's likely cause; ``None`` when the start cannot be linearized (a
-    singular mass matrix: the run reports its own error)."""
+    singular mass matrix: the run reports its own error).
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+    """
     try:
         return _largest(plan, _start(plan))
     except _FAILURES:
@@ -218,7 +222,11 @@ def _feedback(plan: RunPlan, torque: Torque) -> np.ndarray:
 def task_warning(plan: RunPlan) -> str | None:
     """One sentence when an operational-space task starts at (or near) a singularity: its
     smallest singular value (:meth:`OperationalSpace.singular_value`) below the threshold of
-    the law's variable damping (:mod:`robodyn.sim.task_damping`), a stretched or folded arm."""
+    the law's variable damping (:mod:`robodyn.sim.task_damping`), a stretched or folded arm.
+
+    Args:
+        plan: The checked simulation request (robot, controller, options).
+    """
     law = plan.controller
     if not isinstance(law, OperationalSpace) or law.frame is None:
         return None

@@ -23,14 +23,23 @@ if TYPE_CHECKING:
 
 def fixed_base_only(controller: object) -> bool:
     """Whether the controller's twin models fixed bases only (its class's ``twin_fixed_base``:
-    the frame laws' compiled kinematics and LQR)."""
+    the frame laws' compiled kinematics and LQR).
+
+    Args:
+        controller: The controller.
+    """
     return bool(getattr(type(controller), "twin_fixed_base", False))
 
 
 def law_refusal(controller: object, owner: type) -> str | None:
     """Why ``controller`` (an instance of ``owner`` or a subclass) has no twin: a subclass
     that changes the law (its ``__call__``), or, for a twin of fixed bases only
-    (:func:`fixed_base_only`), a floating model; ``None`` when it has one."""
+    (:func:`fixed_base_only`), a floating model; ``None`` when it has one.
+
+    Args:
+        controller: The controller.
+        owner: The class whose law the twin computes.
+    """
     if type(controller).__call__ is not owner.__call__:
         return f"{type(controller).__name__} changes {owner.__name__}'s law; its compiled twin is {owner.__name__}'s"
     model = getattr(controller, "model", None)
@@ -41,6 +50,10 @@ def law_refusal(controller: object, owner: type) -> str | None:
 
 def compiled_model(model: Robot, refusal: str | None) -> CompiledRobot:
     """A controller's own model, compiled (loading the code generator), after its refusal.
+
+    Args:
+        model: The controller's model of the robot.
+        refusal: Why the controller has no twin (``None``: it has one).
 
     Raises:
         CompileError: With the refusal, when there is one.

@@ -35,6 +35,13 @@ def driven_torques(model: Robot, q: np.ndarray, v: np.ndarray, accelerations: np
 
     The undriven rows of ``M a + h = tau`` with ``tau_u = 0`` give
     ``a_u = −M_uu⁻¹ (M_ud a_d + h_u)``.
+
+    Args:
+        model: The controller's model of the robot.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        v: Velocity, shape (nv,), in [rad/s] / [m/s].
+        accelerations: The driven degrees of freedom's accelerations in [rad/s²] / [m/s²], shape (number driven,).
+        driven: Mask of the driven degrees of freedom, shape (nv,) (:func:`driven_dofs`).
     """
     mass, effects = model.mass_matrix(q), model.nonlinear_effects(q, v)
     free = ~driven
@@ -50,6 +57,10 @@ def driven_dofs(robot: Robot, actuated: list[str] | None) -> np.ndarray:
     """Which degrees of freedom an actuator drives, shape (nv,): those of the ``actuated``
     joints, or by default those whose :attr:`~robodyn.dynamics.dofs.Dof.actuated` (never a
     floating base's six).
+
+    Args:
+        robot: The robot.
+        actuated: Names of the actuated joints; ``None``: those whose ``Dof.actuated`` is true.
 
     Raises:
         InputError: ``actuated`` naming an unknown joint, one twice, or none.

@@ -71,6 +71,15 @@ def motion_torques(
 
     An external ``force`` (in [N], world axes) acting on ``frame`` is subtracted through
     ``J(q)ᵀ f``: the motors need that much less torque when it helps, more when it resists.
+
+    Args:
+        robot: The robot.
+        q_start: Start configuration, shape (nq,), in [rad] / [m].
+        q_end: End configuration, shape (nq,), in [rad] / [m].
+        duration: Duration of the motion in [s].
+        samples: Number of evenly spaced times, both ends included.
+        frame: The frame the force acts on (needed with a non-zero ``force``).
+        force: External force on ``frame``'s origin, shape (3,), in [N], world axes (``None``: none).
     """
     reference = quintic_reference(q_start, q_end, duration)
     times = np.linspace(0.0, duration, samples)
@@ -174,7 +183,13 @@ def what_if(
 
 
 def table_of(robot: Robot, duration: float, rows: list[Variant]) -> WhatIfTable:
-    """The table of ``rows`` swept on ``robot`` (names and units from ``robot.dofs``)."""
+    """The table of ``rows`` swept on ``robot`` (names and units from ``robot.dofs``).
+
+    Args:
+        robot: The robot swept.
+        duration: Duration of the motion in [s].
+        rows: The sweep's variants.
+    """
     units = tuple(dof.effort_unit for dof in robot.dofs)
     return WhatIfTable(robot.name, duration, tuple(robot.joint_names), units, tuple(rows))
 
@@ -193,6 +208,10 @@ def _check_sweep(payloads: tuple[float, ...], forces: tuple[tuple[float, float, 
 
 def model_variants(model: str, materials: tuple[str, ...] | None) -> list[tuple[str, Robot]]:
     """The robots a sweep compares: the RP arm in each material, or ``model`` as loaded.
+
+    Args:
+        model: A robot file or name (``"rp_arm"``: the generated RP arm).
+        materials: Material names for the RP arm's links (``None``: the defaults); refused for another robot.
 
     Raises:
         InputError: Materials for another robot than ``rp_arm``, or a floating base.
@@ -231,7 +250,13 @@ def _effort_limits(robot: Robot) -> np.ndarray:
 
 
 def table_text(rows: list[Variant], joint_names: list[str], units: list[str]) -> str:
-    """The sweep as a readable table; a peak above the joint's effort limit ends in ``!``."""
+    """The sweep as a readable table; a peak above the joint's effort limit ends in ``!``.
+
+    Args:
+        rows: The sweep's variants.
+        joint_names: The robot's joint names.
+        units: The torque unit of each joint (``"N m"`` or ``"N"``).
+    """
     header = f"{'material':10s} {'payload':>8s} {'force [N]':>16s} {'mass':>8s}"
     for name, unit in zip((printable(n) for n in joint_names), units, strict=True):
         header += f" {'peak ' + name + ' [' + unit + ']':>22s} {'rms ' + name:>14s}"
@@ -253,7 +278,13 @@ def table_text(rows: list[Variant], joint_names: list[str], units: list[str]) ->
 
 
 def table_dict(rows: list[Variant], joint_names: list[str], units: list[str]) -> dict:
-    """The sweep, JSON-ready."""
+    """The sweep, JSON-ready.
+
+    Args:
+        rows: The sweep's variants.
+        joint_names: The robot's joint names.
+        units: The torque unit of each joint (``"N m"`` or ``"N"``).
+    """
     return {
         "joint_names": joint_names,
         "torque_units": units,

@@ -72,7 +72,11 @@ def coordinate_names_to_joints(v_names: list[str], floating_base: bool) -> list[
 
 def contact_header(contacts: list[str]) -> list[str]:
     """The columns of a contact simulation's forces and active flags, for contacts named
-    ``contacts``: ``f[<c>].x``, ``f[<c>].y``, ``f[<c>].z`` of each, then ``contact[<c>]``."""
+    ``contacts``: ``f[<c>].x``, ``f[<c>].y``, ``f[<c>].z`` of each, then ``contact[<c>]``.
+
+    Args:
+        contacts: The contacts' names.
+    """
     forces = [f"f[{name}].{axis}" for name in contacts for axis in "xyz"]
     return forces + [f"contact[{name}]" for name in contacts]
 
@@ -89,6 +93,11 @@ def commanded_header(contacts: list[str]) -> list[str]:
 
 def contact_columns(header: list[str], table: np.ndarray, contacts: list[str]) -> tuple[np.ndarray, np.ndarray]:
     """A table's contact forces (N, k, 3) [N] and active flags (N, k) (:func:`contact_header`).
+
+    Args:
+        header: The table's column names.
+        table: The table, one sample a row, shape (N, columns).
+        contacts: The contacts' names.
 
     Raises:
         TrajectoryError: When a column of those contacts is missing.

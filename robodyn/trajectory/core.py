@@ -97,6 +97,9 @@ class Trajectory:
     def for_robot(self, robot: Robot) -> Trajectory:
         """This trajectory with its columns in the robot's joint order (checked as :meth:`check`).
 
+        Args:
+            robot: The robot whose joints the trajectory's columns name.
+
         Raises:
             TrajectoryError: If the joints are not the robot's.
         """
@@ -148,6 +151,9 @@ class Trajectory:
     # ----------------------------------------------------------------------------------
     def save(self, path: str | Path) -> Path:
         """Write to ``.csv`` or ``.npz`` (by extension), atomically.
+
+        Args:
+            path: The ``.csv`` or ``.npz`` file to write.
 
         Returns:
             The path written.

@@ -279,6 +279,10 @@ def write_with_extras(path: Path, trajectory: Any, extras: dict[str, np.ndarray]
 def read_extra(path: Path, kind: str) -> np.ndarray | None:
     """The extra columns of one kind a trajectory file holds (``tau_ext``, ``tau_env``, ``G``).
 
+    Args:
+        path: The trajectory file (``.csv`` or ``.npz``).
+        kind: ``"tau_ext"``, ``"tau_env"`` or ``"G"``.
+
     Returns:
         Shape (N, nv) in the file's ``v`` order, or ``None`` when the file has none.
     """

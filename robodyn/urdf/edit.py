@@ -101,7 +101,15 @@ def inertial_element(mass: float, com: np.ndarray, inertia: np.ndarray) -> ET.El
 
 
 def weld_link(spec: URDFSpec, parent: str, link: ET.Element, xyz: str = "0 0 0", rpy: str = "0 0 0") -> str:
-    """URDF text with ``link`` (a ``<link>`` element) welded to ``parent`` by a fixed joint."""
+    """URDF text with ``link`` (a ``<link>`` element) welded to ``parent`` by a fixed joint.
+
+    Args:
+        spec: The validated URDF.
+        parent: The link it is welded to.
+        link: The ``<link>`` element to add (named).
+        xyz: The joint's origin in ``parent``'s frame, URDF text, in [m].
+        rpy: The joint's roll, pitch, yaw, URDF text, in [rad].
+    """
     root = copy.deepcopy(spec.xml)
     root.append(link)
     joint = ET.SubElement(root, "joint", name=f"{link.get('name')}_joint", type="fixed")

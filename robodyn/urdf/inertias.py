@@ -22,7 +22,13 @@ def _fmt(values: np.ndarray) -> str:
 
 
 def moving_links(root: str, children: dict[str, list[JointSpec]], floating_base: bool) -> set[str]:
-    """Links that move: below a moving joint, or every link on a floating base (linear time)."""
+    """Links that move: below a moving joint, or every link on a floating base (linear time).
+
+    Args:
+        root: The root link.
+        children: Child joints of each link (:func:`robodyn.urdf.spec.child_index`).
+        floating_base: Whether the root is free (then every link moves).
+    """
     moving = set()
     frontier = [(root, floating_base)]
     while frontier:
@@ -42,6 +48,13 @@ def check_inertias(reader, links: dict[str, Inertial | None], moving: set[str], 
     The tolerance is relative to the body's scale: ``1e-9`` of the larger of its largest
     principal moment and ``mass × (1 mm)²``, so rounding noise of ±1e-35 kg m² on a
     point-like body is not a negative moment.
+
+    Args:
+        reader: The validator's reader, collecting problems (``reader.error`` / ``reader.warn``).
+        links: Each link's inertial (``None``: none).
+        moving: The links that move (:func:`moving_links`).
+        check_inertia: An impossible inertia on a moving link is an error (else a warning).
+        strict: A broken triangle inequality is an error (else a warning).
     """
     for name, inertial in links.items():
         if inertial is None:
@@ -71,7 +84,14 @@ def check_inertias(reader, links: dict[str, Inertial | None], moving: set[str], 
 
 def check_moving_masses(reader, spec_links: dict, joints: dict[str, JointSpec], children: dict) -> None:
     """Warn about moving joints that carry a massless leaf body (linear time: each link is
-    visited once, by the moving joint whose rigid body holds it)."""
+    visited once, by the moving joint whose rigid body holds it).
+
+    Args:
+        reader: The validator's reader, collecting problems (``reader.error`` / ``reader.warn``).
+        spec_links: Each link's inertial (``None``: none).
+        joints: The joints by name.
+        children: Child joints of each link (:func:`robodyn.urdf.spec.child_index`).
+    """
     for joint in joints.values():
         if joint.type == "fixed":
             continue

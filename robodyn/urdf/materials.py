@@ -24,6 +24,9 @@ ALIASES = {"plastic": "abs", "aluminum": "aluminium", "al": "aluminium"}
 def density(material: str | float) -> float:
     """Density in [kg/m³] of a named material, or a density given as a number.
 
+    Args:
+        material: A material name (:data:`DENSITIES`) or a density in [kg/m³].
+
     Raises:
         InputError: For an unknown name or a non-positive density.
     """
@@ -42,11 +45,21 @@ def density(material: str | float) -> float:
 
 
 def box_mass(material: str | float, size: tuple[float, float, float]) -> float:
-    """Mass in [kg] of a solid box with sides ``size`` in [m]."""
+    """Mass in [kg] of a solid box with sides ``size`` in [m].
+
+    Args:
+        material: A material name (:data:`DENSITIES`) or a density in [kg/m³].
+        size: Side lengths in [m].
+    """
     return density(material) * float(np.prod(size))
 
 
 def box_inertia(mass: float, size: tuple[float, float, float]) -> np.ndarray:
-    """Inertia in [kg m²] about the centre of a solid box, box axes, shape (3, 3)."""
+    """Inertia in [kg m²] about the centre of a solid box, box axes, shape (3, 3).
+
+    Args:
+        mass: Mass in [kg].
+        size: Side lengths along the box's x, y, z, in [m].
+    """
     x, y, z = size
     return mass / 12 * np.diag([y**2 + z**2, x**2 + z**2, x**2 + y**2])

@@ -28,7 +28,12 @@ def _roots(package_dirs: Sequence[Path] | PackageLookup) -> tuple[Path, ...]:
 
 
 def looked_in(filename: str, package_dirs: Sequence[Path] | PackageLookup) -> str:
-    """Where a missing ``package://`` mesh was looked for, for a message."""
+    """Where a missing ``package://`` mesh was looked for, for a message.
+
+    Args:
+        filename: The mesh's ``package://`` file name.
+        package_dirs: A package lookup, or folders each holding packages as subfolders.
+    """
     package = filename[len("package://") :].lstrip("/").partition("/")[0]
     if isinstance(package_dirs, PackageLookup):
         return "; ".join(package_dirs.places(package))
@@ -98,7 +103,11 @@ def _exists(candidate: Path) -> bool:
 
 def is_regular_file(path: Path) -> bool:
     """Whether ``path`` is a regular file (not a FIFO, a device or a directory, which
-    reading would block on or never finish), following symlinks."""
+    reading would block on or never finish), following symlinks.
+
+    Args:
+        path: The path.
+    """
     mode = _mode(path)
     return mode is not None and stat.S_ISREG(mode)
 
@@ -106,7 +115,13 @@ def is_regular_file(path: Path) -> bool:
 def mesh_problems(
     root: ET.Element, *, base_dir: Path | None, package_dirs: Sequence[Path] | PackageLookup
 ) -> list[tuple[str, str, str]]:
-    """Problems of every ``<mesh>``: ``(element, rule, severity)`` tuples."""
+    """Problems of every ``<mesh>``: ``(element, rule, severity)`` tuples.
+
+    Args:
+        root: The URDF's ``<robot>`` element.
+        base_dir: The URDF file's folder (``None`` for text).
+        package_dirs: A package lookup, or folders each holding packages as subfolders.
+    """
     problems = []
     for link in root.findall("link"):
         for kind in ("visual", "collision"):

@@ -193,6 +193,11 @@ def _report(robot: MjcfRobot, label: str, strict: bool) -> None:
 def read_mjcf(root: ET.Element, label: str, base_dir: Path | None) -> MjcfRobot:
     """Read a ``<mujoco>`` element (its includes expanded) into the URDF of the same robot.
 
+    Args:
+        root: The ``<mujoco>`` element.
+        label: The file's name, for the error.
+        base_dir: The file's folder, for its mesh paths (``None`` for text).
+
     Raises:
         URDFError: For what cannot be read (see the module).
     """

@@ -37,7 +37,12 @@ MIN_MASS = 1e-15
 
 
 def free_joint(robot: MjcfRobot, body: ET.Element) -> ET.Element | None:
-    """The body's free joint (``<freejoint>`` or ``<joint type="free">``), if any."""
+    """The body's free joint (``<freejoint>`` or ``<joint type="free">``), if any.
+
+    Args:
+        robot: The MJCF robot being read (its settings, defaults, notes).
+        body: The ``<body>`` element.
+    """
     for joint in body.findall("freejoint"):
         return joint
     for joint in body.findall("joint"):

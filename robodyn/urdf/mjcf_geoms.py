@@ -46,7 +46,16 @@ SIZES = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}
 
 def write_link(robot: MjcfRobot, body: ET.Element, name: str, link: ET.Element, offset: np.ndarray, childclass: str) -> float:
     """The body's inertial, visuals and sites, placed in the link frame (``offset`` from
-    the body frame); returns the body's mass in [kg]."""
+    the body frame); returns the body's mass in [kg].
+
+    Args:
+        robot: The MJCF robot being read (its settings, defaults, notes).
+        body: The ``<body>`` element.
+        name: The body's name, for messages.
+        link: The URDF ``<link>`` element written to.
+        offset: The link frame's origin in the body frame, shape (3,), in [m].
+        childclass: The default class the body's elements inherit.
+    """
     shift = translation(-offset)
     inertial = body.find("inertial")
     geoms = [
@@ -362,7 +371,12 @@ def _shape(kind: str, size: list[float]) -> tuple[str, dict[str, str]] | None:
 
 
 def set_total_mass(urdf: ET.Element, total: float) -> None:
-    """Scale every mass and inertia so that they add up to ``total`` (``<compiler settotalmass>``)."""
+    """Scale every mass and inertia so that they add up to ``total`` (``<compiler settotalmass>``).
+
+    Args:
+        urdf: The URDF's ``<robot>`` element being written.
+        total: The total mass in [kg].
+    """
     inertials = urdf.findall("link/inertial")
     current = sum(float(mass.get("value", "0")) for mass in urdf.findall("link/inertial/mass"))
     if current <= 0:

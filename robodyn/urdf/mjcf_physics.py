@@ -66,7 +66,12 @@ Interval = tuple[float, float]
 def read_option(root: ET.Element, robot: MjcfRobot) -> tuple[float, float, float] | None:
     """The file's gravity in [m/s²] (``None`` if it states none); the ``<flag>`` s robodyn
     honours into ``robot.disabled``; fluid forces and the other flags that change the
-    motion reported."""
+    motion reported.
+
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The MJCF robot being read (its settings, defaults, notes).
+    """
     gravity: tuple[float, float, float] | None = None
     for option in root.findall("option"):
         if "gravity" in option.attrib:
@@ -93,7 +98,12 @@ def read_option(root: ET.Element, robot: MjcfRobot) -> tuple[float, float, float
 
 def read_actuators(root: ET.Element, robot: MjcfRobot) -> None:
     """Each actuator's force range into ``robot.efforts`` by joint, the driven joints into
-    ``robot.actuated`` (``None`` when a transmission is not a joint)."""
+    ``robot.actuated`` (``None`` when a transmission is not a joint).
+
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The MJCF robot being read (its settings, defaults, notes).
+    """
     sections = root.findall("actuator")
     if not sections:
         return
@@ -177,7 +187,14 @@ def _limited(robot: MjcfRobot, where: str, values: dict[str, str], kind: str) ->
 
 def joint_effort(robot: MjcfRobot, where: str, name: str, values: dict[str, str]) -> float:
     """A joint's effort limit in [N m] or [N]: its actuators' range within its
-    ``actuatorfrcrange`` (inf when nothing bounds it)."""
+    ``actuatorfrcrange`` (inf when nothing bounds it).
+
+    Args:
+        robot: The MJCF robot being read (its settings, defaults, notes).
+        where: Where in the file the joint is, for messages.
+        name: The joint's name.
+        values: The joint's attributes (its class's defaults under them).
+    """
     low, high = robot.efforts.get(name, (-math.inf, math.inf))
     if _limited(robot, where, values, "actuatorfrc"):
         bound = _bounds(robot, f"{where}: actuatorfrcrange", values.get("actuatorfrcrange", "0 0"))
@@ -192,7 +209,12 @@ def joint_effort(robot: MjcfRobot, where: str, name: str, values: dict[str, str]
 def read_equalities(root: ET.Element, robot: MjcfRobot) -> tuple[EqualityRecord, ...]:
     """The ``connect`` and ``weld`` equalities between bodies, in the links' frames (the
     robot's constraints, :attr:`robodyn.Robot.constraints`); any other equality (joint,
-    tendon, distance, between sites) is noted as left out."""
+    tendon, distance, between sites) is noted as left out.
+
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The MJCF robot being read (its settings, defaults, notes).
+    """
     records = []
     for section in root.findall("equality"):
         for index, node in enumerate(section):

@@ -19,6 +19,11 @@ from robodyn.urdf.mjcf_values import AUTO, BOOLEAN, floats, keyword, number
 def read_compiler(root: ET.Element, label: str, base_dir: Path | None) -> Compiler:
     """The ``<compiler>`` settings (the last element's value of each, as MuJoCo).
 
+    Args:
+        root: The ``<mujoco>`` element.
+        label: The file's name, for the error.
+        base_dir: The file's folder (``None`` for text), for ``meshdir``.
+
     Raises:
         URDFError: For settings robodyn does not read, and values MuJoCo refuses.
     """
@@ -54,7 +59,12 @@ def read_compiler(root: ET.Element, label: str, base_dir: Path | None) -> Compil
 
 
 def check_option(root: ET.Element, robot: MjcfRobot) -> None:
-    """Report ``<option>`` settings the dynamics does not take."""
+    """Report ``<option>`` settings the dynamics does not take.
+
+    Args:
+        root: The ``<mujoco>`` element.
+        robot: The MJCF robot being read (its settings, defaults, notes).
+    """
     for option in root.findall("option"):
         gravity = option.get("gravity")
         if gravity is not None and not np.allclose(floats(robot.label, "option", gravity, 3), [0, 0, -9.81]):
@@ -67,6 +77,10 @@ def read_defaults(root: ET.Element, label: str) -> dict[str, dict[str, dict[str,
 
     The top ``<default>`` is the class ``main`` (several top elements add to it); a nested
     class needs a name no other class has.
+
+    Args:
+        root: The ``<mujoco>`` element.
+        label: The file's name, for the error.
 
     Raises:
         URDFError: For a renamed top class, a nested class without a name, or a name

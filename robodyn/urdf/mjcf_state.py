@@ -151,16 +151,30 @@ class MjcfRobot:
 
     def note(self, kind: str, name: str) -> None:
         """Report ``name`` under ``kind``, a kind of what the dynamics leaves out (one
-        warning line a kind)."""
+        warning line a kind).
+
+        Args:
+            kind: What is left out, e.g. ``"actuators robodyn does not read"``.
+            name: The element's name.
+        """
         self.notes.setdefault(kind, []).append(name)
 
     def remark(self, sentence: str, name: str) -> None:
         """Report ``name`` under ``sentence``, a reading that differs from MuJoCo's (one
-        warning line a sentence)."""
+        warning line a sentence).
+
+        Args:
+            sentence: How the reading differs.
+            name: The element's name.
+        """
         self.remarks.setdefault(sentence, []).append(name)
 
     def unique(self, name: str, what: str) -> str:
         """``name``, claimed for one link or joint of the URDF.
+
+        Args:
+            name: The name.
+            what: What the name is for, for the error.
 
         Raises:
             URDFError: If it is taken already.
@@ -173,6 +187,11 @@ class MjcfRobot:
 
 def attributes(robot: MjcfRobot, node: ET.Element, childclass: str) -> dict[str, str]:
     """An element's attributes with its class's defaults under them.
+
+    Args:
+        robot: The MJCF robot being read (its settings, defaults, notes).
+        node: The element.
+        childclass: The class its body's ``childclass`` gives (``"main"``: the top class).
 
     Raises:
         URDFError: If its class is not defined.

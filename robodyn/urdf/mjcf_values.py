@@ -25,6 +25,11 @@ ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 def number(label: str, where: str, text: str) -> float:
     """One finite number.
 
+    Args:
+        label: The file's name, for the error.
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        text: The number's text.
+
     Raises:
         URDFError: If ``text`` is not one, naming ``where``.
     """
@@ -36,6 +41,13 @@ def number(label: str, where: str, text: str) -> float:
 
 def keyword(label: str, where: str, attribute: str, text: str, allowed: tuple[str, ...]) -> str:
     """A keyword spelled as MuJoCo spells it (case matters: ``"True"`` is not ``"true"``).
+
+    Args:
+        label: The file's name, for the error.
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        attribute: The attribute's name.
+        text: The attribute's value.
+        allowed: The keywords MuJoCo accepts there.
 
     Raises:
         URDFError: If ``text`` is not one of ``allowed``, naming the attribute.
@@ -53,6 +65,12 @@ AUTO = ("true", "false", "auto")
 def floats(label: str, where: str, text: str, count: int) -> np.ndarray:
     """Exactly ``count`` finite numbers, shape (count,).
 
+    Args:
+        label: The file's name, for the error.
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        text: The attribute's text, numbers separated by whitespace.
+        count: How many numbers it must hold.
+
     Raises:
         URDFError: If there are more, fewer, or one is not a finite number.
     """
@@ -63,12 +81,23 @@ def floats(label: str, where: str, text: str, count: int) -> np.ndarray:
 
 
 def angle(robot: MjcfRobot, value: float) -> float:
-    """An angle of the file in [rad] (``<compiler angle>``)."""
+    """An angle of the file in [rad] (``<compiler angle>``).
+
+    Args:
+        robot: The MJCF robot being read (its compiler settings and file name).
+        value: The angle as the file writes it: in [deg] under ``<compiler angle="degree">`` (MuJoCo's default), else [rad].
+    """
     return math.radians(value) if robot.compiler.degree else value
 
 
 def orientation(robot: MjcfRobot, where: str, attributes: dict[str, str]) -> np.ndarray:
-    """The rotation matrix an element's orientation attribute gives (identity if none)."""
+    """The rotation matrix an element's orientation attribute gives (identity if none).
+
+    Args:
+        robot: The MJCF robot being read (its compiler settings and file name).
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        attributes: The element's attributes (at most one of ``quat``, ``axisangle``, ``euler``, ``xyaxes``, ``zaxis``).
+    """
     given = [key for key in ORIENTATIONS if key in attributes]
     if len(given) > 1:
         raise URDFError(robot.label, f"{where}: more than one orientation ({', '.join(given)})")
@@ -92,7 +121,13 @@ def orientation(robot: MjcfRobot, where: str, attributes: dict[str, str]) -> np.
 
 
 def quaternion_matrix(label: str, where: str, wxyz: np.ndarray) -> np.ndarray:
-    """The rotation of a quaternion in MuJoCo's order (w, x, y, z), normalised."""
+    """The rotation of a quaternion in MuJoCo's order (w, x, y, z), normalised.
+
+    Args:
+        label: The file's name, for the error.
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        wxyz: The quaternion ``(w, x, y, z)``, shape (4,), not zero.
+    """
     norm = float(np.linalg.norm(wxyz))
     if norm < 1e-12:
         raise URDFError(label, f"{where}: the quaternion must not be zero")
@@ -143,7 +178,11 @@ def _euler(robot: MjcfRobot, angles: np.ndarray) -> np.ndarray:
 
 
 def zaxis(z: np.ndarray) -> np.ndarray:
-    """The smallest rotation taking (0, 0, 1) to ``z``, as MuJoCo's ``zaxis``."""
+    """The smallest rotation taking (0, 0, 1) to ``z``, as MuJoCo's ``zaxis``.
+
+    Args:
+        z: The unit direction, shape (3,).
+    """
     cross = np.cross([0.0, 0.0, 1.0], z)
     sine, cosine = float(np.linalg.norm(cross)), float(z[2])
     if sine < 1e-14:
@@ -153,6 +192,11 @@ def zaxis(z: np.ndarray) -> np.ndarray:
 
 def unit(label: str, where: str, vector: np.ndarray) -> np.ndarray:
     """``vector`` normalised.
+
+    Args:
+        label: The file's name, for the error.
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        vector: The direction, shape (3,).
 
     Raises:
         URDFError: If it is zero.
@@ -164,7 +208,13 @@ def unit(label: str, where: str, vector: np.ndarray) -> np.ndarray:
 
 
 def pose(robot: MjcfRobot, where: str, attributes: dict[str, str]) -> np.ndarray:
-    """The 4×4 pose of an element's ``pos`` and orientation in its body's frame."""
+    """The 4×4 pose of an element's ``pos`` and orientation in its body's frame.
+
+    Args:
+        robot: The MJCF robot being read (its compiler settings and file name).
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        attributes: The element's attributes (``pos`` in [m] and an orientation).
+    """
     result = np.eye(4)
     result[:3, :3] = orientation(robot, where, attributes)
     result[:3, 3] = floats(robot.label, where, attributes.get("pos", "0 0 0"), 3)
@@ -172,7 +222,11 @@ def pose(robot: MjcfRobot, where: str, attributes: dict[str, str]) -> np.ndarray
 
 
 def translation(vector: np.ndarray) -> np.ndarray:
-    """The 4×4 pose of a pure translation by ``vector`` (3,) in [m]."""
+    """The 4×4 pose of a pure translation by ``vector`` (3,) in [m].
+
+    Args:
+        vector: The translation, shape (3,), in [m].
+    """
     result = np.eye(4)
     result[:3, 3] = vector
     return result
@@ -180,7 +234,13 @@ def translation(vector: np.ndarray) -> np.ndarray:
 
 def fromto_pose(robot: MjcfRobot, where: str, text: str) -> tuple[np.ndarray, float]:
     """A ``fromto``'s pose (centre; z along the segment, from its second point to its first,
-    as MuJoCo turns it) and half-length."""
+    as MuJoCo turns it) and half-length.
+
+    Args:
+        robot: The MJCF robot being read (its compiler settings and file name).
+        where: Where in the file the value is (e.g. ``'joint "elbow"'``), for the error.
+        text: The ``fromto`` attribute: the segment's two end points, 6 numbers in [m].
+    """
     ends = floats(robot.label, where, text, 6)
     result = np.eye(4)
     result[:3, 3] = (ends[:3] + ends[3:]) / 2
@@ -191,10 +251,19 @@ def fromto_pose(robot: MjcfRobot, where: str, text: str) -> tuple[np.ndarray, fl
 
 
 def write_origin(parent: ET.Element, placement: np.ndarray) -> None:
-    """A URDF ``<origin>`` of a 4×4 pose under ``parent``."""
+    """A URDF ``<origin>`` of a 4×4 pose under ``parent``.
+
+    Args:
+        parent: The URDF element (a ``<joint>``, ``<inertial>``, ``<visual>``, ...).
+        placement: The pose, shape (4, 4), translation in [m].
+    """
     ET.SubElement(parent, "origin", xyz=text(placement[:3, 3]), rpy=text(matrix_rpy(placement[:3, :3])))
 
 
 def text(values: np.ndarray) -> str:
-    """Numbers as URDF text, every digit kept."""
+    """Numbers as URDF text, every digit kept.
+
+    Args:
+        values: The numbers, shape (n,).
+    """
     return " ".join(repr(float(value)) for value in values)

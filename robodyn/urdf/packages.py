@@ -77,7 +77,11 @@ class PackageLookup(tuple[Path, ...]):
 
     def find(self, name: str) -> Path | None:
         """The folder of package ``name``, or ``None`` if no place holds it (or it is not a
-        package name: :func:`name_problem`)."""
+        package name: :func:`name_problem`).
+
+        Args:
+            name: The package's name.
+        """
         if name_problem(name) is not None:
             return None
         for package, folder in self.explicit:
@@ -93,7 +97,11 @@ class PackageLookup(tuple[Path, ...]):
         return None
 
     def places(self, name: str) -> list[str]:
-        """Where ``name`` was looked for, for a message."""
+        """Where ``name`` was looked for, for a message.
+
+        Args:
+            name: The package's name.
+        """
         places = [f"{folder} (packages=)" for package, folder in self.explicit if package == name]
         places += [f"{entry} ($ROS_PACKAGE_PATH)" for entry in self.ros_path]
         places += [f"{folder} (the zoo)" for folder in self.zoo_dirs]
@@ -101,6 +109,10 @@ class PackageLookup(tuple[Path, ...]):
 
     def require(self, name: str, label: str) -> Path:
         """The folder of package ``name``.
+
+        Args:
+            name: The package's name.
+            label: The file or robot name, for the error.
 
         Raises:
             URDFError: Naming the package and the places looked in, or why ``name`` is not
@@ -130,7 +142,11 @@ class PackageLookup(tuple[Path, ...]):
 
 
 def name_problem(name: str) -> str | None:
-    """Why ``name`` is not a package name (empty, ``.``, ``..``, a ``/``, ``\\`` or NUL), or ``None``."""
+    """Why ``name`` is not a package name (empty, ``.``, ``..``, a ``/``, ``\\`` or NUL), or ``None``.
+
+    Args:
+        name: The name to check.
+    """
     if name in ("", ".", ".."):
         return "is not a package name (empty, '.' and '..' name folders, not packages)"
     if any(character in name for character in "/\\\x00"):
@@ -141,6 +157,11 @@ def name_problem(name: str) -> str | None:
 def package_folders(name: str, package_dirs: Sequence[Path] | PackageLookup, *, path: str) -> list[Path]:
     """The folders package ``name`` may be, for the ``package://`` path ``path``: the
     lookup's one, or ``NAME`` under each folder of a plain sequence (the zoo's folders).
+
+    Args:
+        name: The package's name.
+        package_dirs: A :class:`PackageLookup`, or folders each holding packages as subfolders.
+        path: The ``package://`` path, for the error.
 
     Raises:
         MeshPathError: If ``name`` is not a package name (:func:`name_problem`).

@@ -41,7 +41,11 @@ MAX_URDF_BYTES = 64 * 1024 * 1024
 
 
 def max_urdf_bytes(max_bytes: int | None = None) -> int:
-    """The size cap in force: ``max_bytes``, else ``$ROBODYN_MAX_URDF_BYTES``, else the default."""
+    """The size cap in force: ``max_bytes``, else ``$ROBODYN_MAX_URDF_BYTES``, else the default.
+
+    Args:
+        max_bytes: The cap asked for in bytes, or ``None``.
+    """
     if max_bytes is not None:
         return int(max_bytes)
     setting = os.environ.get("ROBODYN_MAX_URDF_BYTES", "").strip()
@@ -57,6 +61,11 @@ def read_regular_file(path: Path, max_bytes: int, label: str | None = None) -> b
     behind a symlink — is refused before it is opened (``os.stat`` follows links), then the
     file is opened with ``O_NONBLOCK`` and checked again (``fstat``: no swap between the
     two), and at most ``max_bytes + 1`` bytes are read.
+
+    Args:
+        path: The file.
+        max_bytes: Largest size accepted, in bytes.
+        label: The name in messages (``None``: the path).
 
     Raises:
         URDFError: If the file does not exist, is not a regular file, is larger than
@@ -104,6 +113,11 @@ def read_text(path: Path, max_bytes: int, label: str | None = None) -> str:
     """The UTF-8 text of a regular file of at most ``max_bytes`` bytes (see
     :func:`read_regular_file`).
 
+    Args:
+        path: The file.
+        max_bytes: Largest size accepted, in bytes.
+        label: The name in messages (``None``: the path).
+
     Raises:
         URDFError: As :func:`read_regular_file`, or if the file is not UTF-8 text.
     """
@@ -138,7 +152,11 @@ _PROLOG = re.compile(r"<\?.*?\?>|<!--.*?-->", re.DOTALL)
 
 
 def root_tag(text: str) -> str | None:
-    """The name of the first element of XML text (after its declaration and comments)."""
+    """The name of the first element of XML text (after its declaration and comments).
+
+    Args:
+        text: The XML text.
+    """
     head = _PROLOG.sub("", text[: 1 << 20])
     match = _ROOT_TAG.search(head)
     return match.group(1) if match else None
@@ -255,7 +273,15 @@ def locked_source(
     check_inertia: bool = True,
     strict: bool = False,
 ) -> URDFSource:
-    """The same source with joints frozen at positions (see :func:`robodyn.urdf.edit.lock_joints`)."""
+    """The same source with joints frozen at positions (see :func:`robodyn.urdf.edit.lock_joints`).
+
+    Args:
+        resolved: The source read.
+        lock: Joints to freeze, by name, at positions in [rad] / [m].
+        floating_base: Read with a free-flyer root (``None``: the source's choice).
+        check_inertia: Refuse inertias that are not positive semi-definite on moving links.
+        strict: Refuse what otherwise loads with a warning.
+    """
     floating = resolved.floating_base if floating_base is None else floating_base
     with warnings.catch_warnings():  # the locked model is validated (and warns) again
         warnings.simplefilter("ignore", RobodynWarning)
@@ -268,6 +294,10 @@ def with_file_dynamics(spec: URDFSpec, label: str) -> URDFSpec:
     """The spec with each joint's ``<dynamics armature=...>`` (robodyn's extension of URDF,
     what its MJCF reader writes for MuJoCo's ``armature``), and ``damping`` / ``friction``
     where the spec has none, read from the spec's XML.
+
+    Args:
+        spec: The validated URDF (its XML is read).
+        label: The file or robot name, for the error.
 
     Raises:
         URDFError: If a value is not a finite number ≥ 0.
@@ -308,6 +338,13 @@ def lint_source(
     robodyn cannot read as a robot (SDF, a xacro that does not expand, an MJCF element it
     refuses). A xacro is linted as its expansion, an MJCF file as the URDF robodyn reads it
     into; what the import reports (MJCF elements left out) is among the warnings.
+
+    Args:
+        source: A URDF, ``.xacro`` or MJCF file path, such XML text, or a robot name (as for :func:`robodyn.load`).
+        floating_base: Lint as with a free-flyer root. ``None``: true for zoo robots that walk, swim or fly, false otherwise.
+        xacro_args: Arguments of a ``.xacro`` source, ``{name: value}``.
+        packages: Package folders, ``{package name: folder}``, for ``package://`` paths and ``$(find name)``.
+        xacro_env: Let a xacro source read environment variables (``$(env NAME)``, ``$(optenv NAME)``).
 
     Raises:
         UnknownRobotError, URDFError: If the source cannot be found or read.

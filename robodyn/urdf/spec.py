@@ -110,14 +110,22 @@ class URDFSpec:
     xml: ET.Element = field(repr=False)
 
     def child_joints(self, link: str) -> list[JointSpec]:
-        """Joints whose parent is ``link``, in document order."""
+        """Joints whose parent is ``link``, in document order.
+
+        Args:
+            link: The link's name.
+        """
         if not hasattr(self, "_children"):
             self._children = child_index(self.joints)
         return list(self._children.get(link, []))
 
 
 def child_index(joints: dict[str, JointSpec]) -> dict[str, list[JointSpec]]:
-    """Child joints of every link, in document order (one pass: linear time)."""
+    """Child joints of every link, in document order (one pass: linear time).
+
+    Args:
+        joints: The joints by name.
+    """
     children: dict[str, list[JointSpec]] = {}
     for joint in joints.values():
         children.setdefault(joint.parent, []).append(joint)

@@ -72,7 +72,12 @@ class Namespace(dict):
 
 
 def size(value: Any, budget: int = MAX_SIZE) -> int:
-    """About how many characters ``str(value)`` has, counting at most past ``budget``."""
+    """About how many characters ``str(value)`` has, counting at most past ``budget``.
+
+    Args:
+        value: The value.
+        budget: Where counting stops.
+    """
     if isinstance(value, str):
         return len(value)
     if isinstance(value, bool) or value is None or isinstance(value, float):
@@ -92,6 +97,9 @@ def size(value: Any, budget: int = MAX_SIZE) -> int:
 
 def checked(value: Any) -> Any:
     """``value`` if it is a value of the language within the bounds.
+
+    Args:
+        value: A value an expression produced.
 
     Raises:
         ExpressionError: If it is too large, complex, or of another kind.

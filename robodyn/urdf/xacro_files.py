@@ -56,7 +56,11 @@ _XACRO_USE = re.compile(r"<xacro:|\$\{|\$\(")
 def is_xacro_text(text: str) -> bool:
     """Whether URDF-looking text is meant for xacro: its ``<robot>`` root declares the xacro
     namespace (``xmlns:xacro=...``) *and* the text uses xacro (a ``<xacro:...>`` element, a
-    ``${...}`` or a ``$(...)``). A URDF that only declares the namespace is plain URDF."""
+    ``${...}`` or a ``$(...)``). A URDF that only declares the namespace is plain URDF.
+
+    Args:
+        text: The document's text.
+    """
     return bool(_XACRO_ROOT.search(text[:20000])) and bool(_XACRO_USE.search(text))
 
 

@@ -67,10 +67,19 @@ class XacroGuard:
         self.started = time.monotonic()
 
     def refuse(self, rule: str) -> URDFError:
+        """The error refusing the expansion (to raise), naming the file.
+
+        Args:
+            rule: What the file broke.
+        """
         return URDFError(self.label, f"xacro: {rule}")
 
     def element(self, macro_depth: int, include_depth: int) -> None:
         """Count one element about to be evaluated.
+
+        Args:
+            macro_depth: How deep macro calls are nested at the element.
+            include_depth: How deep includes are nested at the element.
 
         Raises:
             URDFError: Past :data:`MAX_ELEMENTS`, the depths, or :data:`MAX_SECONDS`.
@@ -88,6 +97,9 @@ class XacroGuard:
     def text(self, value: Any) -> None:
         """Count the text an evaluation produced.
 
+        Args:
+            value: The evaluation's result (a string, or a value whose size is counted).
+
         Raises:
             URDFError: If the expansion's text passes the size cap.
         """
@@ -103,6 +115,10 @@ class XacroGuard:
     def inside(self, filename: str, what: str) -> Path:
         """``filename`` if it is inside one of :attr:`roots` (after symlinks).
 
+        Args:
+            filename: The file's name.
+            what: What the file is for, for the error (e.g. ``"the include"``).
+
         Raises:
             URDFError: Naming the file and the rule.
         """
@@ -115,7 +131,11 @@ class XacroGuard:
         return path
 
     def include_files(self, spec: str) -> list[str]:
-        """The files an include's absolute ``spec`` names (a glob expands inside the roots only)."""
+        """The files an include's absolute ``spec`` names (a glob expands inside the roots only).
+
+        Args:
+            spec: The include's absolute file name, possibly a glob pattern.
+        """
         if not _GLOB.search(spec):
             self.inside(spec, "the include")
             return [spec]
@@ -126,6 +146,9 @@ class XacroGuard:
 
     def load_yaml(self, filename: str) -> Any:
         """The data of a YAML file inside the roots (plain dicts, lists and scalars).
+
+        Args:
+            filename: The YAML file's name.
 
         Raises:
             URDFError: Outside the roots, not a regular file, too large, not YAML, or too large as data.
@@ -151,6 +174,10 @@ class XacroGuard:
 
     def environment(self, name: str, default: str | None = None) -> str:
         """``$(env NAME)`` / ``$(optenv NAME DEFAULT)``, with ``xacro_env=True`` only.
+
+        Args:
+            name: The environment variable's name.
+            default: ``$(optenv)``'s default (``None`` for ``$(env)``).
 
         Raises:
             URDFError: Without the opt-in (naming the variable), or for an unset ``$(env)``.

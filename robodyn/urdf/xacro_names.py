@@ -140,7 +140,11 @@ MATH: dict[str, Any] = {name: Function(name, getattr(math, name)) for name in MA
 
 def base_names(extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The names every expression sees: ``True``/``False``, :data:`MATH` (bare and as
-    ``math.``), :data:`BUILTINS`, and ``extra`` (e.g. a ``xacro`` namespace)."""
+    ``math.``), :data:`BUILTINS`, and ``extra`` (e.g. a ``xacro`` namespace).
+
+    Args:
+        extra: More names (``None``: none).
+    """
     names: dict[str, Any] = {"True": True, "False": False, "math": Namespace(MATH)}
     names.update(MATH)
     names.update(BUILTINS)

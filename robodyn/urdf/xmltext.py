@@ -31,6 +31,12 @@ def parse_xml(
     parsing (the element's attributes are read at its start): a reader counts there, and
     refuses by raising, before the whole tree is built.
 
+    Args:
+        text: The XML text.
+        source: The file or robot name, for the error.
+        root: The root element expected.
+        on_event: Called as ``on_event(event, element)`` while parsing (``None``: not called).
+
     Raises:
         URDFError: If the text is not well-formed XML, declares a DOCTYPE or entities,
             nests elements too deeply, or its root element is not ``<robot>``.
@@ -86,5 +92,9 @@ def parse_number(text: str) -> float | None:
 
 
 def split_numbers(text: str) -> list[str]:
-    """Tokens of a list of numbers separated by ASCII whitespace."""
+    """Tokens of a list of numbers separated by ASCII whitespace.
+
+    Args:
+        text: The attribute's text.
+    """
     return [token for token in re.split("[ \t\n\r]+", text.strip(_ASCII_SPACE)) if token]

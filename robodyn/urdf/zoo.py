@@ -140,6 +140,9 @@ def zoo_names() -> list[str]:
 def zoo_robot(name: str) -> ZooRobot:
     """Look up a zoo robot by name.
 
+    Args:
+        name: The robot's name (``robodyn list`` prints them).
+
     Raises:
         UnknownRobotError: If the name is not in the zoo.
     """
@@ -149,7 +152,11 @@ def zoo_robot(name: str) -> ZooRobot:
 
 
 def zoo_urdf_path(name: str) -> Path:
-    """Absolute path of a zoo robot's URDF file."""
+    """Absolute path of a zoo robot's URDF file.
+
+    Args:
+        name: The robot's name (``robodyn list`` prints them).
+    """
     path = robots_dir() / zoo_robot(name).relative_path
     if not path.is_file():
         raise URDFError(name, f"the zoo robot's URDF {path} is not installed")

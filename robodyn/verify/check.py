@@ -332,7 +332,11 @@ def _compare_dynamics(
 
 
 def report_dict(report: CheckReport) -> dict:
-    """A JSON-ready form of a report."""
+    """A JSON-ready form of a report.
+
+    Args:
+        report: The comparison's report.
+    """
     return {
         "robot": report.robot,
         "samples": report.samples,
@@ -360,7 +364,11 @@ _DESCRIPTIONS = {
 
 
 def report_text(report: CheckReport) -> str:
-    """A readable table of a report."""
+    """A readable table of a report.
+
+    Args:
+        report: The comparison's report.
+    """
     lines = [
         f"check {report.robot}: Pinocchio vs the Lagrangian reference, {report.samples} random states (seed {report.seed}), "
         f"{len(report.joint_names)} joints",

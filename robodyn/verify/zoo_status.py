@@ -18,7 +18,11 @@ from robodyn.verify.check import check_robot
 
 #: Random states a robot, fewer for large robots (the reference's cost grows as n³-n⁴).
 def samples_for(dof: int) -> int:
-    """Number of random states used for a robot with ``dof`` joints in the listing."""
+    """Number of random states used for a robot with ``dof`` joints in the listing.
+
+    Args:
+        dof: The robot's number of joints.
+    """
     return max(3, min(50, 20_000 // max(dof, 1) ** 2))
 
 
@@ -42,7 +46,11 @@ class ZooStatus:
 
 
 def zoo_status(name: str) -> ZooStatus:
-    """Check one zoo robot (fixed base) and say how it went."""
+    """Check one zoo robot (fixed base) and say how it went.
+
+    Args:
+        name: The zoo robot's name.
+    """
     note = "floating base" if ZOO[name].floating_base else ""
     try:
         robot = load(name)
@@ -59,7 +67,11 @@ def zoo_status(name: str) -> ZooStatus:
 
 
 def zoo_statuses(progress: Callable[[str], None] | None = None) -> list[ZooStatus]:
-    """Check every installed zoo robot, in name order."""
+    """Check every installed zoo robot, in name order.
+
+    Args:
+        progress: Called with each robot's name before it is checked (``None``: not called).
+    """
     statuses = []
     for name in zoo_names():
         if progress:
@@ -69,7 +81,11 @@ def zoo_statuses(progress: Callable[[str], None] | None = None) -> list[ZooStatu
 
 
 def zoo_markdown(statuses: list[ZooStatus]) -> str:
-    """The listing as a markdown document."""
+    """The listing as a markdown document.
+
+    Args:
+        statuses: The robots' statuses (:func:`zoo_statuses`).
+    """
     lines = [
         "# The example-robot-data zoo under `robodyn check`",
         "",

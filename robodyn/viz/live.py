@@ -111,7 +111,11 @@ class LiveViewer:
         self._process = None
 
     def send(self, commands: list[dict]) -> None:
-        """Send lowered meshcat commands to the viewer."""
+        """Send lowered meshcat commands to the viewer.
+
+        Args:
+            commands: Meshcat commands, lowered to dicts.
+        """
         if self._socket is None:
             raise ViewerError("the live viewer is not running.")
         for command in commands:
@@ -120,7 +124,16 @@ class LiveViewer:
 
     def show(self, robot: Robot, trajectory: Trajectory | None = None, *, fps: float = 30.0, target=None, frame=None) -> None:
         """Draw the robot (at its start, :meth:`~robodyn.Robot.default_configuration`, or playing the trajectory) with its
-        task: ground grid, ``target`` marker (X,Z or X,Y,Z in [m]) and the frame's path."""
+        task: ground grid, ``target`` marker (X,Z or X,Y,Z in [m]) and the frame's path.
+
+        Args:
+            robot: The robot drawn.
+            trajectory: The motion to play (``None``: the robot at rest).
+            fps: Animation frames per second.
+            target: The task target, X,Z (planar, Y = 0) or X,Y,Z in [m] (``None``: none).
+            frame: The frame whose path is drawn (``None``: ``robot.end_effector``, none when the robot has no
+                default).
+        """
         from robodyn.viz.recording import motion_commands
 
         if trajectory is None:
@@ -136,7 +149,11 @@ def _raise_interrupt(signum, frame) -> None:
 
 
 def wait(seconds: float | None) -> None:
-    """Sleep ``seconds`` (forever when ``None``) until interrupted."""
+    """Sleep ``seconds`` (forever when ``None``) until interrupted.
+
+    Args:
+        seconds: How long in [s] (``None``: forever).
+    """
     deadline = None if seconds is None else time.monotonic() + seconds
     while deadline is None or time.monotonic() < deadline:
         time.sleep(0.2)

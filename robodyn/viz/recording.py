@@ -77,7 +77,12 @@ document.title = "{title} (" + (failed ? failed + " commands failed" : "ready") 
 
 
 def page(commands: list[dict], *, title: str = "robodyn recording") -> str:
-    """The HTML page of meshcat commands (meshcat's viewer inlined)."""
+    """The HTML page of meshcat commands (meshcat's viewer inlined).
+
+    Args:
+        commands: Meshcat commands (lowered to dicts), played in order.
+        title: The page's title.
+    """
     import meshcat
 
     script = (Path(meshcat.__file__).parent / "viewer" / "dist" / "main.min.js").read_text(encoding="utf-8")
@@ -104,7 +109,11 @@ class Recording:
     placeholders: list[str]
 
     def save(self, path: str | os.PathLike) -> Path | None:
-        """Write the page (atomically) and return its path (``None`` for standard output, ``-``)."""
+        """Write the page (atomically) and return its path (``None`` for standard output, ``-``).
+
+        Args:
+            path: The HTML file to write, or ``"-"`` for standard output.
+        """
         return atomic_write_text(path, self.html)
 
     def _repr_html_(self) -> str:
@@ -115,19 +124,37 @@ class Recording:
         )
 
     def still(self, png: str | os.PathLike, *, at: float = 0.0, size: tuple[int, int] = (800, 600)) -> Path | None:
-        """A PNG of the frame at ``at`` seconds (headless Chromium); ``None`` for ``-``."""
+        """A PNG of the frame at ``at`` seconds (headless Chromium); ``None`` for ``-``.
+
+        Args:
+            png: The PNG file to write, or ``"-"`` for standard output.
+            at: Time into the motion in [s], from 0 to :attr:`duration`.
+            size: Width and height in pixels.
+        """
         from robodyn.viz.stills import still_of_page
 
         return still_of_page(self.html, png, at=self._time(at), size=size)
 
     def filmstrip(self, png: str | os.PathLike, count: int, *, size: tuple[int, int] = (480, 360)) -> Path | None:
-        """``count`` frames evenly spread over the motion, side by side in one PNG; ``None`` for ``-``."""
+        """``count`` frames evenly spread over the motion, side by side in one PNG; ``None`` for ``-``.
+
+        Args:
+            png: The PNG file to write, or ``"-"`` for standard output.
+            count: Number of frames, 1 to 60.
+            size: Width and height of each frame in pixels.
+        """
         from robodyn.viz.stills import filmstrip_of_page
 
         return filmstrip_of_page(self.html, png, self.duration, count, size=size)
 
     def video(self, path: str | os.PathLike, *, fps: float = 15.0, size: tuple[int, int] = (640, 480)) -> Path:
-        """An MP4 or GIF (by extension) of the motion at ``fps`` frames per second."""
+        """An MP4 or GIF (by extension) of the motion at ``fps`` frames per second.
+
+        Args:
+            path: The ``.mp4`` or ``.gif`` file to write.
+            fps: Frames per second of the video.
+            size: Width and height in pixels.
+        """
         from robodyn.viz.stills import video_of_page
 
         return video_of_page(self.html, path, self.duration, fps=fps, size=size)
@@ -164,6 +191,10 @@ MAX_FRAMES = 100_000
 
 def frame_count(trajectory: Trajectory, fps: float) -> int:
     """Frames of the animation of ``trajectory`` at ``fps``: ``⌊span × fps⌋ + 1``.
+
+    Args:
+        trajectory: The motion to animate.
+        fps: Animation frames per second.
 
     Raises:
         InputError: Naming ``trajectory`` when its time span × ``fps`` exceeds

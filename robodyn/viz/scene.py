@@ -137,6 +137,10 @@ def build_scene(robot: Robot, *, max_mesh_bytes: int = MAX_MESH_BYTES) -> Scene:
     A mesh that cannot be drawn (missing, outside the model's folders, not a regular file,
     over ``max_mesh_bytes``, corrupt) becomes a magenta placeholder box and a
     :class:`~robodyn.viz.mesh_files.MeshWarning`.
+
+    Args:
+        robot: The robot drawn.
+        max_mesh_bytes: Largest mesh file drawn, in bytes (larger: a placeholder box).
     """
     root = robot.spec.xml
     materials = {}
@@ -170,7 +174,12 @@ def build_scene(robot: Robot, *, max_mesh_bytes: int = MAX_MESH_BYTES) -> Scene:
 
 
 def scene_commands(robot: Robot, *, max_mesh_bytes: int = MAX_MESH_BYTES) -> list[dict]:
-    """Meshcat commands drawing every link's visuals (each mesh sent once)."""
+    """Meshcat commands drawing every link's visuals (each mesh sent once).
+
+    Args:
+        robot: The robot drawn.
+        max_mesh_bytes: Largest mesh file drawn, in bytes (larger: a placeholder box).
+    """
     return build_scene(robot, max_mesh_bytes=max_mesh_bytes).commands
 
 
@@ -178,6 +187,11 @@ def link_placements(robot: Robot, q: np.ndarray, data: pin.Data | None = None) -
     """World pose (4×4) of every URDF link at configuration ``q``.
 
     Pass ``data`` (``robot.model.createData()``) when calling this for many frames.
+
+    Args:
+        robot: The robot drawn.
+        q: Configuration, shape (nq,), in [rad] / [m].
+        data: Pinocchio data of ``robot.model`` to reuse (``None``: new data).
     """
     data = robot.model.createData() if data is None else data
     pin.framesForwardKinematics(robot.model, data, q)
@@ -192,6 +206,11 @@ def resample(trajectory: Trajectory, fps: float, *, floating_base: bool = False)
     nearest the previous one's (``q`` and ``−q`` are one rotation: interpolated across a
     sign flip the base would turn the long way round, or through a zero quaternion); the
     caller renormalises.
+
+    Args:
+        trajectory: The motion.
+        fps: Frames per second.
+        floating_base: Whether ``q[3:7]`` is a floating base's quaternion.
     """
     if len(trajectory) == 0:
         raise ViewerError("the trajectory is empty: nothing to record.")
@@ -223,7 +242,11 @@ class Motion:
     placements: list[dict[str, np.ndarray]]
 
     def points(self, scene: Scene) -> np.ndarray:
-        """World corners of every visual box over the whole motion, shape (K, 3), in [m]."""
+        """World corners of every visual box over the whole motion, shape (K, 3), in [m].
+
+        Args:
+            scene: The scene of the robot (its visual boxes' corners).
+        """
         seen = []
         for placement in self.placements:
             for name, corners in scene.corners.items():
@@ -234,7 +257,11 @@ class Motion:
 
 
 def lower_animation(clips: dict[tuple[str, ...], AnimationClip]) -> dict:
-    """A ``set_animation`` command (plays once on open) of clips by meshcat path."""
+    """A ``set_animation`` command (plays once on open) of clips by meshcat path.
+
+    Args:
+        clips: Animation clips by meshcat path (a tuple of path parts).
+    """
 
     class _Animation:
         def lower(self) -> list[dict]:
@@ -244,7 +271,13 @@ def lower_animation(clips: dict[tuple[str, ...], AnimationClip]) -> dict:
 
 
 def motion(robot: Robot, trajectory: Trajectory, fps: float = 30.0) -> tuple[Motion, dict[tuple[str, ...], AnimationClip]]:
-    """Every link's poses at ``fps`` over a trajectory, as animation clips."""
+    """Every link's poses at ``fps`` over a trajectory, as animation clips.
+
+    Args:
+        robot: The robot drawn.
+        trajectory: The motion (the robot's configurations over time).
+        fps: Animation frames per second.
+    """
     times, configurations = resample(trajectory, fps, floating_base=robot.floating_base)
     if robot.floating_base:
         configurations[:, 3:7] /= np.linalg.norm(configurations[:, 3:7], axis=1, keepdims=True)
@@ -263,13 +296,24 @@ def motion(robot: Robot, trajectory: Trajectory, fps: float = 30.0) -> tuple[Mot
 
 
 def animation_command(robot: Robot, trajectory: Trajectory, fps: float = 30.0) -> tuple[dict, np.ndarray]:
-    """The meshcat animation of every link over a trajectory, and all link positions seen."""
+    """The meshcat animation of every link over a trajectory, and all link positions seen.
+
+    Args:
+        robot: The robot drawn.
+        trajectory: The motion (the robot's configurations over time).
+        fps: Animation frames per second.
+    """
     moved, _clips = motion(robot, trajectory, fps)
     return moved.animation, np.array([m[:3, 3] for frame in moved.placements for m in frame.values()])
 
 
 def pose_commands(robot: Robot, q: np.ndarray) -> list[dict]:
-    """Commands placing every link at configuration ``q`` (a still scene)."""
+    """Commands placing every link at configuration ``q`` (a still scene).
+
+    Args:
+        robot: The robot drawn.
+        q: Configuration, shape (nq,), in [rad] / [m].
+    """
     return [SetTransform(matrix, path=_path(name)).lower() for name, matrix in link_placements(robot, q).items()]
 
 
@@ -285,6 +329,11 @@ def camera_commands(points: np.ndarray, *, fov_deg: float = CAMERA_FOV, margin: 
     one for a landscape picture) as seen looking at the origin. The points are the whole
     motion, the initial pose included. Meshcat's own grid is hidden (the task grid replaces
     it).
+
+    Args:
+        points: Points to keep in view, shape (K, 3), in [m], world frame.
+        fov_deg: Meshcat's vertical field of view in [deg].
+        margin: Factor on the bounding sphere's radius (1: the sphere just fits).
     """
     low, high = points.min(axis=0), points.max(axis=0)
     centre = (low + high) / 2

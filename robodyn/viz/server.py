@@ -27,7 +27,11 @@ PR_SET_PDEATHSIG = 1
 
 
 def bind_to_parent(parent: int) -> None:
-    """Die with the parent process: SIGTERM on its death (Linux); exit if it is already gone."""
+    """Die with the parent process: SIGTERM on its death (Linux); exit if it is already gone.
+
+    Args:
+        parent: The parent's process id.
+    """
     if sys.platform.startswith("linux"):
         import ctypes
 

@@ -154,7 +154,14 @@ def _png(image: np.ndarray) -> bytes:
 
 
 def still_of_page(page: str | os.PathLike, png: str | os.PathLike, *, at: float = 0.0, size=(800, 600)) -> Path | None:
-    """A PNG of the recording's frame at ``at`` seconds (written atomically; ``None`` for ``-``)."""
+    """A PNG of the recording's frame at ``at`` seconds (written atomically; ``None`` for ``-``).
+
+    Args:
+        page: The recording's HTML file (a path) or its text (a ``str`` holding ``<html``).
+        png: The PNG file to write, or ``"-"`` for standard output.
+        at: Time into the animation in [s].
+        size: Width and height in pixels.
+    """
     return atomic_write_bytes(png, _png(capture(page, [at], size=size)[0]))
 
 
@@ -162,12 +169,24 @@ def screenshot(
     html: str | os.PathLike, png: str | os.PathLike, *, at_seconds: float = 0.0, size: tuple[int, int] = (800, 600)
 ) -> Path | None:
     """A PNG of an HTML recording ``at_seconds`` into its animation (headless Chromium);
-    the file written, ``None`` for standard output (``-``)."""
+    the file written, ``None`` for standard output (``-``).
+
+    Args:
+        html: The recording's HTML file.
+        png: The PNG file to write, or ``"-"`` for standard output.
+        at_seconds: Time into the animation in [s].
+        size: Width and height in pixels.
+    """
     return still_of_page(Path(html), png, at=at_seconds, size=size)
 
 
 def evenly(duration: float, count: int) -> list[float]:
-    """``count`` times from the start to the end of a motion, in [s]."""
+    """``count`` times from the start to the end of a motion, in [s].
+
+    Args:
+        duration: Duration of the motion in [s].
+        count: Number of times, 1 to 60.
+    """
     if not (isinstance(count, int) and 1 <= count <= 60):
         raise ViewerError(f"a filmstrip has 1 to 60 frames, got {count}.")
     return [float(t) for t in np.linspace(0.0, duration, count)] if count > 1 else [0.0]
@@ -177,7 +196,16 @@ def filmstrip_of_page(
     page: str | os.PathLike, png: str | os.PathLike, duration: float, count: int, *, size=(480, 360), columns: int = 6
 ) -> Path | None:
     """``count`` frames evenly over the motion, side by side (rows of ``columns``), each
-    labelled with its time; the file written, ``None`` for standard output (``-``)."""
+    labelled with its time; the file written, ``None`` for standard output (``-``).
+
+    Args:
+        page: The recording's HTML file (a path) or its text (a ``str`` holding ``<html``).
+        png: The PNG file to write, or ``"-"`` for standard output.
+        duration: Duration of the motion in [s].
+        count: Number of frames, 1 to 60.
+        size: Width and height of each frame in pixels.
+        columns: Most frames a row.
+    """
     from PIL import Image, ImageDraw
 
     times = evenly(duration, count)
@@ -210,6 +238,15 @@ def video_of_page(
     progress: Progress | None = _stderr_progress,
 ) -> Path:
     """An MP4 (H.264) or GIF of the motion, by the file's extension, written atomically.
+
+    Args:
+        page: The recording's HTML file (a path) or its text (a ``str`` holding ``<html``).
+        path: The ``.mp4`` or ``.gif`` file to write.
+        duration: Duration of the motion in [s].
+        fps: Frames per second of the video.
+        size: Width and height in pixels.
+        progress: Called with ``(frames done, frames in all)`` after each browser run (``None``: silent; default: a counter on
+            stderr).
 
     Raises:
         RobodynError: For another extension, a bad ``fps``, or without the ``viewer`` extra.

@@ -119,6 +119,11 @@ def task_commands(
 def axis_commands(robot: Robot, links: tuple[str, ...] | list[str], points: np.ndarray) -> list[dict]:
     """An x/y/z triad (red, green, blue lines; a tenth of the scene's size) on each link.
 
+    Args:
+        robot: The robot drawn.
+        links: Names of the links given a triad.
+        points: Points of the scene, shape (K, 3), in [m] (their extent sizes the triads).
+
     Raises:
         FrameError: For a name that is not a URDF link.
     """

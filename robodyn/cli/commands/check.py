@@ -9,7 +9,11 @@ from robodyn.common.text import json_text
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("check", help="compare Pinocchio with the independent Lagrangian reference")
     add_model_arguments(parser)
     add_constraints_argument(parser)
@@ -36,7 +40,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn check`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn check`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.common.text import printable, printable_lines
     from robodyn.verify.check import check_robot
 

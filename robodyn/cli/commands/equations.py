@@ -24,7 +24,11 @@ from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("equations", help="tau, M, C and G of a robot at one state")
     add_model_arguments(parser)
     add_constraints_argument(parser)
@@ -150,7 +154,11 @@ def _export(arguments: argparse.Namespace) -> int:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn equations`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn equations`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     if arguments.constraints and not (arguments.derivation or arguments.symbolic or arguments.lecture):
         raise InputError(
             "--constraints",

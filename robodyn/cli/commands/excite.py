@@ -8,7 +8,11 @@ from robodyn.cli.common import add_model_arguments, load_robot, vector
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser(
         "excite", help="a periodic Fourier-series trajectory within the limits that conditions the base regressor"
     )
@@ -30,7 +34,11 @@ def _limit(values: list[float] | None):
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn excite`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn excite`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.ident.run import excite_run
 
     run = excite_run(

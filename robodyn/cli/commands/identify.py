@@ -9,7 +9,11 @@ from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("identify", help="identify base inertial parameters from a trajectory with tau columns")
     add_model_arguments(parser)
     parser.add_argument("data", nargs="?", help="trajectory file (.csv or .npz) with q, v, a and tau columns")
@@ -40,7 +44,11 @@ def _links(text: str) -> list[str]:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn identify`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn identify`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.ident import base_parameters
     from robodyn.ident.render import render_base_parameters
     from robodyn.ident.run import identify_run

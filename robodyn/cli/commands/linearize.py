@@ -11,7 +11,11 @@ from robodyn.common.text import json_text
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser(
         "linearize",
         help="(A, B) of the dynamics about a state: continuous time, or the exact Jacobians of one simulator step",
@@ -32,7 +36,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn linearize`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn linearize`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.sim.linearize import actuation_matrix, linearization
 
     robot = load_robot(arguments)

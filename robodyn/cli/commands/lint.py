@@ -10,7 +10,11 @@ from robodyn.common.text import counted, printable
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("lint", help="every problem of a URDF at once (exit 1 if any error)")
     parser.add_argument("model", help=MODEL_HELP)
     parser.add_argument(
@@ -22,7 +26,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn lint`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn lint`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.urdf.sources import lint_source
 
     problems = lint_source(

@@ -9,7 +9,11 @@ from robodyn.common.text import json_text
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser(
         "observe", help="estimate external torques from a trajectory file (momentum observer); detect a collision"
     )
@@ -32,7 +36,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn observe`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn observe`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.viz.experiment import run_observation
 
     observed = run_observation(

@@ -9,7 +9,11 @@ from robodyn.cli.common import Progress, add_model_arguments, load_robot, vector
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser(
         "optimize", help="a rest-to-rest motion within the joint limits (multiple shooting, IPOPT), as a trajectory file"
     )
@@ -35,7 +39,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn optimize`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn optimize`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.common.text import printable
     from robodyn.optimize import point_to_point
 

@@ -11,7 +11,11 @@ from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser(
         "record", help="write a trajectory as a self-contained HTML animation (and stills, a filmstrip, a video)"
     )
@@ -37,7 +41,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn record`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn record`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.exceptions import MeshWarning
     from robodyn.trajectory import Trajectory
     from robodyn.viz.experiment import record_files

@@ -19,7 +19,11 @@ def _rows(text: str) -> int:
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser(
         "torques",
         help="inverse dynamics over a trajectory file (CSV, NPZ, Parquet), in chunks; writes tau[<joint>] columns",
@@ -45,7 +49,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn torques`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn torques`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.scale.torques import torques_run
 
     robot = load_robot(arguments)

@@ -8,7 +8,11 @@ from robodyn.cli.common import add_model_arguments, load_robot, vector
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("view", help="show a robot (and a trajectory) in a live meshcat viewer on 127.0.0.1")
     add_model_arguments(parser)
     parser.add_argument("--trajectory", help="trajectory file to play")
@@ -19,7 +23,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn view`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn view`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.trajectory import Trajectory
     from robodyn.viz.live import LiveViewer, wait
 

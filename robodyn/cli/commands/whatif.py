@@ -10,7 +10,11 @@ from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("whatif", help="peak and RMS torques of one motion across materials, payloads, forces")
     parser.add_argument("model", nargs="?", default="rp_arm", help="robot (default rp_arm; materials apply to rp_arm only)")
     parser.add_argument("--materials", help="comma-separated: abs (plastic), aluminium, steel or densities in kg/m³")
@@ -31,7 +35,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn whatif`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn whatif`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.viz.experiment import run_whatif
 
     if arguments.force and len(arguments.force) != 3:
