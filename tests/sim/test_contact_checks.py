@@ -146,7 +146,9 @@ def test_a_start_that_puts_links_under_the_ground_is_refused_naming_the_contacts
     path.write_text(HEAD_ONLY)
     robot = robodyn.load(str(path))
     with pytest.raises(InputError, match=r"contacts must be contact points that hold the robot .* 'leg' 0\.\d+ m") as caught:
-        run_simulation(robot, controller="pd", ground=Ground(), duration=0.01)  # the file puts the leg through the floor, the head above it
+        run_simulation(
+            robot, controller="pd", ground=Ground(), duration=0.01
+        )  # the file puts the leg through the floor, the head above it
     assert "\n" not in str(caught.value)
 
 
