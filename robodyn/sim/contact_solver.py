@@ -15,7 +15,7 @@ velocity ``c`` (3k,) (each contact's rows ``t₁, t₂, n``), find the impulses 
    force), *sticking* (``u = 0``) or *slipping* (``u_n = 0``, ``p_t = −μ p_n s`` along its
    slip direction ``s``); those equalities are solved exactly (one LU solve; least-norm,
    the constraints layer's rule, for redundant rows: more of them than the robot's ``nv``,
-   or an LU answer 10⁶ times the problem's scale) and the result kept only when it is a
+   or an LU answer over 10³ times the impulses' scale) and the result kept only when it is a
    solution: every impulse in its cone, every open contact separating, every slip
    continuing along ``s`` (to :data:`POLISH_TOLERANCE`). Otherwise ADMM's answer stands.
 """
@@ -87,8 +87,21 @@ def solve_impulses(
     *, dofs: int | None = None,
 ) -> tuple[np.ndarray, int, bool]:  # fmt: skip
     """The impulses ``p`` (3k,) of the cone complementarity problem ``u = A p + c``
-    (module docstring), with ADMM's iterations and whether it converged; ``dofs``: the
-    robot's ``nv`` (``A``'s rank is at most that: more rows are redundant), if known."""
+    (module docstring), with ADMM's iterations and whether it converged.
+
+    Args:
+        delassus: The Delassus matrix ``A``, shape (3k, 3k), in [m/(N s)] (or per joint unit).
+        velocity: The free velocity ``c`` with the gaps' bias, shape (3k,), in [m/s].
+        friction: The friction coefficient ``μ`` of every cone.
+        settings: ADMM's tolerance and iterations, and whether its answer is polished.
+        guess: Warm start: the previous step's impulses (3k,) or (k, 3), in [N s], or ``None``.
+        dofs: The most independent rows ``A`` can have (a robot's ``nv``: more rows are
+            redundant, solved least-norm at once), or ``None`` if unknown.
+
+    Returns:
+        The impulses (3k,) in [N s], ADMM's iterations (0: the previous modes held), and
+        whether they solve the problem to tolerance.
+    """
     count = len(velocity) // 3
     if not count:  # no contact: nothing to solve (Pinocchio's ADMM would crash on no rows)
         return np.zeros(0), 0, True
@@ -132,6 +145,14 @@ def polish(
     Sticking contacts alone (a robot standing) are one solve of their rows of ``A``; a
     slipping one adds a column ``(−μ s, 1)`` of its normal impulse. The modes are read
     contact by contact on Python floats (a few contacts: cheaper than numpy's calls).
+
+    Args:
+        delassus: The Delassus matrix ``A``, shape (3k, 3k).
+        velocity: The free velocity ``c`` with the gaps' bias, shape (3k,), in [m/s].
+        friction: The friction coefficient ``μ`` of every cone.
+        impulses: The impulses whose modes are solved (ADMM's, or the previous step's), shape (3k,), in [N s].
+        dofs: As for :func:`solve_impulses`.
+        cone: Whether every closed contact is taken as sticking (``impulses``: the previous step's).
     """
     before = delassus @ impulses + velocity
     p, u = impulses.tolist(), before.tolist()
@@ -152,8 +173,8 @@ def polish(
     redundant = dofs is not None and len(stuck) + len(sliding) > dofs
     if sliding:
         solution = _with_slips(delassus, velocity, friction, impulses, stuck, sliding, redundant)
-    elif len(stuck) == len(p):  # every contact sticks: its target's scale is the velocity's
-        solution = _least_norm(delassus, -velocity, 0.0 if redundant else 1e6 * max(scale_p, scale_u))
+    elif len(stuck) == len(p):  # every contact sticks
+        solution = _least_norm(delassus, -velocity, 0.0 if redundant else _bound(impulses))
     else:
         solution = np.zeros_like(velocity)
         if stuck:
