@@ -34,7 +34,8 @@ a step whose previous contacts all stick (a robot standing) is one C call
 (:mod:`robodyn.compiled.contact`: the sticking rows' solve and the complementarity check,
 no ADMM; numpy's polish without a C compiler, :mod:`robodyn.sim.contact_solver`). Robots
 with mimic joints take :func:`generic_step` (``Robot``'s ``M``); the two agree to ADMM's
-tolerance (tests/sim/test_contact_stepper.py).
+tolerance (tests/sim/test_contact_stepper.py). Enforced joint limits are rows of the same
+step in both (:mod:`robodyn.sim.contact_limits`); the C call declines a step with one in reach.
 """
 
 from __future__ import annotations
