@@ -137,7 +137,10 @@ def polish(
     ``None`` when they are not a solution of the cone complementarity problem. More
     equalities than ``dofs`` (the robot's ``nv``, if given) are redundant: least-norm at once.
 
-    A closed contact slips when the velocity ``u = A p + c`` of the impulses moves it; with
+    A closed contact slips when the velocity ``u = A p + c`` of the impulses moves it (by
+    1e-6 of ``c``'s scale, or 1e-12 when its impulse is on its cone's boundary: far open
+    points' ``g / dt`` inflate that scale, and a foot at the edge of sticking slips by
+    micrometres a second, which read as sticking puts its impulse outside the cone); with
     ``cone`` (the previous step's impulses), every closed contact sticks if each impulse is
     inside its cone (to 1e-6), else ``None``: a robot standing while its joints move keeps
     its modes, which the velocities of last step's impulses would call slipping.
@@ -165,7 +168,8 @@ def polish(
             if cone and not math.hypot(p[index], p[index + 1]) < (1 - 1e-6) * friction * p[index + 2]:
                 return None  # on its cone's boundary (or frictionless): it slipped
             slip = 0.0 if cone else math.hypot(u[index], u[index + 1])
-            if friction == 0.0 or slip > 1e-6 * scale_u:  # frictionless: the normal row only
+            edge = math.hypot(p[index], p[index + 1]) >= (1 - 1e-6) * friction * p[index + 2]  # on its cone
+            if friction == 0.0 or slip > (1e-12 if edge else 1e-6) * scale_u:  # frictionless: the normal row only
                 size = max(slip, 1e-300)
                 sliding.append((index, u[index] / size, u[index + 1] / size))
             else:
