@@ -78,8 +78,8 @@ static int rdc_lu_solve(double *a, double *b, int m) {
 }
 
 /* The impulses of the sticking contacts `stuck` (count), others open, into p; 0: not this case. */
-static int rdc_stick(const double *A, const double *c, const double *guess, const int *stuck, int count, int r,
-                     double scale_p, double scale_u, double *work, double *p) {
+static int rdc_stick(const double *A, const double *c, const int *stuck, int count, int r, double scale_p, double *work,
+                     double *p) {
     const int m = 3 * count;
     double *sub = work, *x = work + m * m;
     for (int a = 0; a < m; ++a) {
@@ -87,11 +87,7 @@ static int rdc_stick(const double *A, const double *c, const double *guess, cons
         x[a] = -c[row];
         for (int b = 0; b < m; ++b) sub[a * m + b] = A[row * r + 3 * stuck[b / 3] + b % 3];
     }
-    double bound = 1e6 * (scale_p > scale_u ? scale_p : scale_u); /* every contact sticks */
-    if (m < r) {
-        double target = rdc_largest(x, m), impulses = rdc_largest(guess, r);
-        bound = 1e6 * fmax(fmax(impulses, target), 1e-300);
-    }
+    const double bound = 1e3 * scale_p; /* contact_solver._bound: the impulses' scale, never the target's */
     if (!rdc_lu_solve(sub, x, m) || !(rdc_largest(x, m) <= bound)) return 0;
     for (int i = 0; i < r; ++i) p[i] = 0.0;
     for (int a = 0; a < m; ++a) p[3 * stuck[a / 3] + a % 3] = x[a];
@@ -178,7 +174,7 @@ static int rdc_kept(const double *A, const double *c, const double *guess, doubl
     if (3 * count > nv) return 0; /* redundant rows: least-norm, in Python */
     if (count == 0)
         for (int i = 0; i < r; ++i) p[i] = 0.0;
-    else if (!rdc_stick(A, c, guess, stuck, count, r, scale_p, scale_u, work + 3 * r, p))
+    else if (!rdc_stick(A, c, stuck, count, r, scale_p, work + 3 * r, p))
         return 0;
     return rdc_solves(A, c, p, u_before, friction, r, u);
 }

@@ -34,7 +34,8 @@ a step whose previous contacts all stick (a robot standing) is one C call
 (:mod:`robodyn.compiled.contact`: the sticking rows' solve and the complementarity check,
 no ADMM; numpy's polish without a C compiler, :mod:`robodyn.sim.contact_solver`). Robots
 with mimic joints take :func:`generic_step` (``Robot``'s ``M``); the two agree to ADMM's
-tolerance (tests/sim/test_contact_stepper.py).
+tolerance (tests/sim/test_contact_stepper.py). Enforced joint limits are rows of the same
+step in both (:mod:`robodyn.sim.contact_limits`); the C call declines a step with one in reach.
 """
 
 from __future__ import annotations
@@ -49,6 +50,7 @@ import pinocchio as pin
 from robodyn.compiled.contact import kept_step
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import SingularMassMatrixError
+from robodyn.sim.contact_limits import LimitRows
 from robodyn.sim.contact_solver import ContactSettings, solve_impulses
 from robodyn.sim.ground import ContactPoint, Ground
 
@@ -69,6 +71,8 @@ class ContactStep(NamedTuple):
         gaps: Each point's signed distance above the plane at the start, shape (k,), [m].
         slip: Each point's tangential speed after the step, shape (k,), [m/s].
         iterations: ADMM's iterations; ``converged`` whether it met its tolerance.
+        limits: With limit rows (:mod:`robodyn.sim.contact_limits`), each row's impulse,
+            shape (r,), in [N m s] or [N s] (0 for a row out of reach); else ``None``.
     """
 
     q: np.ndarray
@@ -79,6 +83,7 @@ class ContactStep(NamedTuple):
     slip: np.ndarray
     iterations: int
     converged: bool
+    limits: np.ndarray | None = None
 
 
 def contact_kinematics(
@@ -140,13 +145,15 @@ def contact_step(
     *,
     settings: ContactSettings | None = None,
     guess: np.ndarray | None = None,
+    limits: LimitRows | None = None,
+    held: np.ndarray | None = None,
 ) -> ContactStep:
     """One step of the contact scheme (module docstring) from checked 1-D ``q``, ``v``, ``tau``.
 
-    A run's steps (the same ``robot``, ``ground`` and ``points`` objects, ``guess`` set)
-    reuse one :class:`ContactStepper` of this thread, made again at each first step
-    (``guess=None``); a robot with mimic joints (its ``M`` is not CRBA's) goes through
-    :func:`generic_step`.
+    A run's steps (the same ``robot``, ``ground``, ``points`` and ``limits`` objects,
+    ``guess`` set) reuse one :class:`ContactStepper` of this thread, made again at each
+    first step (``guess=None``); a robot with mimic joints (its ``M`` is not CRBA's) goes
+    through :func:`generic_step`.
 
     Args:
         robot: The robot.
@@ -156,33 +163,39 @@ def contact_step(
         points: The contact points.
         settings: Solver settings (default :class:`ContactSettings`).
         guess: Warm start: the previous step's impulses (k, 3), or ``None``.
+        limits: The joints' position limits as rows of the same problem
+            (:mod:`robodyn.sim.contact_limits`), or ``None``: the joints move freely.
+        held: Warm start of the limit rows: the previous step's ``limits`` impulses (r,), or ``None``.
 
     Returns:
-        The state after the step with the contact impulses and forces.
+        The state after the step with the contact impulses and forces (and the limit rows' impulses).
     """
     settings = settings or _DEFAULT
     if robot.handle.mimic is not None:
-        return generic_step(robot, q, v, tau, dt, ground, points, settings, guess)
+        return generic_step(robot, q, v, tau, dt, ground, points, settings, guess, limits=limits, held=held)
     stepper = getattr(_LOCAL, "stepper", None)
-    if guess is None or stepper is None or not stepper.serves(robot, ground, points):
-        stepper = _LOCAL.stepper = ContactStepper(robot, ground, points)
-    return stepper.step(q, v, tau, dt, settings, guess)
+    if guess is None or stepper is None or not stepper.serves(robot, ground, points, limits):
+        stepper = _LOCAL.stepper = ContactStepper(robot, ground, points, limits)
+    return stepper.step(q, v, tau, dt, settings, guess, held)
 
 
 class ContactStepper:
-    """The contact step of one robot (no mimic joints), ground and point set, its
-    workspace kept from step to step: one Pinocchio ``Data``, the points' anchors in their
-    joints' frames and the rows of ``J`` each point sees.
+    """The contact step of one robot (no mimic joints), ground, point set and limit rows,
+    its workspace kept from step to step: one Pinocchio ``Data``, the points' anchors in
+    their joints' frames and the rows of ``J`` each point sees.
 
     A step is one pass of Pinocchio per quantity (``M⁻¹`` by its ABA-like recursion,
     ``C v + G``, the joints' world Jacobians) and a few stacked products: each point's
     Jacobian is ``axes (J_v − [p]× J_ω)`` of its joint's world Jacobian (``v_p = v₀ + ω × p``
     at the world origin, the joint's supporting columns), every point at once.
+
+    Args:
+        robot, ground, points, limits: As for :func:`contact_step` (a robot without mimic joints).
     """
 
-    def __init__(self, robot: Robot, ground: Ground, points: tuple[ContactPoint, ...]):
+    def __init__(self, robot: Robot, ground: Ground, points: tuple[ContactPoint, ...], limits: LimitRows | None = None) -> None:
         model, nv, count = robot.model, robot.nv, len(points)
-        self.robot, self.ground, self.points = robot, ground, points
+        self.robot, self.ground, self.points, self.limits = robot, ground, points, limits
         self.model, self.data = model, model.createData()
         self.anchors = []
         self.mask = np.zeros((count, 1, nv))
@@ -201,106 +214,177 @@ class ContactStepper:
         #: The compiled step of kept modes (robodyn.compiled.contact), or None: Python alone.
         self.kept = kept_step()
 
-    def serves(self, robot: Robot, ground: Ground, points: tuple[ContactPoint, ...]) -> bool:
-        """Whether this stepper is the one of these very objects."""
-        return robot is self.robot and ground is self.ground and points is self.points
+    def serves(self, robot: Robot, ground: Ground, points: tuple[ContactPoint, ...], limits: LimitRows | None = None) -> bool:
+        """Whether this stepper is the one of these very objects.
+
+        Args:
+            robot, ground, points, limits: As for :func:`contact_step`.
+        """
+        return robot is self.robot and ground is self.ground and points is self.points and limits is self.limits
 
     def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The points' gaps (k,) [m] and Jacobian (3k, nv) (:func:`contact_kinematics`)."""
+        """The points' gaps (k,) [m] and Jacobian (3k, nv) (:func:`contact_kinematics`).
+
+        Args:
+            q: The configuration, shape (nq,).
+        """
         world, gaps = self.locate(q)
         return gaps, self.jacobian(world)
 
     def locate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The points in world axes (k, 3) [m] and their gaps (k,) [m]; the joints' world
-        Jacobians are then in ``data.J``."""
+        Jacobians are then in ``data.J``.
+
+        Args:
+            q: The configuration, shape (nq,).
+        """
         world = self.centres(q) - self.offsets
         return world, world @ self.normal - self.level
 
     def centres(self, q: np.ndarray) -> np.ndarray:
         """The points' anchors (a sphere's centre) in world axes (k, 3) [m], and the joints'
-        world Jacobians in ``data.J``."""
+        world Jacobians in ``data.J``.
+
+        Args:
+            q: The configuration, shape (nq,).
+        """
         pin.computeJointJacobians(self.model, self.data, q)
         placements = self.data.oMi
         return np.array([placements[joint].act(anchor) for joint, anchor in self.anchors]).reshape(-1, 3)
 
     def jacobian(self, world: np.ndarray) -> np.ndarray:
-        """The points' Jacobian (3k, nv) in their contact axes, after :meth:`locate`."""
-        count = len(self.anchors)
-        columns = self.data.J * self.mask  # (k, 6, nv): each point's joint's world Jacobian
+        """The points' Jacobian (3k, nv) in their contact axes, after :meth:`locate`.
+
+        Args:
+            world: The points in world axes, shape (k, 3), in [m].
+        """
+        count, nv = len(self.anchors), self.model.nv
+        columns = self.data.J.reshape(6, nv) * self.mask  # (k, 6, nv): each point's joint's world Jacobian
         linear = columns[:, :3] - (world @ self.skew).reshape(count, 3, 3) @ columns[:, 3:]
-        return _local_jacobian(self.axes, linear).reshape(3 * count, self.model.nv)
+        return _local_jacobian(self.axes, linear).reshape(3 * count, nv)
 
     def step(
-        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, settings: ContactSettings, guess: np.ndarray | None
-    ) -> ContactStep:
-        """:func:`contact_step` of this robot, ground and points."""
-        model, data = self.model, self.data
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, settings: ContactSettings, guess: np.ndarray | None,
+        held: np.ndarray | None = None,
+    ) -> ContactStep:  # fmt: skip
+        """:func:`contact_step` of this robot, ground, points and limit rows.
+
+        Args:
+            q, v, tau: State and joint torques at the start, shapes (nq,), (nv,), (nv,).
+            dt: Step in [s].
+            settings: Solver settings.
+            guess: The previous step's impulses (k, 3), or ``None``.
+            held: The previous step's limit impulses (r,), or ``None``.
+        """
+        model, data, rows = self.model, self.data, self.limits
         inverse = pin.computeMinverse(model, data, q)  # M⁻¹'s upper triangle (armature included)
         bias = pin.nonLinearEffects(model, data, q, v)
         centres = self.centres(q)
-        if self.kept is not None and guess is not None and settings.polish and self.anchors:
-            if self.scalars[0] != (dt, settings):
-                self.scalars = ((dt, settings), np.array([dt, settings.baumgarte, self.ground.friction, self.level]))
-            base = q if self.floating else None
-            done = self.kept(
-                inverse, data.J, centres, self.offsets, self.mask, v, tau, bias, guess, self.axes, self.scalars[1], base
-            )
-            if done is not None:  # the previous modes hold: solved in C, with integrate's base origin
-                v_next, impulses, forces, slip, gaps, dq, origin = done
-                moved = pin.integrate(model, q, dq)
-                if origin is not None:
-                    moved[:3] = origin
-                return ContactStep(moved, v_next, impulses, forces, gaps, slip, 0, True)
-        world = centres - self.offsets
-        gaps = world @ self.normal - self.level
-        jacobian = self.jacobian(world)
-        np.copyto(inverse, inverse.T, where=self.lower)
-        response = inverse @ jacobian.T
-        free = v + dt * (inverse @ (tau - bias))
+        near, free = None, None
+        if rows is not None:  # (the C step reads M⁻¹'s upper triangle alone: mirrored only when needed)
+            np.copyto(inverse, inverse.T, where=self.lower)
+            free = v + dt * (inverse @ (tau - bias))
+            near = rows.near(q, v, free, dt)
+        if near is None or not len(near):  # no limit row in reach: the compiled step may take it
+            done = self._compiled(q, v, tau, dt, settings, guess, (inverse, bias, centres))
+            if done is not None:
+                return done if rows is None else done._replace(limits=np.zeros(len(rows.bound)))
+        if free is None:
+            np.copyto(inverse, inverse.T, where=self.lower)
+            free = v + dt * (inverse @ (tau - bias))
         if not math.isfinite(free @ free) and not np.isfinite(inverse).all():  # (a huge free: not finite squared)
             raise SingularMassMatrixError(self.robot.name, [])
-        return _finish(self.robot, q, dt, self.ground, settings, guess, (gaps, jacobian, free, response))
+        world = centres - self.offsets
+        gaps, jacobian = world @ self.normal - self.level, self.jacobian(world)
+        if rows is not None and near is not None and len(near):
+            jacobian = np.vstack([jacobian, rows.jacobian(near, model.nv)])
+            gaps = np.concatenate([gaps, rows.gaps(q)[near]])
+        terms = (gaps, jacobian, free, inverse @ jacobian.T)
+        return _finish(self.robot, q, dt, self.ground, settings, guess, terms, (rows, near, held))
+
+    def _compiled(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, settings: ContactSettings, guess: np.ndarray | None,
+        terms: tuple[np.ndarray, np.ndarray, np.ndarray],
+    ) -> ContactStep | None:  # fmt: skip
+        """The step by the compiled path when the previous modes hold (every closed contact
+        sticking), else ``None``; ``terms``: ``M⁻¹``, ``C v + G`` and the points' anchors."""
+        if self.kept is None or guess is None or not settings.polish or not self.anchors:
+            return None
+        if self.scalars[0] != (dt, settings):
+            self.scalars = ((dt, settings), np.array([dt, settings.baumgarte, self.ground.friction, self.level]))
+        inverse, bias, centres = terms
+        joints = self.data.J.reshape(6, self.model.nv)
+        base = q if self.floating else None
+        done = self.kept(inverse, joints, centres, self.offsets, self.mask, v, tau, bias, guess, self.axes, self.scalars[1], base)
+        if done is None:
+            return None
+        v_next, impulses, forces, slip, gaps, dq, origin = done  # solved in C, with integrate's base origin
+        moved = pin.integrate(self.model, q, dq)
+        if origin is not None:
+            moved[:3] = origin
+        return ContactStep(moved, v_next, impulses, forces, gaps, slip, 0, True)
 
 
 def generic_step(
     robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, ground: Ground,
-    points: tuple[ContactPoint, ...], settings: ContactSettings, guess: np.ndarray | None,
+    points: tuple[ContactPoint, ...], settings: ContactSettings, guess: np.ndarray | None, *,
+    limits: LimitRows | None = None, held: np.ndarray | None = None,
 ) -> ContactStep:  # fmt: skip
-    """:func:`contact_step` through ``Robot``'s own ``M`` and ``C v + G`` (any robot: mimic joints too)."""
+    """:func:`contact_step` through ``Robot``'s own ``M`` and ``C v + G`` (any robot: mimic joints too).
+
+    Args:
+        robot, q, v, tau, dt, ground, points, settings, guess, limits, held: As for :func:`contact_step`.
+    """
     mass, bias = robot.mass_matrix(q), robot.nonlinear_effects(q, v)
     gaps, jacobian = contact_kinematics(robot, q, ground, points)
     try:
-        solved = np.linalg.solve(mass, np.column_stack([tau - bias, jacobian.T]))
+        inverse = np.linalg.solve(mass, np.column_stack([tau - bias, np.eye(robot.nv)]))
     except np.linalg.LinAlgError:
         raise SingularMassMatrixError(robot.name, []) from None
-    free = v + dt * solved[:, 0]
-    return _finish(robot, q, dt, ground, settings, guess, (gaps, jacobian, free, solved[:, 1:]))
+    free = v + dt * inverse[:, 0]
+    near = None if limits is None else limits.near(q, v, free, dt)
+    if limits is not None and near is not None and len(near):
+        jacobian = np.vstack([jacobian, limits.jacobian(near, robot.nv)])
+        gaps = np.concatenate([gaps, limits.gaps(q)[near]])
+    terms = (gaps, jacobian, free, inverse[:, 1:] @ jacobian.T)
+    return _finish(robot, q, dt, ground, settings, guess, terms, (limits, near, held))
 
 
 def _finish(
     robot: Robot, q: np.ndarray, dt: float, ground: Ground, settings: ContactSettings, guess: np.ndarray | None,
     terms: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    limits: tuple[LimitRows | None, np.ndarray | None, np.ndarray | None],
 ) -> ContactStep:  # fmt: skip
-    """The step from its ``gaps``, ``J``, the free velocity and ``M⁻¹ Jᵀ``: the impulses, ``v⁺``, ``q⁺``."""
+    """The step from its ``gaps``, ``J``, the free velocity and ``M⁻¹ Jᵀ`` (the points' rows,
+    then the limit rows ``near`` in reach, :mod:`robodyn.sim.contact_limits`): the impulses, ``v⁺``, ``q⁺``."""
     gaps, jacobian, free, response = terms
+    rows, near, held = limits
     velocity = jacobian @ free
     beta = settings.baumgarte
     velocity[2::3] += [gap / dt if gap >= 0.0 else beta * gap / dt for gap in gaps.tolist()]
     delassus = jacobian @ response
-    impulses, iterations, converged = solve_impulses(delassus, velocity, ground.friction, settings, guess, dofs=jacobian.shape[1])
+    extra = 0 if near is None else len(near)
+    count = len(gaps) - extra
+    if extra:  # each limit row's tangent rows decoupled, of the normal row's diagonal
+        first = 3 * count + 3 * np.arange(extra)
+        delassus[first, first] = delassus[first + 1, first + 1] = delassus[first + 2, first + 2]
+        if guess is not None:
+            start = np.zeros((count + extra, 3))
+            start[:count] = guess.reshape(count, 3)
+            start[count:, 2] = 0.0 if held is None else held[near]
+            guess = start
+    dofs = jacobian.shape[1] + 2 * extra  # (each limit's decoupled tangent rows add two to A's rank)
+    impulses, iterations, converged = solve_impulses(delassus, velocity, ground.friction, settings, guess, dofs=dofs)
     v_next = free + response @ impulses
     local = impulses.reshape(-1, 3)
-    after = (jacobian @ v_next).reshape(-1, 3)
+    after = (jacobian[: 3 * count] @ v_next).reshape(-1, 3)
+    limit_impulses = None if rows is None else np.zeros(len(rows.bound))
+    if limit_impulses is not None and extra:
+        limit_impulses[near] = local[count:, 2]
     return ContactStep(
-        integrate(robot, q, dt * v_next),
-        v_next,
-        local,
-        local @ ground.frame() / dt,
-        gaps,
-        np.hypot(after[:, 0], after[:, 1]),
-        iterations,
-        converged,
-    )
+        integrate(robot, q, dt * v_next), v_next, local[:count], local[:count] @ ground.frame() / dt, gaps[:count],
+        np.hypot(after[:, 0], after[:, 1]), iterations, converged, limit_impulses,
+    )  # fmt: skip
 
 
 __all__ = [

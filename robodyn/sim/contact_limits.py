@@ -14,9 +14,11 @@ overshoot a step (``b = β g / dt``). Stops are inelastic and frictionless.
 
 **How it enters the solver**: a row is a cone of three rows whose normal row is the
 limit's and whose two tangent rows are decoupled from everything (a Delassus diagonal equal
-to the normal row's, no free velocity). Their impulses are zero at every solution (sticking
-needs ``u_t = d p_t = 0``; slipping would need ``p_t`` against ``u_t = d p_t``), so the
-cone reduces to ``λ ≥ 0`` and De Saxcé's term ``μ ‖u_t‖`` vanishes: the contact solver
+to the normal row's, no free velocity), in the step of a run without limits
+(:func:`robodyn.sim.contact.contact_step` with ``limits``; its compiled path declines a
+step with a row in reach). Their impulses are zero at every solution (sticking needs
+``u_t = d p_t = 0``; slipping would need ``p_t`` against ``u_t = d p_t``), so the cone
+reduces to ``λ ≥ 0`` and De Saxcé's term ``μ ‖u_t‖`` vanishes: the contact solver
 (:func:`robodyn.sim.contact_solver.solve_impulses`, Pinocchio's ADMM and the exact polish)
 solves the combined problem unchanged. A limit enters a step when its joint is within
 reach of it, ``g < 2 dt (|v_j| + |v_free,j|) +`` :data:`REACH` (else its impulse is 0).
@@ -28,10 +30,6 @@ from __future__ import annotations
 import numpy as np
 
 from robodyn.dynamics.robot import Robot
-from robodyn.exceptions import SingularMassMatrixError
-from robodyn.sim.contact import ContactStep, contact_kinematics, integrate
-from robodyn.sim.contact_solver import ContactSettings, solve_impulses
-from robodyn.sim.ground import ContactPoint, Ground
 from robodyn.sim.limits import JointLimits
 
 #: A limit row enters a step when its joint is this close to it (beyond the step's reach),
@@ -83,59 +81,29 @@ class LimitRows:
         np.add.at(out, self.v_index, self.sign * impulses / dt)
         return out
 
+    def near(self, q: np.ndarray, v: np.ndarray, free: np.ndarray, dt: float) -> np.ndarray:
+        """The rows within reach of a step (module docstring), their indices (m,).
 
-def limited_step(
-    robot: Robot, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, ground: Ground,
-    points: tuple[ContactPoint, ...], rows: LimitRows, *, settings: ContactSettings,
-    guess: np.ndarray | None = None, held: np.ndarray | None = None,
-) -> tuple[ContactStep, np.ndarray]:  # fmt: skip
-    """One contact step (:func:`robodyn.sim.contact.contact_step`'s scheme) with the limit
-    rows in its problem (module docstring).
+        Args:
+            q: The configuration at the start, shape (nq,).
+            v: The velocity at the start, shape (nv,), in [rad/s] or [m/s].
+            free: The velocity after the step without constraint impulses, shape (nv,).
+            dt: The step, in [s].
+        """
+        reach = 2 * dt * (np.abs(v) + np.abs(free))[self.v_index] + REACH
+        return np.flatnonzero(self.gaps(q) < reach)
 
-    Args:
-        robot, q, v, tau, dt, ground, points, settings, guess: As for ``contact_step``.
-        rows: The limits.
-        held: Warm start of the rows: the previous step's limit impulses (r,), or ``None``.
+    def jacobian(self, near: np.ndarray, nv: int) -> np.ndarray:
+        """The rows ``near`` as cones of the contact problem: three rows each (two
+        decoupled tangent rows of zeros, then the normal row ``s e_j``), shape (3m, nv).
 
-    Returns:
-        The step, and each row's impulse (r,) in [N m s] / [N s] (0 for a row out of reach).
-    """
-    mass, bias = robot.mass_matrix(q), robot.nonlinear_effects(q, v)
-    gaps, contacts = contact_kinematics(robot, q, ground, points)
-    count = len(points)
-    try:
-        inverse = np.linalg.solve(mass, np.column_stack([tau - bias, np.eye(robot.nv)]))
-    except np.linalg.LinAlgError:
-        raise SingularMassMatrixError(robot.name, []) from None
-    free = v + dt * inverse[:, 0]
-    limit_gaps = rows.gaps(q)
-    near = np.flatnonzero(limit_gaps < 2 * dt * (np.abs(v) + np.abs(free))[rows.v_index] + REACH)
-    jacobian = np.zeros((3 * (count + len(near)), robot.nv))
-    jacobian[: 3 * count] = contacts
-    jacobian[3 * (count + np.arange(len(near))) + 2, rows.v_index[near]] = rows.sign[near]
-    response = inverse[:, 1:] @ jacobian.T
-    delassus = jacobian @ response
-    tangents = 3 * count + np.concatenate([3 * np.arange(len(near)), 3 * np.arange(len(near)) + 1])
-    delassus[tangents, tangents] = np.tile(np.diag(delassus)[3 * count + 2 :: 3], 2)
-    velocity = jacobian @ free
-    all_gaps = np.concatenate([gaps, limit_gaps[near]])
-    velocity[2::3] += np.where(all_gaps >= 0.0, all_gaps, settings.baumgarte * all_gaps) / dt
-    start = None
-    if guess is not None:
-        start = np.zeros((count + len(near), 3))
-        start[:count] = guess
-        start[count:, 2] = 0.0 if held is None else held[near]
-    impulses, iterations, converged = solve_impulses(delassus, velocity, ground.friction, settings, start)
-    v_next = free + response @ impulses
-    local = impulses.reshape(-1, 3)
-    after = (contacts @ v_next).reshape(-1, 3)
-    limit_impulses = np.zeros(len(rows.bound))
-    limit_impulses[near] = local[count:, 2]
-    step = ContactStep(
-        integrate(robot, q, dt * v_next), v_next, local[:count], local[:count] @ ground.frame() / dt, gaps,
-        np.linalg.norm(after[:, :2], axis=1), iterations, converged,
-    )  # fmt: skip
-    return step, limit_impulses
+        Args:
+            near: The rows' indices, shape (m,).
+            nv: The robot's number of velocity coordinates.
+        """
+        out = np.zeros((3 * len(near), nv))
+        out[3 * np.arange(len(near)) + 2, self.v_index[near]] = self.sign[near]
+        return out
 
 
-__all__ = ["REACH", "LimitRows", "limited_step"]
+__all__ = ["REACH", "LimitRows"]

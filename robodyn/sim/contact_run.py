@@ -21,7 +21,7 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.sim.contact import ACTIVE_FORCE, ContactSettings, contact_step
 from robodyn.sim.contact_checks import buried_line
-from robodyn.sim.contact_limits import LimitRows, limited_step
+from robodyn.sim.contact_limits import LimitRows
 from robodyn.sim.ground import ContactPoint, Contacts, Ground, contact_points
 from robodyn.sim.limits import check_mode
 from robodyn.sim.plan import ExternalWrench
@@ -254,13 +254,13 @@ def _run(
     for step in range(steps + 1):
         t = step * dt
         tau = _torque(controller, t, q, v, robot.nv)
-        if rows is None:
-            result = contact_step(robot, q, v, tau - damping * v, dt, ground, points, settings=settings, guess=guess)
-        else:
+        if rows is not None:
             tau = rows.limits.saturate(tau)
-            result, held = limited_step(
-                robot, q, v, tau - damping * v, dt, ground, points, rows, settings=settings, guess=guess, held=held
-            )
+        result = contact_step(
+            robot, q, v, tau - damping * v, dt, ground, points, settings=settings, guess=guess, limits=rows, held=held
+        )
+        if rows is not None and result.limits is not None:
+            held = result.limits
             limit_torques = rows.torques(held, dt, robot.nv)
         values = (q, v, (result.v - v) / dt, tau, result.forces, result.gaps, result.slip, result.iterations,
                   result.converged, limit_torques)  # fmt: skip

@@ -15,7 +15,7 @@ velocity ``c`` (3k,) (each contact's rows ``t₁, t₂, n``), find the impulses 
    force), *sticking* (``u = 0``) or *slipping* (``u_n = 0``, ``p_t = −μ p_n s`` along its
    slip direction ``s``); those equalities are solved exactly (one LU solve; least-norm,
    the constraints layer's rule, for redundant rows: more of them than the robot's ``nv``,
-   or an LU answer 10⁶ times the problem's scale) and the result kept only when it is a
+   or an LU answer over 10³ times the impulses' scale) and the result kept only when it is a
    solution: every impulse in its cone, every open contact separating, every slip
    continuing along ``s`` (to :data:`POLISH_TOLERANCE`). Otherwise ADMM's answer stands.
 """
@@ -87,8 +87,21 @@ def solve_impulses(
     *, dofs: int | None = None,
 ) -> tuple[np.ndarray, int, bool]:  # fmt: skip
     """The impulses ``p`` (3k,) of the cone complementarity problem ``u = A p + c``
-    (module docstring), with ADMM's iterations and whether it converged; ``dofs``: the
-    robot's ``nv`` (``A``'s rank is at most that: more rows are redundant), if known."""
+    (module docstring), with ADMM's iterations and whether it converged.
+
+    Args:
+        delassus: The Delassus matrix ``A``, shape (3k, 3k), in [m/(N s)] (or per joint unit).
+        velocity: The free velocity ``c`` with the gaps' bias, shape (3k,), in [m/s].
+        friction: The friction coefficient ``μ`` of every cone.
+        settings: ADMM's tolerance and iterations, and whether its answer is polished.
+        guess: Warm start: the previous step's impulses (3k,) or (k, 3), in [N s], or ``None``.
+        dofs: The most independent rows ``A`` can have (a robot's ``nv``: more rows are
+            redundant, solved least-norm at once), or ``None`` if unknown.
+
+    Returns:
+        The impulses (3k,) in [N s], ADMM's iterations (0: the previous modes held), and
+        whether they solve the problem to tolerance.
+    """
     count = len(velocity) // 3
     if not count:  # no contact: nothing to solve (Pinocchio's ADMM would crash on no rows)
         return np.zeros(0), 0, True
@@ -124,7 +137,10 @@ def polish(
     ``None`` when they are not a solution of the cone complementarity problem. More
     equalities than ``dofs`` (the robot's ``nv``, if given) are redundant: least-norm at once.
 
-    A closed contact slips when the velocity ``u = A p + c`` of the impulses moves it; with
+    A closed contact slips when the velocity ``u = A p + c`` of the impulses moves it (by
+    1e-6 of ``c``'s scale, or 1e-12 when its impulse is on its cone's boundary: far open
+    points' ``g / dt`` inflate that scale, and a foot at the edge of sticking slips by
+    micrometres a second, which read as sticking puts its impulse outside the cone); with
     ``cone`` (the previous step's impulses), every closed contact sticks if each impulse is
     inside its cone (to 1e-6), else ``None``: a robot standing while its joints move keeps
     its modes, which the velocities of last step's impulses would call slipping.
@@ -132,6 +148,14 @@ def polish(
     Sticking contacts alone (a robot standing) are one solve of their rows of ``A``; a
     slipping one adds a column ``(−μ s, 1)`` of its normal impulse. The modes are read
     contact by contact on Python floats (a few contacts: cheaper than numpy's calls).
+
+    Args:
+        delassus: The Delassus matrix ``A``, shape (3k, 3k).
+        velocity: The free velocity ``c`` with the gaps' bias, shape (3k,), in [m/s].
+        friction: The friction coefficient ``μ`` of every cone.
+        impulses: The impulses whose modes are solved (ADMM's, or the previous step's), shape (3k,), in [N s].
+        dofs: As for :func:`solve_impulses`.
+        cone: Whether every closed contact is taken as sticking (``impulses``: the previous step's).
     """
     before = delassus @ impulses + velocity
     p, u = impulses.tolist(), before.tolist()
@@ -144,7 +168,8 @@ def polish(
             if cone and not math.hypot(p[index], p[index + 1]) < (1 - 1e-6) * friction * p[index + 2]:
                 return None  # on its cone's boundary (or frictionless): it slipped
             slip = 0.0 if cone else math.hypot(u[index], u[index + 1])
-            if friction == 0.0 or slip > 1e-6 * scale_u:  # frictionless: the normal row only
+            edge = math.hypot(p[index], p[index + 1]) >= (1 - 1e-6) * friction * p[index + 2]  # on its cone
+            if friction == 0.0 or slip > (1e-12 if edge else 1e-6) * scale_u:  # frictionless: the normal row only
                 size = max(slip, 1e-300)
                 sliding.append((index, u[index] / size, u[index + 1] / size))
             else:
@@ -152,8 +177,8 @@ def polish(
     redundant = dofs is not None and len(stuck) + len(sliding) > dofs
     if sliding:
         solution = _with_slips(delassus, velocity, friction, impulses, stuck, sliding, redundant)
-    elif len(stuck) == len(p):  # every contact sticks: its target's scale is the velocity's
-        solution = _least_norm(delassus, -velocity, 0.0 if redundant else 1e6 * max(scale_p, scale_u))
+    elif len(stuck) == len(p):  # every contact sticks
+        solution = _least_norm(delassus, -velocity, 0.0 if redundant else _bound(impulses))
     else:
         solution = np.zeros_like(velocity)
         if stuck:

@@ -26,6 +26,7 @@ import math
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from numbers import Real
 
 import numpy as np
 
@@ -51,15 +52,15 @@ class Ground:
     origin: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
-        if not math.isfinite(self.height):
-            raise InputError("height", "a finite height in [m]", repr(self.height))
+        if not (_real(self.height) and math.isfinite(self.height)):
+            raise InputError("height", "a finite height in [m]", repr(self.height)[:80])
         friction = self.friction
         if isinstance(friction, bool) or not (isinstance(friction, int | float) and math.isfinite(friction) and friction >= 0):
             raise InputError("friction", "a finite coefficient μ ≥ 0", repr(self.friction))
-        normal = np.asarray(self.normal, dtype=float).reshape(-1)
-        size = float(np.linalg.norm(normal)) if normal.shape == (3,) and np.isfinite(normal).all() else 0.0
-        if size < 1e-9:
-            raise InputError("normal", "a non-zero finite 3-vector", repr(self.normal))
+        normal = _three(self.normal)
+        size = 0.0 if normal is None else float(np.linalg.norm(normal))
+        if normal is None or size < 1e-9:
+            raise InputError("normal", "a non-zero finite 3-vector", repr(self.normal)[:80])
         object.__setattr__(self, "normal", tuple(float(x) for x in normal / size))
         object.__setattr__(self, "height", float(self.height))
         object.__setattr__(self, "friction", float(self.friction))
@@ -112,14 +113,32 @@ class ContactPoint:
         for argument in ("name", "link"):
             if not (isinstance(getattr(self, argument), str) and getattr(self, argument)):
                 raise InputError(argument, "a non-empty name", repr(getattr(self, argument))[:80])
-        position = np.asarray(self.position, dtype=float).reshape(-1) if np.size(self.position) == 3 else None
-        if position is None or not np.isfinite(position).all():
+        position = _three(self.position)
+        if position is None:
             raise InputError("position", "3 finite coordinates in [m]", repr(self.position)[:80])
         radius = self.radius
         if isinstance(radius, bool) or not (isinstance(radius, int | float) and math.isfinite(radius) and radius >= 0):
             raise InputError("radius", "a finite radius ≥ 0 in [m]", repr(radius))
         object.__setattr__(self, "position", _triple(position))
         object.__setattr__(self, "radius", float(radius))
+
+
+def _real(value: object) -> bool:
+    """Whether ``value`` is a real number (a boolean is not, nor is text)."""
+    return isinstance(value, Real) and not isinstance(value, bool | np.bool_)
+
+
+def _three(value: object) -> np.ndarray | None:
+    """``value`` as 3 finite floats, or ``None``: text and booleans are not numbers
+    (``"123"`` and ``("1", "2", "3")`` are not ``(1, 2, 3)``)."""
+    try:
+        items = np.asarray(value, dtype=object).reshape(-1) if not isinstance(value, str | bytes) else None
+    except ValueError:  # a ragged sequence
+        return None
+    if items is None or len(items) != 3 or not all(_real(x) for x in items):
+        return None
+    values = np.array([float(x) for x in items])
+    return values if np.isfinite(values).all() else None
 
 
 @dataclass(frozen=True)

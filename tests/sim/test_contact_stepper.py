@@ -238,3 +238,43 @@ def test_without_a_c_compiler_the_step_is_numpys(solo, monkeypatch, tmp_path):
         assert step.converged and np.isfinite(step.q).all()
     finally:
         compiled_contact.kept_step.cache_clear()  # built (or found) again for the tests after
+
+
+def test_limit_rows_step_in_the_stepper_as_in_the_general_step_and_the_compiled_step_declines_them():
+    """The stop pendulum (one dof: Pinocchio's ``data.J`` is then 1-D) dropped onto its stop
+    under gravity 7.3: the stepper's run (its C step tried while no limit row is in reach)
+    and the general step's agree, the stop carrying gravity's torque; no C call comes with a
+    row in reach."""
+    from robodyn.sim.contact_limits import LimitRows
+    from tests.sim.test_contact_limits import FAR, GRAVITY, LEVER, MASS, PENDULUM, TIP, UPPER
+
+    robot = robodyn.load(PENDULUM, gravity=GRAVITY)
+    rows, points, settings, dt = LimitRows(robot), tuple(TIP), ContactSettings(), 1e-3
+    stepper = ContactStepper(robot, FAR, points, rows)
+    compiled, in_reach, calls = stepper.kept, [False], []
+
+    def counted(*arguments):
+        calls.append(in_reach[0])
+        return compiled(*arguments)
+
+    if compiled is not None:
+        stepper.kept = counted
+    runs = []
+    for fast in (True, False):
+        q, v, guess, held, run = np.array([0.1]), np.zeros(1), None, None, []
+        for _ in range(300):
+            free = v + dt * np.linalg.solve(robot.mass_matrix(q), -robot.nonlinear_effects(q, v))
+            in_reach[0] = len(rows.near(q, v, free, dt)) > 0
+            if fast:
+                result = stepper.step(q, v, np.zeros(1), dt, settings, guess, held)
+            else:
+                result = generic_step(robot, q, v, np.zeros(1), dt, FAR, points, settings, guess, limits=rows, held=held)
+            run.append((result.q, result.v, result.limits))
+            q, v, guess, held = result.q, result.v, result.impulses, result.limits
+        runs.append(run)
+    for index in range(3):
+        assert _largest_difference(runs, index) < 1e-12
+    assert abs(runs[0][-1][0][0] - UPPER) < 1e-12  # on its stop
+    weight = MASS * abs(GRAVITY[2]) * LEVER * np.cos(UPPER)  # gravity's torque about the hinge, [N m]
+    assert abs(runs[0][-1][2][1] / (weight * dt) - 1) < 1e-9  # the upper stop's impulse carries it
+    assert compiled is None or (calls and not any(calls))  # the C step tried, never with a row in reach

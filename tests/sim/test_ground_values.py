@@ -89,6 +89,43 @@ def test_an_impossible_contact_point_is_refused_in_one_sentence(arguments, messa
     assert str(error.value) == message
 
 
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda: Ground(normal=("0", "0", "1")), "normal must be a non-zero finite 3-vector, got ('0', '0', '1')."),
+        (lambda: Ground(normal="001"), "normal must be a non-zero finite 3-vector, got '001'."),
+        (lambda: Ground(normal=(True, False, True)), "normal must be a non-zero finite 3-vector, got (True, False, True)."),
+        (
+            lambda: Ground(normal=np.array([0.0, 0.0, 1.0]) > 0.5),
+            "normal must be a non-zero finite 3-vector, got array([False, False,  True]).",
+        ),
+        (lambda: Ground(height="1"), "height must be a finite height in [m], got '1'."),
+        (lambda: Ground(height=True), "height must be a finite height in [m], got True."),
+        (
+            lambda: ContactPoint("heel", "foot", ("1", "2", "3")),
+            "position must be 3 finite coordinates in [m], got ('1', '2', '3').",
+        ),
+        (lambda: ContactPoint("heel", "foot", "123"), "position must be 3 finite coordinates in [m], got '123'."),
+        (
+            lambda: ContactPoint("heel", "foot", ((0, 1), 2, 3)),
+            "position must be 3 finite coordinates in [m], got ((0, 1), 2, 3).",
+        ),
+        (lambda: ContactPoint("heel", "foot", (1j, 2, 3)), "position must be 3 finite coordinates in [m], got (1j, 2, 3)."),
+    ],
+)
+def test_text_and_booleans_are_not_a_grounds_or_a_contact_points_numbers(make, message):
+    """As the constraint values refuse them: ``("1", "2", "3")`` is not ``(1, 2, 3)``, ``"123"`` not three digits."""
+    with pytest.raises(InputError) as error:
+        make()
+    assert str(error.value) == message
+
+
+def test_numpy_numbers_are_a_grounds_and_a_contact_points_numbers():
+    ground = Ground(height=np.float32(0.5), normal=np.array([0, 0, 2]))
+    assert (ground.height, ground.normal) == (0.5, (0.0, 0.0, 1.0)) and type(ground.height) is float
+    assert ContactPoint("heel", "foot", [1, 2.5, np.int64(3)]).position == (1.0, 2.5, 3.0)
+
+
 def test_a_contact_points_numbers_are_floats():
     point = ContactPoint("heel", "foot", np.array([1, 2, 3]), 0)
     assert point == ContactPoint("heel", "foot", (1.0, 2.0, 3.0), 0.0)
