@@ -91,8 +91,9 @@ def viscous_params(model: Robot, compensate: bool, joints: int) -> np.ndarray | 
 
 
 def compensate(law: object, joint_friction: bool) -> None:
-    """Make a model-based law (computed torque, task space, operational space, impedance)
-    compensate the joints' viscous damping exactly when the run applies it.
+    """Make a model-based law (computed torque, task space, operational space, impedance,
+    hybrid force/motion, the whole-body QP ``Stand`` or its recording wrapper) compensate the
+    joints' viscous damping exactly when the run applies it.
 
     Args:
         law: The run's controller (others are left as they are).
