@@ -5,7 +5,10 @@ once per term it scales) becomes ``c (a + b − d)``: one multiplication instead
 one constant where ``c`` and ``−c`` were two. It is applied to every assignment and output of
 the exported programs (:mod:`robodyn.export.programs`), so each graph (CasADi's SX, JAX's)
 has fewer operations for the same value (the rounding differs by an ulp or so per term: the
-functions stay within 1e-14 of Pinocchio, as the export's tests check).
+functions stay within 1e-14 of Pinocchio, as the export's tests check). Before that, the
+program's negations are folded into their uses (:func:`negations_inlined`), and every sum is
+printed with a term that is not negative first, so ``a − c x`` needs only ``c`` in the graph
+(ur5's M + C v + G: 915 -> 893 CasADi instructions).
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ position and Jacobian are read. The robot's coordinates map onto the bodies' by 
 map ``theta = S q + offset``; the printer (:mod:`robodyn.export.source`) projects back
 (``tau = Sᵀ tau_bodies``, ``M = Sᵀ M_bodies S``, ``J = J_bodies S``). The dynamics'
 programs are printed with their sums' common factors taken out
-(:func:`robodyn.export.factoring.factored`: ur5's M + C v + G 963 -> 915 CasADi instructions).
+(:func:`robodyn.export.factoring.factored`: ur5's M + C v + G 963 -> 893 CasADi instructions).
 
 Frames are Pinocchio's (:attr:`robodyn.Robot.frame_names`: links, joints, fixed frames):
 a frame is its parent joint's body and a constant placement, so the exported positions and
