@@ -37,7 +37,6 @@ from robodyn.equations.newton_euler import derive_newton_euler, symbolic_bodies
 from robodyn.equations.program import Program, ProgramBuilder
 from robodyn.equations.sharing import shortened
 from robodyn.exceptions import InputError
-from robodyn.export.factoring import factored
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, exact_matrix, joint_symbols
 
@@ -137,9 +136,9 @@ def export_programs(
         offset=bodies.offset,
         parents=coordinate_parents(robot),
         symbols=symbols,
-        dynamics=factored(dynamics),
-        tau=factored(tau),
-        nle=factored(nle),
+        dynamics=dynamics,
+        tau=tau,
+        nle=nle,
         frames=kinematics,
         frame_names=names,
         parameters=dict(sorted(parameters.items(), key=lambda item: str(item[0]))),
