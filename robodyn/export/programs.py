@@ -12,7 +12,7 @@ position and Jacobian are read. The robot's coordinates map onto the bodies' by 
 map ``theta = S q + offset``; the printer (:mod:`robodyn.export.source`) projects back
 (``tau = Sᵀ tau_bodies``, ``M = Sᵀ M_bodies S``, ``J = J_bodies S``). The dynamics'
 programs are printed with their sums' common factors taken out
-(:func:`robodyn.export.factoring.factored`: ur5's M + C v + G 963 -> 915 CasADi instructions).
+(:func:`robodyn.export.factoring.factored`: ur5's M + C v + G 963 -> 893 CasADi instructions).
 
 Frames are Pinocchio's (:attr:`robodyn.Robot.frame_names`: links, joints, fixed frames):
 a frame is its parent joint's body and a constant placement, so the exported positions and
@@ -37,7 +37,6 @@ from robodyn.equations.newton_euler import derive_newton_euler, symbolic_bodies
 from robodyn.equations.program import Program, ProgramBuilder
 from robodyn.equations.sharing import shortened
 from robodyn.exceptions import InputError
-from robodyn.export.factoring import factored
 from robodyn.reference.numeric import ReferenceRobot
 from robodyn.reference.symbolic import Parameters, exact_matrix, joint_symbols
 
@@ -137,9 +136,9 @@ def export_programs(
         offset=bodies.offset,
         parents=coordinate_parents(robot),
         symbols=symbols,
-        dynamics=factored(dynamics),
-        tau=factored(tau),
-        nle=factored(nle),
+        dynamics=dynamics,
+        tau=tau,
+        nle=nle,
         frames=kinematics,
         frame_names=names,
         parameters=dict(sorted(parameters.items(), key=lambda item: str(item[0]))),
