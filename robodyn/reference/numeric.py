@@ -31,6 +31,7 @@ import numpy as np
 from robodyn.common.inputs import as_states
 from robodyn.common.rotations import skew
 from robodyn.reference import centroidal
+from robodyn.reference.mass_derivative import mass_derivative
 from robodyn.reference.tree import KinematicTree
 from robodyn.urdf.validation import URDFSpec
 
@@ -67,20 +68,6 @@ def _base_bias(v: np.ndarray) -> np.ndarray:
     bias[:, :3] = np.cross(angular, linear)
     bias[:, 3:6] = -np.stack([angular[:, 1] * angular[:, 2], -angular[:, 0] * angular[:, 2], angular[:, 0] * angular[:, 1]], -1)
     return bias
-
-
-def _pair_cross(columns: np.ndarray, others: np.ndarray) -> np.ndarray:
-    """``out[n, i, j] = Σ_b columns[n, b, i] × others[n, b, j]``, shape (N, n, n, 3): from the
-    nine sums ``Σ_b columns[n, b, i, d] others[n, b, j, e]``, each one matrix product a state."""
-    products = np.einsum("nbid,nbje->nijde", columns, others, optimize=True)
-    return np.stack(
-        [
-            products[..., 1, 2] - products[..., 2, 1],
-            products[..., 2, 0] - products[..., 0, 2],
-            products[..., 0, 1] - products[..., 1, 0],
-        ],
-        axis=-1,
-    )
 
 
 class ReferenceRobot:
@@ -121,11 +108,6 @@ class ReferenceRobot:
         self._coms = np.array([body.com for body in bodies]).reshape(-1, 3)
         self._inertias = np.array([body.inertia for body in bodies]).reshape(-1, 3, 3)
         self._axis_skews = skew(self._axes)
-        ancestors = tree.ancestors
-        # dJ[b, i]/dθ_k = z_k × J[b, i] where k is i or an ancestor of i, and revolute.
-        self._mask_rotating = ancestors & self._revolute[None, :]
-        # dJ_v[b, i]/dθ_k = z_i × J_v[b, k] where i is a revolute strict ancestor of k.
-        self._mask_lever = ancestors.T & ~np.eye(len(bodies), dtype=bool) & self._revolute[:, None]
         self._selection = tree.selection
         self._offset = tree.offset
 
@@ -212,35 +194,10 @@ class ReferenceRobot:
             "U": -np.einsum("b,nba,a->n", self._masses, coms, self.gravity_vector),
         }
         if derivative:
-            terms["dM"] = self._mass_derivative(linear, angular, weighted, world_inertia, axes)
+            terms["dM"] = mass_derivative(
+                linear, angular, weighted, world_inertia, axes, ancestors=self.tree.ancestors, revolute=self._revolute
+            )
         return terms
-
-    def _mass_derivative(self, linear, angular, weighted, world_inertia, axes) -> np.ndarray:
-        """``dM[n, i, j, k] = ∂M_ij/∂θ_k`` (see the module docstring).
-
-        ``∂M_ij/∂θ_k = Σ_b m_b (∂J_v[b,i]/∂θ_k · J_v[b,j] + J_v[b,i] · ∂J_v[b,j]/∂θ_k)`` plus the
-        rotational terms; each ``∂J/∂θ_k`` is a cross product with a joint axis, so by the
-        triple product ``(z × x) · y = z · (x × y)`` the sums over bodies are taken first (one
-        3-vector per pair of joints) and dotted with the axes after.
-        """
-        rotating, lever = self._mask_rotating, self._mask_lever  # [i, k]
-        moving = (self.tree.ancestors & self._revolute[None, :]).astype(float)  # [b, k]
-        inertia_angular = world_inertia @ np.swapaxes(angular, -1, -2)  # (N, B, 3, n): I_b J_ω[b, j]
-        inertia_angular = np.swapaxes(inertia_angular, -1, -2)  # (N, B, n, 3)
-        # P[n, i, j] = Σ_b J_v[b, i] × m_b J_v[b, j];  Q[n, i, j] = Σ_b J_ω[b, i] × I_b J_ω[b, j]
-        linear_pairs = _pair_cross(linear, weighted)
-        angular_pairs = _pair_cross(angular, inertia_angular)
-        # (z_k × J[b,i]) · Y[b,j] = z_k · (J[b,i] × Y[b,j]);  (z_i × J_v[b,k]) · W[b,j] = z_i · P[k, j]
-        along_k = np.einsum("nija,nka->nijk", linear_pairs + angular_pairs, axes, optimize=True) * rotating[None, :, None, :]
-        along_i = np.einsum("nkja,nia->nijk", linear_pairs, axes, optimize=True) * lever[None, :, None, :]
-        half = along_k + along_i
-        # Σ_b J_ω[b,i] · (∂(R I Rᵀ)/∂θ_k) J_ω[b,j] = Σ_b moving[b,k] z_k · (I J_ω[b,j] × J_ω[b,i] − J_ω[b,j] × I J_ω[b,i])
-        spin = np.cross(inertia_angular[:, :, None, :, :], angular[:, :, :, None, :]) - np.cross(
-            angular[:, :, None, :, :], inertia_angular[:, :, :, None, :]
-        )  # (N, B, i, j, 3)
-        summed = np.einsum("bk,nbija->nijka", moving, spin, optimize=True)  # Σ_b moving[b, k] (…)[b, i, j]
-        spin_term = np.einsum("nijka,nka->nijk", summed, axes, optimize=True)
-        return half + np.swapaxes(half, 1, 2) + spin_term
 
     def _evaluate(self, q: np.ndarray, v: np.ndarray | None, a: np.ndarray | None) -> dict[str, np.ndarray]:
         """All terms in the independent coordinates, for stacks q, v, a (chunked)."""

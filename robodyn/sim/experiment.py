@@ -24,7 +24,6 @@ from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
-import pinocchio as pin
 
 from robodyn.common.text import counted
 from robodyn.dynamics.loading import rebuild
@@ -38,14 +37,17 @@ from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_defaults, p
 from robodyn.sim.ground import Ground, resolve_ground
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
 from robodyn.sim.observer import MomentumObserver
-from robodyn.sim.operational_space import Impedance, OperationalSpace, orientation_error, target_rotation
+from robodyn.sim.operational_space import Impedance, OperationalSpace
 from robodyn.sim.reach import check_reach
-from robodyn.sim.report import Push, SimulationSummary, TaskOutcome
+from robodyn.sim.report import Push, SimulationSummary
 from robodyn.sim.requests import TrajectoryReference, check_planar, pose_target, push_wrenches, task_target, tracked
 from robodyn.sim.requests import applied_torques as applied_torques  # robodyn.viz.experiment imports it here
 from robodyn.sim.requests import observer_outcome as observer_outcome
 from robodyn.sim.simulation import Engine, Integrator, simulate_run
 from robodyn.sim.stand_run import RecordedStand, stand_law, stand_outcome
+from robodyn.sim.task_outcome import REACHED as REACHED  # re-exported, as frame_pose
+from robodyn.sim.task_outcome import frame_pose as frame_pose
+from robodyn.sim.task_outcome import pose_outcome, task_outcome
 from robodyn.sim.twin import compensate
 from robodyn.sim.underactuated import UnderactuatedComputedTorque, UnderactuatedPD, driven_dofs
 from robodyn.trajectory import Trajectory
@@ -57,8 +59,6 @@ CONTROLLERS: tuple[ControllerName, ...] = ("passive", "pd", "computed-torque", "
 POSE_CONTROLLERS = ("osc", "impedance")
 #: The controllers that drive a frame (``frame`` applies to them).
 FRAME_CONTROLLERS = ("task-space", *POSE_CONTROLLERS)
-#: Final task error below which a target counts as reached, in [m] (and [rad]).
-REACHED = 1e-3
 
 
 def controller_model(robot: Robot) -> Robot:
@@ -196,11 +196,11 @@ def run_simulation(
     if observer is not None:
         summary = replace(summary, observer=observer_outcome(robot, trajectory, observer, external))
     if isinstance(law, OperationalSpace | Impedance):
-        return trajectory, replace(summary, task=_pose_outcome(robot, trajectory, law, pushes))
+        return trajectory, replace(summary, task=pose_outcome(robot, trajectory, law, pushes))
     if isinstance(law, RecordedStand):
         return trajectory, replace(summary, **stand_outcome(robot, law, run.contact))
     if task is not None:
-        return trajectory, replace(summary, task=_task_outcome(robot, trajectory, controlled, task))
+        return trajectory, replace(summary, task=task_outcome(robot, trajectory, controlled, task))
     if controller != "passive":
         joints = np.asarray(target, float)
         missed = np.abs(trajectory.q[-1][robot.nq - joints.size :] - joints)
@@ -359,52 +359,3 @@ def _pose_law(
         if values.size not in (1, 3, 6):
             raise InputError(name, "1, 3 or 6 values", counted(values.size, "value"))
     return Impedance(controller_model(robot), frame, position, orientation=rpy, **gains)
-
-
-def _task_outcome(robot: Robot, trajectory: Trajectory, frame: str, task: np.ndarray) -> TaskOutcome:
-    """Where the run left ``frame``, against the target ``task`` in [m]."""
-    position = robot.frame_position(trajectory.q[-1], frame)
-    error = float(np.linalg.norm(position - task))
-    return TaskOutcome(frame, tuple(task.tolist()), tuple(position.tolist()), error, error < REACHED)
-
-
-def frame_pose(robot: Robot, q: np.ndarray, frame: str) -> tuple[np.ndarray, np.ndarray]:
-    """A frame's position in [m] (3,) and attitude (3, 3), by the robot's forward kinematics.
-
-    Args:
-        robot: The robot.
-        q: Configuration, shape (nq,), in [rad] / [m].
-        frame: The frame's name.
-    """
-    model, data = robot.model, robot.data
-    pin.framesForwardKinematics(model, data, np.asarray(q, dtype=float))
-    placement = data.oMf[robot.frame_id(frame)]
-    return placement.translation.copy(), placement.rotation.copy()
-
-
-def _pose_outcome(
-    robot: Robot, trajectory: Trajectory, law: OperationalSpace | Impedance, pushes: tuple[Push, ...]
-) -> TaskOutcome:
-    """Where an osc or impedance run left its frame (the plant's forward kinematics), and an
-    impedance's deflection against ``K⁻¹ F`` when every push acts at that frame."""
-    frame = str(law.frame)
-    target = np.asarray(law.position, dtype=float)
-    position, rotation = frame_pose(robot, trajectory.q[-1], frame)
-    error = float(np.linalg.norm(position - target))
-    rpy = None if law.orientation is None else np.asarray(law.orientation, dtype=float)
-    angle = None if rpy is None else float(np.linalg.norm(orientation_error(rotation, target_rotation(rpy))))
-    outcome = TaskOutcome(
-        frame, tuple(target.tolist()), tuple(position.tolist()), error, error < REACHED and (angle or 0.0) < REACHED,
-        None if rpy is None else tuple(rpy.tolist()), angle,
-    )  # fmt: skip
-    end = float(trajectory.t[-1])
-    acting = [push for push in pushes if push.time <= end]
-    if not isinstance(law, Impedance) or not acting or any(push.frame != frame for push in acting):
-        return outcome
-    force = np.sum([push.force for push in acting], axis=0)
-    expected = force / np.asarray(law.stiffness, dtype=float)[:3]
-    deflection = position - target
-    relative = float(np.linalg.norm(deflection - expected) / max(float(np.linalg.norm(expected)), 1e-300))
-    return replace(
-        outcome, deflection=tuple(deflection.tolist()), expected_deflection=tuple(expected.tolist()), deflection_error=relative
-    )

@@ -11,7 +11,7 @@ their **own** model of the robot like those of :mod:`robodyn.sim.control`.
 
   where ``ẍ*`` makes the task error obey ``ë + Kd ė + Kp e = 0`` (position: ``e = x_d − x``;
   orientation: ``e`` is the SO(3) logarithm of the rotation from the frame to the target,
-  see :func:`orientation_error`) and ``τ₀ = M (Kp₀ (q₀ − q) − Kd₀ v)`` is the posture task,
+  see :func:`robodyn.sim.attitude.orientation_error`) and ``τ₀ = M (Kp₀ (q₀ − q) − Kd₀ v)`` is the posture task,
   which ``Nᵀ`` confines to the null space: it never changes the task's acceleration.
 - :class:`Impedance` — Cartesian impedance with gravity compensation::
 
@@ -37,9 +37,10 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 import pinocchio as pin
 
-from robodyn.common.rotations import rpy_matrix
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError
+from robodyn.sim.attitude import orientation_error as orientation_error  # re-exported (sim/viz experiment import both)
+from robodyn.sim.attitude import target_rotation as target_rotation
 from robodyn.sim.reach import check_reach
 from robodyn.sim.so3_log import log_jacobian, log_jacobian_rate
 from robodyn.sim.task_damping import (
@@ -65,51 +66,6 @@ PSEUDO_INVERSE_DAMPING = 1e-8
 
 #: A task reference: time in [s] -> (x_d in [m], ẋ_d in [m/s], ẍ_d in [m/s²]), each (3,).
 TaskReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
-
-
-def target_rotation(orientation: np.ndarray | list[float]) -> np.ndarray:
-    """A target attitude as a rotation matrix (world axes), shape (3, 3).
-
-    Args:
-        orientation: A rotation matrix (3, 3), a unit quaternion ``(x, y, z, w)`` (4,) or
-            URDF roll-pitch-yaw angles in [rad] (3,).
-
-    Raises:
-        InputError: For another shape, non-finite values, a matrix that is not a rotation
-            or a quaternion that is not unit (to 1e-6).
-    """
-    value = np.asarray(orientation, dtype=float)
-    if not np.isfinite(value).all():
-        raise InputError("orientation", "finite values", "non-finite values")
-    if value.shape == (3,):
-        return rpy_matrix(value)
-    if value.shape == (4,):
-        if abs(np.linalg.norm(value) - 1) > 1e-6:
-            raise InputError("orientation", "a unit quaternion (x, y, z, w)", f"norm {np.linalg.norm(value):.6g}")
-        return pin.Quaternion(value[3], *value[:3]).toRotationMatrix()
-    if value.shape == (3, 3):
-        if not (np.allclose(value @ value.T, np.eye(3), atol=1e-6) and np.linalg.det(value) > 0):
-            raise InputError("orientation", "a rotation matrix (orthonormal, determinant +1)", "another 3 × 3 matrix")
-        return value
-    raise InputError(
-        "orientation", "a 3 × 3 rotation matrix, a quaternion (x, y, z, w) or roll, pitch, yaw", f"shape {value.shape}"
-    )
-
-
-def orientation_error(rotation: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """``log(Rᵀ R_d)``: the rotation from the frame to the target, as an axis times an angle.
-
-    The axis is the same in the frame's and in the target's axes; the angle, in [rad], is
-    the attitude error ``|e|`` (at most π).
-
-    Args:
-        rotation: The frame's attitude ``R``, shape (3, 3).
-        target: The target attitude ``R_d``, shape (3, 3).
-
-    Returns:
-        Shape (3,), in [rad].
-    """
-    return pin.log3(rotation.T @ target)
 
 
 @dataclass

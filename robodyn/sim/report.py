@@ -15,6 +15,8 @@ import numpy as np
 from robodyn.common.text import printable
 from robodyn.dynamics.dofs import BASE_V_NAMES
 from robodyn.sim.limits import LimitViolation, warning_text
+from robodyn.sim.number_text import number_text, seconds_text
+from robodyn.sim.number_text import vector_text as vector_text  # robodyn.sim.surface_run imports it here
 
 
 @dataclass(frozen=True)
@@ -96,15 +98,15 @@ class TaskOutcome:
             lines.append(f"target roll, pitch, yaw: {vector_text(self.target_rpy, 6)} rad")
         lines += [
             f"final position: {vector_text(self.final_position, 6)} m",
-            f"final error: {_number(self.final_error, 3)} m ({self._state()})",
+            f"final error: {number_text(self.final_error, 3)} m ({self._state()})",
         ]
         if self.orientation_error is not None:
-            lines.append(f"final orientation error: {_number(self.orientation_error, 3)} rad")
+            lines.append(f"final orientation error: {number_text(self.orientation_error, 3)} rad")
         if self.deflection is not None and self.expected_deflection is not None:
             lines += [
                 f"deflection: {vector_text(self.deflection, 6)} m",
                 f"K^-1 F: {vector_text(self.expected_deflection, 6)} m "
-                f"(deflection off by {_number(100 * (self.deflection_error or 0.0), 3)} %)",
+                f"(deflection off by {number_text(100 * (self.deflection_error or 0.0), 3)} %)",
             ]
         return lines
 
@@ -294,7 +296,7 @@ class SimulationSummary:
             return "none (passive)"
         if self.control_period is None:
             return "every integrator stage"
-        return f"sampled every {_number(self.control_period)} s and held (zero-order hold)"
+        return f"sampled every {number_text(self.control_period)} s and held (zero-order hold)"
 
     def _timing_lines(self) -> list[str]:
         """Which engine ran and why, how the controller was sampled, where the time went."""
@@ -302,13 +304,13 @@ class SimulationSummary:
         lines = [f"engine: {self.engine}" + (f" ({self.engine_reason})" if self.engine_reason else "")]
         if self.controller != "passive":
             lines.append(f"controller evaluated: {self._sampling()}{where}")
-        times = [] if self.loop_time is None else [f"loop {_seconds(self.loop_time)}"]
+        times = [] if self.loop_time is None else [f"loop {seconds_text(self.loop_time)}"]
         if self.compile_time and self.engine == "compiled":
-            times.append(f"engine choice and compile {_seconds(self.compile_time)} (imports included; kernels cached)")
+            times.append(f"engine choice and compile {seconds_text(self.compile_time)} (imports included; kernels cached)")
         elif self.compile_time:
-            times.append(f"engine choice {_seconds(self.compile_time)}")
+            times.append(f"engine choice {seconds_text(self.compile_time)}")
         if self.startup_time is not None:
-            times.append(f"start-up {_seconds(self.startup_time)} (interpreter, imports, loading)")
+            times.append(f"start-up {seconds_text(self.startup_time)} (interpreter, imports, loading)")
         return lines + ([f"wall-clock time: {', '.join(times)}"] if times else [])
 
     def __getitem__(self, key: str) -> Any:
@@ -329,41 +331,41 @@ class SimulationSummary:
         lines = [
             f"robot: {printable(self.robot)}",
             f"controller: {self.controller} (integrator {self.integrator}, limits {self.limits})",
-            f"simulated: {_number(self.duration)} s in {self.steps} steps of {_number(self.dt)} s"
-            + (f", {_number(self.real_time_factor, 3)}× real time (loop only)" if self.real_time_factor else ""),
+            f"simulated: {number_text(self.duration)} s in {self.steps} steps of {number_text(self.dt)} s"
+            + (f", {number_text(self.real_time_factor, 3)}× real time (loop only)" if self.real_time_factor else ""),
         ]
         lines += self._timing_lines()
         lines += [
-            f"push: {vector_text(push.force, 6)} N at {printable(push.frame or '(the end effector)')} from {_number(push.time)} s"
+            f"push: {vector_text(push.force, 6)} N at {printable(push.frame or '(the end effector)')} from {number_text(push.time)} s"
             for push in self.pushes
         ]
         if self.task is not None:
             lines += self.task.lines()
         if self.final_joint_error is not None:
-            lines.append(f"final joint error: {_number(self.final_joint_error, 3)} (largest |q - target|, rad or m)")
+            lines.append(f"final joint error: {number_text(self.final_joint_error, 3)} (largest |q - target|, rad or m)")
         floating = tuple(self.dof_names[: len(BASE_V_NAMES)]) == BASE_V_NAMES
         q_units = "base position in m, quaternion x y z w, then joints in rad / m" if floating else "rad / m"
         lines.append(f"final q: {vector_text(self.final_q, 6)} ({q_units})")
         peaks = [
-            f"{name} {_number(peak, 4)} {unit}"
+            f"{name} {number_text(peak, 4)} {unit}"
             for name, peak, unit in zip(names, self.peak_abs_torque, self.torque_units, strict=False)
         ]
         lines.append(f"peak |torque|: {', '.join(peaks)}")
-        lines.append(f"energy change: {_number(self.energy_change, 4)} J")
+        lines.append(f"energy change: {number_text(self.energy_change, 4)} J")
         lines += [printable(line) for line in self.ground]
         lines += [printable(line) for line in (self.constrained.summary_lines() if self.constrained is not None else ())]
         lines += self.forces.lines() if self.forces is not None else []
         if self.com_error is not None:
-            lines.append(f"centre of mass: final error {_number(self.com_error, 3)} m")
+            lines.append(f"centre of mass: final error {number_text(self.com_error, 3)} m")
         if self.force_difference is not None:
-            lines.append(f"contact forces: commanded vs measured, largest difference {_number(self.force_difference, 3)} N")
+            lines.append(f"contact forces: commanded vs measured, largest difference {number_text(self.force_difference, 3)} N")
         if self.support_margin is not None:
-            lines.append(f"support margin: {_number(self.support_margin, 4)} m (centre of mass inside the feet's polygon)")
+            lines.append(f"support margin: {number_text(self.support_margin, 4)} m (centre of mass inside the feet's polygon)")
         if self.observer is not None:
             lines += [
-                f"observer (gain {_number(self.observer.gain)} /s): final tau_ext {vector_text(self.observer.final_estimate, 4)}",
+                f"observer (gain {number_text(self.observer.gain)} /s): final tau_ext {vector_text(self.observer.final_estimate, 4)}",
                 f"  applied {vector_text(self.observer.final_applied, 4)} (largest difference "
-                f"{_number(self.observer.final_error, 3)} N m / N)",
+                f"{number_text(self.observer.final_error, 3)} N m / N)",
             ]
         if self.limits == "ignore":
             lines.append('limits: not checked (mode "ignore")')
@@ -372,27 +374,6 @@ class SimulationSummary:
         lines += [f"limit violation: {violation.text()}" for violation in self.violations]
         lines += [f"{kind}: {path}" for kind, path in self.files]
         return "\n".join(lines)
-
-
-def vector_text(values: Any, precision: int) -> str:
-    """``[v0, v1, ...]`` with ``precision`` significant digits.
-
-    Args:
-        values: The numbers, shape (n,).
-        precision: Significant digits.
-    """
-    return "[" + ", ".join(f"{value:.{precision}g}" for value in np.asarray(values, dtype=float)) + "]"
-
-
-def _number(value: object, digits: int = 6) -> str:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return str(value)
-    return "unlimited" if not np.isfinite(value) else f"{value:.{digits}g}"
-
-
-def _seconds(value: float) -> str:
-    """A duration in [s] as ``12.3 ms`` or ``1.23 s``."""
-    return f"{value * 1e3:.3g} ms" if value < 1.0 else f"{value:.3g} s"
 
 
 def seconds_since_process_start() -> float | None:
