@@ -128,3 +128,8 @@ def test_constraints_with_a_ground_are_refused_in_one_line_naming_both_flags(cap
     status, _, err = run(capsys, *argv)
     assert status == 2 and err.count("\n") == 1
     assert "--ground" in err and "--constraints" in err and "--integrator" not in err
+
+
+def test_a_floating_robot_its_constraints_hold_is_not_said_to_fall_freely(capsys, tmp_path):
+    status, text, _ = run(capsys, "simulate", "solo12", "--constraints", feet_anchored(tmp_path), "--duration", "0.002")
+    assert status == 0 and "falls freely" not in text
