@@ -6,7 +6,8 @@ world); ``weld`` a :class:`~robodyn.constraints.values.FrameAnchor` (the first b
 held at ``relpose`` in the second's, or where it is at the neutral configuration).
 MuJoCo's softness (``solref``, ``solimp``) and a weld's ``torquescale`` weight a soft
 constraint's rows; robodyn's constraints are rigid, so they do not apply, and
-:func:`equality_notes` says so in one line each. An element inactive at the start
+:func:`equality_notes` says so (the softness in one line naming the equalities, a
+``torquescale`` in one line each). An element inactive at the start
 (``active="false"``) is no constraint of the robot, and is reported too.
 """
 
@@ -65,18 +66,25 @@ def from_equalities(records: Sequence[EqualityRecord]) -> tuple[Constraint, ...]
 
 def equality_notes(records: Sequence[EqualityRecord]) -> list[str]:
     """One line for each part of the records robodyn does not model (inactive elements,
-    a weld's ``torquescale`` other than 1).
+    a weld's ``torquescale`` other than 1), and one line naming every active equality
+    whose file gives it a softness (``solref``, ``solimp``).
 
     Args:
         records: A file's equality records.
     """
     notes = []
+    soft = []
     for record in records:
         label = f"<equality {record.kind}{' ' + quoted(record.name) if record.name else ''}>"
+        if record.active and record.soft:
+            soft.append(f"{record.kind} {quoted(record.name) if record.name else 'unnamed'} ({'/'.join(record.soft)})")
         if not record.active:
             notes.append(f'{label} is inactive at the start (active="false"): not a constraint of the robot')
         elif record.kind == "weld" and record.torquescale != 1.0:
             notes.append(f"{label}: torquescale {record.torquescale:g} weights a soft weld's rows; robodyn's weld is rigid")
+    if soft:
+        shown = ", ".join(soft[:8]) + (", ..." if len(soft) > 8 else "")
+        notes.append(f"<equality> softness (solref, solimp) is not modelled, robodyn's constraints are rigid: {shown}")
     return notes
 
 

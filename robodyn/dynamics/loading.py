@@ -36,6 +36,7 @@ import pinocchio as pin
 from robodyn.common.text import printable
 from robodyn.constraints import check_frames, equality_notes, from_equalities
 from robodyn.dynamics import engines, pickling
+from robodyn.dynamics.inertia_rank import inertialess_joints
 from robodyn.dynamics.joint_dynamics import apply_joint_dynamics
 from robodyn.dynamics.mimic import has_mimic, mimic_expansion
 from robodyn.dynamics.options import MAX_DOF, LoadOptions, load_options
@@ -299,7 +300,27 @@ def build_robot(resolved: URDFSource, options: LoadOptions) -> Robot:
     check_frames((*from_equalities(resolved.equalities), *options.constraints), list(spec.links), name)
     robot = Robot(model, spec=spec, source=resolved, options=options, name=name, mimic=mimic)
     engines.attach(robot)  # engine="auto": its compiled kernels, if they are built
+    _report_inertialess(robot, resolved.label)
     return robot
+
+
+def _report_inertialess(robot: Robot, label: str) -> None:
+    """One warning line naming the joints whose motions together move no inertia at the
+    neutral configuration (a singular mass matrix there; massless subtrees are reported
+    by the URDF's validation)."""
+    if robot.massless_joints:
+        return
+    joints = inertialess_joints(robot, robot.neutral_configuration())
+    if joints:
+        shown = ", ".join(repr(joint) for joint in joints)
+        warnings.warn(
+            printable(
+                f"{label}: joints {shown} together move no inertia at the neutral configuration (point masses, "
+                "no rotational inertia behind them): the mass matrix is singular there (forward dynamics there is refused)"
+            ),
+            RobodynWarning,
+            stacklevel=4,
+        )
 
 
 def _check_size(spec: URDFSpec, label: str, floating: bool, max_dof: int) -> None:

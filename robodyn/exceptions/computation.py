@@ -27,16 +27,18 @@ class SingularMassMatrixError(RobodynError, ArithmeticError):
     """Forward dynamics asked of a robot whose mass matrix is singular.
 
     Attributes:
-        joints: Joints that move no mass (their whole subtree is massless), if any.
+        joints: Joints that move no mass (their whole subtree is massless), or with
+            ``inertialess`` those whose motions together move no inertia at the state, if any.
     """
 
-    def __init__(self, robot: str, joints: list[str]):
+    def __init__(self, robot: str, joints: list[str], *, inertialess: bool = False):
         self.robot = robot
         self.joints = list(joints)
+        moved = (
+            "together move no inertia here (point masses, no rotational inertia behind them)" if inertialess else "move no mass"
+        )
         reason = (
-            f"joints {', '.join(repr(j) for j in self.joints)} move no mass"
-            if self.joints
-            else "the accelerations are not finite"
+            f"joints {', '.join(repr(j) for j in self.joints)} {moved}" if self.joints else "the accelerations are not finite"
         )
         super().__init__(f"robot {robot!r}: the mass matrix is singular, so forward dynamics is undefined ({reason}).")
 

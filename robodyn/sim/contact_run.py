@@ -276,7 +276,8 @@ def _run(
 
 def ground_lines(robot: Robot, contact: ContactSimulation | None) -> tuple[str, ...]:
     """A run's ground lines for its summary: the contact summary, or for a floating robot
-    without a ground ``"no ground: the base falls freely"`` (nothing for a fixed one)."""
+    without a ground or constraints ``"no ground: the base falls freely"`` (nothing for a
+    fixed one, nor for one its constraints hold)."""
     if contact is not None:
         return tuple(contact.summary_lines())
     note = free_fall_note(robot, None)
@@ -284,8 +285,10 @@ def ground_lines(robot: Robot, contact: ContactSimulation | None) -> tuple[str, 
 
 
 def free_fall_note(robot: Robot, ground: Ground | None) -> str | None:
-    """The one summary line of a floating robot simulated without a ground, else ``None``."""
-    return "no ground: the base falls freely" if robot.floating_base and ground is None else None
+    """The one summary line of a floating robot simulated with nothing holding its base
+    (no ground and no constraint), else ``None``."""
+    free = robot.floating_base and ground is None and not robot.constraints
+    return "no ground: the base falls freely" if free else None
 
 
 __all__ = ["ContactSimulation", "free_fall_note", "ground_lines", "run_contacts", "simulate_contact"]

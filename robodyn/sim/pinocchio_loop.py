@@ -13,6 +13,7 @@ from time import perf_counter
 import numpy as np
 
 from robodyn.compiled.simulation import SimulationArrays
+from robodyn.dynamics.inertia_rank import inertialess_joints
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import SingularMassMatrixError
 from robodyn.sim import constrained_backend, contact_backend
@@ -39,13 +40,15 @@ def run(plan: RunPlan) -> Outcome:
 
     Raises:
         SingularMassMatrixError: If the mass matrix is singular at the start (massless
-            moving bodies).
+            moving bodies, or point masses some joints turn about one line: named).
         SimulationError: If the state stops being finite (``ControllerFailedError``: if
             the controller's own numerics fail).
     """
     robot = plan.robot
-    if robot.massless_joints or singular(robot, plan.q0):
+    if robot.massless_joints:
         raise SingularMassMatrixError(robot.name, robot.massless_joints)
+    if singular(robot, plan.q0):  # point masses behind joints that turn them about one line
+        raise SingularMassMatrixError(robot.name, inertialess_joints(robot, plan.q0), inertialess=True)
     if plan.ground is not None:
         return contact_backend.run(plan)  # on the ground: robodyn.sim.contact's step
     if robot.constraints:

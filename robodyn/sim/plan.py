@@ -246,12 +246,20 @@ def _check_constrained(robot: Robot, integrator: str, every: int | None, limits:
     """Refuse what a robot with constraints (its file's ``<equality>``, ``load(constraints=)``)
     cannot be simulated with: the constrained loop is RK4 plus a projection, evaluates the
     controller at every stage, and models no ground, enforced limits, observer or Coulomb
-    friction (simulating the open tree instead would be a different mechanism)."""
+    friction (simulating the open tree instead would be a different mechanism). A ground
+    is refused first: no integrator serves both, so naming one would send a user in circles."""
     if not robot.constraints:
         return
     names = ", ".join(quoted(c.name or type(c).__name__) for c in robot.constraints[:4])
     held = f"{robot.name} has {counted(len(robot.constraints), 'constraint')} ({names})"
     refusals = [
+        (
+            "ground",
+            ground is not None,
+            "left out for a robot with constraints (constraints= or the file's <equality>; "
+            "a ground and constraints together are not modelled)",
+            held,
+        ),
         (
             "integrator",
             integrator != "rk4",
@@ -266,7 +274,6 @@ def _check_constrained(robot: Robot, integrator: str, every: int | None, limits:
         ),
         ("limits", limits == "enforce", "'warn' or 'ignore' for a robot with constraints", repr(limits)),
         ("observer", observer is not None, "left out for a robot with constraints", held),
-        ("ground", ground is not None, "left out for a robot with constraints (contacts with loops are not modelled yet)", held),
     ]
     for name, refused, expected, received in refusals:
         if refused:

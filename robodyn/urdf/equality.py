@@ -29,6 +29,8 @@ class EqualityRecord:
             reference configuration.
         torquescale: ``weld`` only: MuJoCo's ratio of rotational to translational rows.
         active: Whether the constraint is active at the start (MuJoCo's ``active``).
+        soft: The softness attributes the file gives it (``solref``, ``solimp``, its own
+            or its ``<default><equality>`` class's), which a rigid constraint does not model.
     """
 
     kind: str
@@ -39,3 +41,4 @@ class EqualityRecord:
     relpose: tuple[float, ...] | None = None
     torquescale: float = 1.0
     active: bool = True
+    soft: tuple[str, ...] = ()

@@ -219,12 +219,20 @@ def read_equalities(root: ET.Element, robot: MjcfRobot) -> tuple[EqualityRecord,
     for section in root.findall("equality"):
         for index, node in enumerate(section):
             name = node.get("name")
-            values = attributes(robot, node, "main")
+            values = _equality_attributes(robot, node)
             if node.tag not in ("connect", "weld") or "body1" not in values:
                 robot.note("equality constraints other than body connect/weld", name or f"<{node.tag}> #{index + 1}")
                 continue
             records.append(_equality(robot, node.tag, name, values))
     return tuple(records)
+
+
+def _equality_attributes(robot: MjcfRobot, node: ET.Element) -> dict[str, str]:
+    """An equality element's attributes with its class's ``<default><equality>`` under them."""
+    attributes(robot, node, "main")  # refuses an undefined class
+    values = dict(robot.defaults.get(node.get("class") or "main", {}).get("equality", {}))
+    values.update(node.attrib)
+    return values
 
 
 def _equality(robot: MjcfRobot, kind: str, name: str | None, values: dict[str, str]) -> EqualityRecord:
@@ -237,9 +245,12 @@ def _equality(robot: MjcfRobot, kind: str, name: str | None, values: dict[str, s
     offset2 = np.zeros(3) if body2 is None else robot.offsets[body2]
     anchor = floats(robot.label, f"{where}: anchor", values.get("anchor", "0 0 0"), 3)
     active = keyword(robot.label, where, "active", values.get("active", "true"), ("true", "false")) == "true"
+    soft = tuple(key for key in ("solref", "solimp") if key in values)
     if kind == "connect":
         point = anchor - offset1
-        return EqualityRecord("connect", name, body1, body2, (float(point[0]), float(point[1]), float(point[2])), active=active)
+        return EqualityRecord(
+            "connect", name, body1, body2, (float(point[0]), float(point[1]), float(point[2])), active=active, soft=soft
+        )
     relpose = floats(robot.label, f"{where}: relpose", values.get("relpose", "0 1 0 0 0 0 0"), 7)
     pose = None
     if np.any(relpose[3:]):  # body1's link in body2's link: the same turn, moved by the links' offsets
@@ -248,4 +259,5 @@ def _equality(robot: MjcfRobot, kind: str, name: str | None, values: dict[str, s
         pose = (*(float(value) for value in position), *(float(value) for value in relpose[3:] / np.linalg.norm(relpose[3:])))
     point = anchor - offset2
     scale = number(robot.label, f"{where}: torquescale", values.get("torquescale", "1"))
-    return EqualityRecord("weld", name, body1, body2, (float(point[0]), float(point[1]), float(point[2])), pose, scale, active)
+    point3 = (float(point[0]), float(point[1]), float(point[2]))
+    return EqualityRecord("weld", name, body1, body2, point3, pose, scale, active, soft)

@@ -114,3 +114,22 @@ def test_a_divergence_from_damping_on_a_light_body_is_warned_and_explained_on_th
     assert status == 2 and "largest stable step" in warning and "'fingertip'" in warning
     assert error.startswith("robodyn: error: simulation diverged") and "damping on light links" in error
     assert "use dt <= " in error
+
+
+def feet_anchored(tmp_path) -> str:
+    path = tmp_path / "feet.yaml"
+    path.write_text("anchor:\n" + "".join(f"  - {{frame1: {foot}, point1: [0, 0, 0]}}\n" for foot in FEET.split(",")))
+    return str(path)
+
+
+@pytest.mark.parametrize("integrator", [[], ["--integrator", "rk4"]])
+def test_constraints_with_a_ground_are_refused_in_one_line_naming_both_flags(capsys, tmp_path, integrator):
+    argv = ["simulate", "solo12", "--constraints", feet_anchored(tmp_path), "--ground", "--duration", "0.01", *integrator]
+    status, _, err = run(capsys, *argv)
+    assert status == 2 and err.count("\n") == 1
+    assert "--ground" in err and "--constraints" in err and "--integrator" not in err
+
+
+def test_a_floating_robot_its_constraints_hold_is_not_said_to_fall_freely(capsys, tmp_path):
+    status, text, _ = run(capsys, "simulate", "solo12", "--constraints", feet_anchored(tmp_path), "--duration", "0.002")
+    assert status == 0 and "falls freely" not in text

@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 import robodyn
+from robodyn.constraints import PointAnchor
 from robodyn.exceptions import FrameError, InputError
 from robodyn.sim.control import PDGravity
+from robodyn.sim.ground import Ground
 from robodyn.sim.plan import ExternalWrench, RunPlan, plan
 
 
@@ -52,3 +54,13 @@ def test_each_bad_argument_is_refused_by_name(rp_arm, options, argument):
 def test_a_wrench_on_an_unknown_frame_is_refused_at_plan_time(rp_arm):
     with pytest.raises(FrameError):
         plan(rp_arm, rp_arm.default_configuration(), np.zeros(2), 0.01, 1e-3, external=[ExternalWrench("nowhere", [1, 0, 0])])
+
+
+@pytest.mark.parametrize("integrator", [None, "rk4", "semi-implicit-euler"])
+def test_constraints_with_a_ground_are_refused_as_such_whatever_the_integrator(integrator):
+    robot = robodyn.load("solo12", constraints=[PointAnchor("FL_FOOT", (0.0, 0.0, 0.0), name="foot")])
+    q0 = robot.default_configuration()
+    with pytest.raises(InputError) as raised:
+        plan(robot, q0, np.zeros(robot.nv), 0.01, 1e-3, ground=Ground(), integrator=integrator)
+    assert raised.value.argument == "ground" and "constraints=" in str(raised.value)
+    assert "rk4" not in str(raised.value) and "semi-implicit" not in str(raised.value)
