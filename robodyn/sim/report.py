@@ -173,8 +173,8 @@ class SimulationSummary:
         startup_time: Wall-clock time from the process's start to the run in [s]
             (interpreter, imports, loading the robot; ``robodyn simulate`` fills it in).
         ground: The contact summary of a run on the ground (peak normal force, slip,
-            penetration, what is not modelled), or for a floating robot without one
-            ``"no ground: the base falls freely"``.
+            penetration, what is not modelled), or for a floating robot with neither a ground
+            nor constraints holding it ``"no ground: the base falls freely"``.
         contact: A run on the ground: its :class:`~robodyn.sim.contact_run.ContactSimulation`
             (forces, gaps; not in :meth:`to_dict`), else ``None``.
         constrained: A run with constraints: its
