@@ -116,7 +116,11 @@ def negations_inlined(program: Program) -> Program:
     sympy folds into the expression using it (``a − t`` is ``a + u``, ``u − t`` is ``2 u``,
     ``t t`` is ``u²``): no negation left to compute, the same value (a sign is exact). An
     assignment ``t = −c x`` (or ``−c x − d y``) holds ``c x`` instead and its uses read ``−t`` (the constant
-    ``c`` is usually in the graph already, ``−c`` then is not needed)."""
+    ``c`` is usually in the graph already, ``−c`` then is not needed).
+
+    Args:
+        program: A straight-line program (:class:`~robodyn.equations.program.Program`).
+    """
     negated: dict[sp.Symbol, sp.Expr] = {}
     assignments = []
     for symbol, expr in program.assignments:
