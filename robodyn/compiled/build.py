@@ -94,7 +94,11 @@ def _compiler_identity(compiler: str, mtime: float) -> str:
 
 
 def toolchain_key(compiler: str) -> str:
-    """What besides the source decides the binary: compiler version, flags, Python and numpy ABI."""
+    """What besides the source decides the binary: compiler version, flags, Python and numpy ABI.
+
+    Args:
+        compiler: Path of the C compiler executable (:func:`find_compiler`).
+    """
     identity = _compiler_identity(compiler, os.stat(compiler).st_mtime)
     return "\n".join([identity, " ".join(FLAGS), sysconfig.get_config_var("EXT_SUFFIX") or "", np.__version__, sys.version])
 
@@ -108,7 +112,12 @@ def runtime_source() -> str:
 
 
 def module_source(kernels: str, module_name: str) -> str:
-    """The full C source: includes, the robot's kernels, the runtime and the module init."""
+    """The full C source: includes, the robot's kernels, the runtime and the module init.
+
+    Args:
+        kernels: The robot's generated kernels' C source (:mod:`robodyn.compiled.codegen`).
+        module_name: The extension module's name (``PyInit_<module_name>``).
+    """
     init = f'PyMODINIT_FUNC PyInit_{module_name}(void) {{ return rd_module("{module_name}"); }}\n'
     return prelude() + kernels + "\n" + runtime_source() + "\n" + init
 
@@ -120,6 +129,10 @@ def _suffix() -> str:
 def module_path(key: str, compiler: str) -> Path:
     """Where the module of a robot key is (or would be) for this compiler, flags, ABI and
     SIMD variants (:func:`robodyn.compiled.simd.build_variants`): no source needed.
+
+    Args:
+        key: The robot's cache key (:func:`robodyn.compiled.cache.robot_key`).
+        compiler: Path of the C compiler executable (:func:`find_compiler`).
 
     Raises:
         InputError: ``$ROBODYN_SIMD`` names no instruction set.
@@ -140,7 +153,11 @@ def _memo(key: str) -> tuple[str, tuple[str | None, ...]]:
 
 def loaded(robot: Robot) -> ModuleType | None:
     """The robot's module if this process loaded it already (under the same compiler, cache
-    folder and ``$ROBODYN_SIMD``): a dictionary look-up, microseconds."""
+    folder and ``$ROBODYN_SIMD``): a dictionary look-up, microseconds.
+
+    Args:
+        robot: The loaded robot (its cache key, :func:`robodyn.compiled.cache.robot_key`).
+    """
     return _LOADED.get(_memo(robot_key(robot)))
 
 
@@ -148,6 +165,9 @@ def lookup(robot: Robot) -> Path | None:
     """The robot's compiled module in the cache, or None if it is not compiled (or there is no
     C compiler). Computes the key only: imports no sympy and no code generator, generates no
     source (the engine choice of :func:`robodyn.simulate` asks this).
+
+    Args:
+        robot: The loaded robot (its cache key, :func:`robodyn.compiled.cache.robot_key`).
 
     Raises:
         InputError: ``$ROBODYN_SIMD`` names no instruction set.
@@ -169,6 +189,11 @@ def robot_module(key: str, kernels: Callable[[], str], *, label: str) -> ModuleT
     ``kernels()`` (called only then: the generated kernels, cached or derived). The SIMD
     variants' source is generated only for a build; a build whose variants the compiler
     rejects is the scalar kernels' (batches then run scalar rows).
+
+    Args:
+        key: The robot's cache key (:func:`robodyn.compiled.cache.robot_key`).
+        kernels: Returns the robot's generated kernels' C source; called only to build.
+        label: The robot's name, for messages only.
 
     Raises:
         CompilerNotFoundError: No C compiler.
@@ -272,6 +297,14 @@ def keyed_extension(key: str, source: Callable[[], str], *, init: str, label: st
     key: found by the key alone, ``source()`` (its C after the includes and ``core.c``) asked
     for only to build it. The module is made by the C function ``init``
     (``PyObject *init(const char *name)``).
+
+    Args:
+        key: The cache key the module is named and locked by.
+        source: Returns the module's C source (after the includes and ``core.c``); called
+            only to build.
+        init: Name of the C function that creates the module.
+        label: What is compiled, for messages only.
+        prefix: The start of the module's name (a hash of ``key`` follows).
 
     Raises:
         CompilerNotFoundError: No C compiler.

@@ -96,7 +96,11 @@ def generator_hash() -> str:
 def robot_key(robot: Robot) -> str:
     """The cache key of a robot's generated code: its URDF text, floating base, gravity, the
     armature given to :func:`robodyn.load` (the file's is in the text) and the generator's
-    source (:func:`generator_hash`). Memoised per process: microseconds after the first call."""
+    source (:func:`generator_hash`). Memoised per process: microseconds after the first call.
+
+    Args:
+        robot: The loaded robot.
+    """
     options = robot.options
     memo = (robot.urdf, options.floating_base, tuple(robot.gravity_vector.tolist()), tuple(options.armature))
     key = _KEYS.get(memo)
@@ -108,7 +112,11 @@ def robot_key(robot: Robot) -> str:
 
 
 def cached_kernels(key: str) -> str | None:
-    """The generated kernels stored under a key, if any."""
+    """The generated kernels stored under a key, if any.
+
+    Args:
+        key: The robot's cache key (:func:`robot_key`).
+    """
     path = cache_dir() / f"src-{key}.c"
     try:
         return path.read_text(encoding="utf-8")
@@ -117,7 +125,12 @@ def cached_kernels(key: str) -> str | None:
 
 
 def store_kernels(key: str, kernels: str) -> None:
-    """Keep the generated kernels for a key (atomically; a read-only cache is skipped)."""
+    """Keep the generated kernels for a key (atomically; a read-only cache is skipped).
+
+    Args:
+        key: The robot's cache key (:func:`robot_key`).
+        kernels: The generated kernels' C source.
+    """
     with contextlib.suppress(OSError):
         atomic_write_text(cache_dir() / f"src-{key}.c", kernels)
 
@@ -127,7 +140,11 @@ def locked(key: str) -> Iterator[None]:
     """Hold an exclusive lock on a key (``lock-<key>`` in the cache, ``flock``) while
     deriving and building it: a second process compiling the same robot waits, then finds it
     cached, instead of deriving and building it a second time. No lock where the cache is read-only or
-    the platform has no ``fcntl``."""
+    the platform has no ``fcntl``.
+
+    Args:
+        key: The cache key to lock (:func:`robot_key`, or a module's own key).
+    """
     try:
         import fcntl
 

@@ -73,7 +73,11 @@ RD_TRIG_DEFINE(rd_, double, rd_u64, )
 
 def trig_source(generic: str | None = None) -> str:
     """The generic sin and cos (``generic``, default :data:`TRIG`'s text) and their
-    instantiation on doubles: C, before the kernels."""
+    instantiation on doubles: C, before the kernels.
+
+    Args:
+        generic: The generic sin and cos as C source; ``None``: :data:`TRIG`'s file.
+    """
     return (TRIG.read_text(encoding="utf-8") if generic is None else generic) + _SCALAR_TRIG
 
 

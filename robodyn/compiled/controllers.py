@@ -92,7 +92,15 @@ class CompiledLaw:
         return None
 
     def params(self, n: int) -> np.ndarray:  # pragma: no cover - every twin overrides it
-        """The parameters in :attr:`layout`'s order, for a law of ``n`` coordinates."""
+        """The parameters in :attr:`layout`'s order, for a law of ``n`` coordinates.
+
+        Args:
+            n: The law's coordinate count: the robot's nv, or nv − 6 (its joints) on a floating
+                base.
+
+        Returns:
+            The parameters, shape (size(twin, n),) (:func:`size`).
+        """
         raise NotImplementedError
 
 
@@ -320,7 +328,13 @@ class HasTwin(Protocol):
 
 
 def size(twin: type[CompiledLaw], n: int) -> int:
-    """The number of parameters a law of ``n`` coordinates takes (its layout, summed)."""
+    """The number of parameters a law of ``n`` coordinates takes (its layout, summed).
+
+    Args:
+        twin: The twin's class.
+        n: The law's coordinate count: the robot's nv, or nv − 6 (its joints) on a floating
+            base.
+    """
     return sum(a + b * n + c * n * n for _, (a, b, c) in twin.layout)
 
 
@@ -331,7 +345,16 @@ def _c_size(a: int, b: int, c: int) -> str:
 
 
 def check_layout(twin: CompiledLaw, n: int) -> np.ndarray:
-    """The twin's parameters, checked against its declared layout's size."""
+    """The twin's parameters, checked against its declared layout's size.
+
+    Args:
+        twin: The compiled controller.
+        n: The law's coordinate count: the robot's nv, or nv − 6 (its joints) on a floating
+            base.
+
+    Raises:
+        CompileError: The twin's parameters do not have its layout's size.
+    """
     params = np.ascontiguousarray(twin.params(n), dtype=float)
     if params.shape != (size(type(twin), n),):  # pragma: no cover - a twin's own bug
         raise CompileError(twin.model.name, f"{type(twin).__name__}.params gives {params.size} values, its layout another count")

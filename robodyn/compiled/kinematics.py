@@ -42,6 +42,10 @@ def frame_anchor(robot: Robot, frame: str) -> tuple[int, np.ndarray, np.ndarray]
     """Where a frame sits: the reference body that carries it (-1: the fixed root) and its
     placement in that body's frame (rotation (3, 3), translation (3,) in [m]).
 
+    Args:
+        robot: The loaded robot.
+        frame: The frame's name (a link or joint of the robot).
+
     Raises:
         FrameError: Unknown frame. CompileError: A frame on a joint the reference does not map.
     """
@@ -59,7 +63,12 @@ def frame_anchor(robot: Robot, frame: str) -> tuple[int, np.ndarray, np.ndarray]
 
 
 def derive_frame(robot: Robot, frame: str) -> Program:
-    """The frame's program over the robot's coordinates (order of ``robot.joint_names``)."""
+    """The frame's program over the robot's coordinates (order of ``robot.joint_names``).
+
+    Args:
+        robot: The loaded robot.
+        frame: The frame's name (a link or joint of the robot).
+    """
     body, rotation, translation = frame_anchor(robot, frame)
     tree = build_tree(robot.spec, robot.urdf, floating_base=False)
     reference = ReferenceRobot(tree, name=robot.name, urdf=robot.urdf, spec=robot.spec, gravity=robot.gravity_vector)
@@ -75,7 +84,12 @@ def derive_frame(robot: Robot, frame: str) -> Program:
 
 
 def frame_source(program: Program) -> str:
-    """The three kernels' C source (no includes)."""
+    """The three kernels' C source (no includes).
+
+    Args:
+        program: The frame's program (:func:`derive_frame`): inputs ``q`` and ``qd``, outputs
+            ``position``, ``rotation``, ``jacobian`` and ``bias``.
+    """
     names = {symbol: f"k{index}" for index, (symbol, _) in enumerate(program.assignments)}
     names.update({symbol: f"q[{j}]" for j, symbol in enumerate(program.inputs["q"])})
     names.update({symbol: f"v[{j}]" for j, symbol in enumerate(program.inputs["qd"])})
@@ -101,7 +115,12 @@ def frame_source(program: Program) -> str:
 
 def frame_key(robot_key: str, frame: str) -> str:
     """The cache key of a frame's kernels: the robot's key (its URDF, options and the
-    generator's source, :func:`robodyn.compiled.cache.robot_key`) and the frame."""
+    generator's source, :func:`robodyn.compiled.cache.robot_key`) and the frame.
+
+    Args:
+        robot_key: The robot's cache key (:func:`robodyn.compiled.cache.robot_key`).
+        frame: The frame's name (a link or joint of the robot).
+    """
     return build.digest(robot_key, frame)
 
 
@@ -109,8 +128,9 @@ def build_frame(robot: Robot, frame: str, robot_key: str) -> ModuleType:
     """Generate (or find cached), compile and load the frame's extension module.
 
     Args:
-        robot: The robot; frame: one of its frames; robot_key: its
-            :func:`robodyn.compiled.robot.robot_key`.
+        robot: The loaded robot.
+        frame: The frame's name (a link or joint of the robot).
+        robot_key: The robot's cache key (:func:`robodyn.compiled.cache.robot_key`).
 
     Raises:
         FrameError: Unknown frame. CompileError, CompilerNotFoundError: As :func:`robodyn.compile`.

@@ -25,13 +25,24 @@ MAX_STEPS = 10_000_000
 
 
 def check_integrator(integrator: str) -> None:
-    """Refuse an integrator that is not one of :data:`INTEGRATORS`."""
+    """Refuse an integrator that is not one of :data:`INTEGRATORS`.
+
+    Args:
+        integrator: The integrator's name (``"rk4"`` or ``"semi-implicit-euler"``).
+
+    Raises:
+        InputError: Any other name.
+    """
     if integrator not in INTEGRATORS:
         raise InputError("integrator", f"one of {', '.join(INTEGRATORS)}", repr(integrator))
 
 
 def step_count(duration: float, dt: float) -> int:
     """The number of steps of ``dt`` in ``duration`` (both in [s]).
+
+    Args:
+        duration: The simulated time in [s].
+        dt: The integration step in [s].
 
     Raises:
         InputError: For a step or duration that is not finite and positive (a duration of
@@ -49,7 +60,15 @@ def step_count(duration: float, dt: float) -> int:
 
 
 def period_steps(control_period: float, dt: float) -> int:
-    """The steps of ``dt`` in one control period (both in [s]), refused unless a whole number ≥ 1."""
+    """The steps of ``dt`` in one control period (both in [s]), refused unless a whole number ≥ 1.
+
+    Args:
+        control_period: The controller's sampling period in [s] (its torque held between samples).
+        dt: The integration step in [s].
+
+    Raises:
+        InputError: ``control_period`` is not a whole number (≥ 1) of steps of ``dt``.
+    """
     every = round(control_period / dt) if math.isfinite(control_period) and control_period > 0 else 0
     if every < 1 or abs(every * dt - control_period) > 1e-9 * control_period:
         raise InputError("control_period", f"a whole number of steps of dt = {dt:g} s, in [s]", repr(control_period))
@@ -58,11 +77,24 @@ def period_steps(control_period: float, dt: float) -> int:
 
 def failing_joint(joint_names: Sequence[str], q: np.ndarray, v: np.ndarray) -> str:
     """The joint a non-finite state names: the first whose velocity is not finite, else the
-    first whose position is not (a floating base's q read by its velocity's entries)."""
+    first whose position is not (a floating base's q read by its velocity's entries).
+
+    Args:
+        joint_names: The robot's joint names (``Robot.joint_names``).
+        q: The configuration, shape (nq,).
+        v: The velocity, shape (nv,).
+    """
     bad = np.flatnonzero(~np.isfinite(v)) if not np.isfinite(v).all() else np.flatnonzero(~np.isfinite(q[q.size - v.size :]))
     return joint_names[min(int(bad[0]) if bad.size else 0, len(joint_names) - 1)]
 
 
 def damped(tau: np.ndarray, damping: np.ndarray | None, v: np.ndarray) -> np.ndarray:
-    """The torque with the joints' damping: ``tau − b v`` (``tau`` itself without damping)."""
+    """The torque with the joints' damping: ``tau − b v`` (``tau`` itself without damping).
+
+    Args:
+        tau: The joint torques, shape (nv,), in [N m] or [N].
+        damping: The joints' viscous damping ``b`` (``Robot.joint_damping``), shape (nv,),
+            in [N m s/rad] or [N s/m]; ``None``: none.
+        v: The velocity, shape (nv,), in [rad/s] or [m/s].
+    """
     return tau if damping is None else tau - damping * v

@@ -74,6 +74,9 @@ class DynamicsPrograms:
 def robot_bodies(robot: Robot) -> Bodies:
     """The robot's bodies and the map from its joints' coordinates (cheap: no sympy).
 
+    Args:
+        robot: The loaded robot.
+
     Raises:
         CompileError: If the reference tree and the Pinocchio model disagree on the joints.
     """
@@ -92,7 +95,13 @@ def robot_bodies(robot: Robot) -> Bodies:
 
 def derived(robot: Robot, name: str, derive: Callable[[], T]) -> T:
     """``derive()``'s result for a robot, derived once per robot key and name: from this
-    process's memory, else the cache folder's pickle, else derived and kept in both."""
+    process's memory, else the cache folder's pickle, else derived and kept in both.
+
+    Args:
+        robot: The loaded robot (its cache key, :func:`robodyn.compiled.cache.robot_key`).
+        name: What is derived (``"dynamics"``, ...): with the robot's key, the cache entry's name.
+        derive: Derives the value; called only when neither memory nor the cache has it.
+    """
     key = (robot_key(robot), name)
     if key in _DERIVED:
         return cast(T, _DERIVED[key])
@@ -128,6 +137,9 @@ def _store(path: Path, value: object) -> None:
 def dynamics_programs(robot: Robot) -> DynamicsPrograms:
     """The robot's compact and Newton–Euler programs (derived once per robot key: seconds for a
     7-joint arm the first time, then microseconds in a process, milliseconds from the cache).
+
+    Args:
+        robot: The loaded robot.
 
     Raises:
         CompileError: For joints the reference does not map.

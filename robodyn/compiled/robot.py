@@ -41,6 +41,9 @@ def generate_kernels(robot: Robot) -> str:
 
     A floating base is the tree's body 0, free (:func:`robodyn.equations.newton_euler.floating_tree`).
 
+    Args:
+        robot: The loaded robot.
+
     Raises:
         CompileError: For joints the reference does not map.
     """
@@ -53,7 +56,14 @@ def generate_kernels(robot: Robot) -> str:
 
 
 def robot_kernels(robot: Robot) -> str:
-    """The robot's kernels: cached under its key, else generated (and cached)."""
+    """The robot's kernels: cached under its key, else generated (and cached).
+
+    Args:
+        robot: The loaded robot (its cache key, :func:`robodyn.compiled.cache.robot_key`).
+
+    Raises:
+        CompileError: For joints the reference does not map.
+    """
     key = robot_key(robot)
     kernels = build.cached_kernels(key)
     if kernels is None:
@@ -68,6 +78,12 @@ def coordinate_parents(robot: Robot) -> list[int]:
     With mimic joints ``M = Sᵀ M_bodies S`` need not keep the tree's sparsity, so the chain
     ``i - 1`` (a dense factorisation) is used. A floating base's six coordinates are a chain
     (a dense 6×6 block) and its children hang from the last.
+
+    Args:
+        robot: The loaded robot.
+
+    Returns:
+        One parent index per velocity coordinate, length nv.
     """
     model = robot.model
     if robot.mimic is not None:
@@ -188,14 +204,25 @@ class CompiledRobot:
         return result
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """Joint-space inertia matrix ``M(q)``, symmetric, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg]."""
+        """Joint-space inertia matrix ``M(q)``, symmetric, shape (nv, nv) or (N, nv, nv), in [kg m²] / [kg].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position
+                in [m], then its unit quaternion).
+        """
         result = self._mass(q, self.threads)
         if result.__class__ is _ndarray:
             return result
         return self._checked("mass", self._mass, result, q=q)
 
     def nonlinear_effects(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``C(q, v) v + G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
+        """``C(q, v) v + G(q)``, shape (nv,) or (N, nv), in [N m] / [N].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position
+                in [m], then its unit quaternion).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+        """
         result = self._nle(q, v, self.threads)
         if result.__class__ is _ndarray:
             return result
@@ -208,7 +235,12 @@ class CompiledRobot:
         return self.robot.coriolis_matrix(q, v)
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
-        """Generalised gravity ``G(q)``, shape (nv,) or (N, nv), in [N m] / [N]."""
+        """Generalised gravity ``G(q)``, shape (nv,) or (N, nv), in [N m] / [N].
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (a floating base: position
+                in [m], then its unit quaternion).
+        """
         result = self._gravity(q, self.threads)
         if result.__class__ is _ndarray:
             return result
@@ -299,6 +331,9 @@ class CompiledRobot:
     def frame_module(self, frame: str) -> ModuleType:
         """The compiled kinematics of a frame (built on first use, then cached on disk and here).
 
+        Args:
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+
         Raises:
             FrameError: Unknown frame. CompileError: If the build fails.
         """
@@ -323,24 +358,46 @@ class CompiledRobot:
 
     def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
         """Position of a frame's origin in the world frame, shape (3,) or (N, 3), in [m]
-        (as :meth:`robodyn.Robot.frame_position`, in generated C)."""
+        (as :meth:`robodyn.Robot.frame_position`, in generated C).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+        """
         return self._frame_call("position", frame, q=q)
 
     def frame_rotation(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Rotation world <- frame, shape (3, 3) or (N, 3, 3)."""
+        """Rotation world <- frame, shape (3, 3) or (N, 3, 3).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+        """
         return self._frame_call("rotation", frame, q=q)
 
     def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
         """Frame Jacobian, shape (6, nv) or (N, 6, nv): linear rows then angular, world-aligned
         axes at the frame's origin (Pinocchio's ``LOCAL_WORLD_ALIGNED``, as
-        :meth:`robodyn.Robot.frame_jacobian`)."""
+        :meth:`robodyn.Robot.frame_jacobian`).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+        """
         return self._frame_call("jacobian", frame, q=q)
 
     def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str, *, angular: bool = False) -> np.ndarray:
         """``J̇(q, v) v``: the classical acceleration of the frame's origin at zero joint
         acceleration, world axes, shape (3,) or (N, 3), in [m/s²] (as
         :meth:`robodyn.Robot.frame_bias_acceleration`); with ``angular=True`` the angular
-        acceleration in [rad/s²] follows, shape (6,) or (N, 6)."""
+        acceleration in [rad/s²] follows, shape (6,) or (N, 6).
+
+        Args:
+            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
+            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
+            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
+            angular: Also return the angular part (rows 3–5) after the linear.
+        """
         bias = self._frame_call("bias", frame, q=q, v=v)
         return bias if angular else bias[..., :3].copy()
 

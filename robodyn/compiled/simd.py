@@ -107,7 +107,13 @@ def _lanes(lanes: int, value: str) -> str:
 def vector_trig(vector: str, lanes: int, attribute: str) -> list[str]:
     """``{vector}_sin``, ``_cos``, ``_sincos``: the kernels' own ``RD_TRIG_DEFINE`` (``trig.c``,
     defined in the kernels' text) on vectors, with its helpers (bit casts; libm's sin and cos
-    on the lanes beyond its range, as the scalar ``rd_sin`` does)."""
+    on the lanes beyond its range, as the scalar ``rd_sin`` does).
+
+    Args:
+        vector: The C name of the vector type of doubles (e.g. ``rds4``), the functions' prefix.
+        lanes: The doubles in one vector (2, 4 or 8).
+        attribute: The functions' C attribute (the instruction set's ``target``).
+    """
     inline = f"static inline __attribute__((always_inline)) {attribute}"
     return [
         f"typedef unsigned long long {vector}u __attribute__((vector_size({8 * lanes})));",
@@ -251,12 +257,19 @@ def vector_source(kernels: str, variants: tuple[tuple[str, int, str], ...] | Non
 
 
 def instruction_sets(module: ModuleType) -> tuple[str, ...]:
-    """The instruction sets a loaded module can run on this CPU (``"scalar"`` first)."""
+    """The instruction sets a loaded module can run on this CPU (``"scalar"`` first).
+
+    Args:
+        module: A loaded robot module (:func:`robodyn.compiled.build.robot_module`).
+    """
     return tuple(module.info().get("instruction_sets", ("scalar",)))
 
 
 def configure(module: ModuleType) -> ModuleType:
     """Apply ``$ROBODYN_SIMD`` (if set) to a freshly loaded robot module; returns the module.
+
+    Args:
+        module: The freshly loaded robot module.
 
     Raises:
         InputError: If the variable names no instruction set this module runs on this CPU.

@@ -80,7 +80,8 @@ def simulate_compiled(
         compiled: The plant.
         q0, v0: Initial state, shapes (nq,) and (nv,) (a floating base: Pinocchio's free
             flyer, integrated on SE(3) as ``pinocchio.integrate``).
-        duration: Simulated time in [s], a whole number of steps; dt: step in [s].
+        duration: Simulated time in [s], a whole number of steps.
+        dt: Integration step in [s].
         integrator: ``"rk4"`` or ``"semi-implicit-euler"``.
         controller: ``None`` (passive), a compiled twin (:mod:`robodyn.compiled.controllers`;
             :func:`compiled_controller` makes one from a Python controller), or a Python
@@ -259,12 +260,20 @@ def _raise_if_failed(compiled: CompiledRobot, failed: int, out: list[np.ndarray]
 
 def has_twin(controller: object) -> bool:
     """Whether a controller owns a compiled twin (:class:`~robodyn.compiled.controllers.HasTwin`
-    with no refusal: e.g. computed torque along a quintic, operational space with a fixed target)."""
+    with no refusal: e.g. computed torque along a quintic, operational space with a fixed target).
+
+    Args:
+        controller: Any controller (a :mod:`robodyn.sim` controller or a callable).
+    """
     return isinstance(controller, HasTwin) and controller.twin_refusal() is None
 
 
 def compiled_controller(controller: object) -> CompiledLaw:
     """The compiled twin of a controller (its own ``compiled()``, on its own model compiled).
+
+    Args:
+        controller: A :mod:`robodyn.sim` controller with a compiled twin
+            (:class:`~robodyn.compiled.controllers.HasTwin`).
 
     Raises:
         CompileError: For a controller without one (one sentence saying why), or a model

@@ -24,7 +24,15 @@ SCALAR_CALL = re.compile(r"(?<!\w)(?:rd_)?(?:cos|sin|pow)\(")
 
 def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
     """``rdd_tau_derivatives2``: the same statements on two states, one a SIMD lane
-    (GCC/Clang vector extension; the same IEEE operations, so bit-identical results)."""
+    (GCC/Clang vector extension; the same IEEE operations, so bit-identical results).
+
+    Args:
+        writer: The tangent writer whose scalar statements (:attr:`TangentWriter.lines`) are
+            vectorised.
+        used: The program's symbols the statements read (the coordinates loaded per lane).
+        results: ``(array, index, C value)`` of every output entry: ``array`` ``"dq"`` or
+            ``"dv"`` (∂tau/∂q, ∂tau/∂v), ``index`` ``j * nv + k`` (row j, column k, row-major).
+    """
     pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
     body = [pattern.sub(r"= rdd_\1_2(\2);", line).replace("const double ", "const rdd_v2 ") for line in writer.lines]
     if any(SCALAR_CALL.search(line) for line in body):
@@ -61,7 +69,15 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
     target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
     with its ``target`` attribute; ``cos``/``sin`` the SIMD dynamics' (``rds<L>_sin``: the
     single call's ``rd_sin`` on every lane). ``RDD_BLOCKS`` names the variants for
-    ``derivatives.c``'s blocks and dispatch."""
+    ``derivatives.c``'s blocks and dispatch.
+
+    Args:
+        writer: The tangent writer whose scalar statements (:attr:`TangentWriter.lines`) are
+            vectorised.
+        used: The program's symbols the statements read (the coordinates loaded per lane).
+        results: ``(array, index, C value)`` of every output entry: ``array`` ``"dq"`` or
+            ``"dv"`` (∂tau/∂q, ∂tau/∂v), ``index`` ``j * nv + k`` (row j, column k, row-major).
+    """
     pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
     out: list[str] = []
     names: list[str] = []

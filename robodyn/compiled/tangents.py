@@ -216,7 +216,13 @@ class TangentWriter:
         return 1.0, target, result
 
     def differentiate(self, symbol: sp.Symbol, expr: sp.Expr, name: str) -> None:
-        """The tangents of ``symbol = expr`` in both groups of directions that reach it."""
+        """The tangents of ``symbol = expr`` in both groups of directions that reach it.
+
+        Args:
+            symbol: The assigned symbol.
+            expr: Its value, an expression of earlier symbols and the inputs.
+            name: The symbol's C name; its tangents are named ``d<group>_<name>``.
+        """
         partials = []
         for dependency in sorted(expr.free_symbols & self.tangents.keys(), key=str):
             partial = self._partial(expr, dependency)

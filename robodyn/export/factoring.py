@@ -23,7 +23,11 @@ from robodyn.equations.program import Program
 
 def factored_expression(expr: sp.Basic) -> sp.Basic:
     """``expr`` with the common factors of each sum taken out (unevaluated, so sympy does not
-    distribute them again); everything else as it is."""
+    distribute them again); everything else as it is.
+
+    Args:
+        expr: A sympy expression.
+    """
     if not expr.args or expr.is_Number or expr.is_Symbol:
         return expr
     args = [factored_expression(arg) for arg in expr.args]
@@ -102,7 +106,11 @@ def _sum(parts: list[sp.Basic]) -> sp.Basic:
 
 def factored(program: Program) -> Program:
     """The program with its negations inlined (:func:`negations_inlined`) and
-    :func:`factored_expression` applied to every assignment and output."""
+    :func:`factored_expression` applied to every assignment and output.
+
+    Args:
+        program: A straight-line program (assignments, then outputs).
+    """
     program = negations_inlined(program)
     return dataclasses.replace(
         program,

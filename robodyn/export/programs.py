@@ -78,7 +78,14 @@ class ExportPrograms:
 
 
 def check_exportable(robot: Robot) -> None:
-    """Refuse a floating base or a robot without moving joints, in one sentence."""
+    """Refuse a floating base or a robot without moving joints, in one sentence.
+
+    Args:
+        robot: The loaded robot.
+
+    Raises:
+        InputError: A floating base, or no moving joint.
+    """
     if robot.floating_base:
         raise InputError(
             "robot", "a fixed-base robot (floating_base=False): exported functions model fixed bases", f"a floating {robot.name}"

@@ -324,7 +324,12 @@ def _constants(programs: ExportPrograms) -> list[str]:
 
 def module_text(programs: ExportPrograms, backend: Backend) -> str:
     """The standalone module (imports only ``casadi``, or only ``jax``) whose
-    ``functions()`` returns the robot's functions by name (see the tail's docstring)."""
+    ``functions()`` returns the robot's functions by name (see the tail's docstring).
+
+    Args:
+        programs: The robot's exported programs (:func:`robodyn.export.programs.export_programs`).
+        backend: ``"casadi"`` or ``"jax"``: the only library the module imports.
+    """
     parameters = {symbol: f"p[{index}]" for index, symbol in enumerate(programs.parameters)}
     # the dynamics printed with their sums' common factors out and negations folded
     programs = dataclasses.replace(
