@@ -92,6 +92,12 @@ def contact_kinematics(
     """The points' gaps (k,) [m] and their Jacobian (3k, nv) in the contact axes ``(t₁, t₂, n)``.
 
     A sphere's point is its centre minus ``radius · n`` (the point nearest the plane).
+
+    Args:
+        robot: The robot.
+        q: The configuration, shape (nq,).
+        ground: The plane (its normal ``n`` and contact axes, :meth:`Ground.frame`).
+        points: The contact points (k of them).
     """
     model, data, nv = robot.model, robot.handle.data, robot.nv
     pin.computeJointJacobians(model, data, q)
@@ -117,6 +123,16 @@ def integrate(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
     Pinocchio's ``integrate`` moves the base along the screw of ``SE(3)``'s exponential: a
     rolling ball's body twist is a rotation about its contact point, so its centre would
     dip by ``r (1 − cos ω dt)`` into the plane every step.
+
+    Args:
+        robot: The robot.
+        q: The configuration, shape (nq,).
+        dq: The displacement ``dt v``, shape (nv,), in [rad] / [m]; a floating base's first
+            six: its origin's displacement in [m] then its rotation vector in [rad], both in
+            the base's own axes (Pinocchio's free-flyer velocity convention).
+
+    Returns:
+        The moved configuration, shape (nq,).
     """
     moved = pin.integrate(robot.model, q, dq)
     if robot.floating_base:

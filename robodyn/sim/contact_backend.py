@@ -17,7 +17,11 @@ from robodyn.sim.plan import Outcome, RunPlan, external_torques
 
 
 def run(plan: RunPlan) -> Outcome:
-    """Run a plan that has a ground (``plan.ground`` and ``plan.contacts`` set)."""
+    """Run a plan that has a ground (``plan.ground`` and ``plan.contacts`` set).
+
+    Args:
+        plan: The checked run (:class:`~robodyn.sim.plan.RunPlan`) with its ground and contact points.
+    """
     assert plan.ground is not None and plan.contacts is not None  # the caller's branch
     robot, controller, external = plan.robot, plan.controller, plan.external
 

@@ -41,7 +41,25 @@ def check_contact_run(
     observer: object,
 ) -> Contacts | None:
     """The contact points of a run on ``ground`` (``None`` without one), or an
-    :class:`InputError` naming what a contact run does not do."""
+    :class:`InputError` naming what a contact run does not do.
+
+    Args:
+        robot: The simulated robot.
+        ground: The plane the run stands on (:class:`~robodyn.sim.ground.Ground`); ``None``:
+            no ground (then ``contacts`` must be the default ``"collision"``).
+        contacts: The points that touch the ground (as for
+            :func:`~robodyn.sim.ground.contact_points`).
+        q0: Initial configuration, shape (nq,).
+        integrator: The run's integrator (only ``"semi-implicit-euler"`` with a ground).
+        every: Steps between two samples of a held controller; ``None`` or 1 with a ground.
+        limits: The limits mode, ``"warn"``, ``"enforce"`` or ``"ignore"`` (``"enforce"``:
+            ``q0`` must be within the joint limits).
+        observer: The run's momentum observer; ``None`` with a ground.
+
+    Raises:
+        InputError: For what a contact run does not do (naming the parameter), a start with
+            a contact point, or another link, below the ground, or past an enforced limit.
+    """
     if ground is None:
         if not (isinstance(contacts, str) and contacts == "collision"):
             raise InputError("contacts", "given only with a ground", repr(contacts)[:80])
@@ -163,7 +181,15 @@ def start_above(
     robot: Robot, q0: np.ndarray, ground: Ground, contacts: str | Sequence[str | ContactPoint], clearance: float = 0.05
 ) -> tuple[np.ndarray, float]:
     """A floating robot's configuration moved along the ground's normal so that its lowest
-    contact point is ``clearance`` [m] above the plane, and how far it moved [m]."""
+    contact point is ``clearance`` [m] above the plane, and how far it moved [m].
+
+    Args:
+        robot: The robot (a floating base: ``q0[:3]`` is its position in [m]).
+        q0: Configuration, shape (nq,).
+        ground: The plane.
+        contacts: The points that touch it (as for :func:`~robodyn.sim.ground.contact_points`).
+        clearance: Height of the lowest contact point above the plane, in [m].
+    """
     gaps = contact_kinematics(robot, q0, ground, contact_points(robot, contacts).points)[0]
     lift = clearance - float(gaps.min())
     moved = np.array(q0, dtype=float)

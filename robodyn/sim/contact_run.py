@@ -102,6 +102,14 @@ class ContactSimulation:
         ``f[<contact>].x/.y/.z`` [N] and ``contact[<contact>]`` (1: active), which
         trajectory readers skip (docs/trajectory-format.md).
 
+        Args:
+            path: The ``.csv`` file to write.
+            extras: More columns, kind -> values of shape (N, nv) (one row a sample, one
+                column a velocity coordinate, named ``<kind>[<coordinate>]``); ``None``: none.
+
+        Returns:
+            The path written.
+
         Raises:
             InputError: For a file name that does not end in ``.csv``.
         """
@@ -212,7 +220,24 @@ def run_contacts(
 ) -> ContactSimulation:  # fmt: skip
     """:func:`simulate_contact` of checked arguments (``joint_friction=False``: no joint damping;
     ``limits``: the joints' position limits in the contact problem and their efforts
-    saturating the torques, :mod:`robodyn.sim.contact_limits`)."""
+    saturating the torques, :mod:`robodyn.sim.contact_limits`).
+
+    Args:
+        robot: The robot (a floating base or a fixed one).
+        ground: The plane and its friction.
+        found: The checked contact points (:func:`~robodyn.sim.ground.contact_points`); their
+            ``skipped`` lines go into the run's notes.
+        controller: ``tau(t, q, v) -> (nv,)``, a constant (nv,), or ``None`` (no torque).
+        q: Initial configuration, shape (nq,).
+        v: Initial velocity, shape (nv,).
+        steps: The number of steps (the run has ``steps + 1`` samples).
+        dt: Step in [s].
+        settings: Solver settings (:class:`~robodyn.sim.contact.ContactSettings`); ``None``: the defaults.
+        joint_friction: Apply the joints' damping ``−b v`` (:attr:`Robot.joint_damping`);
+            ``False``: none. The joints' Coulomb friction is not applied (a note says so).
+        limits: Put the joints' position limits in the contact problem and saturate the
+            torques at their efforts.
+    """
     damping = robot.joint_damping if joint_friction else np.zeros(robot.nv)
     rows = LimitRows(robot) if limits else None
     samples = _run(robot, ground, found.points, controller, (q, v), steps, dt, settings or ContactSettings(), damping, rows)
@@ -277,7 +302,13 @@ def _run(
 def ground_lines(robot: Robot, contact: ContactSimulation | None) -> tuple[str, ...]:
     """A run's ground lines for its summary: the contact summary, or for a floating robot
     without a ground or constraints ``"no ground: the base falls freely"`` (nothing for a
-    fixed one, nor for one its constraints hold)."""
+    fixed one, nor for one its constraints hold).
+
+    Args:
+        robot: The simulated robot.
+        contact: The run's contacts (:class:`ContactSimulation`), or ``None`` for a run
+            without a ground.
+    """
     if contact is not None:
         return tuple(contact.summary_lines())
     note = free_fall_note(robot, None)
@@ -286,7 +317,12 @@ def ground_lines(robot: Robot, contact: ContactSimulation | None) -> tuple[str, 
 
 def free_fall_note(robot: Robot, ground: Ground | None) -> str | None:
     """The one summary line of a floating robot simulated with nothing holding its base
-    (no ground and no constraint), else ``None``."""
+    (no ground and no constraint), else ``None``.
+
+    Args:
+        robot: The simulated robot.
+        ground: The plane the run stands on, or ``None``.
+    """
     free = robot.floating_base and ground is None and not robot.constraints
     return "no ground: the base falls freely" if free else None
 

@@ -50,6 +50,10 @@ DIRECTION_TOLERANCE = 1e-6
 def unit_normal(normal: np.ndarray | Sequence[float], name: str = "normal") -> np.ndarray:
     """A surface normal as a unit 3-vector.
 
+    Args:
+        normal: The normal in world axes, 3 finite numbers, not all zero (any length).
+        name: The parameter's name, for the error.
+
     Raises:
         InputError: For another shape, non-finite values or a zero vector.
     """
@@ -70,6 +74,12 @@ def _reference(motion: np.ndarray | TaskReference, t: float) -> tuple[np.ndarray
 def vector(value: object, name: str, size: int = 3, unit: str = "[m]") -> np.ndarray:
     """``value`` as ``size`` finite floats.
 
+    Args:
+        value: The value given.
+        name: The parameter's name, for the error.
+        size: The number of entries expected.
+        unit: Its unit or axes as the error states them (e.g. ``"[m]"``).
+
     Raises:
         InputError: Naming ``name``, for anything else.
     """
@@ -86,6 +96,11 @@ def vector(value: object, name: str, size: int = 3, unit: str = "[m]") -> np.nda
 
 def scalar(value: object, name: str, expected: str) -> float:
     """``value`` as a finite float ≥ 0.
+
+    Args:
+        value: The value given.
+        name: The parameter's name, for the error.
+        expected: What the error says is expected (e.g. ``"a finite gain ≥ 0 in [1/s²]"``).
 
     Raises:
         InputError: Naming ``name``, for anything else.
@@ -189,7 +204,13 @@ class HybridForceMotion:
         return -self.force * self._normal
 
     def motion_error(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``Ω e`` and ``Ω ė`` (``e = x_d − x``), in [m] and [m/s], world axes, each (3,)."""
+        """``Ω e`` and ``Ω ė`` (``e = x_d − x``), in [m] and [m/s], world axes, each (3,).
+
+        Args:
+            t: Time in [s] (the reference ``x_d(t)``).
+            q: Configuration, shape (nq,).
+            v: Velocity, shape (nv,).
+        """
         position, jacobian, _ = _frame_terms(self.model, self._frame_id, q, v)
         x_d, dx_d, _ = _reference(self.motion, t)
         selection = self.motion_selection

@@ -89,7 +89,14 @@ class Ground:
         return np.array([t1, np.cross(n, t1), n])
 
     def gap(self, point: np.ndarray) -> np.ndarray:
-        """Signed distance of points (…, 3) above the plane, in [m] (negative: penetration)."""
+        """Signed distance of points (…, 3) above the plane, in [m] (negative: penetration).
+
+        Args:
+            point: World positions in [m], shape (3,) or (…, 3).
+
+        Returns:
+            The distances along the plane's normal, shape () or (…,), in [m].
+        """
         return (np.asarray(point, dtype=float) - self.point) @ np.array(self.normal)
 
 
@@ -190,7 +197,11 @@ def _shape_points(
 
 
 def collision_points(robot: Robot) -> Contacts:
-    """Contact points from the URDF's ``<collision>`` spheres and boxes (module docstring)."""
+    """Contact points from the URDF's ``<collision>`` spheres and boxes (module docstring).
+
+    Args:
+        robot: The loaded robot (its URDF text is read).
+    """
     root = ET.fromstring(robot.urdf)
     points: list[ContactPoint] = []
     skipped: dict[str, list[str]] = {}  # kind -> the links with one
@@ -294,6 +305,12 @@ def asked_ground(robot: Robot, *, height: float | None = None, friction: float |
 def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -> Contacts:
     """The robot's contact points: ``"collision"`` (its collision spheres and boxes) or a
     list of frame names and :class:`ContactPoint` values.
+
+    Args:
+        robot: The loaded robot.
+        contacts: ``"collision"`` (the URDF's collision spheres, boxes and capsules of moving
+            links; without any, the links named ``*foot``), one frame name, or a sequence of
+            frame names (a point at the frame's origin) and :class:`ContactPoint` values.
 
     Raises:
         FrameError: For a frame the robot does not have (with close names).

@@ -114,7 +114,9 @@ def support_polygon(robot: Robot, q: np.ndarray, contacts: Sequence[PointContact
     """The support polygon: the convex hull of the contact points seen along gravity.
 
     Args:
-        robot: The robot. q: Its configuration (nq,).
+        robot: The robot.
+        q: Its configuration, shape (nq,) (a floating base: position in [m], then its unit
+            quaternion).
         contacts: The contacts (their points on their links).
 
     Returns:
@@ -129,7 +131,15 @@ def support_polygon(robot: Robot, q: np.ndarray, contacts: Sequence[PointContact
 
 def support_margin(robot: Robot, q: np.ndarray, contacts: Sequence[PointContact], point: np.ndarray) -> float:
     """How far ``point`` (3,) seen along gravity lies inside the support polygon, in [m]
-    (negative: outside; −inf for fewer than three contact points not on one line)."""
+    (negative: outside; −inf for fewer than three contact points not on one line).
+
+    Args:
+        robot: The robot.
+        q: Its configuration, shape (nq,) (a floating base: position in [m], then its unit
+            quaternion).
+        contacts: The contacts (their points on their links).
+        point: A world point in [m], shape (3,) (e.g. the centre of mass).
+    """
     polygon = support_polygon(robot, q, contacts)
     if len(polygon) < 3:
         return -np.inf
@@ -299,6 +309,12 @@ class Stand:
 
     def solve(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The QP's ``(v̇, τ, f)`` at a state: (nv,), (actuated,), (3 k,) in SI units, world axes for ``f``.
+
+        Args:
+            q: Configuration, shape (nq,) (a floating base: position in [m], then its unit
+                quaternion).
+            v: Velocity, shape (nv,), in [rad/s] / [m/s] (a floating base's first six in its
+                own axes, Pinocchio's convention).
 
         Raises:
             InputError: If the QP has no solution at this state (naming ``q``).

@@ -16,7 +16,11 @@ if TYPE_CHECKING:
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    """Add the command to the ``robodyn`` parser."""
+    """Add the command to the ``robodyn`` parser.
+
+    Args:
+        commands: The subparsers of the ``robodyn`` parser, from ``add_subparsers``.
+    """
     parser = commands.add_parser("simulate", help="simulate a robot, optionally under a controller; write trajectory and plot")
     add_model_arguments(parser)
     add_constraints_argument(parser)
@@ -89,7 +93,11 @@ def _reference(arguments: argparse.Namespace) -> dict:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    """Run ``robodyn simulate`` with the parsed ``arguments``; return the exit status."""
+    """Run ``robodyn simulate`` with the parsed ``arguments``; return the exit status.
+
+    Args:
+        arguments: The command line parsed by the parser :func:`add_parser` built.
+    """
     from robodyn.sim.report import seconds_since_process_start
     from robodyn.viz.experiment import run_experiment
 
