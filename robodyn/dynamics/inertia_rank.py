@@ -27,6 +27,9 @@ NULL_TOLERANCE = 1e-12
 #: on a singular ``M`` divides a torque by a round-off pivot, some 1e15 times too large.
 SUSPECT_ACCELERATION = 1e12
 
+#: Entries of ``M⁻¹`` above this, in [1/(kg m²)] / [1/kg], have ``M(q)``'s rank looked at.
+SUSPECT_INVERSE = 1e12
+
 #: A degree of freedom whose weight in the null space exceeds this takes part in it.
 WEIGHT = 0.1
 
@@ -74,26 +77,31 @@ def singular_error(robot: Robot, q: np.ndarray, rows: np.ndarray | None = None) 
     return SingularMassMatrixError(robot.name, [])
 
 
-def refuse_singular(robot: Robot, q: np.ndarray, a: np.ndarray) -> None:
-    """Raise :func:`singular_error` if accelerations ``a`` computed at ``q`` came from a
-    singular ``M(q)``. When no acceleration exceeds :data:`SUSPECT_ACCELERATION` this costs a
-    dot product (one state) or an extremum (a batch); ``M``'s rank is looked at only at the
-    states that do.
+def refuse_singular(robot: Robot, q: np.ndarray, values: np.ndarray, limit: float = SUSPECT_ACCELERATION) -> None:
+    """Raise :func:`singular_error` if ``values`` computed at ``q`` (accelerations, or ``M⁻¹``)
+    came from a singular ``M(q)``. When none exceeds ``limit`` in magnitude this costs a dot
+    product (one state) or an extremum (a batch); ``M``'s rank is looked at only at the
+    states whose values do.
 
     Args:
         robot: The robot.
         q: One configuration, shape (nq,), or a batch, shape (N, nq), in [rad] / [m].
-        a: The accelerations, shape (nv,) or (N, nv), in [rad/s²] / [m/s²].
+        values: The state's result, e.g. accelerations of shape (nv,) in [rad/s²] / [m/s²],
+            or a batch's, with a leading axis of length N.
+        limit: The magnitude above which a value is suspect (default :data:`SUSPECT_ACCELERATION`).
     """
-    if a.ndim == 1:
-        if not a.dot(a) > SUSPECT_ACCELERATION**2:
+    rows = None
+    if np.ndim(q) == 1:
+        flat = values.ravel()
+        if not flat.dot(flat) > limit**2:
             return
-    elif not (a.size and (a.max() > SUSPECT_ACCELERATION or a.min() < -SUSPECT_ACCELERATION)):
-        return  # no BLAS on a batch: its threads would wait on Pinocchio's spinning ones (milliseconds)
-    rows = np.flatnonzero(np.abs(a).reshape(-1, robot.nv).max(axis=1) > SUSPECT_ACCELERATION) if a.ndim == 2 else None
+    elif values.size and (values.max() > limit or values.min() < -limit):  # no BLAS on a batch: its threads
+        rows = np.flatnonzero(np.abs(values).reshape(len(values), -1).max(axis=1) > limit)  # wait on Pinocchio's
+    else:
+        return
     error = singular_error(robot, q, rows)
     if error.joints:
         raise error
 
 
-__all__ = ["SUSPECT_ACCELERATION", "inertialess_joints", "refuse_singular", "singular_error"]
+__all__ = ["SUSPECT_ACCELERATION", "SUSPECT_INVERSE", "inertialess_joints", "refuse_singular", "singular_error"]

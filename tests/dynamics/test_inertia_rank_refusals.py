@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 import robodyn
+from robodyn.dynamics import inertia_rank
 from robodyn.exceptions import RobodynWarning, SingularMassMatrixError
 
 # two revolute axes through one point (x, then y) and a point mass behind them on the line
@@ -66,17 +67,28 @@ def test_constrained_forward_dynamics_is_refused_naming_the_joints_one_state_and
     assert raised.value.joints == ["nod", "pitch"] and raised.value.row == 1
 
 
+def test_forward_dynamics_derivatives_are_refused_naming_the_joints_one_state_and_a_batch(neck):
+    with pytest.raises(SingularMassMatrixError) as raised:
+        neck.forward_dynamics_derivatives(np.zeros(2), np.zeros(2), TAU)
+    assert raised.value.joints == ["nod", "pitch"] and raised.value.row is None
+    with pytest.raises(SingularMassMatrixError) as raised:
+        neck.forward_dynamics_derivatives(np.array([[0.5, 0.3], [0.1, 0.2], [-0.3, 0.0]]), np.zeros((3, 2)), np.zeros((3, 2)))
+    assert raised.value.joints == ["nod", "pitch"] and raised.value.row == 2
+
+
 def test_away_from_the_singular_set_the_neck_solves_m_a_equals_the_net_torque(neck):
     q, v = np.array([0.5, 0.3]), np.array([0.3, -0.1])
     a = neck.forward_dynamics(q, v, TAU)
     np.testing.assert_allclose(neck.mass_matrix(q) @ a, TAU - neck.nonlinear_effects(q, v), rtol=1e-10, atol=1e-12)
 
 
-def test_a_regular_robot_with_large_accelerations_gets_the_unchecked_numbers_bit_for_bit():
+def test_a_regular_robot_with_large_accelerations_gets_the_unchecked_numbers_bit_for_bit(monkeypatch):
     # a light point mass off the line, a large torque: accelerations where M's rank is looked at
-    robot = robodyn.load(NECK.replace('xyz="0.2 0.2 0"/><mass value="1.7"', 'xyz="0.2 0.2 0.1"/><mass value="1e-9"'))
+    robot = robodyn.load(NECK.replace('xyz="0.2 0.2 0"/><mass value="1.7"', 'xyz="0.2 0.2 0.1"/><mass value="1e-10"'))
     rng = np.random.default_rng(4)
     q, v, tau = rng.uniform(-1, 1, (7, 2)), rng.normal(size=(7, 2)), 1e6 * rng.normal(size=(7, 2))
+    looked = []  # the states whose M's rank was looked at: this control reaches that check
+    monkeypatch.setattr(inertia_rank, "inertialess_joints", lambda *state: looked.append(state) or [])
     data = robot.model.createData()
     expected = np.array([pin.aba(robot.model, data, *state) for state in zip(q, v, tau, strict=True)])
     assert np.abs(expected).max() > 1e12  # the negative control reaches the looked-at range
@@ -84,3 +96,7 @@ def test_a_regular_robot_with_large_accelerations_gets_the_unchecked_numbers_bit
     assert np.array_equal(batch, robot.handle.calls.a(q, v, tau))  # the path before the check, unchanged
     np.testing.assert_allclose(batch, expected, rtol=1e-9)
     assert np.array_equal(robot.forward_dynamics(q[3], v[3], tau[3]), expected[3])
+    inverse = robot.forward_dynamics_derivatives(q, v, tau)[2]
+    assert np.abs(inverse).max() > 1e12  # M⁻¹ of the light link, regular: returned
+    np.testing.assert_allclose(inverse[3] @ robot.mass_matrix(q[3]), np.eye(2), atol=1e-6)
+    assert len(looked) >= 3
