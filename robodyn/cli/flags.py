@@ -24,6 +24,7 @@ FLAGS: dict[str, str] = {
     "target": "--target",
     "frame": "--frame",
     "q0": "--q0",
+    "keyframe": "--keyframe",
     "out": "--out",
     "scheduler": "--scheduler",
     "form": "--form",

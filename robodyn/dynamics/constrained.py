@@ -39,6 +39,7 @@ import pinocchio as pin
 from robodyn.constraints import Constraint, as_constraints, check_frames
 from robodyn.constraints.algebra import Bound, bind
 from robodyn.dynamics.constraint_rows import EndFrames
+from robodyn.dynamics.inertia_rank import refuse_singular, singular_error
 from robodyn.exceptions import InputError, NonFiniteResultError, SingularMassMatrixError
 
 if TYPE_CHECKING:
@@ -284,11 +285,16 @@ def forward_dynamics(
     if robot.massless_joints:
         raise SingularMassMatrixError(robot.name, robot.massless_joints)
 
-    return _finite(
-        robot,
-        "constrained dynamics",
-        lambda: _per_state(robot, lambda *state: _dynamics(robot, bounds, *state), batch, q, v, tau),
-    )
+    try:
+        a, multipliers = _finite(
+            robot,
+            "constrained dynamics",
+            lambda: _per_state(robot, lambda *state: _dynamics(robot, bounds, *state), batch, q, v, tau),
+        )
+    except SingularMassMatrixError as error:  # M not positive definite at some state: name its joints
+        raise (error if error.joints else singular_error(robot, q)) from None
+    refuse_singular(robot, q, a)  # a round-off pivot of M's Cholesky factor? (M's rank looked at only for huge a)
+    return a, multipliers
 
 
 def forward_dynamics_unchecked(

@@ -34,6 +34,7 @@ from robodyn.dynamics.configurations import PLACEHOLDER_LIMIT
 from robodyn.dynamics.display import robot_html
 from robodyn.dynamics.dofs import Dof, configuration_names, robot_dofs
 from robodyn.dynamics.handle import ModelHandle
+from robodyn.dynamics.inertia_rank import refuse_singular, singular_error
 from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.joints import JointInfo
 from robodyn.dynamics.kernels import massless_joints
@@ -277,14 +278,17 @@ class Robot(RobotDerivatives, RobotKinematics, RobotConstraints, RobotExchange):
             Accelerations, shape (nv,) or (N, nv).
 
         Raises:
-            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
+            SingularMassMatrixError: If ``M(q)`` is singular: massless moving bodies, or joints
+                that together move no inertia at ``q`` (named, with the row of a batch).
         """
         if self.massless_joints:  # M singular for every q: ABA's finite numbers would be wrong
             raise SingularMassMatrixError(self.name, self.massless_joints)
         try:
-            return self.handle.calls.a(q, v, tau)
-        except NonFiniteResultError:  # finite inputs, non-finite accelerations: only a singular M does that
-            raise SingularMassMatrixError(self.name, self.massless_joints) from None
+            a = self.handle.calls.a(q, v, tau)
+        except (NonFiniteResultError, SingularMassMatrixError):  # finite inputs: only a singular M does that
+            raise singular_error(self, q) from None
+        refuse_singular(self, q, a)  # ABA's pivot a round-off? (M's rank looked at only for huge a)
+        return a
 
     def forward_dynamics_unchecked(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """:meth:`forward_dynamics` of one state without the boundary checks.

@@ -4,14 +4,17 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from robodyn.dynamics import derivatives
+from robodyn.dynamics.inertia_rank import SUSPECT_INVERSE, refuse_singular, singular_error
+from robodyn.exceptions import SingularMassMatrixError
 
 if TYPE_CHECKING:
     from robodyn.dynamics.handle import ModelHandle
+    from robodyn.dynamics.robot import Robot
 
 
 class RobotDerivatives:
@@ -60,6 +63,13 @@ class RobotDerivatives:
             Three arrays of shape (nv, nv) or (N, nv, nv), in SI units.
 
         Raises:
-            SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
+            SingularMassMatrixError: If ``M(q)`` is singular: massless moving bodies, or joints
+                that together move no inertia at ``q`` (named, with the row of a batch).
         """
-        return derivatives.forward_dynamics_derivatives(self.handle, q, v, tau)
+        robot = cast("Robot", self)
+        try:
+            result = derivatives.forward_dynamics_derivatives(self.handle, q, v, tau)
+        except SingularMassMatrixError as error:  # non-finite: name the joints, if some move no inertia
+            raise (error if error.joints else singular_error(robot, q)) from None
+        refuse_singular(robot, q, result[2], SUSPECT_INVERSE)  # M⁻¹ of a round-off pivot? (rank looked at only then)
+        return result

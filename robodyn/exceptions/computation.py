@@ -29,18 +29,21 @@ class SingularMassMatrixError(RobodynError, ArithmeticError):
     Attributes:
         joints: Joints that move no mass (their whole subtree is massless), or with
             ``inertialess`` those whose motions together move no inertia at the state, if any.
+        row: The state's row in a batch (0-based), or ``None`` for one state.
     """
 
-    def __init__(self, robot: str, joints: list[str], *, inertialess: bool = False):
+    def __init__(self, robot: str, joints: list[str], *, inertialess: bool = False, row: int | None = None):
         self.robot = robot
         self.joints = list(joints)
+        self.row = row
         moved = (
             "together move no inertia here (point masses, no rotational inertia behind them)" if inertialess else "move no mass"
         )
         reason = (
             f"joints {', '.join(repr(j) for j in self.joints)} {moved}" if self.joints else "the accelerations are not finite"
         )
-        super().__init__(f"robot {robot!r}: the mass matrix is singular, so forward dynamics is undefined ({reason}).")
+        where = "" if row is None else f" at row {row} of the batch"
+        super().__init__(f"robot {robot!r}: the mass matrix is singular{where}, so forward dynamics is undefined ({reason}).")
 
 
 class SimulationError(RobodynError):

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from robodyn.cli.common import RANGES, add_constraints_argument, add_model_arguments, load_robot, vector, warn
 from robodyn.cli.flags import command_line_text
+from robodyn.cli.start import add_start_arguments, start_configuration
 from robodyn.common.text import json_text, printable
 from robodyn.exceptions import InputError
 
@@ -42,7 +43,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "must move); with any controller, the path --record and --plot draw",
     )
     _add_controller_options(parser)
-    parser.add_argument("--q0", type=vector, help="start (default: joints at 0 in their limits, an MJCF free body at its pose)")
+    add_start_arguments(parser)
     parser.add_argument("--duration", type=float, default=3.0, help=f"simulated time, {RANGES['duration'].text()} (default 3)")
     parser.add_argument("--dt", type=float, default=1e-3, help=f"step, {RANGES['dt'].text()}, at most --duration (default 0.001)")
     parser.add_argument(
@@ -108,7 +109,7 @@ def run(arguments: argparse.Namespace) -> int:
         controller=arguments.controller,
         target=arguments.target,
         frame=arguments.frame,
-        q0=arguments.q0,
+        q0=start_configuration(robot, arguments),
         duration=arguments.duration,
         dt=arguments.dt,
         integrator=arguments.integrator,
