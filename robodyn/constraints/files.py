@@ -198,7 +198,8 @@ def read_constraints(source: str | os.PathLike) -> tuple[Constraint, ...]:
         raise InputError("constraints", _EXPECTED, f"{quoted(label)}: an unknown list {quoted(unknown[0][:40])}")
     constraints: list[Constraint] = []
     for table in TABLES:
-        entries = document.get(table) or []
+        entries = document.get(table)
+        entries = [] if entries is None else entries  # `anchor:` left empty; `anchor: 0` is refused
         if not isinstance(entries, list):
             raise InputError(table, f"a list of {table} entries (each a '- ' item)", f"{quoted(label)}: {type(entries).__name__}")
         if len(constraints) + len(entries) > MAX_CONSTRAINTS:

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.sim.contact_limits import LimitRows
+from robodyn.sim.contact_limits import REACH, LimitRows
 from robodyn.sim.contact_run import simulate_contact
 from robodyn.sim.ground import ContactPoint, Ground, resolve_ground
 from robodyn.sim.simulation import simulate_run
@@ -164,3 +164,52 @@ def test_the_general_step_also_rests_the_quadruped_on_its_stops(monkeypatch):
     assert np.abs(run.trajectory.q[-1, 7:][index] - np.radians(list(stops.values()))).max() < 1e-9
     assert np.abs(run.trajectory.v[-1]).max() < 1e-9  # at rest
     assert abs(run.normal_forces[-1].sum() / (robot.total_mass * 9.81) - 1) < 1e-6
+
+
+_LINK = '<link name="{}"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+# an unlimited hinge first (no row), then a limited hinge and a limited slider
+THREE = (
+    '<robot name="three">'
+    + "".join(_LINK.format(name) for name in "abcd")
+    + '<joint name="c" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>'
+    + '<joint name="j1" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>'
+    + '<limit lower="-1" upper="0.5" effort="5" velocity="2"/></joint>'
+    + '<joint name="j2" type="prismatic"><parent link="c"/><child link="d"/><origin xyz="0.3 0 0"/><axis xyz="1 0 0"/>'
+    + '<limit lower="-0.2" upper="0.3" effort="5" velocity="2"/></joint></robot>'
+)
+
+
+@pytest.mark.parametrize("floating", [False, True])
+def test_limit_rows_point_at_their_own_joints_coordinates_fixed_or_floating(floating):
+    robot = robodyn.load(THREE, floating_base=floating)
+    rows = LimitRows(robot)
+    joints = [robot.model.joints[robot.model.getJointId(name)] for name in ("j1", "j2", "j1", "j2")]
+    assert rows.names == ["j1 lower", "j2 lower", "j1 upper", "j2 upper"]
+    assert rows.q_index.tolist() == [joint.idx_q for joint in joints]
+    assert rows.v_index.tolist() == [joint.idx_v for joint in joints]
+    assert rows.bound.tolist() == [-1.0, -0.2, 0.5, 0.3] and rows.sign.tolist() == [1.0, 1.0, -1.0, -1.0]
+    q = robot.random_configuration(np.random.default_rng(3))
+    q1, q2 = q[joints[0].idx_q], q[joints[1].idx_q]
+    np.testing.assert_allclose(rows.gaps(q), [q1 + 1.0, q2 + 0.2, 0.5 - q1, 0.3 - q2], rtol=0, atol=1e-15)
+    # the step's reach (module docstring): 2 dt (|v_j| + |v_free,j|) + REACH, j1 alone near
+    dt, v, free = 1e-3, np.zeros(robot.nv), np.zeros(robot.nv)
+    v[joints[0].idx_v], free[joints[0].idx_v] = -1.0, 3.0
+    v[joints[0].idx_v - 1] = 1e3  # the unlimited hinge's speed is no limit's
+    reach = 2 * dt * 4.0 + REACH
+    for gap, expected in ((0.99 * reach, [2]), (1.01 * reach, [])):
+        q[joints[0].idx_q], q[joints[1].idx_q] = 0.5 - gap, 0.05
+        assert rows.near(q, v, free, dt).tolist() == expected
+    # two rows near: two cones of three rows, each normal row last, signed
+    expected_rows = np.zeros((6, robot.nv))
+    expected_rows[2, joints[0].idx_v], expected_rows[5, joints[1].idx_v] = 1.0, -1.0
+    assert np.array_equal(rows.jacobian(np.array([0, 3]), robot.nv), expected_rows)
+
+
+def test_a_robot_without_finite_limits_has_no_rows():
+    text = THREE.replace('type="revolute"', 'type="continuous"').replace('type="prismatic"', 'type="continuous"')
+    robot = robodyn.load(text)
+    rows = LimitRows(robot)
+    q, v = robot.neutral_configuration(), np.ones(robot.nv)
+    assert rows.names == [] and rows.gaps(q).shape == (0,) and rows.near(q, v, v, 1e-3).shape == (0,)
+    assert rows.jacobian(rows.near(q, v, v, 1e-3), robot.nv).shape == (0, robot.nv)
+    assert np.array_equal(rows.torques(np.zeros(0), 1e-3, robot.nv), np.zeros(robot.nv))
