@@ -25,6 +25,7 @@ import numpy as np
 
 from robodyn.compiled import build
 from robodyn.compiled.cache import SNAP, robot_key
+from robodyn.compiled.robot_frames import CompiledFrames, fixed_base_only
 from robodyn.dynamics.batch import check_threads
 from robodyn.dynamics.joint_dynamics import friction_torque
 from robodyn.dynamics.robot import Robot
@@ -133,9 +134,10 @@ def compile(robot: Robot, *, threads: int | None = None) -> CompiledRobot:
     return CompiledRobot(robot, module, threads=threads)
 
 
-class CompiledRobot:
+class CompiledRobot(CompiledFrames):
     """A robot's dynamics in compiled C; the methods and shape rules of :class:`robodyn.Robot`
     (both satisfy :class:`robodyn.dynamics.protocol.Dynamics`, with the same signatures).
+    Its frame kinematics: :class:`~robodyn.compiled.robot_frames.CompiledFrames`.
 
     Attributes:
         robot: The Pinocchio-backed robot it was compiled from (names, limits, checks). Its
@@ -271,7 +273,7 @@ class CompiledRobot:
         and kept in the instance's ``__dict__`` (so a call costs one dictionary look-up)."""
         module = self.__dict__.get("_derivative_module")
         if module is None:
-            _fixed_base_only(self.robot, "derivatives")
+            fixed_base_only(self.robot, "derivatives")
             from robodyn.compiled import derivatives  # the generator: only when first asked for
 
             module = derivatives.derivative_module(self.robot, kernels=lambda: robot_kernels(self.robot))
@@ -326,93 +328,12 @@ class CompiledRobot:
             return result
         return _derivatives_checked(function, self.robot, self.threads, "fd", q=q, v=v, tau=tau)
 
-    # ---- frame kinematics (robodyn.compiled.kinematics): one small module a frame ----------
-
-    def frame_module(self, frame: str) -> ModuleType:
-        """The compiled kinematics of a frame (built on first use, then cached on disk and here).
-
-        Args:
-            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
-
-        Raises:
-            FrameError: Unknown frame. CompileError: If the build fails.
-        """
-        modules = self.__dict__.setdefault("_frames", {})
-        if frame not in modules:
-            _fixed_base_only(self.robot, "frame kinematics")
-            from robodyn.compiled.kinematics import build_frame  # the generator: only when first asked for
-
-            modules[frame] = build_frame(self.robot, frame, robot_key(self.robot))
-        return modules[frame]
-
-    def _frame_call(self, kind: str, frame: str, **named: np.ndarray) -> np.ndarray:
-        function = getattr(self.frame_module(frame), kind)
-        result = function(*named.values())
-        if result.__class__ is _ndarray:
-            return result
-        arrays, _ = self.robot.validate(**named)
-        result = function(*[np.ascontiguousarray(array, dtype=np.float64) for array in arrays])
-        if result.__class__ is not _ndarray:  # cannot happen after validate(): refuse rather than guess
-            raise CompileError(self.name, f"the compiled frame {kind} refused checked inputs (status {result})")
-        return result
-
-    def frame_position(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Position of a frame's origin in the world frame, shape (3,) or (N, 3), in [m]
-        (as :meth:`robodyn.Robot.frame_position`, in generated C).
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
-            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
-        """
-        return self._frame_call("position", frame, q=q)
-
-    def frame_rotation(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Rotation world <- frame, shape (3, 3) or (N, 3, 3).
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
-            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
-        """
-        return self._frame_call("rotation", frame, q=q)
-
-    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
-        """Frame Jacobian, shape (6, nv) or (N, 6, nv): linear rows then angular, world-aligned
-        axes at the frame's origin (Pinocchio's ``LOCAL_WORLD_ALIGNED``, as
-        :meth:`robodyn.Robot.frame_jacobian`).
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
-            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
-        """
-        return self._frame_call("jacobian", frame, q=q)
-
-    def frame_bias_acceleration(self, q: np.ndarray, v: np.ndarray, frame: str, *, angular: bool = False) -> np.ndarray:
-        """``J̇(q, v) v``: the classical acceleration of the frame's origin at zero joint
-        acceleration, world axes, shape (3,) or (N, 3), in [m/s²] (as
-        :meth:`robodyn.Robot.frame_bias_acceleration`); with ``angular=True`` the angular
-        acceleration in [rad/s²] follows, shape (6,) or (N, 6).
-
-        Args:
-            q: Configuration, shape (nq,) or (N, nq), in [rad] / [m] (fixed base only).
-            v: Velocity, shape (nv,) or (N, nv), in [rad/s] / [m/s].
-            frame: Name of a frame of the robot (a link, a joint or a fixed frame).
-            angular: Also return the angular part (rows 3–5) after the linear.
-        """
-        bias = self._frame_call("bias", frame, q=q, v=v)
-        return bias if angular else bias[..., :3].copy()
-
 
 def _derivatives_checked(function, robot: Robot, threads: int, kind: str, **named: np.ndarray):
     """:func:`robodyn.compiled.derivatives.checked` (its module imported only on this path)."""
     from robodyn.compiled import derivatives
 
     return derivatives.checked(function, robot, threads, kind, **named)
-
-
-def _fixed_base_only(robot: Robot, what: str) -> None:
-    """Refuse a floating base for the compiled ``what`` (its kernels model fixed bases)."""
-    if robot.floating_base:
-        raise CompileError(robot.name, f"it has a floating base; the compiled {what} model fixed-base robots")
 
 
 __all__ = ["SNAP", "CompiledRobot", "compile", "coordinate_parents", "generate_kernels", "robot_kernels", "robot_key"]

@@ -15,8 +15,9 @@ a constant times another is not a statement.
 
 The single call runs these vector statements (GCC/Clang vector extension; compiled once
 plainly and once per instruction set of the build's SIMD variants, the widest the CPU runs
-chosen at the first call). A batch runs states in lanes instead (``rdd_tau_derivatives2``,
-``rdd<L>_tau_derivatives``: :mod:`robodyn.compiled.derivatives`), from the same statements
+chosen at the first call: :mod:`robodyn.compiled.tangent_single`). A batch runs states in
+lanes instead (``rdd_tau_derivatives2``, ``rdd<L>_tau_derivatives``:
+:mod:`robodyn.compiled.derivatives`), from the same statements
 written lane by lane: each direction's entry is the vector statement's lane, the same IEEE
 operations in the same order, the terms a lane cannot have left out (they add an exact
 zero in the vector: at most the sign of a zero differs), so a batch row equals its single
@@ -32,6 +33,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.compiled.tangent_batches import block_functions, pair_function
+from robodyn.compiled.tangent_single import single_functions
 from robodyn.equations.c_printer import CPrinter, c_number
 from robodyn.equations.program import Program, needed
 
@@ -122,7 +124,7 @@ class TangentWriter:
         self._partials: dict[sp.Expr, str] = {}
         self.lines: list[str] = []  # lane by lane (the batches' statements)
         # The single call's: scalar lines, and vector statements (name, terms) printed for a
-        # width of vectors by _vector_body.
+        # width of vectors by robodyn.compiled.tangent_single.
         self.vector_lines: list[str | Statement] = []
 
     def _both(self, line: str) -> None:
@@ -253,7 +255,7 @@ class TangentWriter:
             self.names[symbol] = f"tb{b}"
             self.differentiate(symbol, sp.sympify(expr), f"tb{b}")
         results, stores = self._outputs(outputs)
-        single = self._single(used, stores)
+        single = single_functions(self, used, stores)
         return "\n".join(single + pair_function(self, used, results) + block_functions(self, used, results))
 
     def _outputs(self, outputs: Sequence[sp.Symbol]) -> tuple[list[tuple[str, int, str]], list[Statement]]:
@@ -275,132 +277,3 @@ class TangentWriter:
                     results.append((array, j * n + k, c_number(lane) if isinstance(lane, float) else lane))
                 stores.append((f"b{group}[{j}]", terms))
         return results, stores
-
-    def _vector_body(self, used: set[sp.Basic], stores: list[Statement], width: int) -> list[str]:
-        """``rdd_dirs_w<width>``: the single call's statements, each tangent in chunks of
-        ``width`` directions (a chunk no lane of which can be non-zero is not computed)."""
-        vector, chunks = f"rdd_w{width}", -(-self.nv // width)
-        lines = [
-            f"typedef double {vector} __attribute__((vector_size({8 * width})));",
-            _SOLVE.replace("TYPE", vector).replace("CHUNKS", str(chunks)),
-            f"static inline __attribute__((always_inline)) void rdd_dirs_w{width}("
-            f"const double *q, const double *v, const double *a, {vector} (*bq)[{chunks}], {vector} (*bv)[{chunks}]) {{",
-            *self._coordinates(used),
-        ]
-        for item in [*self.vector_lines, *stores]:
-            if isinstance(item, str):
-                lines.append(item)
-                continue
-            target, terms = item
-            for c in range(chunks):
-                lanes = range(c * width, (c + 1) * width)
-                present = [(k, f, t) for k, f, t in terms if any(lane in t[2] for lane in lanes)]
-                value = " + ".join(self._vector_term(k, f, t, lanes, vector) for k, f, t in present) or f"({vector}){{0.0}}"
-                if target.startswith("b"):
-                    lines.append(f"    {target}[{c}] = {value};")
-                elif present:
-                    lines.append(f"    const {vector} {target}_c{c} = {value};")
-        return [*lines, "}"]
-
-    def _single(self, used: set[sp.Basic], stores: list[Statement]) -> list[str]:
-        """``rdd_tau_derivatives`` and ``rdd_fd_derivatives`` (:data:`_SINGLE`): the vector
-        statements in chunks of the instruction set's width, compiled plainly (2 lanes, SSE2)
-        and once per SIMD variant of the build (its ``target``), the widest the CPU runs
-        chosen at the first call."""
-        variants = [("plain", 2, "")] + [(name, lanes, target) for name, lanes, target in self.variants if lanes > 2]
-        lines: list[str] = []
-        for width in sorted({lanes for _, lanes, _ in variants}):
-            lines += self._vector_body(used, stores, width)
-        choice = []
-        for name, lanes, target in variants:
-            attribute = f'__attribute__((target("{target}")))' if target else ""
-            text = (
-                _SINGLE.replace("NAME", name)
-                .replace("ATTR", attribute)
-                .replace("VZEROUPPER", "" if not target else "__builtin_ia32_vzeroupper();")
-            )
-            text = text.replace("TYPE", f"rdd_w{lanes}").replace("CHUNKS", str(-(-self.nv // lanes))).replace("WIDTH", str(lanes))
-            if target:
-                text = f"#if defined(__x86_64__) && defined(__GNUC__)\n{text}\n#endif"
-                choice.append(f'    if (__builtin_cpu_supports("{target}")) tau = rdd_tau_{name}, fd = rdd_fd_{name};')
-            lines.append(text)
-        choose = ["#if defined(__x86_64__) && defined(__GNUC__)", "    __builtin_cpu_init();", *choice, "#endif"]
-        return [*lines, _DISPATCH.replace("CHOOSE", "\n".join(choose if choice else [])), ""]
-
-
-#: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
-#: core.c's ``ldl_apply_columns``' operations, column ``c`` in lane ``c`` (the same bits).
-_SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
-    const int n = RD_NV;
-    RD_UNROLL for (int i = n - 1; i >= 0; --i)
-        RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
-            const int j = rd_ancestor[i][a];
-            RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[j][c] -= M[i * n + j] * b[i][c];
-        }
-    RD_UNROLL for (int i = 0; i < n; ++i)
-        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] /= M[i * n + i];
-    RD_UNROLL for (int i = 0; i < n; ++i)
-        RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
-            const int j = rd_ancestor[i][a];
-            RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] -= M[i * n + j] * b[j][c];
-        }
-}"""
-#: One variant's functions: the direction vectors, then ``∂τ`` stored, or ``∂q̈ = −M⁻¹ ∂τ``
-#: and ``M⁻¹`` (derivatives.c's ``rdd_fd_finish``: solved, then negated).
-_SINGLE = """static ATTR void rdd_dirs_NAME(const double *q, const double *v, const double *a, TYPE (*bq)[CHUNKS],
-                               TYPE (*bv)[CHUNKS]) {
-    rdd_dirs_wWIDTH(q, v, a, bq, bv);
-}
-static ATTR void rdd_tau_NAME(const double *q, const double *v, const double *a, double *dq, double *dv) {
-    TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS];
-    rdd_dirs_NAME(q, v, a, bq, bv);
-    RD_UNROLL for (int j = 0; j < RD_NV; ++j) RD_UNROLL for (int c = 0; c < CHUNKS; ++c) {
-        const int size = 8 * (c + 1 < CHUNKS ? WIDTH : RD_NV - c * WIDTH);
-        memcpy(dq + j * RD_NV + c * WIDTH, &bq[j][c], size);
-        memcpy(dv + j * RD_NV + c * WIDTH, &bv[j][c], size);
-    }
-    VZEROUPPER
-}
-static ATTR void rdd_fd_NAME(const double *q, const double *v, const double *a, const double *M, double *dq,
-                             double *dv, double *minv) {
-    TYPE bq[RD_NV][CHUNKS], bv[RD_NV][CHUNKS], bi[RD_NV][CHUNKS];
-    rdd_dirs_NAME(q, v, a, bq, bv);
-    RD_UNROLL for (int j = 0; j < RD_NV; ++j) {
-        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) bi[j][c] = (TYPE){0.0};
-        bi[j][j / WIDTH][j % WIDTH] = 1.0;
-    }
-    rdd_apply_TYPE(M, bq);
-    rdd_apply_TYPE(M, bv);
-    rdd_apply_TYPE(M, bi);
-    RD_UNROLL for (int j = 0; j < RD_NV; ++j) RD_UNROLL for (int c = 0; c < CHUNKS; ++c) {
-        const int size = 8 * (c + 1 < CHUNKS ? WIDTH : RD_NV - c * WIDTH);
-        const TYPE nq = -bq[j][c], nv = -bv[j][c];
-        memcpy(dq + j * RD_NV + c * WIDTH, &nq, size);
-        memcpy(dv + j * RD_NV + c * WIDTH, &nv, size);
-        memcpy(minv + j * RD_NV + c * WIDTH, &bi[j][c], size);
-    }
-    VZEROUPPER
-}"""
-#: ``rdd_tau_derivatives`` (one state: ``∂τ/∂q``, ``∂τ/∂v``) and ``rdd_fd_derivatives`` (one
-#: state at ``a = q̈`` with ``M`` factored: ``∂q̈/∂q``, ``∂q̈/∂v``, ``M⁻¹``), each the widest
-#: variant the CPU runs.
-_DISPATCH = """typedef void (*rdd_tau_fn)(const double *, const double *, const double *, double *, double *);
-typedef void (*rdd_fd_fn)(const double *, const double *, const double *, const double *, double *, double *, double *);
-static rdd_tau_fn rdd_tau_current = NULL;
-static rdd_fd_fn rdd_fd_current = NULL;
-static void rdd_choose(void) {
-    rdd_tau_fn tau = rdd_tau_plain;
-    rdd_fd_fn fd = rdd_fd_plain;
-CHOOSE
-    rdd_fd_current = fd;
-    rdd_tau_current = tau;
-}
-static void rdd_tau_derivatives(const double *q, const double *v, const double *a, double *dq, double *dv) {
-    if (!rdd_tau_current) rdd_choose();
-    rdd_tau_current(q, v, a, dq, dv);
-}
-static void rdd_fd_derivatives(const double *q, const double *v, const double *a, const double *M, double *dq,
-                               double *dv, double *minv) {
-    if (!rdd_fd_current) rdd_choose();
-    rdd_fd_current(q, v, a, M, dq, dv, minv);
-}"""

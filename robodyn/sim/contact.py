@@ -18,7 +18,8 @@ slip). The solver is **Pinocchio's ADMM** (``ADMMConstraintSolver`` with ``solve
 over **robodyn's Delassus matrix** ``A = J M⁻¹ Jᵀ`` (``DelassusOperatorDense``): ``M`` is
 robodyn's (mimic joints and armature included, which Pinocchio's own constraint
 algorithms refuse), the cones are ``PointContactConstraintModel``\\ s, warm-started with
-the previous step's impulses. The contact force reported is ``p / dt`` [N].
+the previous step's impulses. The contact force reported is ``p / dt`` [N] (the solve and
+the state after it: :mod:`robodyn.sim.contact_impulses`).
 
 **Stabilisation** (the bias ``b`` on the normal rows, :class:`ContactSettings`): a point
 above the plane (gap ``g ≥ 0``) may close the gap in the step but not cross it,
@@ -42,7 +43,6 @@ from __future__ import annotations
 
 import math
 import threading
-from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -50,8 +50,9 @@ import pinocchio as pin
 from robodyn.compiled.contact import kept_step
 from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import SingularMassMatrixError
+from robodyn.sim.contact_impulses import ContactStep, finish_step, integrate
 from robodyn.sim.contact_limits import LimitRows
-from robodyn.sim.contact_solver import ContactSettings, solve_impulses
+from robodyn.sim.contact_solver import ContactSettings
 from robodyn.sim.ground import ContactPoint, Ground
 
 #: A contact is active when its normal force exceeds this, in [N].
@@ -59,31 +60,6 @@ ACTIVE_FORCE = 1e-9
 
 _DEFAULT = ContactSettings()
 _LOCAL = threading.local()  # this thread's ContactStepper of the run it steps
-
-
-class ContactStep(NamedTuple):
-    """One step's outcome.
-
-    Attributes:
-        q, v: The state at the end of the step, shapes (nq,), (nv,).
-        impulses: ``p`` per contact in its axes ``(t₁, t₂, n)``, shape (k, 3), [N s].
-        forces: ``p / dt`` in world axes, shape (k, 3), [N].
-        gaps: Each point's signed distance above the plane at the start, shape (k,), [m].
-        slip: Each point's tangential speed after the step, shape (k,), [m/s].
-        iterations: ADMM's iterations; ``converged`` whether it met its tolerance.
-        limits: With limit rows (:mod:`robodyn.sim.contact_limits`), each row's impulse,
-            shape (r,), in [N m s] or [N s] (0 for a row out of reach); else ``None``.
-    """
-
-    q: np.ndarray
-    v: np.ndarray
-    impulses: np.ndarray
-    forces: np.ndarray
-    gaps: np.ndarray
-    slip: np.ndarray
-    iterations: int
-    converged: bool
-    limits: np.ndarray | None = None
 
 
 def contact_kinematics(
@@ -114,31 +90,6 @@ def contact_kinematics(
         gaps[index] = ground.gap(placement.translation + lever)
         rows.append(_local_jacobian(axes, linear))
     return gaps, np.vstack(rows) if rows else np.zeros((0, nv))
-
-
-def integrate(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
-    """``q ⊕ dq`` with a floating base on ``R³ × SO(3)``: its origin moves along the world
-    velocity ``R v`` in a straight line, its rotation by ``exp(ω dt)`` (MuJoCo's rule).
-
-    Pinocchio's ``integrate`` moves the base along the screw of ``SE(3)``'s exponential: a
-    rolling ball's body twist is a rotation about its contact point, so its centre would
-    dip by ``r (1 − cos ω dt)`` into the plane every step.
-
-    Args:
-        robot: The robot.
-        q: The configuration, shape (nq,).
-        dq: The displacement ``dt v``, shape (nv,), in [rad] / [m]; a floating base's first
-            six: its origin's displacement in [m] then its rotation vector in [rad], both in
-            the base's own axes (Pinocchio's free-flyer velocity convention).
-
-    Returns:
-        The moved configuration, shape (nq,).
-    """
-    moved = pin.integrate(robot.model, q, dq)
-    if robot.floating_base:
-        rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
-        moved[:3] = q[:3] + rotation @ dq[:3]
-    return moved
 
 
 def _local_jacobian(axes: np.ndarray, linear: np.ndarray) -> np.ndarray:
@@ -316,7 +267,7 @@ class ContactStepper:
             jacobian = np.vstack([jacobian, rows.jacobian(near, model.nv)])
             gaps = np.concatenate([gaps, rows.gaps(q)[near]])
         terms = (gaps, jacobian, free, inverse @ jacobian.T)
-        return _finish(self.robot, q, dt, self.ground, settings, guess, terms, (rows, near, held))
+        return finish_step(self.robot, q, dt, self.ground, settings, guess, terms, (rows, near, held))
 
     def _compiled(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, dt: float, settings: ContactSettings, guess: np.ndarray | None,
@@ -363,44 +314,7 @@ def generic_step(
         jacobian = np.vstack([jacobian, limits.jacobian(near, robot.nv)])
         gaps = np.concatenate([gaps, limits.gaps(q)[near]])
     terms = (gaps, jacobian, free, inverse[:, 1:] @ jacobian.T)
-    return _finish(robot, q, dt, ground, settings, guess, terms, (limits, near, held))
-
-
-def _finish(
-    robot: Robot, q: np.ndarray, dt: float, ground: Ground, settings: ContactSettings, guess: np.ndarray | None,
-    terms: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-    limits: tuple[LimitRows | None, np.ndarray | None, np.ndarray | None],
-) -> ContactStep:  # fmt: skip
-    """The step from its ``gaps``, ``J``, the free velocity and ``M⁻¹ Jᵀ`` (the points' rows,
-    then the limit rows ``near`` in reach, :mod:`robodyn.sim.contact_limits`): the impulses, ``v⁺``, ``q⁺``."""
-    gaps, jacobian, free, response = terms
-    rows, near, held = limits
-    velocity = jacobian @ free
-    beta = settings.baumgarte
-    velocity[2::3] += [gap / dt if gap >= 0.0 else beta * gap / dt for gap in gaps.tolist()]
-    delassus = jacobian @ response
-    extra = 0 if near is None else len(near)
-    count = len(gaps) - extra
-    if extra:  # each limit row's tangent rows decoupled, of the normal row's diagonal
-        first = 3 * count + 3 * np.arange(extra)
-        delassus[first, first] = delassus[first + 1, first + 1] = delassus[first + 2, first + 2]
-        if guess is not None:
-            start = np.zeros((count + extra, 3))
-            start[:count] = guess.reshape(count, 3)
-            start[count:, 2] = 0.0 if held is None else held[near]
-            guess = start
-    dofs = jacobian.shape[1] + 2 * extra  # (each limit's decoupled tangent rows add two to A's rank)
-    impulses, iterations, converged = solve_impulses(delassus, velocity, ground.friction, settings, guess, dofs=dofs)
-    v_next = free + response @ impulses
-    local = impulses.reshape(-1, 3)
-    after = (jacobian[: 3 * count] @ v_next).reshape(-1, 3)
-    limit_impulses = None if rows is None else np.zeros(len(rows.bound))
-    if limit_impulses is not None and extra:
-        limit_impulses[near] = local[count:, 2]
-    return ContactStep(
-        integrate(robot, q, dt * v_next), v_next, local[:count], local[:count] @ ground.frame() / dt, gaps[:count],
-        np.hypot(after[:, 0], after[:, 1]), iterations, converged, limit_impulses,
-    )  # fmt: skip
+    return finish_step(robot, q, dt, ground, settings, guess, terms, (limits, near, held))
 
 
 __all__ = [
