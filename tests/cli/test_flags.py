@@ -25,7 +25,7 @@ NOT_OUR_FLAGS = {
     ("viz/plots.py", "--"),
     ("compiled/build.py", "--version"),
     ("compiled/simd.py", "--rds"),  # C source: the decrement --rds_level
-    ("compiled/tangents.py", "--i"),  # C source: the decrement --i
+    ("compiled/tangent_single.py", "--i"),  # C source: the decrement --i
 }
 #: Files whose every ``--`` literal is a flag of the program they run.
 OTHER_PROGRAMS = {"viz/stills.py"}
