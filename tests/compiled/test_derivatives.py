@@ -124,7 +124,11 @@ def _runs(instruction_set: str) -> bool:
     return any(name == instruction_set and target in flags for name, _, target in VARIANTS)
 
 
-@pytest.mark.parametrize(("instruction_set", "lanes"), [("sse2", 2), ("avx2", 4), ("avx512", 8)])
+@pytest.mark.parametrize(
+    ("instruction_set", "lanes"),
+    # SSE2 runs on every x86-64 machine: the fast tier's; the wider sets (5 s each) in the slow tier
+    [("sse2", 2), pytest.param("avx2", 4, marks=pytest.mark.slow), pytest.param("avx512", 8, marks=pytest.mark.slow)],
+)
 def test_batches_run_simd_blocks_whose_rows_are_bit_for_bit_the_single_call(instruction_set, lanes, monkeypatch, rng):
     """Each instruction set's blocks of L rows (the derivative module built for it, as
     ``$ROBODYN_SIMD`` picks): every row of batches of 1, 7, 2L - 1, 2L + 1 and 129 states (two
