@@ -38,7 +38,7 @@ from robodyn.dynamics.robot import Robot
 from robodyn.exceptions import InputError, SimulationError
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import constraint_header
-from robodyn.trajectory.io import write_csv
+from robodyn.trajectory.io import write_csv_with_columns
 
 #: Largest ``|Φ|`` left by the position projection, in [m] / [rad].
 POSITION_TOLERANCE = 1e-12
@@ -127,12 +127,8 @@ class ConstrainedSimulation:
         path = Path(path)
         if path.suffix != ".csv":
             raise InputError("out", "a .csv file for a run with constraints (its multipliers are columns)", repr(str(path)))
-        extras = extras or {}
-        _, v_names = self.trajectory.coordinate_names
-        header = self.trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names]
-        table = np.column_stack([self.trajectory.table(), *extras.values(), self.multipliers.reshape(len(self.trajectory.t), -1)])
-        write_csv(path, self.trajectory.robot, header + constraint_header(self.labels), table)
-        return path
+        multipliers = self.multipliers.reshape(len(self.trajectory.t), -1)
+        return write_csv_with_columns(path, self.trajectory, extras or {}, constraint_header(self.labels), [multipliers])
 
 
 def _correction(robot: Robot, bounds, q: np.ndarray, rows: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from robodyn.sim.limits import check_mode
 from robodyn.sim.plan import ExternalWrench
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import contact_header
-from robodyn.trajectory.io import write_csv
+from robodyn.trajectory.io import write_csv_with_columns
 
 #: Most steps of one run (100 s at 1 ms).
 MAX_STEPS = 100_000
@@ -116,14 +116,9 @@ class ContactSimulation:
         path = Path(path)
         if path.suffix != ".csv":
             raise InputError("path", "a .csv file name for a run on the ground (its contact forces are columns)", repr(str(path)))
-        extras = extras or {}
-        _, v_names = self.trajectory.coordinate_names
-        header = self.trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names]
-        count = len(self.contacts)
-        forces = self.forces.reshape(len(self.forces), 3 * count)
-        table = np.column_stack([self.trajectory.table(), *extras.values(), forces, self.active.astype(float)])
-        write_csv(path, self.trajectory.robot, header + contact_header(self.contacts), table)
-        return path
+        forces = self.forces.reshape(len(self.forces), 3 * len(self.contacts))
+        columns = [forces, self.active.astype(float)]
+        return write_csv_with_columns(path, self.trajectory, extras or {}, contact_header(self.contacts), columns)
 
     def summary_lines(self) -> list[str]:
         """The run's contact summary: peak normal force, slip and penetration."""

@@ -31,7 +31,7 @@ from robodyn.sim.ground import ContactPoint, Ground, contact_points
 from robodyn.sim.whole_body import Stand, support_margin
 from robodyn.trajectory import Trajectory
 from robodyn.trajectory.columns import commanded_header, contact_header
-from robodyn.trajectory.io import write_csv
+from robodyn.trajectory.io import write_csv_with_columns
 
 #: A contact point is a foot when it lies within this gap [m] of the ground at the start.
 FOOT_GAP = 1e-3
@@ -115,15 +115,12 @@ class CommandedContacts:
         path = Path(path)
         if path.suffix != ".csv":
             raise InputError("out", "a .csv file for a run on the ground (its contact forces are columns)", repr(str(path)))
-        extras = extras or {}
-        trajectory, names, count = self.run.trajectory, list(self.run.contacts), len(self.run.contacts)
-        header = trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in trajectory.coordinate_names[1]]
+        names, count = list(self.run.contacts), len(self.run.contacts)
         flags = contact_header(names)
-        header += flags[: 3 * count] + commanded_header(names) + flags[3 * count :]
+        header = flags[: 3 * count] + commanded_header(names) + flags[3 * count :]
         forces, commanded = (array.reshape(len(array), 3 * count) for array in (self.run.forces, self.commanded))
-        table = np.column_stack([trajectory.table(), *extras.values(), forces, commanded, self.run.active.astype(float)])
-        write_csv(path, trajectory.robot, header, table)
-        return path
+        columns = [forces, commanded, self.run.active.astype(float)]
+        return write_csv_with_columns(path, self.run.trajectory, extras or {}, header, columns)
 
 
 def _feet(robot: Robot, q: np.ndarray, ground: Ground, points: Sequence[ContactPoint]) -> tuple[PointContact, ...]:

@@ -241,6 +241,30 @@ def _read_parquet(path: Path) -> tuple[np.ndarray, Layout, str]:
     return values, parse_header(header, str(path)), robot
 
 
+def write_csv_with_columns(
+    path: Path, trajectory: Any, extras: dict[str, np.ndarray], names: list[str], columns: list[np.ndarray]
+) -> Path:
+    """Write a trajectory's columns, then ``extras`` (named like ``v``, ``<kind>[<coordinate>]``),
+    then further ``columns`` named ``names`` (a run's forces, multipliers, flags), atomically, as
+    CSV: the one place the three are laid side by side.
+
+    Args:
+        path: The ``.csv`` file.
+        trajectory: A :class:`robodyn.Trajectory` of N samples.
+        extras: Kind -> values, each shape (N, nv).
+        names: The further columns' header names, one a column.
+        columns: The further columns, each shape (N,) or (N, k); ``k`` columns in all
+            equal ``len(names)``.
+
+    Returns:
+        The path written.
+    """
+    _, v_names = trajectory.coordinate_names
+    header = trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names] + list(names)
+    write_csv(path, trajectory.robot, header, np.column_stack([trajectory.table(), *extras.values(), *columns]))
+    return path
+
+
 def write_with_extras(path: Path, trajectory: Any, extras: dict[str, np.ndarray]) -> Path:
     """Write a trajectory with extra columns (:data:`~robodyn.trajectory.columns.EXTRA_KINDS`
     named like ``v``, e.g. ``tau_ext[<joint>]``), atomically, to ``.csv`` or ``.npz``.
@@ -267,9 +291,7 @@ def write_with_extras(path: Path, trajectory: Any, extras: dict[str, np.ndarray]
         return trajectory.save(path)
     q_names, v_names = trajectory.coordinate_names
     if path.suffix == ".csv":
-        header = trajectory.header() + [f"{kind}[{name}]" for kind in extras for name in v_names]
-        write_csv(path, trajectory.robot, header, np.column_stack([trajectory.table(), *extras.values()]))
-        return path
+        return write_csv_with_columns(path, trajectory, extras, [], [])
     arrays = {"t": trajectory.t, "q": trajectory.q, "v": trajectory.v, "a": trajectory.a}
     arrays |= {} if trajectory.tau is None else {"tau": trajectory.tau}
     write_npz(path, arrays | extras, q_names=q_names, v_names=v_names, joint_names=trajectory.joint_names, robot=trajectory.robot)
@@ -302,6 +324,7 @@ __all__ = [
     "read_extra",
     "read_table",
     "write_csv",
+    "write_csv_with_columns",
     "write_npz",
     "write_with_extras",
 ]
