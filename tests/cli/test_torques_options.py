@@ -28,6 +28,7 @@ from robodyn.cli.app import main
 from tests.conftest import ROOT
 from tests.differential.cases import random_state_batch
 from tests.differential.pairs import expected_header, written_columns
+from tests.pairwise import pairwise, uncovered_pairs
 
 ROWS = 23
 OBLIQUE = ROOT / "tests" / "data" / "robots" / "oblique.urdf"
@@ -52,42 +53,11 @@ FACTORS: dict[str, tuple] = {
 DEFAULT = {name: values[0] for name, values in FACTORS.items()}
 
 
-def pairwise(factors: dict[str, tuple]) -> list[dict]:
-    """A small set of runs in which every pair of values of every two factors appears
-    (greedy: each run starts from an uncovered pair and fills in the values that cover the
-    most pairs still uncovered)."""
-    names = list(factors)
-    uncovered = {
-        frozenset([(a, i), (b, j)])
-        for a, b in itertools.combinations(names, 2)
-        for i in range(len(factors[a]))
-        for j in range(len(factors[b]))
-    }
-    runs = []
-    while uncovered:
-        (a, i), (b, j) = sorted(min(uncovered, key=sorted))
-        chosen = {a: i, b: j}
-        for name in names:
-            if name not in chosen:
-                gains = [_gain(uncovered, chosen, name, k) for k in range(len(factors[name]))]
-                chosen[name] = int(np.argmax(gains))
-        uncovered -= {frozenset(pair) for pair in itertools.combinations(chosen.items(), 2)}
-        runs.append({name: factors[name][k] for name, k in chosen.items()})
-    return runs
-
-
-def _gain(uncovered: set, chosen: dict, name: str, k: int) -> int:
-    """How many uncovered pairs value ``k`` of ``name`` covers beside the values chosen."""
-    return sum(frozenset([(name, k), (other, chosen[other])]) in uncovered for other in chosen)
-
-
 RUNS = pairwise(FACTORS)
 
 
 def test_the_runs_cover_every_pair_and_are_few():
-    for a, b in itertools.combinations(FACTORS, 2):
-        for x, y in itertools.product(FACTORS[a], FACTORS[b]):
-            assert any(run[a] == x and run[b] == y for run in RUNS), (a, x, b, y)
+    assert uncovered_pairs(RUNS, FACTORS) == []
     assert len(RUNS) <= 16  # not the 2304 of all combinations
 
 
