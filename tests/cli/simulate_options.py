@@ -69,7 +69,7 @@ LOW_GROUND = -0.3  # below every link of either robot at any start here: a float
 BASE = (0.01, -0.02, 0.03, *(np.array([0.1, 0.05, -0.02, 1.0]) / np.linalg.norm([0.1, 0.05, -0.02, 1.0])))
 
 #: Each option of ``robodyn simulate`` with its values; the first is the default (the option left out).
-FACTORS: dict[str, tuple] = {  # in the order the pairwise generator fills a run: the options others depend on first
+FACTORS: dict[str, tuple | list] = {  # in the order the pairwise generator fills a run: the options others depend on first
     "model": ("oblique", "xacro"),
     "base": (None, "floating", "fixed"),
     "ground": (None, "given"),
