@@ -220,6 +220,7 @@ class JointFriction:
             if high - low <= EVENT_TOLERANCE * h:
                 break
             middle = (low * g_high - high * g_low) / (g_high - g_low)
+            middle = middle if np.isfinite(middle) else 0.5 * (low + high)  # a margin blown up within the step: halve
             middle = min(max(middle, low + 0.01 * (high - low)), high - 0.01 * (high - low))
             g_middle, q_middle, v_middle = margin(middle)
             if g_middle < 0.0:

@@ -79,17 +79,14 @@ class Stepper:
         self.forward = forward if friction is None else friction.wrap(forward)
         self.every = every  # steps between two samples of the controller at a step's start
         self.friction = friction
-        if controller is None or hold:  # the step's torque (zero when passive) holds
-            self.accelerate = self.forward
-        else:
-            plant = self.forward
+        plant, held = self.forward, controller is None or hold  # held: the step's torque (zero when passive) holds
 
-            def accelerate(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-                if not (np.isfinite(q).all() and np.isfinite(v).all()):  # blew up within the step
-                    raise StageDivergedError(failing_joint(robot.joint_names, q, v))
-                return plant(t, q, v, np.asarray(controller(t, q, v), dtype=float))
+        def accelerate(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+            if not (np.isfinite(q).all() and np.isfinite(v).all()):  # blew up within the step (held torque too)
+                raise StageDivergedError(failing_joint(robot.joint_names, q, v))
+            return plant(t, q, v, tau if held else np.asarray(controller(t, q, v), dtype=float))  # type: ignore[misc]
 
-            self.accelerate = accelerate
+        self.accelerate = accelerate
         # Fixed base: q moves by plain addition (no call); floating base: on SE(3).
         self.integrate = robot.integrate if robot.floating_base else None
         self.rk4 = rk4

@@ -167,3 +167,16 @@ def test_each_refused_combination_is_one_stderr_line_naming_what_conflicts(pair,
     assert error.count("\n") == 1 and error.startswith("robodyn: error: ") and "Traceback" not in error
     assert all(word in error for word in named), error
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("friction", [[], ["--no-joint-friction"]], ids=["joint-friction", "rigid"])
+def test_a_run_that_diverges_under_a_held_controller_says_so_not_that_v_is_not_finite(friction, capsys):
+    """Found crossing ``--control-period`` with a floating base: a divergence inside a step of a
+    held controller reached the base's integration as ``v must be finite`` (an input error
+    naming a parameter nobody gave); the joints' stick-slip event search bisected a blown-up
+    margin into a NaN step. Now, as without ``--control-period``: the simulation diverged, when, which joint."""
+    argv = arguments_of(DEFAULT | {"model": "xacro", "base": "floating", "controller": "computed-torque"}, None)
+    held = [*argv, "--target=0.1,0.03,0.2", "--control-period", "0.002", "--engine", "pinocchio", *friction]
+    assert main([*held, "--kp", "4e6", "--kd", "4e3"] if friction else held) == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert error.startswith("robodyn: error: simulation diverged at t = ") and "is no longer finite" in error, error
