@@ -82,7 +82,8 @@ class Stepper:
         plant, held = self.forward, controller is None or hold  # held: the step's torque (zero when passive) holds
 
         def accelerate(t: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-            if not (np.isfinite(q).all() and np.isfinite(v).all()):  # blew up within the step (held torque too)
+            finite = math.isfinite(q.dot(q)) and math.isfinite(v.dot(v))  # cheap: finite squares, every entry finite
+            if not finite and not (np.isfinite(q).all() and np.isfinite(v).all()):  # blew up within the step (held too)
                 raise StageDivergedError(failing_joint(robot.joint_names, q, v))
             return plant(t, q, v, tau if held else np.asarray(controller(t, q, v), dtype=float))  # type: ignore[misc]
 
