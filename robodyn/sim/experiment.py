@@ -171,7 +171,9 @@ def run_simulation(
         law = ComputedTorque(controller_model(robot), TrajectoryReference(reference))
     compensate(law, joint_friction)
     pushes, external = push_wrenches(robot, force_at, controlled or None)
-    observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque="sampled")
+    # held: a controller sampled every control_period holds its torque through each step
+    torque = "held" if control_period is not None else "sampled"
+    observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque=torque)
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
         trajectory, run = simulate_run(

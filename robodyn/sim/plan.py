@@ -198,8 +198,8 @@ def plan(
             evaluate it continuously.
         observer: A momentum observer fed every sample (time, state, applied torque) as
             the run goes; afterwards ``observer.residuals`` holds its estimate of the
-            external torques at each sample. Give it ``torque="held"`` with ``hold=True``,
-            ``"sampled"`` otherwise.
+            external torques at each sample. Give it ``torque="held"`` with ``hold`` or a
+            ``control_period``, ``"sampled"`` otherwise.
         joint_friction: Honour the joints' damping and Coulomb friction
             (:attr:`Robot.joint_damping`, :attr:`Robot.joint_friction`: ``−b v``, and
             stick–slip friction up to ``±f``, :mod:`robodyn.sim.joint_friction`); ``False``
