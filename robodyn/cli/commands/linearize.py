@@ -56,7 +56,7 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.integrator is not None and arguments.dt is None:
         raise InputError("--integrator", "given with --dt (continuous time has no integrator)", repr(arguments.integrator))
     if arguments.precision is not None and arguments.json:
-        raise InputError("--precision", "left out with --json (JSON carries every digit)", arguments.precision)
+        raise InputError("--precision", "left out with --json (JSON carries every digit)", str(arguments.precision))
     robot = load_robot(arguments)
     q = state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
     v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
