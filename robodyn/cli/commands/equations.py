@@ -223,11 +223,15 @@ def _refuse_unread(arguments: argparse.Namespace) -> None:
         InputError: Naming the options and the output.
     """
     output = _output(arguments)
-    unread = [name for name in _NOT_GIVEN if name not in _READS[output] and _given(arguments, name)]
+    reads = _READS[output] - ({"precision"} if arguments.format not in ("text", "latex", "pdf") else set())
+    unread = [name for name in _NOT_GIVEN if name not in reads and _given(arguments, name)]
     if unread:
         flags = ["--no-check-inertia" if name == "check_inertia" else f"--{name.replace('_', '-')}" for name in unread]
         them = "it" if len(flags) == 1 else "them"
         hint = {"the numbers at one state": "; --symbolic derives the equations"}.get(output, "")
+        hint += (
+            f"; --format {arguments.format} writes every digit" if "precision" in unread and arguments.format != "text" else ""
+        )
         raise InputError(", ".join(flags), f"left out with {output} (it does not read {them}{hint})", "given")
 
 
