@@ -172,6 +172,21 @@ def test_each_option_the_numbers_do_not_read_is_one_stderr_line(flags):
     assert flags[0] in error
 
 
+#: Options the other outputs do not read (each refused before any derivation): (the output's flags, the option).
+UNREAD = [
+    (["--derivation"], ["--floating-base"]), (["--lecture"], ["--gravity=0,0,-1.62"]), (["--base-parameters"], ["--q=0.1,0.2"]),
+    (["--symbolic", "--kinematics", "link2"], ["--christoffel"]), (["--symbolic", "--kinematics", "link2"], ["--keep-params"]),
+    (["--symbolic"], ["--json"]), (["--symbolic"], ["--no-check-inertia"]), (["--symbolic", "--format", "c"], ["--precision=3"]),
+    (["--format", "casadi"], ["--precision=3"]), (["--lecture"], ["--derivation"]),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("output", "option"), UNREAD, ids=[" ".join(o + f) for o, f in UNREAD])
+def test_an_option_another_output_does_not_read_is_one_stderr_line_naming_it(output, option):
+    error = refused(["equations", "rp_arm", *output, *option])
+    assert option[0].split("=")[0] in error and "left out with" in error
+
+
 def test_the_written_file_is_what_the_terminal_shows(tmp_path):
     shown = ok(["equations", *model_arguments("xacro"), "--json"])
     check_run(BASE | {"model": "xacro", "out": "file"}, tmp_path)
