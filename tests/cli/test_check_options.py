@@ -58,7 +58,7 @@ ANCHORED = {"oblique": "end_effector", "xacro": "r_wrist"}
 
 def test_the_runs_cover_every_pair_and_are_few():
     assert uncovered_pairs(RUNS, FACTORS) == []
-    assert len(RUNS) <= 14  # not the 5184 of all combinations
+    assert len(RUNS) <= 14  # not the 10368 of all combinations
 
 
 def files(options: dict, folder: Path) -> tuple[str | None, str | None]:

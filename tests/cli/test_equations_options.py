@@ -48,7 +48,7 @@ RUNS = pairwise(FACTORS, valid)
 
 def test_the_runs_cover_every_pair_and_are_few():
     assert uncovered_pairs(RUNS, FACTORS, valid) == [] and all(valid(run) for run in RUNS)
-    assert len(RUNS) <= 12  # not the 1152 of all combinations
+    assert len(RUNS) <= 12  # not the 2304 of all combinations
 
 
 def library_options(options: dict) -> dict:
