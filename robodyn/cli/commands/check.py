@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.cli.common import RANGES, Progress, add_constraints_argument, add_model_arguments, load_robot
+from robodyn.cli.common import (
+    RANGES,
+    Progress,
+    add_constraints_argument,
+    add_model_arguments,
+    load_robot,
+    package_arguments,
+    xacro_arguments,
+)
 from robodyn.common.text import json_text
 
 
@@ -33,7 +41,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--reference",
         metavar="URDF",
-        help="build the reference from this URDF instead of the model's own (e.g. the true model of a suspect file)",
+        help="build the reference from this URDF instead of the model's own (e.g. the true model of a suspect file); "
+        "--xacro-arg, --package and --xacro-env read it too",
     )
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.set_defaults(run=run)
@@ -57,10 +66,25 @@ def run(arguments: argparse.Namespace) -> int:
             seed=arguments.seed,
             tolerance=arguments.tolerance,
             check_inertia=arguments.check_inertia,
-            reference_source=arguments.reference,
+            reference_source=_reference(arguments),
             progress=progress,
         )
     finally:
         progress.close()
     print(json_text(report.to_dict()) if arguments.json else printable_lines(report.text()))
     return 0 if report.passed else 1
+
+
+def _reference(arguments: argparse.Namespace) -> str | None:
+    """The ``--reference`` file, read with the model's ``--xacro-arg``, ``--package`` and
+    ``--xacro-env`` (its text then), never without the packages the user named."""
+    if arguments.reference is None or not (arguments.xacro_arg or arguments.package or arguments.xacro_env):
+        return arguments.reference
+    from robodyn.urdf.sources import resolve_source
+
+    return resolve_source(
+        arguments.reference,
+        xacro_args=xacro_arguments(arguments.xacro_arg),
+        packages=package_arguments(arguments.package),
+        xacro_env=arguments.xacro_env,
+    ).text

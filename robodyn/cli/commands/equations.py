@@ -22,6 +22,33 @@ from robodyn.cli.common import (
 from robodyn.common.text import json_text
 from robodyn.exceptions import InputError
 
+#: Each option's value when it is not given (``--fixed-base`` is never refused: every output models a fixed base or reads it).
+_NOT_GIVEN: dict[str, object] = {
+    "q": None, "v": None, "a": None, "json": False, "precision": 6, "symbolic": False, "format": "text", "out": None,
+    "form": "auto", "keep_params": False, "lock": None, "kinematics": None, "christoffel": False, "base_parameters": False,
+    "lecture": False, "derivation": False, "gravity": None, "floating_base": None, "strict": False, "check_inertia": True,
+    "max_dof": None, "constraints": None,
+}  # fmt: skip
+_LOADING = frozenset({"gravity", "floating_base", "lock", "strict", "check_inertia", "max_dof"})
+_EQUATIONS = frozenset(
+    {"symbolic", "format", "out", "form", "keep_params", "gravity", "lock", "floating_base", "precision", "constraints"}
+)
+#: The options each output reads, by its label in a refusal (besides the model, --xacro-arg,
+#: --package and --xacro-env): any other one given is refused, never silently ignored.
+_READS: dict[str, frozenset[str]] = {
+    "the numbers at one state": frozenset({"q", "v", "a", "json", "precision", "out"}) | _LOADING,
+    "the numbers at one state as JSON": frozenset({"q", "v", "a", "json", "out"}) | _LOADING,
+    "--symbolic": _EQUATIONS,
+    "--christoffel": _EQUATIONS | {"christoffel"},
+    "--kinematics": frozenset({"symbolic", "kinematics", "format", "out", "lock", "precision", "constraints"}),
+    "--derivation": frozenset(
+        {"symbolic", "derivation", "format", "out", "keep_params", "gravity", "lock", "precision", "constraints"}
+    ),
+    "--lecture": frozenset({"symbolic", "lecture", "format", "out"}),
+    "--base-parameters": frozenset({"base_parameters", "format", "out"}) | _LOADING,
+    "--format casadi or jax": frozenset({"symbolic", "format", "out", "keep_params"}) | _LOADING,
+}
+
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add the command to the ``robodyn`` parser.
@@ -82,9 +109,6 @@ def _symbolic(arguments: argparse.Namespace) -> int:
     from robodyn.common.text import printable
     from robodyn.equations.document import What, equations_document
 
-    given = [f"--{name}" for name in ("q", "v", "a") if getattr(arguments, name) is not None]
-    if given:
-        raise InputError(", ".join(given), "left out with --symbolic (the equations hold for every state)", "a state")
     if arguments.format == "pdf" and not arguments.out:
         raise InputError("--out", "given with --format pdf (a PDF is not printed)", "no --out")
     documents: tuple[What, ...] = ("lecture", "derivation", "kinematics", "christoffel")
@@ -127,23 +151,13 @@ def _base_parameters(arguments: argparse.Namespace) -> int:
     if arguments.format not in ("text", "latex", "json"):
         raise InputError("--format", "text, latex or json with --base-parameters", repr(arguments.format))
     robot = load_robot(arguments)
-    print(render_base_parameters(base_parameters(robot), arguments.format), end="")
-    return 0
+    return _emit(arguments, render_base_parameters(base_parameters(robot), arguments.format), "base parameters")
 
 
 def _export(arguments: argparse.Namespace) -> int:
     from robodyn.common.text import printable
     from robodyn.export import module_source
 
-    given = [f"--{name}" for name in ("q", "v", "a", "kinematics") if getattr(arguments, name) is not None]
-    given += [f"--{name}" for name in ("christoffel", "lecture", "derivation") if getattr(arguments, name)]
-    given += ["--form"] if arguments.form != "auto" else []
-    if given:
-        raise InputError(
-            ", ".join(given),
-            f"left out with --format {arguments.format} (the module holds the compact equations and every frame)",
-            "given",
-        )
     robot = load_robot(arguments)
     progress = Progress(f"exporting {printable(robot.name)[:60]}")
     try:
@@ -165,6 +179,7 @@ def run(arguments: argparse.Namespace) -> int:
             "given only with --derivation or --symbolic (the other outputs are the open tree's)",
             "it without them",
         )
+    _refuse_unread(arguments)
     if arguments.base_parameters:
         return _base_parameters(arguments)
     if arguments.format in ("casadi", "jax"):
@@ -180,5 +195,48 @@ def run(arguments: argparse.Namespace) -> int:
     v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
     a = state(robot, arguments.a, "a", robot.nv, np.zeros(robot.nv))
     terms = dynamics_terms(robot, q, v, a)
-    print(json_text(terms.to_dict()) if arguments.json else terms.text(precision=arguments.precision))
-    return 0
+    return _emit(
+        arguments,
+        (json_text(terms.to_dict()) if arguments.json else terms.text(precision=arguments.precision)) + "\n",
+        "tau, M, C, G",
+    )
+
+
+def _output(arguments: argparse.Namespace) -> str:
+    """Which output the options ask for: its label in :data:`_READS` (the dispatch of :func:`run`)."""
+    if arguments.base_parameters:
+        return "--base-parameters"
+    if arguments.format in ("casadi", "jax"):
+        return "--format casadi or jax"
+    for name in ("lecture", "derivation", *(("kinematics", "christoffel") if arguments.symbolic else ())):
+        if getattr(arguments, name):
+            return f"--{name}"
+    if arguments.symbolic:
+        return "--symbolic"
+    return "the numbers at one state as JSON" if arguments.json else "the numbers at one state"
+
+
+def _refuse_unread(arguments: argparse.Namespace) -> None:
+    """Refuse the options given that the output asked for does not read (one line naming them all).
+
+    Raises:
+        InputError: Naming the options and the output.
+    """
+    output = _output(arguments)
+    reads = _READS[output] - ({"precision"} if arguments.format not in ("text", "latex", "pdf") else set())
+    unread = [name for name in _NOT_GIVEN if name not in reads and _given(arguments, name)]
+    if unread:
+        flags = ["--no-check-inertia" if name == "check_inertia" else f"--{name.replace('_', '-')}" for name in unread]
+        them = "it" if len(flags) == 1 else "them"
+        hint = {"the numbers at one state": "; --symbolic derives the equations"}.get(output, "")
+        hint += (
+            f"; --format {arguments.format} writes every digit" if "precision" in unread and arguments.format != "text" else ""
+        )
+        raise InputError(", ".join(flags), f"left out with {output} (it does not read {them}{hint})", "given")
+
+
+def _given(arguments: argparse.Namespace, name: str) -> bool:
+    value = getattr(arguments, name)
+    if name == "floating_base":
+        return value is True  # --fixed-base: every output models a fixed base or reads it
+    return value != _NOT_GIVEN[name]

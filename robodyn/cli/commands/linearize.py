@@ -8,6 +8,7 @@ import numpy as np
 
 from robodyn.cli.common import RANGES, add_model_arguments, load_robot, state, vector
 from robodyn.common.text import json_text
+from robodyn.exceptions import InputError
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -28,10 +29,19 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--v", type=vector, help="velocity in [rad/s] / [m/s] (default: zeros)")
     parser.add_argument("--tau", type=vector, help="torques in [N m] / [N] (default: the holding torque C(q, v) v + G(q))")
     parser.add_argument("--dt", type=float, help=f"step, {RANGES['dt'].text()}: the Jacobians of one step (default: continuous)")
-    parser.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], default="rk4", help="with --dt (default rk4)")
+    parser.add_argument("--integrator", choices=["rk4", "semi-implicit-euler"], help="with --dt (default rk4)")
     parser.add_argument("--actuated", help="actuated joints, comma-separated (default: all): the columns of B")
+    parser.add_argument(
+        "--no-joint-friction",
+        dest="joint_friction",
+        action="store_false",
+        help="leave out the joints' damping and friction (<dynamics>): the rigid-body dynamics (needed at rest "
+        "joints with Coulomb friction, where stiction is not differentiable)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON (keys A, B, state, inputs, units, ...)")
-    parser.add_argument("--precision", type=int, default=6, choices=range(1, 18), metavar="1..17", help="significant digits")
+    parser.add_argument(
+        "--precision", type=int, choices=range(1, 18), metavar="1..17", help="significant digits of the text (default 6)"
+    )
     parser.set_defaults(run=run)
 
 
@@ -43,13 +53,18 @@ def run(arguments: argparse.Namespace) -> int:
     """
     from robodyn.sim.linearize import actuation_matrix, linearization
 
+    if arguments.integrator is not None and arguments.dt is None:
+        raise InputError("--integrator", "given with --dt (continuous time has no integrator)", repr(arguments.integrator))
+    if arguments.precision is not None and arguments.json:
+        raise InputError("--precision", "left out with --json (JSON carries every digit)", str(arguments.precision))
     robot = load_robot(arguments)
     q = state(robot, arguments.q, "q", robot.nq, robot.neutral_configuration())
     v = state(robot, arguments.v, "v", robot.nv, np.zeros(robot.nv))
     tau = None if arguments.tau is None else state(robot, arguments.tau, "tau", robot.nv, np.zeros(robot.nv))
     actuated = None if arguments.actuated is None else [name.strip() for name in arguments.actuated.split(",")]
     result = linearization(
-        robot, q, v, tau, dt=arguments.dt, integrator=arguments.integrator, actuation=actuation_matrix(robot, actuated)
-    )
-    print(json_text(result.to_dict()) if arguments.json else result.text(precision=arguments.precision))
+        robot, q, v, tau, dt=arguments.dt, integrator=arguments.integrator or "rk4",
+        actuation=actuation_matrix(robot, actuated), joint_friction=arguments.joint_friction,
+    )  # fmt: skip
+    print(json_text(result.to_dict()) if arguments.json else result.text(precision=arguments.precision or 6))
     return 0
