@@ -9,13 +9,13 @@ every test that crosses options (the CLI's commands, the constrained dynamics' o
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 
 #: Whether a partial run (some options chosen) can be completed; True when it cannot tell.
 Valid = Callable[[dict], bool]
 
 
-def pairwise(factors: dict[str, tuple | list], valid: Valid | None = None) -> list[dict]:
+def pairwise(factors: Mapping[str, Sequence], valid: Valid | None = None) -> list[dict]:
     """A small deterministic set of runs covering every valid pair of option values.
 
     Greedy: each run starts from the first uncovered pair and fills in, option by option,
@@ -54,7 +54,7 @@ def pairwise(factors: dict[str, tuple | list], valid: Valid | None = None) -> li
     return runs
 
 
-def uncovered_pairs(runs: list[dict], factors: dict[str, tuple | list], valid: Valid | None = None) -> list[tuple]:
+def uncovered_pairs(runs: list[dict], factors: Mapping[str, Sequence], valid: Valid | None = None) -> list[tuple]:
     """The valid pairs of option values no run holds (empty for a covering set): the check
     a test of a pairwise set asserts, independent of how the set was made."""
     valid = valid or (lambda run: True)
@@ -66,7 +66,7 @@ def uncovered_pairs(runs: list[dict], factors: dict[str, tuple | list], valid: V
     return missing
 
 
-def _values(factors: dict, chosen: dict) -> dict:
+def _values(factors: Mapping[str, Sequence], chosen: dict) -> dict:
     return {name: factors[name][k] for name, k in chosen.items()}
 
 

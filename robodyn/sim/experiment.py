@@ -36,7 +36,7 @@ from robodyn.sim.gains import LQR_ACCELERATION as LQR_ACCELERATION
 from robodyn.sim.gains import computed_torque_gains, lqr_weights, pd_defaults, pd_gains
 from robodyn.sim.ground import Ground, resolve_ground
 from robodyn.sim.limits import LimitMode, check_mode, limit_violations
-from robodyn.sim.observer import MomentumObserver
+from robodyn.sim.observer import MomentumObserver, TorqueMode
 from robodyn.sim.operational_space import Impedance, OperationalSpace
 from robodyn.sim.reach import check_reach
 from robodyn.sim.report import Push, SimulationSummary
@@ -172,7 +172,7 @@ def run_simulation(
     compensate(law, joint_friction)
     pushes, external = push_wrenches(robot, force_at, controlled or None)
     # held: a controller sampled every control_period holds its torque through each step
-    torque = "held" if control_period is not None else "sampled"
+    torque: TorqueMode = "held" if control_period is not None else "sampled"
     observer = None if observer_gain is None else MomentumObserver(controller_model(robot), observer_gain, torque=torque)
     with warnings.catch_warnings():  # the summary reports the violations; the caller warns
         warnings.simplefilter("ignore", JointLimitWarning)
