@@ -39,7 +39,7 @@ GOALS = {
 #: Each option's values; the first is the default (the option left out), but for
 #: ``joint_friction``: the reference run is the cheap xacro arm's, which plans only rigid
 #: (``--no-joint-friction``, its Coulomb friction); True leaves the flag out (the oblique robot).
-FACTORS: dict[str, tuple] = {
+FACTORS: dict[str, tuple | list] = {
     "model": ("xacro", "oblique"),
     "cost": ("effort", "time"),
     "actuated": (None, "all but the last"),
