@@ -98,7 +98,7 @@ def check_run(options: dict) -> dict:
         unloaded = next(r for r in rows if r["material"] == row["material"] and r["payload_kg"] == 0.0)
         assert row["robot_mass_kg"] == pytest.approx(unloaded["robot_mass_kg"] + row["payload_kg"], abs=1e-12)
     if options["model"] == "oblique":
-        masses = [float(m.get("value")) for m in ET.parse(OBLIQUE).getroot().iter("mass")]
+        masses = [float(m.attrib["value"]) for m in ET.parse(OBLIQUE).getroot().iter("mass")]
         assert rows[0]["robot_mass_kg"] == pytest.approx(sum(masses), rel=1e-12)
     frame_free = [names.index(n) for n in INNER[options["model"]][1]] if options["frame"] else []
     for material in materials:  # the joints after the frame do not feel its load
