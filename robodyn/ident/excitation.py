@@ -207,10 +207,10 @@ def excite(
         raise InputError(
             "duration, harmonics, margin", "T > 0 s, L ≥ 1, 0 ≤ margin < 0.5", f"{duration!r}, {harmonics!r}, {margin!r}"
         )
+    lower, upper, v_max, a_max = _limits(robot, velocity_limit, acceleration_limit, margin)  # refused before any work
     base = base_parameters(robot) if base is None else base
     nv = robot.nv
     omega = 2 * np.pi / duration
-    lower, upper, v_max, a_max = _limits(robot, velocity_limit, acceleration_limit, margin)
     t_constraint = np.linspace(0.0, duration, constraint_points, endpoint=False)
     t_objective = np.linspace(0.0, duration, objective_points, endpoint=False)
     Bq, Bv, Ba = _basis(t_constraint, nv, harmonics, omega)

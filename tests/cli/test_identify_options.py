@@ -328,9 +328,22 @@ def test_excite_options_crossed_pairwise_write_the_librarys_motion(run, tmp_path
         np.testing.assert_allclose(columns[name], values, rtol=1e-12, atol=1e-12, err_msg=name)
 
 
+def test_a_limit_of_another_count_is_refused_naming_the_parameter():
+    """acceleration_limit=[3, 3, 0.4] for a robot of four joints raised numpy's ValueError
+    (robodyn excite: a traceback); now one InputError naming it, before any work."""
+    from robodyn.exceptions import InputError
+    from robodyn.ident.excitation import excite
+
+    robot = robot_of(IDENTIFY_DEFAULT)
+    with pytest.raises(InputError, match=r"^acceleration_limit must be one value or 4 \(j_yaw, .*got 3 values"):
+        excite(robot, acceleration_limit=[3.0, 3.0, 0.4])
+    with pytest.raises(InputError, match=r"^velocity_limit must be one value or 4 .*got 2 values"):
+        excite(robot, velocity_limit=[1.0, 1.0])
+
+
+@pytest.mark.slow
 def test_a_limit_of_another_count_is_one_line_not_a_traceback(tmp_path):
-    """--acceleration-limit 3,3,0.4 on a robot of four joints raised numpy's ValueError (a
-    traceback); the library now refuses it naming the parameter, the CLI its flag."""
+    """The same on the command line: one line naming the flag."""
     oblique = ["excite", str(OBLIQUE), "--out", str(tmp_path / "e.csv"), "--iterations", "1"]
     refused_in_one_line([*oblique, "--acceleration-limit", "3,3,0.4"], "--acceleration-limit", "j_tool", "3 values")
     refused_in_one_line([*oblique, "--velocity-limit", "1,1"], "--velocity-limit", "2 values")
