@@ -177,3 +177,20 @@ def test_what_observe_cannot_do_is_one_line(tmp_path):
     refused_in_one_line(["observe", *oblique, "--gain", "50", "--threshold", "-1"], "threshold")
     refused_in_one_line(["observe", *oblique, "--gain", "50", "--frame", "base"], "base")
     refused_in_one_line(["observe", *oblique, "--gain", "50", "--floating-base"], "does not fit")  # a fixed robot's file
+
+
+@pytest.mark.slow
+def test_plot_alone_draws_a_png_and_says_so(tmp_path):
+    """``--plot`` (matplotlib: left out of the crossed runs) writes a PNG of the estimate
+    against the file's applied torques and adds its line, nothing else."""
+    robot = robot_of(DEFAULT)
+    source = tmp_path / "pushed.csv"
+    recorded_motion(robot, "oblique", source)
+    plot = tmp_path / "estimate.png"
+    argv = ["observe", *model_arguments(DEFAULT), str(source), "--gain", "100"]
+    code, printed, error = run_command([*argv, "--plot", str(plot)])
+    assert code == 0, error
+    width, height = int.from_bytes(plot.read_bytes()[16:20], "big"), int.from_bytes(plot.read_bytes()[20:24], "big")
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and width > 200 and height > 200
+    _, without, _ = run_command(argv)
+    assert printed == without + f"plot: {plot}\n"

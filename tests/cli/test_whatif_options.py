@@ -154,3 +154,15 @@ def test_the_options_crossed_pairwise_print_the_librarys_table(run):
 )
 def test_what_whatif_cannot_do_is_one_line(argv, names):
     refused_in_one_line(["whatif", *argv], *names)
+
+
+def test_plot_alone_draws_a_png_and_says_so(tmp_path):
+    """``--plot`` (matplotlib: left out of the crossed runs) writes the bar chart and adds
+    its key to the JSON, nothing else."""
+    plot = tmp_path / "whatif.png"
+    code, printed, error = run_command(["whatif", "--payloads", "0,1", "--plot", str(plot), "--json"])
+    assert code == 0, error
+    head = plot.read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n" and int.from_bytes(head[16:20], "big") > 200
+    _, without, _ = run_command(["whatif", "--payloads", "0,1", "--json"])
+    assert json.loads(printed) == json.loads(without) | {"plot": str(plot)}
