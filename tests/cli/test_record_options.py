@@ -266,7 +266,6 @@ def test_the_view_runs_cover_every_pair_and_are_few():
 VIEW_ALONE = [(name, value) for name, values in VIEW.items() for value in values[1:]]
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(("option", "value"), VIEW_ALONE, ids=[f"{n}={v}" for n, v in VIEW_ALONE])
 def test_each_view_option_alone_reaches_the_viewer(option, value, tmp_path, monkeypatch):
     check_view(VIEW_DEFAULT | {option: value}, tmp_path, monkeypatch)
