@@ -57,6 +57,8 @@ FLAGS: dict[str, str] = {
     "goal": "--goal",
     "intervals": "--intervals",
     "cost": "--cost",
+    "velocity_limit": "--velocity-limit",
+    "acceleration_limit": "--acceleration-limit",
     "reference": "--reference",
     "engine": "--engine",
     "control_period": "--control-period",

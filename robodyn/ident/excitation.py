@@ -140,16 +140,23 @@ def _unpack(x: np.ndarray, nv: int, harmonics: int) -> tuple[np.ndarray, np.ndar
     return offset, sine, cosine
 
 
+def _per_joint(robot: Robot, name: str, values) -> np.ndarray:
+    """One limit for every joint, or one a joint, as (nv,); another count is refused (by name)."""
+    limits = np.asarray(values, dtype=float)
+    if limits.size not in (1, robot.nv) or limits.ndim > 1:
+        joints = ", ".join(robot.joint_names)
+        raise InputError(name, f"one value or {robot.nv} ({joints})", f"{limits.size} values")
+    return np.broadcast_to(limits.reshape(-1), (robot.nv,)).copy()
+
+
 def _limits(robot: Robot, velocity, acceleration, margin):
     prismatic = np.array([joint.type == "prismatic" for joint in robot.joints])
     scale = np.where(prismatic, 0.1, 1.0)
     urdf_velocity = np.array([joint.velocity for joint in robot.joints])
     default_velocity = np.where(np.isfinite(urdf_velocity) & (urdf_velocity > 0), urdf_velocity, DEFAULT_VELOCITY * scale)
-    velocity_limit = default_velocity if velocity is None else np.broadcast_to(np.asarray(velocity, float), (robot.nv,)).copy()
+    velocity_limit = default_velocity if velocity is None else _per_joint(robot, "velocity_limit", velocity)
     acceleration_limit = (
-        DEFAULT_ACCELERATION * scale
-        if acceleration is None
-        else np.broadcast_to(np.asarray(acceleration, float), (robot.nv,)).copy()
+        DEFAULT_ACCELERATION * scale if acceleration is None else _per_joint(robot, "acceleration_limit", acceleration)
     )
     for name, values in (("velocity_limit", velocity_limit), ("acceleration_limit", acceleration_limit)):
         if not (np.isfinite(values).all() and (values > 0).all()):
@@ -200,10 +207,10 @@ def excite(
         raise InputError(
             "duration, harmonics, margin", "T > 0 s, L ≥ 1, 0 ≤ margin < 0.5", f"{duration!r}, {harmonics!r}, {margin!r}"
         )
+    lower, upper, v_max, a_max = _limits(robot, velocity_limit, acceleration_limit, margin)  # refused before any work
     base = base_parameters(robot) if base is None else base
     nv = robot.nv
     omega = 2 * np.pi / duration
-    lower, upper, v_max, a_max = _limits(robot, velocity_limit, acceleration_limit, margin)
     t_constraint = np.linspace(0.0, duration, constraint_points, endpoint=False)
     t_objective = np.linspace(0.0, duration, objective_points, endpoint=False)
     Bq, Bv, Ba = _basis(t_constraint, nv, harmonics, omega)

@@ -43,6 +43,28 @@ def _links(text: str) -> list[str]:
     return [name.strip() for name in text.split(",") if name.strip()]
 
 
+def _refuse_what_is_not_used(arguments: argparse.Namespace) -> None:
+    """``--base-parameters`` prints the model's base parameters and identifies nothing: what
+    an identification takes is refused with it, and ``--format`` without it."""
+    if arguments.base_parameters:
+        unused = [
+            name
+            for name, given in (
+                ("DATA", arguments.data is not None),
+                ("--method", arguments.method != "ls"),
+                ("--out", arguments.out is not None),
+                ("--urdf-out", arguments.urdf_out is not None),
+            )
+            if given
+        ]
+        if unused:
+            raise InputError("--base-parameters", "given without DATA, --method, --out and --urdf-out", ", ".join(unused))
+    elif arguments.format != "text":
+        raise InputError(
+            "--format", "given with --base-parameters (an identification prints text, --out writes JSON)", arguments.format
+        )
+
+
 def run(arguments: argparse.Namespace) -> int:
     """Run ``robodyn identify`` with the parsed ``arguments``; return the exit status.
 
@@ -56,6 +78,7 @@ def run(arguments: argparse.Namespace) -> int:
 
     if arguments.data is None and not arguments.base_parameters:
         raise InputError("DATA", "a trajectory file (or --base-parameters)", "nothing")
+    _refuse_what_is_not_used(arguments)
     robot = load_robot(arguments)
     if arguments.base_parameters:
         base = base_parameters(robot, friction=arguments.friction, bodies=arguments.bodies)
