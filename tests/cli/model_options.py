@@ -10,20 +10,12 @@ Python API gives for them, :func:`model_arguments` writes them as the command li
 
 from __future__ import annotations
 
-import contextlib
-import io
 from collections.abc import Sequence
 
 import robodyn
-from robodyn.cli.app import main
-from tests.conftest import ROOT
+from tests.cli.option_runs import GRAVITY, OBLIQUE, PACKAGE, XACRO, XACRO_ARGS, refused, run
 
-OBLIQUE = ROOT / "tests" / "data" / "robots" / "oblique.urdf"
-PACKAGE = ROOT / "tests" / "data" / "packages" / "robodyn_test_arm"
-XACRO = PACKAGE / "urdf" / "arm.urdf.xacro"
-XACRO_ARGS = {"prefix": "r_", "upper_mass": "2.1"}
-#: Not the default, not along an axis.
-GRAVITY = (1.5, -2.0, -8.0)
+__all__ = ["GRAVITY", "OBLIQUE", "PACKAGE", "XACRO", "XACRO_ARGS", "model_arguments", "robot_of", "run_command"]
 #: The joint each model locks for ``lock="locked"``, at a non-zero position.
 LOCKS = {"oblique": {"j_extend": 0.05}, "xacro": {"r_slide": 0.05}}
 
@@ -57,18 +49,11 @@ def model_arguments(options: dict, model: str | None = None) -> list[str]:
     return arguments
 
 
-def run_command(argv: Sequence[str]) -> tuple[int, str, str]:
-    """``robodyn ARGV`` in this process: the exit status, what it printed and its stderr."""
-    stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-        code = main(list(argv))
-    return code, stdout.getvalue(), stderr.getvalue()
+run_command = run
 
 
 def refused_in_one_line(argv: Sequence[str], *names: str) -> None:
     """``robodyn ARGV`` exits 2 with one stderr line that names each of ``names``."""
-    code, _, error = run_command(argv)
-    assert code == 2, error
-    assert error.count("\n") == 1 and error.startswith("robodyn: error: "), error
+    error = refused(list(argv))
     for name in names:
         assert name in error, (name, error)

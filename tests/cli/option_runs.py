@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+from collections.abc import Sequence
 
 import robodyn
 from robodyn.cli.app import main
@@ -19,6 +20,7 @@ OBLIQUE = ROOT / "tests" / "data" / "robots" / "oblique.urdf"
 PACKAGE = ROOT / "tests" / "data" / "packages" / "robodyn_test_arm"
 XACRO = PACKAGE / "urdf" / "arm.urdf.xacro"
 XACRO_ARGS = {"prefix": "r_", "upper_mass": "2.1"}
+#: Not the default, not along an axis.
 GRAVITY = (1.5, -2.0, -8.0)
 #: Each file's <dynamics> (damping b in [N m s/rad], Coulomb friction f in [N m]), read off the files by eye.
 FRICTION = {"oblique": {"j_twist": (0.1, 0.05)}, "xacro": {"r_shoulder": (0.4, 0.1)}}
@@ -70,7 +72,7 @@ def shared_flags(options: dict) -> list[str]:
     return flags
 
 
-def run(argv: list[str]) -> tuple[int, str, str]:
+def run(argv: Sequence[str]) -> tuple[int, str, str]:
     """``robodyn ARGV`` in-process: its exit status, stdout and stderr."""
     stdout, stderr = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
@@ -78,14 +80,14 @@ def run(argv: list[str]) -> tuple[int, str, str]:
     return code, stdout.getvalue(), stderr.getvalue()
 
 
-def ok(argv: list[str]) -> str:
+def ok(argv: Sequence[str]) -> str:
     """The stdout of a run that must succeed."""
     code, out, err = run(argv)
     assert code == 0, f"{argv}: {err}"
     return out
 
 
-def refused(argv: list[str]) -> str:
+def refused(argv: Sequence[str]) -> str:
     """The one stderr line of a run that must be refused (exit 2, nothing on stdout)."""
     code, out, err = run(argv)
     assert (code, out) == (2, ""), f"{argv}: {code} {out[:200]} {err}"

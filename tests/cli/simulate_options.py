@@ -28,14 +28,9 @@ from robodyn.sim.gains import pd_defaults, pd_gains
 from robodyn.sim.ground import Ground
 from robodyn.sim.observer import MomentumObserver
 from robodyn.sim.simulation import ExternalWrench, external_torques
-from tests.conftest import ROOT
+from tests.cli.option_runs import GRAVITY, OBLIQUE, PACKAGE, XACRO, XACRO_ARGS
 from tests.differential.pairs import expected_header, written_columns
 
-OBLIQUE = ROOT / "tests" / "data" / "robots" / "oblique.urdf"
-PACKAGE = ROOT / "tests" / "data" / "packages" / "robodyn_test_arm"
-XACRO = PACKAGE / "urdf" / "arm.urdf.xacro"
-XACRO_ARGS = {"prefix": "r_", "upper_mass": "2.1"}
-GRAVITY = (1.5, -2.0, -8.0)
 DURATION = 0.01
 PUSH_TIME, PUSH_FORCE = 0.005, (1.5, -2.0, 3.0)
 PD_GAINS, CT_GAINS = (5.0, 0.05), (100.0, 20.0)  # --kp, --kd of pd [N m/rad], [N m s/rad]; computed torque [1/s²], [1/s]

@@ -25,17 +25,12 @@ import pytest
 
 import robodyn
 from robodyn.cli.app import main
-from tests.conftest import ROOT
+from tests.cli.option_runs import GRAVITY, OBLIQUE, PACKAGE, XACRO, XACRO_ARGS
 from tests.differential.cases import random_state_batch
 from tests.differential.pairs import expected_header, written_columns
 from tests.pairwise import pairwise, uncovered_pairs
 
 ROWS = 23
-OBLIQUE = ROOT / "tests" / "data" / "robots" / "oblique.urdf"
-PACKAGE = ROOT / "tests" / "data" / "packages" / "robodyn_test_arm"
-XACRO = PACKAGE / "urdf" / "arm.urdf.xacro"
-XACRO_ARGS = {"prefix": "r_", "upper_mass": "2.1"}
-GRAVITY = (1.5, -2.0, -8.0)
 
 #: Each option's values; the first is the default (the option left out).
 FACTORS: dict[str, tuple] = {
