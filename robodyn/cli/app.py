@@ -45,12 +45,31 @@ COMMANDS = (
 )  # fmt: skip
 
 
+class _CommandParser(argparse.ArgumentParser):
+    """A command's parser that takes its positionals among its options in any order
+    (``identify MODEL --floating-base DATA``: argparse alone fills an optional positional only
+    from the run of positionals before the first option and refuses ``DATA`` after it)."""
+
+    _intermixing = False
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        if self._intermixing:  # parse_known_intermixed_args calls back here
+            return super().parse_known_args(args, namespace)
+        self._intermixing = True
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._intermixing = False
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``robodyn`` command."""
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics from any URDF, verified.")
     parser.add_argument("--version", action="version", version=f"robodyn {robodyn.__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
-    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_CommandParser)
 
     for command in COMMANDS:
         command.add_parser(commands)
