@@ -1,11 +1,11 @@
 """Derivatives of the compiled dynamics: ``∂τ/∂q``, ``∂τ/∂v`` and ``∂q̈/∂q``, ``∂q̈/∂v`` in C.
 
 ``∂τ/∂q`` and ``∂τ/∂v`` are the Newton–Euler program (the one the ``tau`` kernel runs)
-differentiated forward, assignment by assignment (:mod:`robodyn.compiled.tangents`): for
-``x = e(y1, y2, …)`` the partials ``∂e/∂y`` are printed once and ``dx = Σ ∂e/∂y · dy`` is one
-SIMD statement over the directions (``q_0 … q_{n−1}`` in the lanes of one vector,
-``v_0 … v_{n−1}`` in another), seeded through the bodies' linear map (``θ = S q + offset``,
-``θ̇ = S v``: mimic joints included) and projected back (``∂τ/∂x = Sᵀ ∂τ_bodies/∂x``).
+differentiated in reverse, assignment by assignment (:mod:`robodyn.compiled.tangents`): for
+``x = e(y1, y2, …)`` the partials ``∂e/∂y`` are printed once, and the reverse sweep's
+``ȳ ← ȳ + ∂e/∂y · x̄`` is one SIMD statement over the outputs (``τ_0 … τ_{n−1}`` in the
+lanes of one vector), one sweep for both ``∂τ/∂q`` and ``∂τ/∂v``, seeded through the
+bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``: mimic joints included).
 ``∂τ/∂a = M`` is the ``mass`` kernel.
 
 The forward dynamics' derivatives follow: ``q̈ = FD(q, v, τ)`` (the LDLᵀ of ``M``),
@@ -20,7 +20,7 @@ about as much CPU as the robot's ``tau`` program, plus the C compiler). The func
                                     double *dq, double *dv);   /* (nv, nv) row-major each */
     static void rdd_tau_derivatives2(...);  /* 2 states, SSE2; rdd8_...: 8 states, AVX-512 */
 
-The single call runs the directions in lanes (the widest instruction set of the build the CPU
+The single call runs the outputs in lanes (the widest instruction set of the build the CPU
 runs: panda arm 0.43× Pinocchio's ``computeRNEADerivatives`` against 0.78× written direction
 by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
 of the instruction set the build chose (:func:`robodyn.compiled.simd.build_variants`, as the
@@ -32,12 +32,12 @@ operations in the same order as the single call's lane (no FMA: contraction is o
 each row equals its single call; ``cos``/``sin`` are the kernels' own (``trig.c``:
 ``rd_sin`` in the single call, its vector form in the blocks, as the dynamics' SIMD blocks).
 
-Why forward mode through the program, not the analytical recursions (Carpentier and Mansard
+Why the program differentiated, not the analytical recursions (Carpentier and Mansard
 2018): the program is exact for every robot the compiled engine takes (mimic joints, oblique
 axes, prismatic joints), constants folded, structural zeros known; the recursions in world
 coordinates (Pinocchio's ``computeRNEADerivatives``) cost about as many operations on a
 7-joint arm (~9 000 by an estimate of its 6×6 products, against ~10 000 a panda-arm state),
-and forward mode's statements over directions are SIMD statements.
+and the sweep's statements over outputs are SIMD statements.
 """
 
 from __future__ import annotations

@@ -49,14 +49,18 @@ def single_functions(writer: TangentWriter, used: set[sp.Basic], stores: list[St
 
 
 def _vector_body(writer: TangentWriter, used: set[sp.Basic], stores: list[Statement], width: int) -> list[str]:
-    """``rdd_dirs_w<width>``: the single call's statements, each tangent in chunks of
-    ``width`` directions (a chunk no lane of which can be non-zero is not computed)."""
+    """``rdd_dirs_w<width>``: the single call's statements, each adjoint in chunks of
+    ``width`` outputs (a chunk no lane of which can be non-zero is not computed), then the
+    columns of ``∂τ/∂q`` and ``∂τ/∂v`` turned into rows ``bq``, ``bv`` (lane ``k``:
+    ``∂τ_j/∂x_k``)."""
     vector, chunks = f"rdd_w{width}", -(-writer.nv // width)
     lines = [
         f"typedef double {vector} __attribute__((vector_size({8 * width})));",
         _SOLVE.replace("TYPE", vector).replace("CHUNKS", str(chunks)),
+        _TRANSPOSE.replace("TYPE", vector).replace("CHUNKS", str(chunks)).replace("WIDTH", str(width)),
         f"static inline __attribute__((always_inline)) void rdd_dirs_w{width}("
         f"const double *q, const double *v, const double *a, {vector} (*bq)[{chunks}], {vector} (*bv)[{chunks}]) {{",
+        f"    {vector} cq[RD_NV][{chunks}], cv[RD_NV][{chunks}];",
         *writer._coordinates(used),
     ]
     for item in [*writer.vector_lines, *stores]:
@@ -68,13 +72,19 @@ def _vector_body(writer: TangentWriter, used: set[sp.Basic], stores: list[Statem
             lanes = range(c * width, (c + 1) * width)
             present = [(k, f, t) for k, f, t in terms if any(lane in t[2] for lane in lanes)]
             value = " + ".join(writer._vector_term(k, f, t, lanes, vector) for k, f, t in present) or f"({vector}){{0.0}}"
-            if target.startswith("b"):
+            if target.startswith("c"):
                 lines.append(f"    {target}[{c}] = {value};")
             elif present:
                 lines.append(f"    const {vector} {target}_c{c} = {value};")
-    return [*lines, "}"]
+    return [*lines, f"    rdd_rows_{vector}(cq, bq);", f"    rdd_rows_{vector}(cv, bv);", "}"]
 
 
+#: Rows from columns (``b[j]``'s lane ``k`` is ``c[k]``'s lane ``j``; lanes past ``RD_NV`` zero).
+_TRANSPOSE = """static inline __attribute__((always_inline)) void rdd_rows_TYPE(TYPE (*c)[CHUNKS], TYPE (*b)[CHUNKS]) {
+    RD_UNROLL for (int j = 0; j < RD_NV; ++j)
+        RD_UNROLL for (int k = 0; k < CHUNKS * WIDTH; ++k)
+            b[j][k / WIDTH][k % WIDTH] = k < RD_NV ? c[k][j / WIDTH][j % WIDTH] : 0.0;
+}"""
 #: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
 #: core.c's ``ldl_apply_columns``' operations, column ``c`` in lane ``c`` (the same bits).
 _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
