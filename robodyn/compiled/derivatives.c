@@ -118,6 +118,13 @@ typedef struct {
     rdd_block tau, fd;
 } rdd_variant;
 
+/* count vectors of L lanes (x as doubles: entry e of lane l at x[e L + l]) -> L rows of count
+ * entries (stride count): each row written in order. */
+static inline __attribute__((always_inline)) void rdd_to_rows(const double *x, int count, int L, double *rows) {
+    for (int l = 0; l < L; ++l)
+        for (int e = 0; e < count; ++e) rows[l * count + e] = x[e * L + l];
+}
+
 /* The forward dynamics' part of a block around the derivatives: with the robot's SIMD
  * dynamics in the module (RD_SIMD: simd.py's rds<L>_mass_nle and tree LDLᵀ on vectors, the
  * same operations as the scalar ones in the same order), on L lanes at once; else row by row. */
@@ -132,8 +139,8 @@ typedef struct {
     } while (0)
 #define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
     static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
-        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
-        S q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], h[RD_NV], X[RD_NV * RD_NV];                   \
+        const Py_ssize_t n = RD_NV;                                                                      \
+        S q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], h[RD_NV], X[3][RD_NV * RD_NV];                \
         double acc[L * RD_NV];                                                                           \
         S##_load(in[0], RD_NV, q);                                                                       \
         S##_load(in[1], RD_NV, v);                                                                       \
@@ -145,22 +152,16 @@ typedef struct {
         S##_ldl_apply(M, h);                                                                             \
         S##_store(h, RD_NV, acc);                                                                        \
         const double *qs[L], *vs[L], *as[L];                                                             \
-        double *dq[L], *dv[L];                                                                           \
-        for (int l = 0; l < L; ++l) {                                                                    \
-            qs[l] = in[0] + l * n, vs[l] = in[1] + l * n, as[l] = acc + l * n;                           \
-            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
-        }                                                                                                \
-        T##_tau_derivatives(qs, vs, as, dq, dv);                                                         \
+        for (int l = 0; l < L; ++l) qs[l] = in[0] + l * n, vs[l] = in[1] + l * n, as[l] = acc + l * n;   \
+        T##_tau_derivatives(qs, vs, as, X[0], X[1]);                                                     \
+        for (int i = 0; i < RD_NV * RD_NV; ++i) X[2][i] = S##_splat((i % (RD_NV + 1)) == 0 ? 1.0 : 0.0); \
         for (int k = 0; k < 3; ++k) {                                                                    \
-            if (k < 2) S##_load(out[k], RD_NV * RD_NV, X);                                               \
-            else                                                                                         \
-                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = S##_splat((i % (RD_NV + 1)) == 0 ? 1.0 : 0.0); \
-            S##_ldl_apply_columns(M, X, RD_NV);                                                          \
+            S##_ldl_apply_columns(M, X[k], RD_NV);                                                       \
             if (k < 2)                                                                                   \
-                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = -X[i];                                    \
-            if (S##_bad(X, RD_NV * RD_NV)) return 3;                                                     \
-            S##_store(X, RD_NV * RD_NV, out[k]);                                                         \
+                for (int i = 0; i < RD_NV * RD_NV; ++i) X[k][i] = -X[k][i];                              \
+            if (S##_bad(X[k], RD_NV * RD_NV)) return 3;                                                  \
         }                                                                                                \
+        for (int k = 0; k < 3; ++k) rdd_to_rows((const double *)X[k], RD_NV * RD_NV, L, out[k]);           \
         return 0;                                                                                        \
     }
 #else
@@ -171,15 +172,16 @@ typedef struct {
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
         double M[L][RD_NV * RD_NV], acc[L][RD_NV];                                                       \
         const double *q[L], *v[L], *a[L];                                                                \
-        double *dq[L], *dv[L];                                                                           \
+        T dq[RD_NV * RD_NV], dv[RD_NV * RD_NV];                                                          \
         for (int l = 0; l < L; ++l) {                                                                    \
             const double *row[3] = {in[0] + l * n, in[1] + l * n, in[2] + l * n};                        \
             const int status = rdd_fd_start(row, M[l], acc[l]);                                          \
             if (status) return status;                                                                   \
             q[l] = row[0], v[l] = row[1], a[l] = acc[l];                                                 \
-            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
         }                                                                                                \
         T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        rdd_to_rows((const double *)dq, RD_NV * RD_NV, L, out[0]);                                          \
+        rdd_to_rows((const double *)dv, RD_NV * RD_NV, L, out[1]);                                          \
         int worst = 0;                                                                                   \
         for (int l = 0; l < L; ++l) {                                                                    \
             double *const row[3] = {out[0] + l * size, out[1] + l * size, out[2] + l * size};            \
@@ -194,13 +196,14 @@ typedef struct {
     static ATTR int T##_tau_inner(const double *const *in, double *const *out) {                         \
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
         const double *q[L], *v[L], *a[L];                                                                \
-        double *dq[L], *dv[L];                                                                           \
+        T dq[RD_NV * RD_NV], dv[RD_NV * RD_NV];                                                          \
         for (int l = 0; l < L; ++l) {                                                                    \
             q[l] = in[0] + l * n, v[l] = in[1] + l * n, a[l] = in[2] + l * n;                            \
             if (!rd_finite(q[l], RD_NV) || !rd_finite(v[l], RD_NV) || !rd_finite(a[l], RD_NV)) return 1; \
-            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
         }                                                                                                \
         T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        rdd_to_rows((const double *)dq, RD_NV * RD_NV, L, out[0]);                                          \
+        rdd_to_rows((const double *)dv, RD_NV * RD_NV, L, out[1]);                                          \
         RDD_MASS(L, S, in[0], out[2]);                                                                   \
         for (int l = 0; l < L; ++l)                                                                      \
             for (int k = 0; k < 3; ++k)                                                                  \

@@ -65,11 +65,13 @@ def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tupl
 
 def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
     """``rdd<L>_tau_derivatives``: the same statements on ``L`` states at once, one a lane
-    of a vector of the instruction set of each of :attr:`TangentWriter.variants` (``(name, L, GCC
-    target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
+    of a vector of the instruction set of each of :attr:`TangentWriter.variants` (``(name,
+    L, GCC target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
     with its ``target`` attribute; ``cos``/``sin`` the SIMD dynamics' (``rds<L>_sin``: the
     single call's ``rd_sin`` on every lane). ``RDD_BLOCKS`` names the variants for
-    ``derivatives.c``'s blocks and dispatch.
+    ``derivatives.c``'s blocks and dispatch. Inputs: ``L`` rows; outputs: ``∂τ/∂q`` and
+    ``∂τ/∂v`` as ``nv²`` vectors each (entry ``j nv + k`` of the ``L`` states in one), which
+    the forward dynamics' solves take as they are.
 
     Args:
         writer: The tangent writer whose scalar statements (:attr:`TangentWriter.lines`) are
@@ -95,14 +97,11 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
         for array, index, value in results:
             try:  # a constant: the same in every lane
                 constant = c_number(float(value))
-                tail.append("    " + " = ".join(f"{array}{lane}[{index}]" for lane in range(lanes)) + f" = {constant};")
+                tail.append(f"    {array}[{index}] = ({vector}){{{', '.join([constant] * lanes)}}};")
             except ValueError:
-                stores = " ".join(f"{array}{lane}[{index}] = o[{lane}];" for lane in range(lanes))
-                tail.append(f"    {{ const {vector} o = {value}; {stores} }}")
+                tail.append(f"    {array}[{index}] = {value};")
         pointers = [
-            f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];"
-            f" double *dq{lane} = dq[{lane}], *dv{lane} = dv[{lane}];"
-            for lane in range(lanes)
+            f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];" for lane in range(lanes)
         ]
         inline = f"static inline __attribute__((always_inline)) {attribute}"
         lane_loop = f"{vector} r; for (int l = 0; l < {lanes}; ++l) r[l] ="
@@ -116,7 +115,7 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
             f"{inline} {vector} {vector}_sin({vector} x) {{ {lane_loop} rd_sin(x[l]); return r; }}",
             "#endif",
             f"static {attribute} void {vector}_tau_derivatives(const double *const *q, const double *const *v,",
-            "        const double *const *a, double *const *dq, double *const *dv) {",
+            f"        const double *const *a, {vector} *dq, {vector} *dv) {{",
             *pointers,
             *head,
             *body,
