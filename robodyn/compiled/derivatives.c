@@ -5,7 +5,8 @@
  *   tau_derivatives(q, v, a, threads) -> (dtau_dq, dtau_dv, M)
  *   fd_derivatives(q, v, tau, threads) -> (dqdd_dq, dqdd_dv, Minv)
  *   info() -> {"nv", "instruction_set" (of batches: "scalar", "sse2", "avx2", "avx512"), "lanes"}
- * Each returns a tuple of three new float64 arrays (nv, nv) or (rows, nv, nv), or None when
+ * Each returns a tuple of three new float64 arrays (nv, nv) or (rows, nv, nv) (a batch's three: views
+ * of one buffer, the allocation the next call reuses), or None when
  * an argument is not a C-contiguous native float64 array of the right shape (the caller then
  * checks and converts it), or an int status as the runtime's: 1 a non-finite input, 2 a
  * non-finite output, 3 a singular mass matrix. Batches run on `threads` POSIX threads with
@@ -309,9 +310,27 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         job.block = row == rdd_row_tau ? variant->tau : variant->fd;
         job.lanes = variant->lanes;
     }
+    /* A batch's three results share one buffer (one allocation: the allocator keeps it for the
+     * next call, where three would be returned to the system and their pages faulted in again). */
+    npy_intp whole[4] = {3, rows, RD_NV, RD_NV};
+    PyObject *base = ndim == 2 ? PyArray_SimpleNew(4, whole, NPY_DOUBLE) : NULL;
+    if (ndim == 2 && !base) {
+        Py_DECREF(result);
+        return NULL;
+    }
     for (int k = 0; k < 3; ++k) {
-        PyObject *out = PyArray_SimpleNew(ndim + 1, ndim == 2 ? dims : dims + 1, NPY_DOUBLE);
+        PyObject *out;
+        if (base) {
+            double *data = (double *)PyArray_DATA((PyArrayObject *)base) + k * rows * RD_NV * RD_NV;
+            out = PyArray_NewFromDescr(&PyArray_Type, PyArray_DescrFromType(NPY_DOUBLE), 3, dims, NULL, data,
+                                       NPY_ARRAY_CARRAY, NULL);
+            Py_INCREF(base); /* the view's reference, which PyArray_SetBaseObject steals */
+            if (out && PyArray_SetBaseObject((PyArrayObject *)out, base) < 0) Py_CLEAR(out);
+        } else {
+            out = PyArray_SimpleNew(1 + 1, dims + 1, NPY_DOUBLE);
+        }
         if (!out) {
+            Py_XDECREF(base);
             Py_DECREF(result);
             return NULL;
         }
@@ -319,6 +338,7 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         job.in[k] = (const double *)PyArray_DATA((PyArrayObject *)args[k]);
         job.out[k] = (double *)PyArray_DATA((PyArrayObject *)out);
     }
+    Py_XDECREF(base);
     int status;
     if (ndim == 1) {
         status = row(job.in, job.out);

@@ -3,6 +3,9 @@ differences of the compiled kernels, and the identities ∂τ/∂a = M, ∂q̈/�
 
 from __future__ import annotations
 
+import gc
+import weakref
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -162,6 +165,23 @@ def test_identities_dtau_da_is_m_and_dqdd_dtau_inverts_it(mimic_tree, rng):
     # ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈ (here q̈ = a: tau was made from it)
     assert relative_error(ddq, -np.linalg.solve(mass, dq)) < 1e-10
     assert relative_error(ddv, -np.linalg.solve(mass, dv)) < 1e-10
+
+
+def test_a_batchs_three_results_are_separate_arrays_freed_with_them(mimic_tree, rng):
+    """A batch's results share one buffer: each is its own C-contiguous writable array (writing
+    one leaves the others), and the buffer goes when they do (no reference kept)."""
+    robot, compiled = mimic_tree
+    q, v, a, tau = states(robot, rng, 9)
+    for method, third in ((compiled.inverse_dynamics_derivatives, a), (compiled.forward_dynamics_derivatives, tau)):
+        results = method(q, v, third)
+        copies = [result.copy() for result in results]
+        assert all(r.flags.c_contiguous and r.flags.writeable and r.shape == (9, robot.nv, robot.nv) for r in results)
+        results[0][...] = np.nan
+        assert all(np.array_equal(r, c) for r, c in zip(results[1:], copies[1:], strict=True))
+        buffer = weakref.ref(results[0].base if results[0].base is not None else results[0])
+        del results
+        gc.collect()
+        assert buffer() is None
 
 
 def _central_difference(function, x: np.ndarray, step: float) -> np.ndarray:
