@@ -42,6 +42,7 @@ and the sweep's statements over outputs are SIMD statements.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
@@ -84,12 +85,40 @@ def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType
             build.store_kernels(own, derivative)
         runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
         robot_kernels = kernels()  # and their SIMD variants: the forward dynamics' part of a block
-        return robot_kernels + "\n" + simd.vector_source(robot_kernels, variants) + derivative + "\n" + runtime
+        vectors = simd.vector_source(robot_kernels, variants)
+        return paired_trig(robot_kernels) + "\n" + vectors + derivative + "\n" + runtime
 
     module = build.keyed_extension(own, source, init="rdd_module", label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached derivative kernels do not match the robot; clear the cache folder")
     return module
+
+
+def paired_trig(kernels: str) -> str:
+    """The kernels' C with each function's ``rd_sin(x)`` and ``rd_cos(x)`` of one ``x`` as one
+    ``rd_sincos`` where the first of the two stood (each of the two computes both: the
+    compiler does not always merge them); the same results, bit for bit."""
+    pattern = re.compile(r"^    const double (\w+) = rd_(sin|cos)\((\w+)\);$")
+    lines = kernels.splitlines()
+    first: dict[tuple[str, str], int] = {}
+    for index, line in enumerate(lines):
+        if line.startswith("static void rd_"):
+            first = {}  # a function of the kernels: pairs only within it
+        match = pattern.match(line)
+        if match is None:
+            continue
+        name, function, argument = match.groups()
+        other = first.get(("cos" if function == "sin" else "sin", argument))
+        if other is None:
+            first[(function, argument)] = index
+            continue
+        partner = pattern.match(lines[other])
+        assert partner is not None
+        sine, cosine = (name, partner.group(1)) if function == "sin" else (partner.group(1), name)
+        lines[other] = f"    double {sine}, {cosine}; rd_sincos({argument}, &{sine}, &{cosine});"
+        lines[index] = ""
+        del first[("cos" if function == "sin" else "sin", argument)]
+    return "\n".join(lines) + "\n"
 
 
 def checked(function, robot: Robot, threads: int, kind: str, **named: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

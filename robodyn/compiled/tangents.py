@@ -284,7 +284,7 @@ class TangentWriter:
         used = set().union(*(sp.sympify(e).free_symbols for e in tau), *(e.free_symbols for _, e in values))
         inputs = {s for symbols in self.program.inputs.values() for s in symbols}
         early = {s for s, e in values if isinstance(e, (sp.sin, sp.cos)) and e.free_symbols <= inputs}
-        for line in self.printer.statements([(s, e) for s, e in values if s in early]):
+        for line in self._trig([(s, e) for s, e in values if s in early]):
             self._both(line)  # sin and cos first: a partial of one is the other
         for symbol, expr in values:  # each value's partials, then the value (from them where shorter)
             partials = self._record(symbol, expr)
@@ -303,6 +303,23 @@ class TangentWriter:
         results, stores = self._outputs()
         single = single_functions(self, used, stores)
         return "\n".join(single + pair_function(self, used, results) + block_functions(self, used, results))
+
+    def _trig(self, values: list[tuple[sp.Symbol, sp.Expr]]) -> list[str]:
+        """The sines and cosines of the coordinates: of one argument together as one
+        ``rd_sincos`` (the kernels' own: ``rd_sin`` and ``rd_cos`` each compute both)."""
+        by_argument: dict[sp.Expr, dict[type, sp.Symbol]] = {}
+        for symbol, expr in values:
+            by_argument.setdefault(expr.args[0], {})[expr.func] = symbol
+        lines = []
+        for argument, pair in by_argument.items():
+            if len(pair) == 2:
+                sine, cosine = self.names[pair[sp.sin]], self.names[pair[sp.cos]]
+                call = f"rd_sincos({self.printer.expression(argument)}, &{sine}, &{cosine});"
+                lines.append(f"    double {sine}, {cosine}; {call}")
+            else:
+                ((function, symbol),) = pair.items()
+                lines += self.printer.statements([(symbol, function(argument))])
+        return lines
 
     def _outputs(self) -> tuple[list[tuple[str, int, str]], list[Statement]]:
         """``(array, index, C value)`` of every entry of ``dq`` and ``dv`` lane by lane, and
