@@ -86,7 +86,7 @@ _TRANSPOSE = """static inline __attribute__((always_inline)) void rdd_rows_TYPE(
             b[j][k / WIDTH][k % WIDTH] = k < RD_NV ? c[k][j / WIDTH][j % WIDTH] : 0.0;
 }"""
 #: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
-#: core.c's ``ldl_apply_columns``' operations, column ``c`` in lane ``c`` (the same bits).
+#: derivatives.c's ``rdd_columns``' operations (a reciprocal a row), column ``c`` in lane ``c`` (the same bits).
 _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
     const int n = RD_NV;
     RD_UNROLL for (int i = n - 1; i >= 0; --i)
@@ -94,8 +94,10 @@ _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(con
             const int j = rd_ancestor[i][a];
             RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[j][c] -= M[i * n + j] * b[i][c];
         }
-    RD_UNROLL for (int i = 0; i < n; ++i)
-        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] /= M[i * n + i];
+    RD_UNROLL for (int i = 0; i < n; ++i) {
+        const double r = 1.0 / M[i * n + i];
+        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] *= r;
+    }
     RD_UNROLL for (int i = 0; i < n; ++i)
         RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
             const int j = rd_ancestor[i][a];
