@@ -57,10 +57,8 @@ def _vector_body(writer: TangentWriter, used: set[sp.Basic], stores: list[Statem
     lines = [
         f"typedef double {vector} __attribute__((vector_size({8 * width})));",
         _SOLVE.replace("TYPE", vector).replace("CHUNKS", str(chunks)),
-        _TRANSPOSE.replace("TYPE", vector).replace("CHUNKS", str(chunks)).replace("WIDTH", str(width)),
         f"static inline __attribute__((always_inline)) void rdd_dirs_w{width}("
         f"const double *q, const double *v, const double *a, {vector} (*bq)[{chunks}], {vector} (*bv)[{chunks}]) {{",
-        f"    {vector} cq[RD_NV][{chunks}], cv[RD_NV][{chunks}];",
         *writer._coordinates(used),
     ]
     for item in [*writer.vector_lines, *stores]:
@@ -72,19 +70,21 @@ def _vector_body(writer: TangentWriter, used: set[sp.Basic], stores: list[Statem
             lanes = range(c * width, (c + 1) * width)
             present = [(k, f, t) for k, f, t in terms if any(lane in t[2] for lane in lanes)]
             value = " + ".join(writer._vector_term(k, f, t, lanes, vector) for k, f, t in present) or f"({vector}){{0.0}}"
-            if target.startswith("c"):
-                lines.append(f"    {target}[{c}] = {value};")
+            if target.startswith("c"):  # column k of a group: c<group>[k]
+                lines.append(f"    const {vector} {target.replace('[', '').replace(']', '')}_c{c} = {value};")
             elif present:
                 lines.append(f"    const {vector} {target}_c{c} = {value};")
-    return [*lines, f"    rdd_rows_{vector}(cq, bq);", f"    rdd_rows_{vector}(cv, bv);", "}"]
+    n = writer.nv
+    for group in ("q", "v"):  # rows from the columns, in registers (lanes past nv zero)
+        for j in range(n):
+            for c in range(chunks):
+                entries = [
+                    f"c{group}{k}_c{j // width}[{j % width}]" if k < n else "0.0" for k in range(c * width, (c + 1) * width)
+                ]
+                lines.append(f"    b{group}[{j}][{c}] = ({vector}){{{', '.join(entries)}}};")
+    return [*lines, "}"]
 
 
-#: Rows from columns (``b[j]``'s lane ``k`` is ``c[k]``'s lane ``j``; lanes past ``RD_NV`` zero).
-_TRANSPOSE = """static inline __attribute__((always_inline)) void rdd_rows_TYPE(TYPE (*c)[CHUNKS], TYPE (*b)[CHUNKS]) {
-    RD_UNROLL for (int j = 0; j < RD_NV; ++j)
-        RD_UNROLL for (int k = 0; k < CHUNKS * WIDTH; ++k)
-            b[j][k / WIDTH][k % WIDTH] = k < RD_NV ? c[k][j / WIDTH][j % WIDTH] : 0.0;
-}"""
 #: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
 #: derivatives.c's ``rdd_columns``' operations (a reciprocal a row), column ``c`` in lane ``c`` (the same bits).
 _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
