@@ -10,8 +10,8 @@ bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``: mimic joints included
 
 The forward dynamics' derivatives follow: ``q̈ = FD(q, v, τ)`` (the LDLᵀ of ``M``),
 ``∂q̈/∂x = −M⁻¹ ∂τ/∂x`` at ``a = q̈`` and ``∂q̈/∂τ = M⁻¹``, the three solved with the one
-factorisation (``derivatives.c``).
-
+factorisation (``derivatives.c``'s ``rdd_columns``: one reciprocal of a pivot a row, times
+each entry, in the single call, the pairs and the blocks alike).
 The kernels make a module of their own, built on the first derivative asked for
 (:func:`derivative_module`) and cached like the robot's (:mod:`robodyn.compiled.build`;
 about as much CPU as the robot's ``tau`` program, plus the C compiler). The functions::
@@ -21,8 +21,8 @@ about as much CPU as the robot's ``tau`` program, plus the C compiler). The func
     static void rdd_tau_derivatives2(...);  /* 2 states, SSE2; rdd8_...: 8 states, AVX-512 */
 
 The single call runs the outputs in lanes (the widest instruction set of the build the CPU
-runs: panda arm 0.43× Pinocchio's ``computeRNEADerivatives`` against 0.78× written direction
-by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
+runs: panda arm ∂τ 0.39× Pinocchio's ``computeRNEADerivatives``, against 0.43× in forward
+mode with its directions in lanes and 0.78× written direction by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
 of the instruction set the build chose (:func:`robodyn.compiled.simd.build_variants`, as the
 dynamics' SIMD blocks: the widest the CPU runs, or ``$ROBODYN_SIMD``; 2, 4 or 8 lanes,
 compiled with that ``target`` attribute and chosen at run time with
@@ -30,14 +30,18 @@ compiled with that ``target`` attribute and chosen at run time with
 the runtime's thread pool, the same statements written lane by lane: the same IEEE
 operations in the same order as the single call's lane (no FMA: contraction is off), so
 each row equals its single call; ``cos``/``sin`` are the kernels' own (``trig.c``:
-``rd_sin`` in the single call, its vector form in the blocks, as the dynamics' SIMD blocks).
+``rd_sincos`` in the single call, its vector form in the blocks, as the dynamics' SIMD
+blocks). A block hands ``∂τ`` on as vectors (the forward dynamics' solves take them as they
+are) and writes each state's rows in order at the end; a batch's three results are views of
+one buffer (one allocation, which the allocator keeps for the next call: three were handed
+back to the system and their pages faulted in again each call).
 
 Why the program differentiated, not the analytical recursions (Carpentier and Mansard
 2018): the program is exact for every robot the compiled engine takes (mimic joints, oblique
 axes, prismatic joints), constants folded, structural zeros known; the recursions in world
 coordinates (Pinocchio's ``computeRNEADerivatives``) cost about as many operations on a
-7-joint arm (~9 000 by an estimate of its 6×6 products, against ~10 000 a panda-arm state),
-and the sweep's statements over outputs are SIMD statements.
+7-joint arm (~9 000 by an estimate of its 6×6 products; a panda-arm block of 8 states is
+9 400 AVX-512 instructions), and the sweep's statements over outputs are SIMD statements.
 """
 
 from __future__ import annotations
