@@ -106,8 +106,8 @@ def paired_trig(kernels: str) -> str:
     lines = kernels.splitlines()
     first: dict[tuple[str, str], int] = {}
     for index, line in enumerate(lines):
-        if line.startswith("static void rd_"):
-            first = {}  # a function of the kernels: pairs only within it
+        if not line.startswith(" "):
+            first = {}  # a function's start or end, or text between: pairs only within a function
         match = pattern.match(line)
         if match is None:
             continue

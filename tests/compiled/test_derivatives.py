@@ -12,6 +12,7 @@ import pytest
 
 import robodyn
 from robodyn.compiled import compile
+from robodyn.compiled.derivatives import paired_trig
 from robodyn.exceptions import InputError, SingularMassMatrixError
 from tests.compiled_helpers import shared_cache
 from tests.conftest import NONDEGENERATE_CASES
@@ -182,6 +183,31 @@ def test_a_batchs_three_results_are_separate_arrays_freed_with_them(mimic_tree, 
         del results
         gc.collect()
         assert buffer() is None
+
+
+def test_sin_and_cos_of_one_coordinate_are_paired_within_a_function_only():
+    """The module's copy of the kernels computes sin and cos of a coordinate once (the same
+    function, so the same bits); a sin in one kernel is never paired with a cos in another."""
+    text = "\n".join(
+        [
+            "static void rd_a(const double *q, double *out) {",
+            "    const double th1 = q[1];",
+            "    const double t0 = rd_sin(th1);",
+            "    const double t1 = t0 * 2.0;",
+            "    const double t2 = rd_cos(th1);",
+            "    out[0] = t1 + t2;",
+            "}",
+            "static void rd_b(const double *q, double *out) {",
+            "    const double th1 = q[1];",
+            "    const double t0 = rd_cos(th1);",
+            "    out[0] = t0;",
+            "}",
+        ]
+    )
+    lines = paired_trig(text).splitlines()
+    assert lines[2] == "    double t0, t2; rd_sincos(th1, &t0, &t2);"
+    assert "    const double t2 = rd_cos(th1);" not in lines
+    assert "    const double t0 = rd_cos(th1);" in lines  # rd_b's own, left alone
 
 
 def _central_difference(function, x: np.ndarray, step: float) -> np.ndarray:
