@@ -5,7 +5,8 @@
  *   tau_derivatives(q, v, a, threads) -> (dtau_dq, dtau_dv, M)
  *   fd_derivatives(q, v, tau, threads) -> (dqdd_dq, dqdd_dv, Minv)
  *   info() -> {"nv", "instruction_set" (of batches: "scalar", "sse2", "avx2", "avx512"), "lanes"}
- * Each returns a tuple of three new float64 arrays (nv, nv) or (rows, nv, nv), or None when
+ * Each returns a tuple of three new float64 arrays (nv, nv) or (rows, nv, nv) (a batch's three: views
+ * of one buffer, the allocation the next call reuses), or None when
  * an argument is not a C-contiguous native float64 array of the right shape (the caller then
  * checks and converts it), or an int status as the runtime's: 1 a non-finite input, 2 a
  * non-finite output, 3 a singular mass matrix. Batches run on `threads` POSIX threads with
@@ -13,9 +14,37 @@
  */
 
 /* The LDLᵀ is the runtime's (core.c's RD_LDL_DEFINE on doubles): rd_ldl_factor, rd_ldl_apply,
- * rd_ldl_apply_columns; the thread pool too (core.c's rd_parallel). */
+ * rd_ldl_apply_columns (the derivatives' own rdd_columns below: a reciprocal a row); the thread pool
+ * too (core.c's rd_parallel). */
 
 typedef int (*rdd_row)(const double *const *in, double *const *out);
+
+/* P##columns(M, B, k): B -> M⁻¹ B for k columns at once (B n×k row-major), M factored by
+ * rd_ldl_factor: core.c's ldl_apply_columns with the diagonal applied as one reciprocal a row
+ * times each entry (a division an entry cost a block of 8 states 147 vector divisions, 20 % of
+ * its time). The single call (tangent_single.py's rdd_apply) does the same operations, column c
+ * in lane c, so the bits are the same everywhere. Q the qualifiers, T the type. */
+#define RDD_COLUMNS_DEFINE(Q, P, T)                                                           \
+    Q void P##columns(const T *M, T *B, int k) {                                              \
+        const int n = RD_NV;                                                                  \
+        for (int i = n - 1; i >= 0; --i)                                                      \
+            for (int a = 0; a < rd_depth[i]; ++a) {                                           \
+                const int j = rd_ancestor[i][a];                                              \
+                const T x = M[i * n + j];                                                     \
+                for (int c = 0; c < k; ++c) B[j * k + c] -= x * B[i * k + c];                 \
+            }                                                                                 \
+        for (int i = 0; i < n; ++i) {                                                         \
+            const T r = 1.0 / M[i * n + i];                                                   \
+            for (int c = 0; c < k; ++c) B[i * k + c] *= r;                                    \
+        }                                                                                     \
+        for (int i = 0; i < n; ++i)                                                           \
+            for (int a = 0; a < rd_depth[i]; ++a) {                                           \
+                const int j = rd_ancestor[i][a];                                              \
+                const T x = M[i * n + j];                                                     \
+                for (int c = 0; c < k; ++c) B[i * k + c] -= x * B[j * k + c];                 \
+            }                                                                                 \
+    }
+RDD_COLUMNS_DEFINE(static inline __attribute__((always_inline)), rdd_, double)
 
 /* rd_finite's answer on outputs (a row's, a block's), without a branch an entry: x * 0 is ±0 for a
  * finite x and NaN otherwise (four sums: no one chain of dependent additions). */
@@ -56,7 +85,7 @@ static int rdd_fd_start(const double *const *in, double *M, double *a) {
 static int rdd_fd_finish(const double *M, double *const *out) {
     const int n = RD_NV;
     for (int i = 0; i < n * n; ++i) out[2][i] = (i % (n + 1)) == 0 ? 1.0 : 0.0;
-    for (int k = 0; k < 3; ++k) rd_ldl_apply_columns(M, out[k], n);
+    for (int k = 0; k < 3; ++k) rdd_columns(M, out[k], n);
     for (int i = 0; i < n * n; ++i) {
         out[0][i] = -out[0][i];
         out[1][i] = -out[1][i];
@@ -118,6 +147,13 @@ typedef struct {
     rdd_block tau, fd;
 } rdd_variant;
 
+/* count vectors of L lanes (x as doubles: entry e of lane l at x[e L + l]) -> L rows of count
+ * entries (stride count): each row written in order. */
+static inline __attribute__((always_inline)) void rdd_to_rows(const double *x, int count, int L, double *rows) {
+    for (int l = 0; l < L; ++l)
+        for (int e = 0; e < count; ++e) rows[l * count + e] = x[e * L + l];
+}
+
 /* The forward dynamics' part of a block around the derivatives: with the robot's SIMD
  * dynamics in the module (RD_SIMD: simd.py's rds<L>_mass_nle and tree LDLᵀ on vectors, the
  * same operations as the scalar ones in the same order), on L lanes at once; else row by row. */
@@ -131,9 +167,10 @@ typedef struct {
         S##_store(M_, RD_NV * RD_NV, rows_M);                                                            \
     } while (0)
 #define RDD_FD_BLOCK(T, L, S, ATTR)                                                                       \
+    RDD_COLUMNS_DEFINE(static inline __attribute__((always_inline)) ATTR, T##_, T)                       \
     static ATTR int T##_fd_inner(const double *const *in, double *const *out) {                          \
-        const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
-        S q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], h[RD_NV], X[RD_NV * RD_NV];                   \
+        const Py_ssize_t n = RD_NV;                                                                      \
+        S q[RD_NV], v[RD_NV], tau[RD_NV], M[RD_NV * RD_NV], h[RD_NV], X[3][RD_NV * RD_NV];                \
         double acc[L * RD_NV];                                                                           \
         S##_load(in[0], RD_NV, q);                                                                       \
         S##_load(in[1], RD_NV, v);                                                                       \
@@ -145,22 +182,16 @@ typedef struct {
         S##_ldl_apply(M, h);                                                                             \
         S##_store(h, RD_NV, acc);                                                                        \
         const double *qs[L], *vs[L], *as[L];                                                             \
-        double *dq[L], *dv[L];                                                                           \
-        for (int l = 0; l < L; ++l) {                                                                    \
-            qs[l] = in[0] + l * n, vs[l] = in[1] + l * n, as[l] = acc + l * n;                           \
-            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
-        }                                                                                                \
-        T##_tau_derivatives(qs, vs, as, dq, dv);                                                         \
+        for (int l = 0; l < L; ++l) qs[l] = in[0] + l * n, vs[l] = in[1] + l * n, as[l] = acc + l * n;   \
+        T##_tau_derivatives(qs, vs, as, X[0], X[1]);                                                     \
+        for (int i = 0; i < RD_NV * RD_NV; ++i) X[2][i] = S##_splat((i % (RD_NV + 1)) == 0 ? 1.0 : 0.0); \
         for (int k = 0; k < 3; ++k) {                                                                    \
-            if (k < 2) S##_load(out[k], RD_NV * RD_NV, X);                                               \
-            else                                                                                         \
-                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = S##_splat((i % (RD_NV + 1)) == 0 ? 1.0 : 0.0); \
-            S##_ldl_apply_columns(M, X, RD_NV);                                                          \
+            T##_columns(M, X[k], RD_NV);                                                                 \
             if (k < 2)                                                                                   \
-                for (int i = 0; i < RD_NV * RD_NV; ++i) X[i] = -X[i];                                    \
-            if (S##_bad(X, RD_NV * RD_NV)) return 3;                                                     \
-            S##_store(X, RD_NV * RD_NV, out[k]);                                                         \
+                for (int i = 0; i < RD_NV * RD_NV; ++i) X[k][i] = -X[k][i];                              \
+            if (S##_bad(X[k], RD_NV * RD_NV)) return 3;                                                  \
         }                                                                                                \
+        for (int k = 0; k < 3; ++k) rdd_to_rows((const double *)X[k], RD_NV * RD_NV, L, out[k]);           \
         return 0;                                                                                        \
     }
 #else
@@ -171,15 +202,16 @@ typedef struct {
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
         double M[L][RD_NV * RD_NV], acc[L][RD_NV];                                                       \
         const double *q[L], *v[L], *a[L];                                                                \
-        double *dq[L], *dv[L];                                                                           \
+        T dq[RD_NV * RD_NV], dv[RD_NV * RD_NV];                                                          \
         for (int l = 0; l < L; ++l) {                                                                    \
             const double *row[3] = {in[0] + l * n, in[1] + l * n, in[2] + l * n};                        \
             const int status = rdd_fd_start(row, M[l], acc[l]);                                          \
             if (status) return status;                                                                   \
             q[l] = row[0], v[l] = row[1], a[l] = acc[l];                                                 \
-            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
         }                                                                                                \
         T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        rdd_to_rows((const double *)dq, RD_NV * RD_NV, L, out[0]);                                          \
+        rdd_to_rows((const double *)dv, RD_NV * RD_NV, L, out[1]);                                          \
         int worst = 0;                                                                                   \
         for (int l = 0; l < L; ++l) {                                                                    \
             double *const row[3] = {out[0] + l * size, out[1] + l * size, out[2] + l * size};            \
@@ -194,13 +226,14 @@ typedef struct {
     static ATTR int T##_tau_inner(const double *const *in, double *const *out) {                         \
         const Py_ssize_t n = RD_NV, size = RD_NV * RD_NV;                                                \
         const double *q[L], *v[L], *a[L];                                                                \
-        double *dq[L], *dv[L];                                                                           \
+        T dq[RD_NV * RD_NV], dv[RD_NV * RD_NV];                                                          \
         for (int l = 0; l < L; ++l) {                                                                    \
             q[l] = in[0] + l * n, v[l] = in[1] + l * n, a[l] = in[2] + l * n;                            \
             if (!rd_finite(q[l], RD_NV) || !rd_finite(v[l], RD_NV) || !rd_finite(a[l], RD_NV)) return 1; \
-            dq[l] = out[0] + l * size, dv[l] = out[1] + l * size;                                        \
         }                                                                                                \
         T##_tau_derivatives(q, v, a, dq, dv);                                                            \
+        rdd_to_rows((const double *)dq, RD_NV * RD_NV, L, out[0]);                                          \
+        rdd_to_rows((const double *)dv, RD_NV * RD_NV, L, out[1]);                                          \
         RDD_MASS(L, S, in[0], out[2]);                                                                   \
         for (int l = 0; l < L; ++l)                                                                      \
             for (int k = 0; k < 3; ++k)                                                                  \
@@ -306,9 +339,27 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         job.block = row == rdd_row_tau ? variant->tau : variant->fd;
         job.lanes = variant->lanes;
     }
+    /* A batch's three results share one buffer (one allocation: the allocator keeps it for the
+     * next call, where three would be returned to the system and their pages faulted in again). */
+    npy_intp whole[4] = {3, rows, RD_NV, RD_NV};
+    PyObject *base = ndim == 2 ? PyArray_SimpleNew(4, whole, NPY_DOUBLE) : NULL;
+    if (ndim == 2 && !base) {
+        Py_DECREF(result);
+        return NULL;
+    }
     for (int k = 0; k < 3; ++k) {
-        PyObject *out = PyArray_SimpleNew(ndim + 1, ndim == 2 ? dims : dims + 1, NPY_DOUBLE);
+        PyObject *out;
+        if (base) {
+            double *data = (double *)PyArray_DATA((PyArrayObject *)base) + k * rows * RD_NV * RD_NV;
+            out = PyArray_NewFromDescr(&PyArray_Type, PyArray_DescrFromType(NPY_DOUBLE), 3, dims, NULL, data,
+                                       NPY_ARRAY_CARRAY, NULL);
+            Py_INCREF(base); /* the view's reference, which PyArray_SetBaseObject steals */
+            if (out && PyArray_SetBaseObject((PyArrayObject *)out, base) < 0) Py_CLEAR(out);
+        } else {
+            out = PyArray_SimpleNew(1 + 1, dims + 1, NPY_DOUBLE);
+        }
         if (!out) {
+            Py_XDECREF(base);
             Py_DECREF(result);
             return NULL;
         }
@@ -316,6 +367,7 @@ static PyObject *rdd_entry(PyObject *const *args, Py_ssize_t nargs, rdd_row row,
         job.in[k] = (const double *)PyArray_DATA((PyArrayObject *)args[k]);
         job.out[k] = (double *)PyArray_DATA((PyArrayObject *)out);
     }
+    Py_XDECREF(base);
     int status;
     if (ndim == 1) {
         status = row(job.in, job.out);

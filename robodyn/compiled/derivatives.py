@@ -1,17 +1,17 @@
 """Derivatives of the compiled dynamics: ``∂τ/∂q``, ``∂τ/∂v`` and ``∂q̈/∂q``, ``∂q̈/∂v`` in C.
 
 ``∂τ/∂q`` and ``∂τ/∂v`` are the Newton–Euler program (the one the ``tau`` kernel runs)
-differentiated forward, assignment by assignment (:mod:`robodyn.compiled.tangents`): for
-``x = e(y1, y2, …)`` the partials ``∂e/∂y`` are printed once and ``dx = Σ ∂e/∂y · dy`` is one
-SIMD statement over the directions (``q_0 … q_{n−1}`` in the lanes of one vector,
-``v_0 … v_{n−1}`` in another), seeded through the bodies' linear map (``θ = S q + offset``,
-``θ̇ = S v``: mimic joints included) and projected back (``∂τ/∂x = Sᵀ ∂τ_bodies/∂x``).
+differentiated in reverse, assignment by assignment (:mod:`robodyn.compiled.tangents`): for
+``x = e(y1, y2, …)`` the partials ``∂e/∂y`` are printed once, and the reverse sweep's
+``ȳ ← ȳ + ∂e/∂y · x̄`` is one SIMD statement over the outputs (``τ_0 … τ_{n−1}`` in the
+lanes of one vector), one sweep for both ``∂τ/∂q`` and ``∂τ/∂v``, seeded through the
+bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``: mimic joints included).
 ``∂τ/∂a = M`` is the ``mass`` kernel.
 
 The forward dynamics' derivatives follow: ``q̈ = FD(q, v, τ)`` (the LDLᵀ of ``M``),
 ``∂q̈/∂x = −M⁻¹ ∂τ/∂x`` at ``a = q̈`` and ``∂q̈/∂τ = M⁻¹``, the three solved with the one
-factorisation (``derivatives.c``).
-
+factorisation (``derivatives.c``'s ``rdd_columns``: one reciprocal of a pivot a row, times
+each entry, in the single call, the pairs and the blocks alike).
 The kernels make a module of their own, built on the first derivative asked for
 (:func:`derivative_module`) and cached like the robot's (:mod:`robodyn.compiled.build`;
 about as much CPU as the robot's ``tau`` program, plus the C compiler). The functions::
@@ -20,9 +20,9 @@ about as much CPU as the robot's ``tau`` program, plus the C compiler). The func
                                     double *dq, double *dv);   /* (nv, nv) row-major each */
     static void rdd_tau_derivatives2(...);  /* 2 states, SSE2; rdd8_...: 8 states, AVX-512 */
 
-The single call runs the directions in lanes (the widest instruction set of the build the CPU
-runs: panda arm 0.43× Pinocchio's ``computeRNEADerivatives`` against 0.78× written direction
-by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
+The single call runs the outputs in lanes (the widest instruction set of the build the CPU
+runs: panda arm ∂τ 0.39× Pinocchio's ``computeRNEADerivatives``, against 0.43× in forward
+mode with its directions in lanes and 0.78× written direction by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
 of the instruction set the build chose (:func:`robodyn.compiled.simd.build_variants`, as the
 dynamics' SIMD blocks: the widest the CPU runs, or ``$ROBODYN_SIMD``; 2, 4 or 8 lanes,
 compiled with that ``target`` attribute and chosen at run time with
@@ -30,18 +30,23 @@ compiled with that ``target`` attribute and chosen at run time with
 the runtime's thread pool, the same statements written lane by lane: the same IEEE
 operations in the same order as the single call's lane (no FMA: contraction is off), so
 each row equals its single call; ``cos``/``sin`` are the kernels' own (``trig.c``:
-``rd_sin`` in the single call, its vector form in the blocks, as the dynamics' SIMD blocks).
+``rd_sincos`` in the single call, its vector form in the blocks, as the dynamics' SIMD
+blocks). A block hands ``∂τ`` on as vectors (the forward dynamics' solves take them as they
+are) and writes each state's rows in order at the end; a batch's three results are views of
+one buffer (one allocation, which the allocator keeps for the next call: three were handed
+back to the system and their pages faulted in again each call).
 
-Why forward mode through the program, not the analytical recursions (Carpentier and Mansard
+Why the program differentiated, not the analytical recursions (Carpentier and Mansard
 2018): the program is exact for every robot the compiled engine takes (mimic joints, oblique
 axes, prismatic joints), constants folded, structural zeros known; the recursions in world
 coordinates (Pinocchio's ``computeRNEADerivatives``) cost about as many operations on a
-7-joint arm (~9 000 by an estimate of its 6×6 products, against ~10 000 a panda-arm state),
-and forward mode's statements over directions are SIMD statements.
+7-joint arm (~9 000 by an estimate of its 6×6 products; a panda-arm block of 8 states is
+9 400 AVX-512 instructions), and the sweep's statements over outputs are SIMD statements.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
@@ -84,12 +89,40 @@ def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType
             build.store_kernels(own, derivative)
         runtime = build.runtime_source() + "\n" + _RUNTIME.read_text(encoding="utf-8")
         robot_kernels = kernels()  # and their SIMD variants: the forward dynamics' part of a block
-        return robot_kernels + "\n" + simd.vector_source(robot_kernels, variants) + derivative + "\n" + runtime
+        vectors = simd.vector_source(robot_kernels, variants)
+        return paired_trig(robot_kernels) + "\n" + vectors + derivative + "\n" + runtime
 
     module = build.keyed_extension(own, source, init="rdd_module", label=robot.name)
     if module.info()["nv"] != robot.nv:
         raise CompileError(robot.name, "the cached derivative kernels do not match the robot; clear the cache folder")
     return module
+
+
+def paired_trig(kernels: str) -> str:
+    """The kernels' C with each function's ``rd_sin(x)`` and ``rd_cos(x)`` of one ``x`` as one
+    ``rd_sincos`` where the first of the two stood (each of the two computes both: the
+    compiler does not always merge them); the same results, bit for bit."""
+    pattern = re.compile(r"^    const double (\w+) = rd_(sin|cos)\((\w+)\);$")
+    lines = kernels.splitlines()
+    first: dict[tuple[str, str], int] = {}
+    for index, line in enumerate(lines):
+        if not line.startswith(" "):
+            first = {}  # a function's start or end, or text between: pairs only within a function
+        match = pattern.match(line)
+        if match is None:
+            continue
+        name, function, argument = match.groups()
+        other = first.get(("cos" if function == "sin" else "sin", argument))
+        if other is None:
+            first[(function, argument)] = index
+            continue
+        partner = pattern.match(lines[other])
+        assert partner is not None
+        sine, cosine = (name, partner.group(1)) if function == "sin" else (partner.group(1), name)
+        lines[other] = f"    double {sine}, {cosine}; rd_sincos({argument}, &{sine}, &{cosine});"
+        lines[index] = ""
+        del first[("cos" if function == "sin" else "sin", argument)]
+    return "\n".join(lines) + "\n"
 
 
 def checked(function, robot: Robot, threads: int, kind: str, **named: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

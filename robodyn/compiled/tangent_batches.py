@@ -19,7 +19,9 @@ if TYPE_CHECKING:
     from robodyn.compiled.tangents import TangentWriter
 
 #: A scalar call left in a vector statement (the vector forms take none).
-SCALAR_CALL = re.compile(r"(?<!\w)(?:rd_)?(?:cos|sin|pow)\(")
+SCALAR_CALL = re.compile(r"(?<!\w)(?:rd_)?(?:cos|sin|sincos|pow)\(")
+#: The writer's ``double s, c; rd_sincos(x, &s, &c);`` (a vector form replaces its start).
+SINCOS = re.compile(r"^    double (\w+), (\w+); rd_sincos\(")
 
 
 def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
@@ -34,7 +36,12 @@ def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tupl
             ``"dv"`` (∂tau/∂q, ∂tau/∂v), ``index`` ``j * nv + k`` (row j, column k, row-major).
     """
     pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
-    body = [pattern.sub(r"= rdd_\1_2(\2);", line).replace("const double ", "const rdd_v2 ") for line in writer.lines]
+    body = [
+        pattern.sub(r"= rdd_\1_2(\2);", SINCOS.sub(r"    rdd_v2 \1, \2; rdd_sincos_2(", line)).replace(
+            "const double ", "const rdd_v2 "
+        )
+        for line in writer.lines
+    ]
     if any(SCALAR_CALL.search(line) for line in body):
         return ["#define RDD_PAIRS 0", ""]
     lanes = zip(writer._coordinates(used, "0"), writer._coordinates(used, "1"), strict=True)
@@ -53,6 +60,9 @@ def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tupl
         "typedef double rdd_v2 __attribute__((vector_size(16)));",
         "static inline rdd_v2 rdd_cos_2(rdd_v2 x) { const rdd_v2 r = {rd_cos(x[0]), rd_cos(x[1])}; return r; }",
         "static inline rdd_v2 rdd_sin_2(rdd_v2 x) { const rdd_v2 r = {rd_sin(x[0]), rd_sin(x[1])}; return r; }",
+        "static inline void rdd_sincos_2(rdd_v2 x, rdd_v2 *s, rdd_v2 *c) {",
+        "    for (int l = 0; l < 2; ++l) { double a, b; rd_sincos(x[l], &a, &b); (*s)[l] = a; (*c)[l] = b; }",
+        "}",
         "static void rdd_tau_derivatives2(const double *q0, const double *v0, const double *a0, const double *q1,",
         "                                 const double *v1, const double *a1, double *dq0, double *dv0, double *dq1, double *dv1) {",
         *head,
@@ -65,11 +75,13 @@ def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tupl
 
 def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
     """``rdd<L>_tau_derivatives``: the same statements on ``L`` states at once, one a lane
-    of a vector of the instruction set of each of :attr:`TangentWriter.variants` (``(name, L, GCC
-    target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
+    of a vector of the instruction set of each of :attr:`TangentWriter.variants` (``(name,
+    L, GCC target)``, :data:`robodyn.compiled.simd.VARIANTS`: SSE2, AVX2, AVX-512), compiled
     with its ``target`` attribute; ``cos``/``sin`` the SIMD dynamics' (``rds<L>_sin``: the
     single call's ``rd_sin`` on every lane). ``RDD_BLOCKS`` names the variants for
-    ``derivatives.c``'s blocks and dispatch.
+    ``derivatives.c``'s blocks and dispatch. Inputs: ``L`` rows; outputs: ``∂τ/∂q`` and
+    ``∂τ/∂v`` as ``nv²`` vectors each (entry ``j nv + k`` of the ``L`` states in one), which
+    the forward dynamics' solves take as they are.
 
     Args:
         writer: The tangent writer whose scalar statements (:attr:`TangentWriter.lines`) are
@@ -83,7 +95,12 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
     names: list[str] = []
     for name, lanes, target in writer.variants:
         vector, attribute = f"rdd{lanes}", f'__attribute__((target("{target}")))'
-        body = [pattern.sub(rf"= {vector}_\1(\2);", line).replace("const double ", f"const {vector} ") for line in writer.lines]
+        body = [
+            pattern.sub(rf"= {vector}_\1(\2);", SINCOS.sub(rf"    {vector} \1, \2; {vector}_sincos(", line)).replace(
+                "const double ", f"const {vector} "
+            )
+            for line in writer.lines
+        ]
         if any(SCALAR_CALL.search(line) for line in body):
             return ["#define RDD_BLOCKS(X)", ""]
         lane_values = [writer._coordinates(used, str(lane)) for lane in range(lanes)]
@@ -95,14 +112,11 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
         for array, index, value in results:
             try:  # a constant: the same in every lane
                 constant = c_number(float(value))
-                tail.append("    " + " = ".join(f"{array}{lane}[{index}]" for lane in range(lanes)) + f" = {constant};")
+                tail.append(f"    {array}[{index}] = ({vector}){{{', '.join([constant] * lanes)}}};")
             except ValueError:
-                stores = " ".join(f"{array}{lane}[{index}] = o[{lane}];" for lane in range(lanes))
-                tail.append(f"    {{ const {vector} o = {value}; {stores} }}")
+                tail.append(f"    {array}[{index}] = {value};")
         pointers = [
-            f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];"
-            f" double *dq{lane} = dq[{lane}], *dv{lane} = dv[{lane}];"
-            for lane in range(lanes)
+            f"    const double *q{lane} = q[{lane}], *v{lane} = v[{lane}], *a{lane} = a[{lane}];" for lane in range(lanes)
         ]
         inline = f"static inline __attribute__((always_inline)) {attribute}"
         lane_loop = f"{vector} r; for (int l = 0; l < {lanes}; ++l) r[l] ="
@@ -111,12 +125,16 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
             "#ifdef RD_SIMD",  # the SIMD dynamics' sin and cos on vectors: rd_sin's operations on every lane
             f"{inline} {vector} {vector}_cos({vector} x) {{ return rds{lanes}_cos(x); }}",
             f"{inline} {vector} {vector}_sin({vector} x) {{ return rds{lanes}_sin(x); }}",
+            f"{inline} void {vector}_sincos({vector} x, {vector} *s, {vector} *c) {{ rds{lanes}_sincos(x, s, c); }}",
             "#else",
             f"{inline} {vector} {vector}_cos({vector} x) {{ {lane_loop} rd_cos(x[l]); return r; }}",
             f"{inline} {vector} {vector}_sin({vector} x) {{ {lane_loop} rd_sin(x[l]); return r; }}",
+            f"{inline} void {vector}_sincos({vector} x, {vector} *s, {vector} *c) {{",
+            f"    for (int l = 0; l < {lanes}; ++l) {{ double a, b; rd_sincos(x[l], &a, &b); (*s)[l] = a; (*c)[l] = b; }}",
+            "}",
             "#endif",
             f"static {attribute} void {vector}_tau_derivatives(const double *const *q, const double *const *v,",
-            "        const double *const *a, double *const *dq, double *const *dv) {",
+            f"        const double *const *a, {vector} *dq, {vector} *dv) {{",
             *pointers,
             *head,
             *body,

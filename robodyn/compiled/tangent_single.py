@@ -49,8 +49,10 @@ def single_functions(writer: TangentWriter, used: set[sp.Basic], stores: list[St
 
 
 def _vector_body(writer: TangentWriter, used: set[sp.Basic], stores: list[Statement], width: int) -> list[str]:
-    """``rdd_dirs_w<width>``: the single call's statements, each tangent in chunks of
-    ``width`` directions (a chunk no lane of which can be non-zero is not computed)."""
+    """``rdd_dirs_w<width>``: the single call's statements, each adjoint in chunks of
+    ``width`` outputs (a chunk no lane of which can be non-zero is not computed), then the
+    columns of ``∂τ/∂q`` and ``∂τ/∂v`` turned into rows ``bq``, ``bv`` (lane ``k``:
+    ``∂τ_j/∂x_k``)."""
     vector, chunks = f"rdd_w{width}", -(-writer.nv // width)
     lines = [
         f"typedef double {vector} __attribute__((vector_size({8 * width})));",
@@ -68,15 +70,23 @@ def _vector_body(writer: TangentWriter, used: set[sp.Basic], stores: list[Statem
             lanes = range(c * width, (c + 1) * width)
             present = [(k, f, t) for k, f, t in terms if any(lane in t[2] for lane in lanes)]
             value = " + ".join(writer._vector_term(k, f, t, lanes, vector) for k, f, t in present) or f"({vector}){{0.0}}"
-            if target.startswith("b"):
-                lines.append(f"    {target}[{c}] = {value};")
+            if target.startswith("c"):  # column k of a group: c<group>[k]
+                lines.append(f"    const {vector} {target.replace('[', '').replace(']', '')}_c{c} = {value};")
             elif present:
                 lines.append(f"    const {vector} {target}_c{c} = {value};")
+    n = writer.nv
+    for group in ("q", "v"):  # rows from the columns, in registers (lanes past nv zero)
+        for j in range(n):
+            for c in range(chunks):
+                entries = [
+                    f"c{group}{k}_c{j // width}[{j % width}]" if k < n else "0.0" for k in range(c * width, (c + 1) * width)
+                ]
+                lines.append(f"    b{group}[{j}][{c}] = ({vector}){{{', '.join(entries)}}};")
     return [*lines, "}"]
 
 
 #: ``b -> M⁻¹ b`` for direction vectors ``b`` (rows of ``CHUNKS`` ``TYPE``s), ``M`` factored:
-#: core.c's ``ldl_apply_columns``' operations, column ``c`` in lane ``c`` (the same bits).
+#: derivatives.c's ``rdd_columns``' operations (a reciprocal a row), column ``c`` in lane ``c`` (the same bits).
 _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(const double *M, TYPE (*b)[CHUNKS]) {
     const int n = RD_NV;
     RD_UNROLL for (int i = n - 1; i >= 0; --i)
@@ -84,8 +94,10 @@ _SOLVE = """static inline __attribute__((always_inline)) void rdd_apply_TYPE(con
             const int j = rd_ancestor[i][a];
             RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[j][c] -= M[i * n + j] * b[i][c];
         }
-    RD_UNROLL for (int i = 0; i < n; ++i)
-        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] /= M[i * n + i];
+    RD_UNROLL for (int i = 0; i < n; ++i) {
+        const double r = 1.0 / M[i * n + i];
+        RD_UNROLL for (int c = 0; c < CHUNKS; ++c) b[i][c] *= r;
+    }
     RD_UNROLL for (int i = 0; i < n; ++i)
         RD_UNROLL for (int a = 0; a < rd_depth[i]; ++a) {
             const int j = rd_ancestor[i][a];

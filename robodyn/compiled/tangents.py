@@ -1,24 +1,28 @@
-"""The Newton–Euler program differentiated forward, its directions in SIMD lanes.
+"""The Newton–Euler program differentiated in reverse, its outputs in SIMD lanes.
 
 :class:`TangentWriter` writes ``rdd_tau_derivatives`` (``∂τ/∂q``, ``∂τ/∂v`` of one state) and
 its batch forms (and ``rdd_fd_derivatives``: ``−M⁻¹ ∂τ`` and ``M⁻¹`` of one state) for
 :mod:`robodyn.compiled.derivatives`. For ``x = e(y1, y2, …)`` the partials
 ``∂e/∂y`` are differentiated symbolically (sympy, on the program's small expressions;
-``∂cos θ/∂θ`` is the program's own ``−sin θ``) and printed once as scalars; the tangents are
-vectors over the directions, one group for ``q_0 … q_{n−1}`` and one for ``v_0 … v_{n−1}``
-(a lane a direction, in chunks of the instruction set's width ``W``: 2 SSE2, 4 AVX2, 8
-AVX-512): ``dx = Σ ∂e/∂y · dy`` is one vector statement a chunk however many directions
-reach ``x``, and a chunk no lane of which can be non-zero is not computed. The
-directions are seeded through the bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``:
-mimic joints included) and projected back (``∂τ/∂x = Sᵀ ∂τ_bodies/∂x``); a tangent that is
-a constant times another is not a statement.
+``∂cos θ/∂θ`` is the program's own ``−sin θ``) and printed once as scalars, in the
+program's order (a value whose sum is ``c A + s B`` in a rotation's cos and sin is then
+printed from its partials ``A`` and ``B``). Then the reverse sweep: the adjoint ``x̄`` of a
+quantity is a vector over the outputs (lane ``j``: ``∂τ_j/∂x``, in chunks of the
+instruction set's width ``W``: 2 SSE2, 4 AVX2, 8 AVX-512), and ``ȳ ← ȳ + ∂e/∂y · x̄`` is one
+vector statement a chunk for each dependency ``y`` of each ``x``, last statement first; a
+chunk no lane of which can be non-zero is not computed, an adjoint that is a constant
+times another is not a statement. One sweep gives both ``∂τ/∂q`` and ``∂τ/∂v`` (forward
+mode ran one group of directions for each: a quarter more vector work on a 7-joint arm);
+only the quantities that depend on ``q`` or ``v`` are swept. The outputs are seeded through
+the bodies' linear map (``θ = S q + offset``, ``θ̇ = S v``, ``τ = Sᵀ τ_bodies``: mimic joints
+included) and the body coordinates' adjoints projected back (``∂τ/∂q = (Sᵀ θ̄)ᵀ``).
 
 The single call runs these vector statements (GCC/Clang vector extension; compiled once
 plainly and once per instruction set of the build's SIMD variants, the widest the CPU runs
-chosen at the first call: :mod:`robodyn.compiled.tangent_single`). A batch runs states in
-lanes instead (``rdd_tau_derivatives2``, ``rdd<L>_tau_derivatives``:
-:mod:`robodyn.compiled.derivatives`), from the same statements
-written lane by lane: each direction's entry is the vector statement's lane, the same IEEE
+chosen at the first call: :mod:`robodyn.compiled.tangent_single`), its columns turned into
+rows at the end. A batch runs states in lanes instead (``rdd_tau_derivatives2``,
+``rdd<L>_tau_derivatives``: :mod:`robodyn.compiled.derivatives`), from the same statements
+written lane by lane: each output's entry is the vector statement's lane, the same IEEE
 operations in the same order, the terms a lane cannot have left out (they add an exact
 zero in the vector: at most the sign of a zero differs), so a batch row equals its single
 call (no FMA: contraction is off).
@@ -111,14 +115,16 @@ class TangentWriter:
         for symbols, local in zip(inputs, ("th", "thd", "thdd"), strict=True):
             self.names.update({symbol: f"{local}{b}" for b, symbol in enumerate(symbols)})
         self.printer = CPrinter(self.names, trig="rd_")  # the kernels' own sin and cos (trig.c)
-        # Each quantity's tangents by group.
-        self.tangents: dict[sp.Symbol, dict[str, Tangent]] = {}
+        # The quantities that depend on q or v (the inputs seeded: rows of S not zero), each
+        # with its partials ``[(dependency, ∂x/∂dependency)]``, in the program's order.
+        self.active: set[sp.Basic] = set()
         for b in range(self.bodies):
-            seeds = {j: float(s) for j, s in enumerate(self.selection[b]) if s != 0}
-            if seeds:
-                lanes: dict[int, float | None] = dict(seeds)
-                self.tangents[program.inputs["q"][b]] = {"q": (1.0, None, lanes)}
-                self.tangents[program.inputs["qd"][b]] = {"v": (1.0, None, dict(lanes))}
+            if self.selection[b].any():
+                self.active |= {program.inputs["q"][b], program.inputs["qd"][b]}
+        self.uses: list[tuple[sp.Symbol, list[tuple[sp.Symbol, Term]]]] = []
+        # Each quantity's adjoint (lane j: ∂τ_j/∂x), and how many sums made it so far.
+        self.adjoints: dict[sp.Basic, Tangent] = {}
+        self._sums: dict[sp.Basic, int] = {}
         trig = (sp.sin, sp.cos)
         self._known = {expr: symbol for symbol, expr in program.assignments if isinstance(expr, trig)}
         self._partials: dict[sp.Expr, str] = {}
@@ -217,23 +223,58 @@ class TangentWriter:
                 self.lines.append(f"    const double {target}_{k} = {lane};")
         return 1.0, target, result
 
-    def differentiate(self, symbol: sp.Symbol, expr: sp.Expr, name: str) -> None:
-        """The tangents of ``symbol = expr`` in both groups of directions that reach it.
-
-        Args:
-            symbol: The assigned symbol.
-            expr: Its value, an expression of earlier symbols and the inputs.
-            name: The symbol's C name; its tangents are named ``d<group>_<name>``.
-        """
+    def _record(self, symbol: sp.Symbol, expr: sp.Expr) -> dict[sp.Symbol, Term]:
+        """The partials of ``symbol = expr`` by the quantities that depend on q or v (printed
+        where not simple); ``symbol`` depends on them if one is not zero."""
         partials = []
-        for dependency in sorted(expr.free_symbols & self.tangents.keys(), key=str):
+        for dependency in sorted(expr.free_symbols & self.active, key=str):
             partial = self._partial(expr, dependency)
             if partial is not None:
-                partials.append((partial, self.tangents[dependency]))
-        for group in GROUPS:
-            terms = [(c, factor, tangents[group]) for (c, factor), tangents in partials if group in tangents]
-            if terms:
-                self.tangents.setdefault(symbol, {})[group] = self._statement(f"d{group}_{name}", terms)
+                partials.append((dependency, partial))
+        if partials:
+            self.active.add(symbol)
+            self.uses.append((symbol, partials))
+        return dict(partials)
+
+    def _value(self, symbol: sp.Symbol, expr: sp.Expr, partials: dict[sp.Symbol, Term]) -> list[str]:
+        """``symbol = expr`` printed, its sum regrouped by its partials where that is shorter:
+        ``Σ y ∂e/∂y + rest`` over variables ``y`` of degree 1 in every product of the sum
+        that has them, no two in one product (a rotation's cos and sin: ``c A + s B``)."""
+        plain = self.printer.statements([(symbol, expr)])
+        if not expr.is_Add:
+            return plain
+        powers = [product.as_powers_dict() for product in expr.args]
+        candidates = []
+        for y, (_, factor) in partials.items():
+            if factor is not None and all(power.get(y, 0) in (0, 1) for power in powers):
+                products = {i for i, power in enumerate(powers) if power.get(y, 0) == 1}
+                candidates.append((-len(products), str(y), y, products))
+        taken: set[int] = set()
+        chosen = []
+        for count, _, y, products in sorted(candidates, key=lambda c: c[:2]):
+            if count <= -2 and not products & taken:
+                taken |= products
+                chosen.append(y)
+        if not chosen:
+            return plain
+        parts = [_product(partials[y][0], [self.names[y], partials[y][1]]) for y in chosen]
+        rest = sp.Add(*(product for i, product in enumerate(expr.args) if i not in taken))
+        if rest != 0:
+            parts.append(self.printer.expression(rest))
+        return [f"    const double {self.names[symbol]} = {' + '.join(parts)};"]
+
+    def _accumulate(self, symbol: sp.Symbol, partials: list[tuple[sp.Symbol, Term]]) -> None:
+        """A step of the reverse sweep: ``ȳ ← ȳ + ∂x/∂y · x̄`` for each dependency ``y`` of
+        ``x = symbol`` (``x̄`` complete: every later use of ``x`` is done)."""
+        adjoint = self.adjoints.get(symbol)
+        if adjoint is None:
+            return
+        for dependency, (coefficient, factor) in partials:
+            terms: list[tuple[float, str | None, Tangent]] = [(coefficient, factor, adjoint)]
+            if dependency in self.adjoints:
+                terms.insert(0, (1.0, None, self.adjoints[dependency]))
+            count = self._sums[dependency] = self._sums.get(dependency, 0) + 1
+            self.adjoints[dependency] = self._statement(f"a{count}_{self.names[dependency]}", terms)
 
     def source(self) -> str:
         """The single call ``rdd_tau_derivatives`` and the batches' ``rdd_tau_derivatives2``
@@ -243,37 +284,61 @@ class TangentWriter:
         used = set().union(*(sp.sympify(e).free_symbols for e in tau), *(e.free_symbols for _, e in values))
         inputs = {s for symbols in self.program.inputs.values() for s in symbols}
         early = {s for s, e in values if isinstance(e, (sp.sin, sp.cos)) and e.free_symbols <= inputs}
-        for line in self.printer.statements([(s, e) for s, e in values if s in early]):
+        for line in self._trig([(s, e) for s, e in values if s in early]):
             self._both(line)  # sin and cos first: a partial of one is the other
-        for symbol, expr in values:  # each value, then its derivatives (short live ranges)
+        for symbol, expr in values:  # each value's partials, then the value (from them where shorter)
+            partials = self._record(symbol, expr)
             if symbol not in early:
-                for line in self.printer.statements([(symbol, expr)]):
+                for line in self._value(symbol, expr, partials):
                     self._both(line)
-            self.differentiate(symbol, expr, self.names[symbol])
-        outputs = [sp.Dummy(f"tau_body{b}") for b in range(self.bodies)]
-        for b, (symbol, expr) in enumerate(zip(outputs, tau, strict=True)):
-            self.names[symbol] = f"tb{b}"
-            self.differentiate(symbol, sp.sympify(expr), f"tb{b}")
-        results, stores = self._outputs(outputs)
+        for b, expr in enumerate(tau):  # τ_j = Σ_b S[b, j] τ_body_b: the seeds
+            output = sp.Dummy(f"tau_body{b}")
+            self.names[output] = f"tb{b}"
+            self._record(output, sp.sympify(expr))
+            seeds: dict[int, float | None] = {j: float(s) for j, s in enumerate(self.selection[b]) if s != 0}
+            if seeds:
+                self.adjoints[output] = (1.0, None, seeds)
+        for symbol, partials in reversed(self.uses):
+            self._accumulate(symbol, partials)
+        results, stores = self._outputs()
         single = single_functions(self, used, stores)
         return "\n".join(single + pair_function(self, used, results) + block_functions(self, used, results))
 
-    def _outputs(self, outputs: Sequence[sp.Symbol]) -> tuple[list[tuple[str, int, str]], list[Statement]]:
+    def _trig(self, values: list[tuple[sp.Symbol, sp.Expr]]) -> list[str]:
+        """The sines and cosines of the coordinates: of one argument together as one
+        ``rd_sincos`` (the kernels' own: ``rd_sin`` and ``rd_cos`` each compute both)."""
+        by_argument: dict[sp.Expr, dict[type, sp.Symbol]] = {}
+        for symbol, expr in values:
+            by_argument.setdefault(expr.args[0], {})[expr.func] = symbol
+        lines = []
+        for argument, pair in by_argument.items():
+            if len(pair) == 2:
+                sine, cosine = self.names[pair[sp.sin]], self.names[pair[sp.cos]]
+                call = f"rd_sincos({self.printer.expression(argument)}, &{sine}, &{cosine});"
+                lines.append(f"    double {sine}, {cosine}; {call}")
+            else:
+                ((function, symbol),) = pair.items()
+                lines += self.printer.statements([(symbol, function(argument))])
+        return lines
+
+    def _outputs(self) -> tuple[list[tuple[str, int, str]], list[Statement]]:
         """``(array, index, C value)`` of every entry of ``dq`` and ``dv`` lane by lane, and
-        the single call's stores (``Sᵀ`` times the bodies' tangents)."""
+        the single call's stores: column ``k`` of each (``c<group>[k]``, lane ``j``:
+        ``∂τ_j/∂x_k``), ``Sᵀ`` times the body coordinates' adjoints."""
         n, S = self.nv, self.selection
         results: list[tuple[str, int, str]] = []
         stores: list[Statement] = []
-        for j in range(n):
-            for group, array in zip(GROUPS, ("dq", "dv"), strict=True):
+        for group, array in zip(GROUPS, ("dq", "dv"), strict=True):
+            symbols = self.program.inputs["q" if group == "q" else "qd"]
+            for k in range(n):
                 terms: list[tuple[float, str | None, Tangent]] = [
-                    (float(S[b, j]), None, self.tangents[outputs[b]][group])
+                    (float(S[b, k]), None, self.adjoints[symbols[b]])
                     for b in range(self.bodies)
-                    if S[b, j] != 0 and group in self.tangents.get(outputs[b], {})
+                    if S[b, k] != 0 and symbols[b] in self.adjoints
                 ]
-                for k in range(n):
-                    parts = [self._lane_term(c, f, t, k) for c, f, t in terms if k in t[2]]
+                for j in range(n):
+                    parts = [self._lane_term(c, f, t, j) for c, f, t in terms if j in t[2]]
                     lane = self._lane_sum(parts) if parts else 0.0
                     results.append((array, j * n + k, c_number(lane) if isinstance(lane, float) else lane))
-                stores.append((f"b{group}[{j}]", terms))
+                stores.append((f"c{group}[{k}]", terms))
         return results, stores

@@ -3,12 +3,16 @@ differences of the compiled kernels, and the identities ∂τ/∂a = M, ∂q̈/�
 
 from __future__ import annotations
 
+import gc
+import weakref
+
 import numpy as np
 import pinocchio as pin
 import pytest
 
 import robodyn
 from robodyn.compiled import compile
+from robodyn.compiled.derivatives import paired_trig
 from robodyn.exceptions import InputError, SingularMassMatrixError
 from tests.compiled_helpers import shared_cache
 from tests.conftest import NONDEGENERATE_CASES
@@ -162,6 +166,48 @@ def test_identities_dtau_da_is_m_and_dqdd_dtau_inverts_it(mimic_tree, rng):
     # ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈ (here q̈ = a: tau was made from it)
     assert relative_error(ddq, -np.linalg.solve(mass, dq)) < 1e-10
     assert relative_error(ddv, -np.linalg.solve(mass, dv)) < 1e-10
+
+
+def test_a_batchs_three_results_are_separate_arrays_freed_with_them(mimic_tree, rng):
+    """A batch's results share one buffer: each is its own C-contiguous writable array (writing
+    one leaves the others), and the buffer goes when they do (no reference kept)."""
+    robot, compiled = mimic_tree
+    q, v, a, tau = states(robot, rng, 9)
+    for method, third in ((compiled.inverse_dynamics_derivatives, a), (compiled.forward_dynamics_derivatives, tau)):
+        results = method(q, v, third)
+        copies = [result.copy() for result in results]
+        assert all(r.flags.c_contiguous and r.flags.writeable and r.shape == (9, robot.nv, robot.nv) for r in results)
+        results[0][...] = np.nan
+        assert all(np.array_equal(r, c) for r, c in zip(results[1:], copies[1:], strict=True))
+        buffer = weakref.ref(results[0].base if results[0].base is not None else results[0])
+        del results
+        gc.collect()
+        assert buffer() is None
+
+
+def test_sin_and_cos_of_one_coordinate_are_paired_within_a_function_only():
+    """The module's copy of the kernels computes sin and cos of a coordinate once (the same
+    function, so the same bits); a sin in one kernel is never paired with a cos in another."""
+    text = "\n".join(
+        [
+            "static void rd_a(const double *q, double *out) {",
+            "    const double th1 = q[1];",
+            "    const double t0 = rd_sin(th1);",
+            "    const double t1 = t0 * 2.0;",
+            "    const double t2 = rd_cos(th1);",
+            "    out[0] = t1 + t2;",
+            "}",
+            "static void rd_b(const double *q, double *out) {",
+            "    const double th1 = q[1];",
+            "    const double t0 = rd_cos(th1);",
+            "    out[0] = t0;",
+            "}",
+        ]
+    )
+    lines = paired_trig(text).splitlines()
+    assert lines[2] == "    double t0, t2; rd_sincos(th1, &t0, &t2);"
+    assert "    const double t2 = rd_cos(th1);" not in lines
+    assert "    const double t0 = rd_cos(th1);" in lines  # rd_b's own, left alone
 
 
 def _central_difference(function, x: np.ndarray, step: float) -> np.ndarray:
