@@ -151,8 +151,11 @@ def _task_space_deviation(path, frame, speed, *, flip_bias=False):
     kp, kd = 60.0, 12.0
     jacobian = robot.frame_jacobian(q0, frame)[:3]
     assert np.linalg.svd(jacobian, compute_uv=False)[-1] > 0.05  # full row rank: the task is reachable
+    # the control's patched method lives in Python: the compiled engine (auto's choice once the
+    # robot is in the compile cache) would run the controller's C twin without it
+    engine = "pinocchio" if flip_bias else "auto"
     trajectory = robodyn.simulate(
-        robot, q0, v0, 1.0, 2 * DT, controller=TaskSpace(robot, frame, target, kp, kd), joint_friction=False
+        robot, q0, v0, 1.0, 2 * DT, controller=TaskSpace(robot, frame, target, kp, kd), joint_friction=False, engine=engine
     )
     error = target - robot.frame_position(trajectory.q, frame)
     exact = _linear_error(target - start, -jacobian @ v0, kp, kd, trajectory.t)
