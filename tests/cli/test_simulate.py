@@ -55,7 +55,12 @@ def test_a_floating_robot_without_a_ground_says_its_base_falls_freely(capsys):
     [
         (MJCF_BOX, [], "ground (the file's plane): height 0.1 m, normal (0.0, 0.0, 1.0), μ 0.7;"),
         (MJCF_BOX, ["--friction", "0.25"], "ground (the file's plane, μ given): height 0.1 m, normal (0.0, 0.0, 1.0), μ 0.25;"),
-        (MJCF_BOX, ["0.05"], "ground: height 0.05 m, normal (0.0, 0.0, 1.0), μ 1;"),
+        (
+            MJCF_BOX,
+            ["0.05"],
+            "ground (flat at the height given, the file's plane's μ): height 0.05 m, normal (0.0, 0.0, 1.0), μ 0.7;",
+        ),
+        (MJCF_BOX, ["0.05", "--friction", "0.25"], "ground: height 0.05 m, normal (0.0, 0.0, 1.0), μ 0.25;"),
         (
             BOX,
             ["--floating-base"],
