@@ -16,6 +16,9 @@ from tests.compiled_helpers import shared_cache
 from tests.conftest import NONDEGENERATE_CASES, random_states
 
 CASES = ["ur5", "panda_mimic", "solo12", "oblique"]
+#: ur5 under a tilted gravity: the build tests/compiled/test_simd.py makes (one per session),
+#: and a gravity that is not the default.
+UR5_GRAVITY = [1.3, -0.8, -9.4]
 QUANTITIES = ("inverse_dynamics", "forward_dynamics", "mass_matrix", "gravity", "nonlinear_effects")
 
 
@@ -31,6 +34,8 @@ def _load(name: str, **options) -> robodyn.Robot:
     if name in NONDEGENERATE_CASES:
         path, extra = NONDEGENERATE_CASES[name]
         return robodyn.load(str(path), **extra, **options)
+    if name == "ur5":
+        options.setdefault("gravity", UR5_GRAVITY)
     return robodyn.load("panda" if name == "panda_mimic" else name, **options)  # panda: its mimic finger
 
 
@@ -169,9 +174,9 @@ def test_engine_pinocchio_never_uses_the_kernels_and_travels_with_the_robot(pair
     with pytest.raises(InputError, match="engine"):
         robodyn.load("ur5", engine="compiled")
     monkeypatch.delenv("ROBODYN_ENGINE")
-    assert robodyn.load("ur5").handle.engine == "compiled"  # the default: "auto"
+    assert robodyn.load("ur5", gravity=UR5_GRAVITY).handle.engine == "compiled"  # the default: "auto"
     monkeypatch.setenv("ROBODYN_ENGINE", "pinocchio")
-    assert robodyn.load("ur5").options.engine == "pinocchio"
+    assert robodyn.load("ur5", gravity=UR5_GRAVITY).options.engine == "pinocchio"
     monkeypatch.setenv("ROBODYN_ENGINE", "fast")
     with pytest.raises(InputError, match="ROBODYN_ENGINE"):
         robodyn.load("ur5")
