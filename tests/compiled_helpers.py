@@ -74,9 +74,25 @@ def compiled_pair(source, **load_options):
     return robot, compile(robot, threads=2)
 
 
-#: One compile cache for every compiled-engine test of a session (never the user's cache).
-_SHARED_CACHE = tempfile.mkdtemp(prefix="robodyn-test-cache-")
-atexit.register(shutil.rmtree, _SHARED_CACHE, True)
+#: The environment variable naming the session's compile cache: set by tests/conftest.py in
+#: the process that starts the session, so every pytest-xdist worker it starts compiles a
+#: robot into the same folder once (the cache's writes are atomic and its builds locked).
+SESSION_CACHE = "ROBODYN_TEST_SESSION_CACHE"
+
+
+def _session_cache() -> str:
+    """The session's folder, or one of this process's own (removed at exit) outside a session."""
+    folder = os.environ.get(SESSION_CACHE)
+    if folder:
+        return folder
+    folder = tempfile.mkdtemp(prefix="robodyn-test-cache-")
+    atexit.register(shutil.rmtree, folder, True)
+    return folder
+
+
+#: One compile cache for every compiled-engine test of a session, shared by its workers
+#: (never the user's cache).
+_SHARED_CACHE = _session_cache()
 
 
 @contextmanager

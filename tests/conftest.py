@@ -65,7 +65,16 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 def pytest_configure(config: pytest.Config) -> None:
     import os
+    import tempfile
 
+    # One compile cache for the compiled-engine tests of the whole session
+    # (tests/compiled_helpers.py): made here, in the process that starts the session, whose
+    # environment the pytest-xdist workers inherit; a robot built by one worker is found by
+    # the other instead of being derived and compiled a second time.
+    if "PYTEST_XDIST_WORKER" not in os.environ and not os.environ.get("ROBODYN_TEST_SESSION_CACHE"):
+        folder = tempfile.mkdtemp(prefix="robodyn-test-cache-")
+        os.environ["ROBODYN_TEST_SESSION_CACHE"] = folder
+        config.add_cleanup(lambda: _remove_session_cache(folder))
     # What a robot's single calls run on must not depend on what the compile cache holds
     # (a machine that compiled rp_arm before would answer with its kernels): Pinocchio,
     # unless a test asks for engine="auto" itself (tests/compiled/test_engine.py).
@@ -73,3 +82,12 @@ def pytest_configure(config: pytest.Config) -> None:
     seed = config.getoption("--differential-seed", default=None)
     if seed:
         os.environ["ROBODYN_DIFFERENTIAL_SEED"] = seed
+
+
+def _remove_session_cache(folder: str) -> None:
+    import os
+    import shutil
+
+    shutil.rmtree(folder, ignore_errors=True)
+    if os.environ.get("ROBODYN_TEST_SESSION_CACHE") == folder:
+        del os.environ["ROBODYN_TEST_SESSION_CACHE"]

@@ -11,6 +11,7 @@ import pytest
 from robodyn.cli.app import main
 from robodyn.equations import derive_equations, render
 from robodyn.equations.render_latex import compile_latex
+from tests.equations.derived import derived
 
 RRP = str(Path(__file__).parents[1] / "data" / "rrp_arm.urdf")
 DOCUMENTS = [
@@ -38,7 +39,7 @@ def test_symbols_are_typeset_with_dots_numbers_and_upright_names():
 
 
 def test_long_entries_are_broken_across_lines():
-    tex = render(derive_equations("ur5"), "latex")
+    tex = render(derived("ur5"), "latex")
     assert r"&\quad" in tex
     longest = max(len(line) for line in tex.splitlines() if "&" in line)
     assert longest < 400

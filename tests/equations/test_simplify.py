@@ -16,6 +16,7 @@ from robodyn.equations.derive import substitute_parameters
 from robodyn.equations.model import numeric
 from robodyn.equations.simplify import chop
 from robodyn.exceptions import InputError
+from tests.equations.derived import derived
 
 RRP = str(Path(__file__).parents[1] / "data" / "rrp_arm.urdf")
 CLOSED = ["rp_arm", "double_pendulum", RRP]
@@ -32,7 +33,7 @@ def coefficients(expr: sp.Expr) -> list[float]:
 
 @pytest.mark.parametrize("name", CLOSED, ids=["rp_arm", "double_pendulum", "rrp_arm"])
 def test_no_round_off_terms_in_closed_forms(name):
-    equations = derive_equations(name)
+    equations = derived(name)
     for entry in (*equations.M, *equations.Cv, *equations.G, *equations.C):
         sizes = coefficients(entry)
         if sizes:
@@ -47,7 +48,7 @@ def test_chop_removes_round_off_and_keeps_the_rest():
 
 def test_double_pendulum_inertia_of_the_last_link_is_constant():
     """Round-off made M22 depend on q1 (impossible for a serial chain); exact numbers do not."""
-    equations = derive_equations("double_pendulum")
+    equations = derived("double_pendulum")
     assert equations.M[1, 1].free_symbols == set()
     assert equations.q[0] not in equations.M.free_symbols
 
@@ -63,7 +64,7 @@ def test_text_has_short_numbers_and_no_unit_coefficients(capsys):
 
 
 def test_rrp_arm_reads_like_a_hand_derivation():
-    equations = derive_equations(RRP)
+    equations = derived(RRP)
     _q1, q2, q3 = equations.q
     qd1, qd2, _qd3 = equations.qd
     r = q3 + sp.Rational(41, 100)  # the slider's centre of mass beyond the elbow, x and z offsets
@@ -76,7 +77,7 @@ def test_rrp_arm_reads_like_a_hand_derivation():
 
 
 def test_compact_forms_meet_the_size_targets_without_copy_lines():
-    equations = derive_equations("ur5")
+    equations = derived("ur5")
     assert equations.operation_count() <= 760
     assert not [s for s, e in equations.assignments if e.is_Symbol or e.is_Number]  # no `a = b`
     expressions = [e for _, e in equations.assignments]
@@ -113,7 +114,7 @@ def test_kept_parameters_for_every_robot_give_the_robots_numbers(name, form, rng
 def test_christoffel_symbols_rebuild_the_coriolis_matrix(name, capsys):
     from robodyn.equations.christoffel import christoffel_symbols
 
-    equations = derive_equations(name)
+    equations = derived(name)
     gamma = christoffel_symbols(equations)
     n = len(equations.q)
     C = sp.zeros(n, n)

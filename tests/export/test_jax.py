@@ -1,13 +1,14 @@
 """robodyn.export.jax_functions and the standalone JAX module against the Pinocchio engine.
 
 Every test enables float64 in a ``jax.enable_x64`` block: the global setting is left alone.
+JAX is imported by the tests that use it (a second of CPU): a pytest-xdist worker that
+collects this file but runs none of it never imports it.
 """
 
 from __future__ import annotations
 
 import ast
 
-import jax
 import numpy as np
 import pytest
 
@@ -22,6 +23,8 @@ from tests.export.cases import CASES, FAST_CASES, differences, exported
 
 @pytest.fixture
 def x64():
+    import jax
+
     with jax.enable_x64(True):
         yield
 
@@ -39,6 +42,8 @@ def test_every_jax_function_equals_the_pinocchio_engine(case, rng, x64):
 
 
 def test_jit_and_vmap_give_the_engine_on_a_batch(rng, x64):
+    import jax
+
     robot, source = exported("gripper_locked_prismatic", "jax")
     functions = _run(source)
     q, v, a = random_states(robot, rng, 7)
@@ -52,6 +57,8 @@ def test_jit_and_vmap_give_the_engine_on_a_batch(rng, x64):
 
 
 def test_jax_grad_equals_finite_differences_of_the_engine(rng, x64):
+    import jax
+
     robot, source = exported("gripper_locked_prismatic", "jax")
     functions = _run(source)
     q, v, tau = (x[0] for x in random_states(robot, rng, 1))
@@ -73,6 +80,8 @@ def test_jax_grad_equals_finite_differences_of_the_engine(rng, x64):
 
 
 def test_without_float64_jax_functions_are_refused_in_one_line():
+    import jax
+
     robot, _ = exported("oblique_locked")
     with jax.enable_x64(False), pytest.raises(InputError, match="jax_enable_x64"):
         jax_functions(robot)
