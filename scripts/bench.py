@@ -1004,6 +1004,10 @@ def bench_compiled_derivatives_single(quick: bool) -> list[dict]:
                 min(timeit.Timer(call, timer=time.thread_time).repeat(7, 5000)) / 5000
                 for call in (lambda: ours(q, v, third), lambda: theirs(model, data, q, v, third))
             )
+            # the steadiest column on a loaded machine: this thread's CPU time, the two alternated
+            _, _, cpu_alternated = _cpu_paired(
+                lambda: ours(q, v, third), lambda: theirs(model, data, q, v, third), repeats=9 if quick else 21
+            )
             rows.append(
                 {
                     "robot": label,
@@ -1012,6 +1016,7 @@ def bench_compiled_derivatives_single(quick: bool) -> list[dict]:
                     "pinocchio_us": raw_s * 1e6,
                     "ratio": ratio,
                     "ratio_cpu_time": cpu_ours / cpu_raw,
+                    "ratio_cpu_alternated": cpu_alternated,
                     "load_average": os.getloadavg()[0],
                 }
             )

@@ -64,7 +64,7 @@ static inline int rdd_finite(const double *x, int n) {
 static int rdd_row_tau(const double *const *in, double *const *out) {
     if (!rd_finite(in[0], RD_NV) || !rd_finite(in[1], RD_NV) || !rd_finite(in[2], RD_NV)) return 1;
     rdd_tau_derivatives(in[0], in[1], in[2], out[0], out[1]);
-    rd_mass(in[0], out[2]);
+    rdd_single_mass(in[0], out[2]); /* rd_mass (tangent_single.py: for the single call's instruction set) */
     for (int k = 0; k < 3; ++k)
         if (!rdd_finite(out[k], RD_NV * RD_NV)) return 2;
     return 0;
@@ -100,7 +100,7 @@ static int rdd_fd_finish(const double *M, double *const *out) {
  * operations on each column (the same bits as the pairs' and blocks' column by column). */
 static int rdd_row_fd(const double *const *in, double *const *out) {
     double M[RD_NV * RD_NV], a[RD_NV];
-    const int status = rdd_fd_start(in, M, a);
+    const int status = rdd_single_start(in, M, a); /* rdd_fd_start, as rdd_single_mass */
     if (status) return status;
     rdd_fd_derivatives(in[0], in[1], a, M, out[0], out[1], out[2]);
     for (int k = 0; k < 3; ++k)

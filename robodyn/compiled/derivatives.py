@@ -22,7 +22,11 @@ about as much CPU as the robot's ``tau`` program, plus the C compiler). The func
 
 The single call runs the outputs in lanes (the widest instruction set of the build the CPU
 runs: panda arm ∂τ 0.39× Pinocchio's ``computeRNEADerivatives``, against 0.43× in forward
-mode with its directions in lanes and 0.78× written direction by direction). A batch runs states in lanes instead: ``L`` rows at a time through the variant
+mode with its directions in lanes and 0.78× written direction by direction); its scalar
+part, ``M`` (``rd_mass``) or the forward dynamics' ``rd_mass_nle``, ``q̈`` and LDLᵀ of ``M``,
+is compiled for that instruction set too (tangent_single.py's ``_SCALAR``: the same IEEE
+operations, so the same bits, in three-operand forms and, with AVX-512, 32 registers: ~9 %
+of a panda-arm ∂q̈ call at -O1). A batch runs states in lanes instead: ``L`` rows at a time through the variant
 of the instruction set the build chose (:func:`robodyn.compiled.simd.build_variants`, as the
 dynamics' SIMD blocks: the widest the CPU runs, or ``$ROBODYN_SIMD``; 2, 4 or 8 lanes,
 compiled with that ``target`` attribute and chosen at run time with

@@ -19,6 +19,7 @@ checked path. Batches run across rows on ``threads`` native threads, the GIL rel
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import ModuleType
 
 import numpy as np
@@ -161,6 +162,9 @@ class CompiledRobot(CompiledFrames):
         self.threads = check_threads(threads)
         self._tau, self._mass, self._nle = module.tau, module.mass, module.nle
         self._gravity, self._fd = module.gravity, module.fd
+        # The derivative module's two functions once it is built (a call reads one attribute).
+        self._tau_derivatives: Callable[..., object] | None = None
+        self._fd_derivatives: Callable[..., object] | None = None
 
     def __repr__(self) -> str:
         return f"<CompiledRobot {self.name!r}: nv={self.nv}, threads={self.threads}>"
@@ -270,7 +274,8 @@ class CompiledRobot(CompiledFrames):
     # ---- derivatives (issue 25): kernels of their own, generated and built on first use ----
     def _derivatives(self) -> ModuleType:
         """The derivative module (:mod:`robodyn.compiled.derivatives`), built on first use
-        and kept in the instance's ``__dict__`` (so a call costs one dictionary look-up)."""
+        and kept in the instance's ``__dict__``, its two functions as attributes (so a call
+        reads one attribute: no look-up of the module or in it)."""
         module = self.__dict__.get("_derivative_module")
         if module is None:
             fixed_base_only(self.robot, "derivatives")
@@ -278,6 +283,7 @@ class CompiledRobot(CompiledFrames):
 
             module = derivatives.derivative_module(self.robot, kernels=lambda: robot_kernels(self.robot))
             self.__dict__["_derivative_module"] = module
+            self._tau_derivatives, self._fd_derivatives = module.tau_derivatives, module.fd_derivatives
         return module
 
     def inverse_dynamics_derivatives(
@@ -297,7 +303,7 @@ class CompiledRobot(CompiledFrames):
             ``(dtau_dq, dtau_dv, M)``, each (nv, nv) or (N, nv, nv); entry ``[i, j]`` is
             ``∂τ_i/∂x_j`` (in [N m/rad], [N m s/rad], [kg m²], or per [m] for prismatic joints).
         """
-        function = (self.__dict__.get("_derivative_module") or self._derivatives()).tau_derivatives
+        function = self._tau_derivatives or self._derivatives().tau_derivatives
         result = function(q, v, a, self.threads)
         if result.__class__ is tuple:
             return result
@@ -322,7 +328,7 @@ class CompiledRobot(CompiledFrames):
         Raises:
             SingularMassMatrixError: If ``M(q)`` is singular (massless moving bodies).
         """
-        function = (self.__dict__.get("_derivative_module") or self._derivatives()).fd_derivatives
+        function = self._fd_derivatives or self._derivatives().fd_derivatives
         result = function(q, v, tau, self.threads)
         if result.__class__ is tuple:
             return result

@@ -161,6 +161,8 @@ def test_identities_dtau_da_is_m_and_dqdd_dtau_inverts_it(mimic_tree, rng):
     q, v, a, tau = states(robot, rng, 7)
     dq, dv, mass = compiled.inverse_dynamics_derivatives(q, v, a)
     assert np.array_equal(mass, compiled.mass_matrix(q))
+    # one state: the single call's M (compiled for its SIMD variant's instruction set) too
+    assert np.array_equal(compiled.inverse_dynamics_derivatives(q[3], v[3], a[3])[2], compiled.mass_matrix(q[3]))
     ddq, ddv, inverse = compiled.forward_dynamics_derivatives(q, v, tau)
     assert np.abs(inverse @ mass - np.eye(robot.nv)).max() < 1e-10
     # ∂q̈/∂x = −M⁻¹ ∂τ/∂x at a = q̈ (here q̈ = a: tau was made from it)
