@@ -280,7 +280,7 @@ class TangentWriter:
         """The single call ``rdd_tau_derivatives`` and the batches' ``rdd_tau_derivatives2``
         (``RDD_PAIRS``) and ``rdd<L>_tau_derivatives`` (``RDD_BLOCKS``)."""
         tau = list(self.program.outputs["tau"])
-        values = needed(self.program.assignments, tau)
+        values = self._with_partners(needed(self.program.assignments, tau))
         used = set().union(*(sp.sympify(e).free_symbols for e in tau), *(e.free_symbols for _, e in values))
         inputs = {s for symbols in self.program.inputs.values() for s in symbols}
         early = {s for s, e in values if isinstance(e, (sp.sin, sp.cos)) and e.free_symbols <= inputs}
@@ -303,6 +303,22 @@ class TangentWriter:
         results, stores = self._outputs()
         single = single_functions(self, used, stores)
         return "\n".join(single + pair_function(self, used, results) + block_functions(self, used, results))
+
+    def _with_partners(self, values: list[tuple[sp.Symbol, sp.Expr]]) -> list[tuple[sp.Symbol, sp.Expr]]:
+        """``values`` with the program's cosine of each sine printed (and the sine of each
+        cosine): a partial of one is the other (``_partial`` names the program's), which ``τ``
+        alone may not need (a pendulum's ``τ`` reads ``cos θ`` only)."""
+        present = {symbol for symbol, _ in values}
+        completed = []
+        for symbol, expr in values:
+            if isinstance(expr, (sp.sin, sp.cos)):
+                partner = (sp.cos if isinstance(expr, sp.sin) else sp.sin)(expr.args[0])
+                known = self._known.get(partner)
+                if known is not None and known not in present:
+                    completed.append((known, partner))
+                    present.add(known)
+            completed.append((symbol, expr))
+        return completed
 
     def _trig(self, values: list[tuple[sp.Symbol, sp.Expr]]) -> list[str]:
         """The sines and cosines of the coordinates: of one argument together as one
