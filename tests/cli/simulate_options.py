@@ -225,7 +225,8 @@ def library_run(run: dict) -> tuple[robodyn.Robot, robodyn.Trajectory, dict[str,
     if ground is not None and robot.floating_base and given is None:  # the command lifts a floating robot out of the ground
         lifted, lift = start_above(robot, start, ground, contacts, clearance=0.05)
         start = lifted if lift > 0.05 else start
-    observer = None if run["observer_gain"] is None else MomentumObserver(robot_of(run), run["observer_gain"], torque="sampled")
+    held = "held" if run["control_period"] else "sampled"  # a sampled controller's torque is held through a step
+    observer = None if run["observer_gain"] is None else MomentumObserver(robot_of(run), run["observer_gain"], torque=held)
     external = [ExternalWrench(model.frame, _Step())] if run["push"] else []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -134,7 +134,8 @@ def test_the_frame_controllers_crossed_pairwise_write_the_python_apis_run(run, t
     written = run_cli(shared, tmp_path)
     robot = robot_of(shared)
     external = [ExternalWrench(controlled(run)[0], _Step())] if run["push"] else []
-    observer = None if run["observer_gain"] is None else MomentumObserver(robot_of(shared), 20.0, torque="sampled")
+    held = "held" if run["control_period"] else "sampled"  # a sampled controller's torque is held through a step
+    observer = None if run["observer_gain"] is None else MomentumObserver(robot_of(shared), 20.0, torque=held)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         trajectory = robodyn.simulate(
