@@ -72,3 +72,47 @@ def test_a_sum_is_printed_with_a_positive_term_first_so_its_negative_constants_a
     text = CPrinter({x: "x", y: "y", z: "z"}).expression(factored_expression(expr))
     assert text == "y*z - (3.0/7.0)*x"
     assert "(-" not in CPrinter({x: "x", y: "y", z: "z"}).expression(factored_expression(-sp.Rational(3, 7) - x * y + z))
+
+
+SYMBOLS = sp.symbols("a b c d e")
+
+
+def random_sum(rng, depth: int = 0) -> sp.Expr:
+    """A sum of 2–6 terms, each a number (±1, a fraction, sometimes negative) times 0–3 factors
+    drawn from a few symbols, a sine and (at depth 0) another such sum: shared factors likely."""
+    terms = []
+    for _ in range(rng.integers(2, 7)):
+        number = [sp.Integer(1), sp.Integer(-1), sp.Rational(int(rng.integers(-9, 10)) or 1, int(rng.integers(1, 5)))][
+            rng.integers(3)
+        ]
+        factors = [SYMBOLS[k] for k in rng.integers(0, len(SYMBOLS), size=rng.integers(0, 4))]
+        if rng.random() < 0.2:
+            factors.append(sp.sin(SYMBOLS[0]))
+        if depth == 0 and rng.random() < 0.25:
+            factors.append(random_sum(rng, 1))
+        terms.append(sp.Mul(number, *factors))
+    return sp.Add(*terms)
+
+
+def test_random_sums_keep_their_value_and_never_gain_an_operation_or_lead_with_a_negative_term(rng):
+    point = dict(zip(SYMBOLS, (sp.Float(value, 30) for value in rng.normal(size=len(SYMBOLS))), strict=True))
+    for _ in range(25):
+        expr = random_sum(rng)
+        out = factored_expression(expr)
+        assert sp.expand(out - expr) == 0  # the same polynomial in the symbols and sin(a)
+        assert abs(float((out - expr).xreplace(point).evalf(30))) <= 1e-20 * max(1.0, abs(float(expr.xreplace(point))))
+        assert sp.count_ops(out) <= sp.count_ops(expr)
+        for add in out.atoms(sp.Add):
+            # a negative term first only when every term is negative
+            if any(not (t.is_Number and t < 0) and not (t.is_Mul and t.args[0].is_Number and t.args[0] < 0) for t in add.args):
+                first = add.args[0]
+                assert not (first.is_Number and first < 0) and not (
+                    first.is_Mul and first.args[0].is_Number and first.args[0] < 0
+                )
+    # the check can fail: one coefficient changed is another polynomial
+    assert (
+        sp.expand(
+            factored_expression(3 * SYMBOLS[0] * SYMBOLS[1] + 3 * SYMBOLS[0]) - (3 * SYMBOLS[0] * SYMBOLS[1] + 2 * SYMBOLS[0])
+        )
+        != 0
+    )
