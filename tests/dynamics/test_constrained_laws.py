@@ -4,6 +4,8 @@ asked."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -50,6 +52,8 @@ def test_the_rank_is_of_the_given_constraints_and_of_one_configuration(rng):
     assert robot.constraint_rank(q, PointContact("rocker", (0.1, 0.05, 0.02), normal=(0.6, 0.0, 0.8), friction=0.0)) == 1
     with pytest.raises(InputError):
         robot.constraint_rank(np.array([q, q]))
+    with pytest.raises(InputError, match=r"must be a link of robot 'four_bar_3d' \("):
+        robot.constraint_rank(q, PointContact("nowhere", friction=0.0))
 
 
 def test_contact_inverse_dynamics_of_a_fully_actuated_robot_is_its_inverse_dynamics_with_no_multipliers(rng):
@@ -117,12 +121,70 @@ def test_a_massless_joint_is_refused_naming_the_robot_and_the_joint(tmp_path):
     )
 
 
-def test_an_overflow_is_refused_naming_the_robot_and_the_computation():
+def test_an_overflow_is_refused_naming_the_robot_and_the_computation_without_a_warning():
     from robodyn.constraints import PointAnchor
     from robodyn.exceptions import NonFiniteResultError
 
     robot = load_linkage("four_bar")
-    huge = [PointAnchor("coupler", (1e308, 0, 0), "rocker", (0.3, 0, 0))]
-    with pytest.raises(NonFiniteResultError) as refused:
-        robot.constrained_forward_dynamics(np.zeros(3), np.ones(3), np.zeros(3), huge)
-    assert str(refused.value) == f"robot {robot.name!r}: constrained dynamics overflowed to a non-finite value for finite inputs."
+    sentence = f"robot {robot.name!r}: constrained dynamics overflowed to a non-finite value for finite inputs."
+    huge = [PointAnchor("coupler", (1e308, 0, 0), "rocker", (0.3, 0, 0))]  # the Delassus matrix's solver fails
+    overflowing = ((np.zeros(3), np.ones(3), np.zeros(3), huge), (np.zeros(3), np.ones(3), np.array([0.0, 0.0, 1e308])))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # refused, not warned about
+        for arguments in (*overflowing, (np.zeros(3), np.ones(3), np.array([0.0, 0.0, 1e308]), [])):  # the last: λ empty
+            with pytest.raises(NonFiniteResultError) as refused:
+                robot.constrained_forward_dynamics(*arguments)
+            assert str(refused.value) == sentence
+    with (
+        np.errstate(all="ignore"),
+        pytest.raises(np.linalg.LinAlgError, match=r"^the Delassus matrix's eigendecomposition did not converge$"),
+    ):
+        constrained.solve_kkt(np.eye(2), np.ones(2), np.array([[np.inf, 1.0], [1.0, 2.0]]), np.ones(2))
+
+
+@pytest.mark.parametrize("scale", [1e-4, 1.0, 1e4])
+def test_a_row_nearly_repeating_another_shares_its_force_whatever_the_robots_mass(solo, scale, rng):
+    # the four feet's 12 rows and a foot's 3 rows again, off by 1e-7 of J's largest entry (a
+    # stand-in Jacobian): the Delassus matrix's Cholesky factorisation succeeds (its smallest
+    # eigenvalues are 1e-13 of the largest, not round-off), but they are below the tolerance:
+    # the least-norm λ shares the foot's force equally. M and the forces scaled by k (a robot
+    # k times heavier): v̇ the same, λ k times.
+    robot, q = solo
+    v, tau = rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    mass, force = robot.mass_matrix(q), tau - robot.nonlinear_effects(q, v)
+    feet = constrained.bound(robot, [PointContact(foot, friction=0.7) for foot in FEET])
+    _, jacobian, drift = constrained.state_rows(robot, feet, q, v)
+    again = jacobian[:3] + 1e-7 * np.abs(jacobian).max() * rng.normal(size=(3, robot.nv))
+    a, lam = constrained.solve_kkt(scale * mass, scale * force, np.vstack([jacobian, again]), np.concatenate([drift, drift[:3]]))
+    a_single, lam_single = constrained.solve_kkt(scale * mass, scale * force, jacobian, drift)
+    size = np.abs(lam_single).max()
+    assert np.allclose(a, a_single, rtol=0, atol=1e-5 * np.abs(a_single).max())
+    assert np.allclose(lam[:3], lam[12:], rtol=0, atol=1e-5 * size)
+    shared = lam[:12].copy()
+    shared[:3] += lam[12:]
+    assert np.allclose(shared, lam_single, rtol=0, atol=1e-5 * size)
+    assert np.allclose(lam_single / scale, constrained.solve_kkt(mass, force, jacobian, drift)[1], rtol=1e-9, atol=1e-12 * size)
+    # the check can fail: the foot's force all on one of its two contacts
+    assert not np.allclose(lam[:3], lam_single[:3], rtol=0, atol=1e-3 * size)
+
+
+def test_the_inner_loops_dynamics_refuse_a_mass_matrix_without_a_cholesky_factor_naming_the_robot(tmp_path):
+    text = robodyn.rp_arm_urdf().replace(
+        "</robot>",
+        '<joint name="finger" type="revolute"><parent link="link2"/><child link="tip"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint><link name="tip"/></robot>',
+    )
+    (tmp_path / "arm.urdf").write_text(text)
+    robot = robodyn.load(tmp_path / "arm.urdf")
+    with pytest.raises(robodyn.SingularMassMatrixError, match=f"^robot {robot.name!r}: the mass matrix is singular"):
+        constrained.forward_dynamics_unchecked(robot, (), np.zeros(3), np.zeros(3), np.zeros(3))
+
+
+def test_the_kkt_solve_refuses_a_mass_matrix_that_is_not_positive_definite_and_takes_no_coordinate():
+    with pytest.raises(robodyn.SingularMassMatrixError) as refused:
+        constrained.solve_kkt(-np.eye(2), np.ones(2), np.ones((1, 2)), np.ones(1))
+    assert refused.value.joints == [] and str(refused.value) == (
+        "robot 'robot': the mass matrix is singular, so forward dynamics is undefined (the accelerations are not finite)."
+    )
+    a, lam = constrained.solve_kkt(np.zeros((0, 0)), np.zeros(0), np.zeros((2, 0)), np.zeros(2))
+    assert (a.shape, lam.shape) == ((0,), (2,)) and not lam.any()
