@@ -116,3 +116,37 @@ def test_random_sums_keep_their_value_and_never_gain_an_operation_or_lead_with_a
         )
         != 0
     )
+
+
+def test_a_symbol_shared_by_two_terms_comes_out_once():
+    a, p, r = sp.symbols("a p r")
+    for expr in (a * p + a * r, a * p * x + a * r * y, a * sp.sin(x) * p - a * r):
+        text = CPrinter({a: "a", p: "p", r: "r", x: "x", y: "y"}).expression(factored_expression(expr))
+        assert text.count("a") == 1 and sp.expand(factored_expression(expr) - expr) == 0
+    # the check can fail: the unfactored sum has a twice
+    assert CPrinter({a: "a", p: "p", r: "r"}).expression(a * p + a * r).count("a") == 2
+
+
+def test_of_factors_shared_alike_the_last_by_name_comes_out_first_whatever_the_hash_order():
+    # the greedy choice ties broken by name, so the exported source is the same in every process
+    for index in range(20):
+        first, second, p, r = sp.symbols(f"s{index} t{index} p r")
+        out = factored_expression(first * second * p + first * second * r)
+        assert out.is_Mul and out.args[0] == second and sp.expand(out - first * second * (p + r)) == 0
+
+
+def test_every_assignment_and_output_of_a_program_is_factored_and_a_negation_reaches_later_assignments(rng):
+    t, u, s, w, k = sp.symbols("t u s w k")
+    program = Program(
+        {"q": (x, y)},
+        ((u, x * sp.sin(y)), (t, -u), (s, t * y + 3 * x * y + 3 * y), (w, x * y), (k, sp.cos(x))),
+        {"tau": (5 * s * x + 5 * w, k * w)},
+    )
+    out = factored(program)
+    assert [symbol for symbol, _ in out.assignments] == [u, s, w, k]  # only t = -u is gone
+    printer = CPrinter({x: "x", y: "y", u: "u", s: "s", w: "w", k: "k"})
+    assert printer.expression(dict(out.assignments)[s]).count("y") == 1  # y (3 x + 3 − u): y once
+    assert printer.expression(out.outputs["tau"][0]).count("5") == 1  # 5 (s x + w)
+    for _ in range(3):
+        values = dict(zip((x, y), map(sp.Float, rng.normal(size=2)), strict=True))
+        assert np.allclose(_run(out, values), _run(program, values), rtol=1e-14, atol=0)
