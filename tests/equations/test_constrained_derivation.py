@@ -148,3 +148,20 @@ def test_a_weld_is_derived_its_rotation_rows_by_the_angular_velocity_jacobian_as
     assert "except rows weld.my: the relative angular velocity's Jacobian" in text and "R₁(q) R₂(q)ᵀ" in text
     assert r"\omega_1 - \omega_2" in latex and r"R_1 R_2^\top" in latex
     assert constrained_dict(derivation)["angular_rows"] == ["weld.my"]
+
+
+@pytest.mark.slow
+def test_a_constraint_given_twice_shares_the_wall_force_equally_and_is_stated_as_the_kkt_system(rng):
+    # the Delassus matrix is singular for every q: no closed form (it raised sympy's
+    # NonInvertibleMatrixError before), λ the least-norm solution of the KKT system
+    again = PointContact("end_effector", normal=(-1.0, 0.0, 0.0), friction=0.0, plane_point=(0.8, 0.0, 0.0), name="again")
+    twice = derive_constrained("rp_arm", [WALL, again])
+    assert twice.lam is None and "step 10: λ (2 rows) and q̈ solve that system" in to_text(twice)
+    robot = robodyn.load("rp_arm", constraints=[WALL])
+    for _ in range(3):
+        q, v, tau = robot.random_configuration(rng), rng.normal(size=2), rng.normal(scale=5.0, size=2)
+        a, lam = robot.constrained_forward_dynamics(q, v, tau)
+        qdd, shared = twice.solve(q, v, tau)
+        assert np.abs(qdd - a).max() <= 1e-9 * max(1.0, np.abs(a).max())
+        assert np.abs(shared - lam[0] / 2).max() <= 1e-9 * max(1.0, abs(lam[0]))
+        assert not np.allclose(shared, [lam[0], 0.0], atol=1e-3 * abs(lam[0]))  # the check can fail: all on one
