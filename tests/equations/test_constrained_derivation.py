@@ -137,6 +137,8 @@ def test_a_weld_is_derived_its_rotation_rows_by_the_angular_velocity_jacobian_as
         q, v, tau = rng.uniform(-1.0, 1.0, 2), rng.normal(size=2), rng.normal(scale=3.0, size=2)
         terms = numeric_terms(robot, derivation, q, v, tau)
         assert max(value for key, value in terms.items() if key != "phi") <= 1e-9
+        flipped = replace(derivation, J=-derivation.J, lam=None)  # the check can fail: M q̈ + … = τ − Jᵀ λ
+        assert numeric_terms(robot, flipped, q, v, tau)["lambda"] > 1e-3
         residual = robot.constraint_residual(q)
         shown = np.concatenate([residual[:3], sine_of(residual[3:])])[list(derivation.kept)]
         derived = derivation._numbers(derivation.phi, q[order], v[order], tau[order]).ravel()
@@ -165,3 +167,32 @@ def test_a_constraint_given_twice_shares_the_wall_force_equally_and_is_stated_as
         assert np.abs(qdd - a).max() <= 1e-9 * max(1.0, np.abs(a).max())
         assert np.abs(shared - lam[0] / 2).max() <= 1e-9 * max(1.0, abs(lam[0]))
         assert not np.allclose(shared, [lam[0], 0.0], atol=1e-3 * abs(lam[0]))  # the check can fail: all on one
+
+
+@pytest.mark.slow
+def test_a_constraint_no_configuration_satisfies_is_refused_naming_its_row():
+    floor = PointContact("base_link", normal=(0.0, 0.0, 1.0), friction=0.0, plane_point=(0.0, 0.0, 0.25), name="floor")
+    with pytest.raises(InputError) as refused:
+        derive_constrained("rp_arm", [WALL, floor])  # the fixed base's point is 0.25 m below the plane for every q
+    assert str(refused.value) == (
+        "constraints must be constraints some configuration satisfies, got row floor.n of Φ is the constant -0.25 m for every q."
+    )
+
+
+@pytest.mark.slow
+def test_a_weld_between_two_moving_links_takes_their_relative_angular_velocity(rng):
+    from dataclasses import replace
+
+    # the four-bar's coupler welded to its crank (the loop left open): ω₁ − ω₂ is the coupler
+    # joint's speed alone, against robodyn's numeric J and λ (a sum ω₁ + ω₂ would not be)
+    four_bar = Path(__file__).resolve().parents[1] / "data" / "constraints" / "four_bar.urdf"
+    weld = FrameAnchor("coupler", (0.1, 0.0, 0.0, 0.0, 0.0, 0.0), "crank", name="elbow")
+    derivation = derive_constrained(four_bar, weld, gravity=GRAVITY)
+    robot = robodyn.load(str(four_bar), constraints=[weld], gravity=GRAVITY)
+    assert [derivation.labels[i][1] for i in derivation.angular]  # a rotation row is kept
+    for _ in range(2):
+        q, v, tau = rng.uniform(-1.0, 1.0, 3), rng.normal(size=3), rng.normal(scale=3.0, size=3)
+        terms = numeric_terms(robot, derivation, q, v, tau)
+        assert max(value for key, value in terms.items() if key != "phi") <= 1e-9
+        flipped = replace(derivation, J=-derivation.J, lam=None)  # the check can fail: M q̈ + … = τ − Jᵀ λ
+        assert numeric_terms(robot, flipped, q, v, tau)["lambda"] > 1e-3
