@@ -150,6 +150,11 @@ def test_a_weld_is_derived_its_rotation_rows_by_the_angular_velocity_jacobian_as
     assert "except rows weld.my: the relative angular velocity's Jacobian" in text and "R₁(q) R₂(q)ᵀ" in text
     assert r"\omega_1 - \omega_2" in latex and r"R_1 R_2^\top" in latex
     assert constrained_dict(derivation)["angular_rows"] == ["weld.my"]
+    # the fixed base's link is the world: a weld to it is the same weld
+    to_base = derive_constrained("rp_arm", FrameAnchor("link2", WELD.origin1, "base_link", name="weld"), gravity=GRAVITY)
+    assert to_base.kept == derivation.kept and to_base.angular == derivation.angular
+    for ours, theirs in ((to_base.phi, derivation.phi), (to_base.J, derivation.J), (to_base.Jdot_qd, derivation.Jdot_qd)):
+        assert sp.simplify(ours - theirs) == sp.zeros(*theirs.shape)
 
 
 @pytest.mark.slow
