@@ -43,6 +43,17 @@ def test_the_closed_form_at_rest_is_the_free_body_diagrams_force(derivation):
     assert abs(derivation.multipliers([q1, q2], [0.0, 0.0], tau)[0] - push) < 1e-12 * push
 
 
+def test_a_state_of_another_size_than_the_joints_is_refused(derivation):
+    for q, v, tau in (
+        ([0.1, 0.2, 0.3], [0.0, 0.0], [0.0, 0.0]),
+        ([0.1, 0.2], [0.0], [0.0, 0.0]),
+        ([0.1, 0.2], [0.0, 0.0], [1.0]),
+    ):
+        with pytest.raises(ValueError):
+            derivation.multipliers(q, v, tau)
+    assert derivation.multipliers([0.1, 0.2], [0.0, 0.0], [0.0, 0.0]).shape == (1,)
+
+
 def test_the_steps_are_printed(derivation):
     text = to_text(derivation)
     for step in ("step 7: Φ(q) = 0", "step 8: J = ∂Φ/∂q", "step 10: λ ="):
