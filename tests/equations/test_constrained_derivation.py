@@ -67,6 +67,18 @@ def test_a_sticking_contact_is_refused_saying_what_is_not_derived_and_where_the_
         derive_constrained("rp_arm", PointContact("link2", friction=0.5))
     with pytest.raises(InputError, match="constraints"):
         derive_constrained("rp_arm", PointContact("nowhere", friction=0.0))
+    sticking = [
+        ([WALL, PointContact("link2", friction=0.5)], "constraints[1]", "0.5"),
+        (PointContact("link2", friction=0.8), "constraint", "0.8"),
+    ]
+    for given, name, friction in sticking:
+        with pytest.raises(InputError) as refused:
+            derive_constrained("rp_arm", given)
+        assert str(refused.value) == (
+            f"{name} must be a PointAnchor, a FrameAnchor (weld) or a frictionless PointContact: a sticking contact's "
+            "tangential rows hold a velocity, not a position, and are not derived (with friction 0 its normal row is; "
+            f"without constraints, the open tree's derivation), got a point contact with friction {friction}."
+        )
 
 
 # A loop between two bodies: an arm's tip held on a carriage's pin (oblique slider), gravity
