@@ -54,6 +54,18 @@ def test_a_state_of_another_size_than_the_joints_is_refused(derivation):
     assert derivation.multipliers([0.1, 0.2], [0.0, 0.0], [0.0, 0.0]).shape == (1,)
 
 
+def test_no_constraint_or_something_else_is_refused_before_any_algebra():
+    refusals = {
+        "constraints must be at least one constraint, got none.": [],
+        "constraints must be a PointAnchor, FrameAnchor, PointContact or a list of them, got 42.": 42,
+        "constraints[0] must be a PointAnchor, FrameAnchor or PointContact, got 'x'.": ["x"],
+    }
+    for sentence, given in refusals.items():
+        with pytest.raises(InputError) as refused:
+            derive_constrained("rp_arm", given)
+        assert str(refused.value) == sentence
+
+
 def test_the_steps_are_printed(derivation):
     text = to_text(derivation)
     for step in ("step 7: Φ(q) = 0", "step 8: J = ∂Φ/∂q", "step 10: λ ="):
