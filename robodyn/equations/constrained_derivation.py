@@ -19,7 +19,8 @@ After the Lagrangian derivation of :mod:`robodyn.equations.derivation` (``M``, `
    ``[[M, −Jᵀ], [J, 0]] (q̈, λ) = (τ − C q̇ − G, −J̇ q̇)``;
 10. eliminating ``q̈``: ``λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇)`` in closed form
     when it is small enough to read (at most :data:`CLOSED_FORM_JOINTS` joints and
-    :data:`CLOSED_FORM_ROWS` rows); else ``λ`` is stated as the KKT system's solution.
+    :data:`CLOSED_FORM_ROWS` rows, ``J M⁻¹ Jᵀ`` not singular for every ``q``); else ``λ`` is stated as the
+    KKT system's (least-norm) solution.
 
 The worked example is the RP arm whose tip slides without friction on the wall ``x = c``
 (``PointContact("end_effector", normal=(−1, 0, 0), friction=0, plane_point=(c, 0, 0))``):
@@ -39,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
+from sympy.matrices.exceptions import NonInvertibleMatrixError
 
 from robodyn import reference
 from robodyn.common.text import identifier, printable
@@ -186,6 +188,18 @@ def _refuse_constant_rows(rows: sp.Matrix, q: Sequence[sp.Symbol], constraints: 
             )
 
 
+def _closed_form(steps: DerivationSteps, jacobian: sp.Matrix, drift: sp.Matrix, tau: Sequence[sp.Symbol]) -> sp.Matrix | None:
+    """``λ = −(J M⁻¹ Jᵀ)⁻¹ (J M⁻¹ (τ − C q̇ − G) + J̇ q̇)``, or ``None`` when ``J M⁻¹ Jᵀ`` is
+    singular for every ``q`` (redundant rows, e.g. one constraint given twice: ``λ`` is then
+    the KKT system's least-norm solution, :meth:`ConstrainedDerivation.solve`)."""
+    mass_inverse_jt = steps.M.LUsolve(jacobian.T)
+    free = steps.M.LUsolve(sp.Matrix(tau) - steps.Cv - steps.G)
+    try:
+        return (-(jacobian * mass_inverse_jt).LUsolve(jacobian * free + drift)).applyfunc(sp.simplify)
+    except NonInvertibleMatrixError:
+        return None
+
+
 def derive_constrained(
     source: str | os.PathLike, constraints: object, *, gravity: Sequence[float] | None = None
 ) -> ConstrainedDerivation:
@@ -231,9 +245,7 @@ def derive_constrained(
     tau = tuple(sp.Symbol(identifier(name, taken, prefix="tau_"), real=True) for name in steps.joint_names)
     lam = None
     if len(steps.q) <= CLOSED_FORM_JOINTS and len(kept) <= CLOSED_FORM_ROWS:
-        mass_inverse_jt = steps.M.LUsolve(jacobian.T)
-        free = steps.M.LUsolve(sp.Matrix(tau) - steps.Cv - steps.G)
-        lam = (-(jacobian * mass_inverse_jt).LUsolve(jacobian * free + drift)).applyfunc(sp.simplify)
+        lam = _closed_form(steps, jacobian, drift, tau)
     points = tuple((first.position, second.position) for first, second in ends)
     rotations = tuple(
         sp.simplify(first.rotation * second.rotation.T)

@@ -97,3 +97,18 @@ def test_threads_each_keep_their_own_state(linkage, rng):
     for index, result in enumerate(threaded):
         for ours, theirs in zip(result, serial[index % len(states)], strict=True):
             assert np.allclose(ours, theirs, rtol=0.0, atol=1e-12)
+
+
+def test_no_constraint_gives_rows_of_no_length_and_the_free_dynamics(linkage, rng):
+    robot, _ = linkage
+    q, v, tau = robot.random_configuration(rng), rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    phi, jacobian, drift = constrained.end_frames(robot, ()).compute(q, v)
+    assert (phi.shape, jacobian.shape, drift.shape) == ((0,), (0, robot.nv), (0,))
+    batch = np.array([q, robot.random_configuration(rng)])
+    assert robot.constraint_residual(batch, []).shape == (2, 0)
+    assert robot.constraint_jacobian(batch, []).shape == (2, 0, robot.nv)
+    assert robot.constraint_drift(batch, np.zeros((2, robot.nv)), []).shape == (2, 0)
+    a, lam = robot.constrained_forward_dynamics(q, v, tau, [])
+    assert lam.shape == (0,) and np.allclose(a, robot.forward_dynamics(q, v, tau), rtol=1e-12, atol=1e-12)
+    # the check can fail: with the linkage's own loop the accelerations differ
+    assert not np.allclose(robot.constrained_forward_dynamics(q, v, tau)[0], a, atol=1e-6)

@@ -43,6 +43,29 @@ def test_the_closed_form_at_rest_is_the_free_body_diagrams_force(derivation):
     assert abs(derivation.multipliers([q1, q2], [0.0, 0.0], tau)[0] - push) < 1e-12 * push
 
 
+def test_a_state_of_another_size_than_the_joints_is_refused(derivation):
+    for q, v, tau in (
+        ([0.1, 0.2, 0.3], [0.0, 0.0], [0.0, 0.0]),
+        ([0.1, 0.2], [0.0], [0.0, 0.0]),
+        ([0.1, 0.2], [0.0, 0.0], [1.0]),
+    ):
+        with pytest.raises(ValueError):
+            derivation.multipliers(q, v, tau)
+    assert derivation.multipliers([0.1, 0.2], [0.0, 0.0], [0.0, 0.0]).shape == (1,)
+
+
+def test_no_constraint_or_something_else_is_refused_before_any_algebra():
+    refusals = {
+        "constraints must be at least one constraint, got none.": [],
+        "constraints must be a PointAnchor, FrameAnchor, PointContact or a list of them, got 42.": 42,
+        "constraints[0] must be a PointAnchor, FrameAnchor or PointContact, got 'x'.": ["x"],
+    }
+    for sentence, given in refusals.items():
+        with pytest.raises(InputError) as refused:
+            derive_constrained("rp_arm", given)
+        assert str(refused.value) == sentence
+
+
 def test_the_steps_are_printed(derivation):
     text = to_text(derivation)
     for step in ("step 7: Φ(q) = 0", "step 8: J = ∂Φ/∂q", "step 10: λ ="):
@@ -56,6 +79,18 @@ def test_a_sticking_contact_is_refused_saying_what_is_not_derived_and_where_the_
         derive_constrained("rp_arm", PointContact("link2", friction=0.5))
     with pytest.raises(InputError, match="constraints"):
         derive_constrained("rp_arm", PointContact("nowhere", friction=0.0))
+    sticking = [
+        ([WALL, PointContact("link2", friction=0.5)], "constraints[1]", "0.5"),
+        (PointContact("link2", friction=0.8), "constraint", "0.8"),
+    ]
+    for given, name, friction in sticking:
+        with pytest.raises(InputError) as refused:
+            derive_constrained("rp_arm", given)
+        assert str(refused.value) == (
+            f"{name} must be a PointAnchor, a FrameAnchor (weld) or a frictionless PointContact: a sticking contact's "
+            "tangential rows hold a velocity, not a position, and are not derived (with friction 0 its normal row is; "
+            f"without constraints, the open tree's derivation), got a point contact with friction {friction}."
+        )
 
 
 # A loop between two bodies: an arm's tip held on a carriage's pin (oblique slider), gravity
@@ -137,6 +172,8 @@ def test_a_weld_is_derived_its_rotation_rows_by_the_angular_velocity_jacobian_as
         q, v, tau = rng.uniform(-1.0, 1.0, 2), rng.normal(size=2), rng.normal(scale=3.0, size=2)
         terms = numeric_terms(robot, derivation, q, v, tau)
         assert max(value for key, value in terms.items() if key != "phi") <= 1e-9
+        flipped = replace(derivation, J=-derivation.J, lam=None)  # the check can fail: M q̈ + … = τ − Jᵀ λ
+        assert numeric_terms(robot, flipped, q, v, tau)["lambda"] > 1e-3
         residual = robot.constraint_residual(q)
         shown = np.concatenate([residual[:3], sine_of(residual[3:])])[list(derivation.kept)]
         derived = derivation._numbers(derivation.phi, q[order], v[order], tau[order]).ravel()
@@ -148,3 +185,54 @@ def test_a_weld_is_derived_its_rotation_rows_by_the_angular_velocity_jacobian_as
     assert "except rows weld.my: the relative angular velocity's Jacobian" in text and "R₁(q) R₂(q)ᵀ" in text
     assert r"\omega_1 - \omega_2" in latex and r"R_1 R_2^\top" in latex
     assert constrained_dict(derivation)["angular_rows"] == ["weld.my"]
+    # the fixed base's link is the world: a weld to it is the same weld
+    to_base = derive_constrained("rp_arm", FrameAnchor("link2", WELD.origin1, "base_link", name="weld"), gravity=GRAVITY)
+    assert to_base.kept == derivation.kept and to_base.angular == derivation.angular
+    for ours, theirs in ((to_base.phi, derivation.phi), (to_base.J, derivation.J), (to_base.Jdot_qd, derivation.Jdot_qd)):
+        assert sp.simplify(ours - theirs) == sp.zeros(*theirs.shape)
+
+
+@pytest.mark.slow
+def test_a_constraint_given_twice_shares_the_wall_force_equally_and_is_stated_as_the_kkt_system(rng):
+    # the Delassus matrix is singular for every q: no closed form (it raised sympy's
+    # NonInvertibleMatrixError before), λ the least-norm solution of the KKT system
+    again = PointContact("end_effector", normal=(-1.0, 0.0, 0.0), friction=0.0, plane_point=(0.8, 0.0, 0.0), name="again")
+    twice = derive_constrained("rp_arm", [WALL, again])
+    assert twice.lam is None and "step 10: λ (2 rows) and q̈ solve that system" in to_text(twice)
+    robot = robodyn.load("rp_arm", constraints=[WALL])
+    for _ in range(3):
+        q, v, tau = robot.random_configuration(rng), rng.normal(size=2), rng.normal(scale=5.0, size=2)
+        a, lam = robot.constrained_forward_dynamics(q, v, tau)
+        qdd, shared = twice.solve(q, v, tau)
+        assert np.abs(qdd - a).max() <= 1e-9 * max(1.0, np.abs(a).max())
+        assert np.abs(shared - lam[0] / 2).max() <= 1e-9 * max(1.0, abs(lam[0]))
+        assert not np.allclose(shared, [lam[0], 0.0], atol=1e-3 * abs(lam[0]))  # the check can fail: all on one
+
+
+@pytest.mark.slow
+def test_a_constraint_no_configuration_satisfies_is_refused_naming_its_row():
+    floor = PointContact("base_link", normal=(0.0, 0.0, 1.0), friction=0.0, plane_point=(0.0, 0.0, 0.25), name="floor")
+    with pytest.raises(InputError) as refused:
+        derive_constrained("rp_arm", [WALL, floor])  # the fixed base's point is 0.25 m below the plane for every q
+    assert str(refused.value) == (
+        "constraints must be constraints some configuration satisfies, got row floor.n of Φ is the constant -0.25 m for every q."
+    )
+
+
+@pytest.mark.slow
+def test_a_weld_between_two_moving_links_takes_their_relative_angular_velocity(rng):
+    from dataclasses import replace
+
+    # the four-bar's coupler welded to its crank (the loop left open): ω₁ − ω₂ is the coupler
+    # joint's speed alone, against robodyn's numeric J and λ (a sum ω₁ + ω₂ would not be)
+    four_bar = Path(__file__).resolve().parents[1] / "data" / "constraints" / "four_bar.urdf"
+    weld = FrameAnchor("coupler", (0.1, 0.0, 0.0, 0.0, 0.0, 0.0), "crank", name="elbow")
+    derivation = derive_constrained(four_bar, weld, gravity=GRAVITY)
+    robot = robodyn.load(str(four_bar), constraints=[weld], gravity=GRAVITY)
+    assert [derivation.labels[i][1] for i in derivation.angular]  # a rotation row is kept
+    for _ in range(2):
+        q, v, tau = rng.uniform(-1.0, 1.0, 3), rng.normal(size=3), rng.normal(scale=3.0, size=3)
+        terms = numeric_terms(robot, derivation, q, v, tau)
+        assert max(value for key, value in terms.items() if key != "phi") <= 1e-9
+        flipped = replace(derivation, J=-derivation.J, lam=None)  # the check can fail: M q̈ + … = τ − Jᵀ λ
+        assert numeric_terms(robot, flipped, q, v, tau)["lambda"] > 1e-3
