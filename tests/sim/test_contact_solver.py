@@ -247,3 +247,19 @@ def test_each_setting_out_of_its_range_is_refused_in_one_sentence_and_its_bounds
         ContactSettings(**{field: value})
     assert str(caught.value) == sentence and caught.value.argument == field
     assert ContactSettings(baumgarte=1, tolerance=1e-300, max_iterations=1).baumgarte == 1  # the bounds: accepted
+
+
+def test_last_steps_sticking_impulses_keep_their_modes_without_admm_when_the_problem_changed():
+    """Two feet sticking last step; this step the free velocity changed (the joints moved):
+    last step's impulses, inside their cones, keep both feet sticking — the answer is this
+    step's sticking impulses (``u = A p + c = 0``, inside the cones) with no ADMM iteration.
+    Read by their velocities instead, the feet would slip (the change moves them): ADMM
+    would run (the negative control: ``cone=False``'s reading alone declines them)."""
+    delassus, friction = _problem(np.random.default_rng(12), 2)[0], 0.8
+    sticking = np.array([0.1, -0.05, 1.0, -0.08, 0.12, 0.7])  # this step's, inside the cones
+    velocity = -delassus @ sticking
+    previous = sticking + np.array([0.15, 0.1, 0.2, 0.1, -0.2, -0.1])  # last step's, inside the cones too
+    impulses, iterations, converged = solve_impulses(delassus, velocity, friction, ContactSettings(), previous)
+    assert iterations == 0 and converged
+    assert np.abs(impulses - sticking).max() < 1e-12 and np.abs(delassus @ impulses + velocity).max() < 1e-12
+    assert polish(delassus, velocity, friction, previous) is None  # the velocities' reading: slipping
