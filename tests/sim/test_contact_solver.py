@@ -263,3 +263,27 @@ def test_last_steps_sticking_impulses_keep_their_modes_without_admm_when_the_pro
     assert iterations == 0 and converged
     assert np.abs(impulses - sticking).max() < 1e-12 and np.abs(delassus @ impulses + velocity).max() < 1e-12
     assert polish(delassus, velocity, friction, previous) is None  # the velocities' reading: slipping
+
+
+def _residual(delassus, velocity, friction, impulses):
+    """The cone complementarity problem's largest violation: ``|p · û|``, the cone, ``u_n < 0``."""
+    u, worst = delassus @ impulses + velocity, 0.0
+    for p, ui in zip(impulses.reshape(-1, 3), u.reshape(-1, 3), strict=True):
+        desaxce = ui + np.array([0.0, 0.0, friction * np.hypot(*ui[:2])])
+        worst = max(worst, abs(p @ desaxce), np.hypot(*p[:2]) - friction * p[2], -ui[2])
+    return worst
+
+
+def test_admms_loose_answer_is_polished_exact_and_left_as_it_is_without_the_polish():
+    """Two contacts sticking and one lifting off (an answer built first, its free velocity
+    from it); ADMM stopped at a loose tolerance (1e-7): polished, the answer is the built
+    one to round-off; with ``polish=False`` it is ADMM's own, off by about its tolerance
+    (the negative control: the residual sees the difference)."""
+    delassus, friction = _problem(np.random.default_rng(21), 3)[0], 0.8
+    answer = np.array([0.2, -0.1, 1.0, -0.3, 0.25, 0.9, 0.0, 0.0, 0.0])  # inside the cones, the last open
+    velocity = np.r_[np.zeros(6), 0.3, -0.2, 0.5] - delassus @ answer
+    exact, iterations, converged = solve_impulses(delassus, velocity, friction, ContactSettings(tolerance=1e-7))
+    assert converged and iterations > 0 and np.abs(exact - answer).max() < 1e-12
+    assert _residual(delassus, velocity, friction, exact) < 1e-12
+    raw = solve_impulses(delassus, velocity, friction, ContactSettings(tolerance=1e-7, polish=False))[0]
+    assert 1e-9 < _residual(delassus, velocity, friction, raw) < 1e-2
