@@ -11,7 +11,7 @@ import pytest
 import robodyn
 from robodyn.compiled import build
 from robodyn.compiled import contact as compiled_contact
-from robodyn.exceptions import CompilerNotFoundError
+from robodyn.exceptions import CompilerNotFoundError, SingularMassMatrixError
 from robodyn.sim import contact
 from robodyn.sim.contact import ContactSettings, ContactStepper, contact_kinematics, contact_step, generic_step
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
@@ -278,3 +278,20 @@ def test_limit_rows_step_in_the_stepper_as_in_the_general_step_and_the_compiled_
     weight = MASS * abs(GRAVITY[2]) * LEVER * np.cos(UPPER)  # gravity's torque about the hinge, [N m]
     assert abs(runs[0][-1][2][1] / (weight * dt) - 1) < 1e-9  # the upper stop's impulse carries it
     assert compiled is None or (calls and not any(calls))  # the C step tried, never with a row in reach
+
+
+def test_a_singular_mass_matrix_is_refused_by_both_steps_in_one_sentence_naming_the_robot():
+    """A link that moves no mass (the tip of tests/sim/test_limits.py's arm): the general
+    step (``M`` solved) and the stepper (``M⁻¹`` not finite) refuse it alike."""
+    from tests.sim.test_limits import MASSLESS_TIP
+
+    robot, ground = robodyn.load(MASSLESS_TIP), Ground(height=-1.0)
+    points, zeros = (ContactPoint("tip", "l1", (0.4, 0.0, 0.0)),), np.zeros(2)
+    sentence = (
+        "robot 'massless_tip': the mass matrix is singular, so forward dynamics is undefined (the accelerations are not finite)."
+    )
+    with pytest.raises(SingularMassMatrixError) as general:
+        generic_step(robot, zeros, zeros, zeros, 1e-3, ground, points, ContactSettings(), None)
+    with pytest.raises(SingularMassMatrixError) as fast:
+        ContactStepper(robot, ground, points).step(zeros, zeros, zeros, 1e-3, ContactSettings(), None)
+    assert str(general.value) == str(fast.value) == sentence and general.value.joints == fast.value.joints == []
