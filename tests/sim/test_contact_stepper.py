@@ -295,3 +295,15 @@ def test_a_singular_mass_matrix_is_refused_by_both_steps_in_one_sentence_naming_
     with pytest.raises(SingularMassMatrixError) as fast:
         ContactStepper(robot, ground, points).step(zeros, zeros, zeros, 1e-3, ContactSettings(), None)
     assert str(general.value) == str(fast.value) == sentence and general.value.joints == fast.value.joints == []
+
+
+def test_a_mimic_arm_with_no_contact_point_steps_freely_by_its_forward_dynamics():
+    """No contact point (the general step: a mimic robot): no row at all, and the step is
+    semi-implicit Euler of the forward dynamics, ``v⁺ = v + dt a(q, v, τ)``."""
+    arm = robodyn.load(DATA.parent / "mimic_arm.urdf", gravity=(0.4, -0.3, -7.5))
+    q, v, tau = np.full(arm.nq, 0.2), np.linspace(-0.5, 0.5, arm.nv), np.linspace(0.3, -0.1, arm.nv)
+    gaps, jacobian = contact_kinematics(arm, q, Ground(), ())
+    assert gaps.shape == (0,) and jacobian.shape == (0, arm.nv)
+    step = contact_step(arm, q, v, tau, 1e-3, Ground(), ())
+    assert step.forces.shape == (0, 3)
+    assert np.abs(step.v - (v + 1e-3 * arm.forward_dynamics(q, v, tau))).max() < 1e-12
