@@ -307,3 +307,32 @@ def test_a_mimic_arm_with_no_contact_point_steps_freely_by_its_forward_dynamics(
     step = contact_step(arm, q, v, tau, 1e-3, Ground(), ())
     assert step.forces.shape == (0, 3)
     assert np.abs(step.v - (v + 1e-3 * arm.forward_dynamics(q, v, tau))).max() < 1e-12
+
+
+def test_without_the_polish_standing_is_admms_even_where_the_compiled_step_could_take_it(solo):
+    """``polish=False`` asks for ADMM's answer: solo12 standing, from last step's impulses
+    off by 10 %, the stepper runs ADMM (iterations > 0), neither the compiled step of kept
+    modes nor numpy's polish; with the polish, the kept modes answer at once (0 iterations,
+    the negative control)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    ground, q = Ground(friction=0.8), solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, ground, points)[0].min()  # the feet on the ground
+    v, tau = np.zeros(solo.nv), np.zeros(solo.nv)
+    stepper, guess = ContactStepper(solo, ground, points), None
+    for _ in range(20):  # landed, standing
+        step = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+        q, v, guess = step.q, step.v, step.impulses
+    assert stepper.step(q, v, tau, 1e-3, ContactSettings(polish=False), 1.1 * guess).iterations > 0
+    assert stepper.step(q, v, tau, 1e-3, ContactSettings(), 1.1 * guess).iterations == 0
+
+
+def test_a_torque_too_large_to_integrate_is_a_diverged_run_not_a_singular_mass_matrix(box):
+    """1e200 N on the box: the free velocity overflows, the mass matrix is fine — the run
+    says it diverged (a smaller step), never that ``M`` is singular."""
+    from robodyn.exceptions import SimulationError
+    from robodyn.sim.contact_run import simulate_contact
+
+    q = box.neutral_configuration()
+    q[2] = 0.05
+    with np.errstate(all="ignore"), pytest.raises(SimulationError, match="diverged at t = 0 s"):
+        simulate_contact(box, ground=Ground(friction=0.5), duration=0.01, q0=q, controller=lambda t, q, v: np.full(6, 1e200))
