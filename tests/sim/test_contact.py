@@ -276,3 +276,13 @@ def test_a_mimic_arm_driven_into_its_elbow_stop_stays_on_it_when_limits_are_enfo
     assert abs(held.trajectory.q[:, elbow].max() - 2.0) < 1e-12 and abs(held.trajectory.q[-1, elbow] - 2.0) < 1e-12
     assert (held.iterations[-20:] == 0).all()
     assert simulate_contact(arm, limits="warn", **options).trajectory.q[:, elbow].max() > 2.5
+
+
+def test_a_pendulum_resting_on_its_stop_keeps_last_steps_modes_without_admm():
+    """The stepper's path (no mimic joint): once the stop pendulum of
+    tests/sim/test_contact_limits.py rests on its stop, each step is last step's modes kept,
+    the stop's impulse warm-started (no ADMM iteration), and the stop carries gravity."""
+    from tests.sim.test_contact_limits import _drop
+
+    run = _drop("enforce")
+    assert (run.iterations[-50:] == 0).all() and abs(run.trajectory.v[-1, 0]) < 1e-9
