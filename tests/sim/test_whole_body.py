@@ -335,3 +335,35 @@ def test_a_call_keeps_the_qps_contact_forces_which_carry_the_weight():
     tau = control(0.0, q, np.zeros(robot.nv))
     forces = control.last_forces.reshape(-1, 3)
     assert abs(forces[:, 2].sum() / (robot.total_mass * 9.81) - 1) < 1e-6 and np.abs(tau[:6]).max() == 0.0
+
+
+def test_the_qps_acceleration_makes_the_centre_of_mass_and_attitude_follow_their_pd_laws():
+    """solo12 moving (its base turned 0.1 rad, every joint and the base with a velocity), the
+    posture's weight 0: the QP's ``v̇`` gives ``c̈ = Kp (c_d − c) − Kd ċ`` and
+    ``ω̇ = Kp log(R_d Rᵀ) − Kd ω`` (world axes), both read by central differences of the
+    motion ``q ⊕ (v t + v̇ t²/2)`` (the centre of mass and the base's rotation, not the QP's
+    rows). Negative control: the laws with ``+Kd`` are off by ``2 Kd ċ``, ``2 Kd ω``."""
+    import pinocchio as pin
+
+    robot, q, feet = standing()
+    start = robot.floating_configuration(list(q[:3]), [0.05, -0.08, 0.04], list(q[7:]))
+    v = np.r_[0.03, -0.02, 0.01, 0.2, -0.1, 0.15, np.linspace(-0.3, 0.3, robot.nv - 6)]
+    target = robot.center_of_mass(q) + np.array([0.01, -0.005, 0.004])
+    stand = Stand(robot, feet, target, np.eye(3), q, kp=100.0, kd=20.0, weights=(1.0, 1.0, 0.0))
+    acceleration = stand.solve(start, v)[0]
+    h = 1e-4
+
+    def at(t: float) -> np.ndarray:
+        return pin.integrate(robot.model, start, v * t + 0.5 * acceleration * t**2)
+
+    centres = [robot.center_of_mass(at(t)) for t in (-h, 0.0, h)]
+    velocity, com_acceleration = (centres[2] - centres[0]) / (2 * h), (centres[2] - 2 * centres[1] + centres[0]) / h**2
+    rotations = [_rotation_of(at(t)) for t in (-h, 0.0, h)]
+    ahead, behind = pin.log3(rotations[2] @ rotations[1].T), pin.log3(rotations[1] @ rotations[0].T)
+    omega, omega_dot = (ahead + behind) / (2 * h), (ahead - behind) / h**2
+    com_law = 100.0 * (target - centres[1]) - 20.0 * velocity
+    attitude_law = 100.0 * pin.log3(rotations[1].T) - 20.0 * omega
+    assert np.abs(com_acceleration - com_law).max() < 1e-5 * np.abs(com_law).max()
+    assert np.abs(omega_dot - attitude_law).max() < 1e-5 * np.abs(attitude_law).max()
+    assert np.abs(com_acceleration - (com_law + 40.0 * velocity)).max() > 0.1 * np.abs(com_law).max()  # the negative control
+    assert np.abs(omega_dot - (attitude_law + 40.0 * omega)).max() > 0.1 * np.abs(attitude_law).max()
