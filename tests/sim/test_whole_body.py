@@ -342,7 +342,8 @@ def test_the_qps_acceleration_makes_the_centre_of_mass_and_attitude_follow_their
     posture's weight 0: the QP's ``v̇`` gives ``c̈ = Kp (c_d − c) − Kd ċ`` and
     ``ω̇ = Kp log(R_d Rᵀ) − Kd ω`` (world axes), both read by central differences of the
     motion ``q ⊕ (v t + v̇ t²/2)`` (the centre of mass and the base's rotation, not the QP's
-    rows). Negative control: the laws with ``+Kd`` are off by ``2 Kd ċ``, ``2 Kd ω``."""
+    rows); the feet, moving, do not accelerate. Negative control: the laws with ``+Kd`` are
+    off by ``2 Kd ċ``, ``2 Kd ω``."""
     import pinocchio as pin
 
     robot, q, feet = standing()
@@ -366,4 +367,24 @@ def test_the_qps_acceleration_makes_the_centre_of_mass_and_attitude_follow_their
     assert np.abs(com_acceleration - com_law).max() < 1e-5 * np.abs(com_law).max()
     assert np.abs(omega_dot - attitude_law).max() < 1e-5 * np.abs(attitude_law).max()
     assert np.abs(com_acceleration - (com_law + 40.0 * velocity)).max() > 0.1 * np.abs(com_law).max()  # the negative control
+    for foot in FEET:  # the feet do not accelerate (Jc v̇ + J̇c v = 0), though they move
+        points = [robot.frame_position(at(t), foot) for t in (-h, 0.0, h)]
+        assert np.abs(points[2] - 2 * points[1] + points[0]).max() / h**2 < 1e-5 < np.abs(points[2] - points[0]).max() / (2 * h)
     assert np.abs(omega_dot - (attitude_law + 40.0 * omega)).max() > 0.1 * np.abs(attitude_law).max()
+
+
+def test_torque_limits_that_bind_hold_exactly_on_both_sides_and_slack_ones_leave_the_stand_at_rest():
+    """solo12 at rest with every joint limited to half the largest torque the unlimited QP
+    asks: the torques reach the limit on both sides and never pass it (the tasks then give
+    way: the base accelerates); limited to twice that torque (slack), the QP holds the robot
+    at rest as without limits."""
+    robot, q, feet = standing()
+    centre, rest = robot.center_of_mass(q), np.zeros(robot.nv)
+    largest = np.abs(Stand(robot, feet, centre, np.eye(3), q).solve(q, rest)[1]).max()
+    acceleration, torques, _ = Stand(robot, feet, centre, np.eye(3), q, torque_limit=0.5 * largest).solve(q, rest)
+    ratio = torques / (0.5 * largest)
+    assert ratio.max() <= 1 + 1e-9 and ratio.min() >= -1 - 1e-9  # never past it
+    assert ratio.max() > 1 - 1e-6 and ratio.min() < -1 + 1e-6  # reached on both sides
+    assert np.abs(acceleration).max() > 1.0  # the tasks gave way
+    slack = Stand(robot, feet, centre, np.eye(3), q, torque_limit=2.0 * largest).solve(q, rest)
+    assert np.abs(slack[0]).max() < 1e-6 and np.abs(slack[1]).max() < 2.0 * largest
