@@ -329,12 +329,13 @@ def test_an_orientation_that_is_no_rotation_is_refused_in_one_sentence_and_a_rot
     assert np.abs(Stand(robot, feet, centre, turned.tolist(), q).orientation - turned).max() == 0.0
 
 
-def test_a_call_keeps_the_qps_contact_forces_which_carry_the_weight():
+def test_a_call_keeps_the_qps_contact_forces_which_carry_the_weight_and_prints_nothing(capfd):
     robot, q, feet = standing()
     control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
     tau = control(0.0, q, np.zeros(robot.nv))
     forces = control.last_forces.reshape(-1, 3)
     assert abs(forces[:, 2].sum() / (robot.total_mass * 9.81) - 1) < 1e-6 and np.abs(tau[:6]).max() == 0.0
+    assert capfd.readouterr() == ("", "")  # the solver's log stays off
 
 
 def test_the_qps_acceleration_makes_the_centre_of_mass_and_attitude_follow_their_pd_laws():
@@ -388,3 +389,35 @@ def test_torque_limits_that_bind_hold_exactly_on_both_sides_and_slack_ones_leave
     assert np.abs(acceleration).max() > 1.0  # the tasks gave way
     slack = Stand(robot, feet, centre, np.eye(3), q, torque_limit=2.0 * largest).solve(q, rest)
     assert np.abs(slack[0]).max() < 1e-6 and np.abs(slack[1]).max() < 2.0 * largest
+
+
+def test_a_qp_without_solution_is_refused_in_one_sentence_naming_the_state():
+    """Feet of friction 0.01 and torques of at most 1 mN m: no force in the cones carries
+    solo12 (the negative control: the same feet with the model's torques can)."""
+    robot, q, feet = standing(0.01)
+    rest = np.zeros(robot.nv)
+    with pytest.raises(InputError) as caught:
+        Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q, torque_limit=1e-3).solve(q, rest)
+    assert str(caught.value) == (
+        "q must be a state from which the contacts can carry the robot within their cones and torque limits, "
+        "got a QP PrimalInfeasible (a leg stretched, a push beyond friction)."
+    )
+    assert np.abs(Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q).solve(q, rest)[0]).max() < 1e-6
+
+
+def test_without_clarabel_the_stand_names_the_extra_to_install(monkeypatch):
+    import sys
+
+    from robodyn.exceptions import MissingExtraError
+
+    robot, q, feet = standing()
+    stand = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    for module in ("clarabel", "scipy.sparse"):
+        with monkeypatch.context() as patch:
+            patch.setitem(sys.modules, module, None)  # its import fails
+            with pytest.raises(MissingExtraError) as caught:
+                stand.solve(q, np.zeros(robot.nv))
+        assert str(caught.value) == (
+            f"the whole-body controller's QP need {module!r}, which is not installed: the 'robodyn[ident]' extra "
+            "(pip install '.[ident]' in a clone of robodyn)."
+        )
