@@ -153,3 +153,4 @@ def test_each_stand_it_cannot_do_is_refused_in_one_sentence_naming_the_parameter
         caught.value.argument == "target"
         and caught.value.received == f"{table.center_of_mass(placed)[0] + 1.0 - 0.2:.3g} m outside it"
     )
+    assert caught.value.expected == "a centre of mass shift that stays over the support polygon of the feet"
