@@ -258,3 +258,31 @@ def test_a_box_thrown_tumbling_loses_energy_at_every_step_and_rests_on_a_face(bo
     assert run.slip[run.active].max() > 0.1  # it slid and rolled over edges on the way
     assert run.active[-1].sum() == 4 and abs(run.normal_forces[-1].sum() / (MASS * G) - 1) < 1e-6
     assert run.trajectory.q[-1, 2] == pytest.approx(HALF_HEIGHT, abs=1e-9)
+
+
+def test_a_mimic_arm_driven_into_its_elbow_stop_stays_on_it_when_limits_are_enforced():
+    """The mimic arm (the general step) driven by 5 N m into its elbow's upper limit (2 rad),
+    its fingertip a contact point far above the ground: enforced, the elbow stops exactly at
+    2 rad and rests there, each step keeping last step's modes (no ADMM iteration); warned
+    (the negative control), it swings past the stop."""
+    arm = robodyn.load(DATA.parent / "mimic_arm.urdf", gravity=(0.4, -0.3, -7.5))
+    tip, elbow = ContactPoint("fingertip", "tip", (0.1, 0.0, 0.0)), arm.joint_names.index("elbow")
+
+    def drive(t, q, v):
+        return np.where(np.arange(arm.nv) == elbow, 5.0, 0.0) - 0.5 * v
+
+    options = {"ground": Ground(height=-5.0), "contacts": [tip], "duration": 0.3, "q0": np.array([0.0, 1.8]), "controller": drive}
+    held = simulate_contact(arm, limits="enforce", **options)
+    assert abs(held.trajectory.q[:, elbow].max() - 2.0) < 1e-12 and abs(held.trajectory.q[-1, elbow] - 2.0) < 1e-12
+    assert (held.iterations[-20:] == 0).all()
+    assert simulate_contact(arm, limits="warn", **options).trajectory.q[:, elbow].max() > 2.5
+
+
+def test_a_pendulum_resting_on_its_stop_keeps_last_steps_modes_without_admm():
+    """The stepper's path (no mimic joint): once the stop pendulum of
+    tests/sim/test_contact_limits.py rests on its stop, each step is last step's modes kept,
+    the stop's impulse warm-started (no ADMM iteration), and the stop carries gravity."""
+    from tests.sim.test_contact_limits import _drop
+
+    run = _drop("enforce")
+    assert (run.iterations[-50:] == 0).all() and abs(run.trajectory.v[-1, 0]) < 1e-9

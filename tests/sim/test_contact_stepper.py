@@ -11,7 +11,7 @@ import pytest
 import robodyn
 from robodyn.compiled import build
 from robodyn.compiled import contact as compiled_contact
-from robodyn.exceptions import CompilerNotFoundError
+from robodyn.exceptions import CompilerNotFoundError, SingularMassMatrixError
 from robodyn.sim import contact
 from robodyn.sim.contact import ContactSettings, ContactStepper, contact_kinematics, contact_step, generic_step
 from robodyn.sim.ground import ContactPoint, Ground, contact_points
@@ -278,3 +278,61 @@ def test_limit_rows_step_in_the_stepper_as_in_the_general_step_and_the_compiled_
     weight = MASS * abs(GRAVITY[2]) * LEVER * np.cos(UPPER)  # gravity's torque about the hinge, [N m]
     assert abs(runs[0][-1][2][1] / (weight * dt) - 1) < 1e-9  # the upper stop's impulse carries it
     assert compiled is None or (calls and not any(calls))  # the C step tried, never with a row in reach
+
+
+def test_a_singular_mass_matrix_is_refused_by_both_steps_in_one_sentence_naming_the_robot():
+    """A link that moves no mass (the tip of tests/sim/test_limits.py's arm): the general
+    step (``M`` solved) and the stepper (``M⁻¹`` not finite) refuse it alike."""
+    from tests.sim.test_limits import MASSLESS_TIP
+
+    robot, ground = robodyn.load(MASSLESS_TIP), Ground(height=-1.0)
+    points, zeros = (ContactPoint("tip", "l1", (0.4, 0.0, 0.0)),), np.zeros(2)
+    sentence = (
+        "robot 'massless_tip': the mass matrix is singular, so forward dynamics is undefined (the accelerations are not finite)."
+    )
+    with pytest.raises(SingularMassMatrixError) as general:
+        generic_step(robot, zeros, zeros, zeros, 1e-3, ground, points, ContactSettings(), None)
+    with pytest.raises(SingularMassMatrixError) as fast:
+        ContactStepper(robot, ground, points).step(zeros, zeros, zeros, 1e-3, ContactSettings(), None)
+    assert str(general.value) == str(fast.value) == sentence and general.value.joints == fast.value.joints == []
+
+
+def test_a_mimic_arm_with_no_contact_point_steps_freely_by_its_forward_dynamics():
+    """No contact point (the general step: a mimic robot): no row at all, and the step is
+    semi-implicit Euler of the forward dynamics, ``v⁺ = v + dt a(q, v, τ)``."""
+    arm = robodyn.load(DATA.parent / "mimic_arm.urdf", gravity=(0.4, -0.3, -7.5))
+    q, v, tau = np.full(arm.nq, 0.2), np.linspace(-0.5, 0.5, arm.nv), np.linspace(0.3, -0.1, arm.nv)
+    gaps, jacobian = contact_kinematics(arm, q, Ground(), ())
+    assert gaps.shape == (0,) and jacobian.shape == (0, arm.nv)
+    step = contact_step(arm, q, v, tau, 1e-3, Ground(), ())
+    assert step.forces.shape == (0, 3)
+    assert np.abs(step.v - (v + 1e-3 * arm.forward_dynamics(q, v, tau))).max() < 1e-12
+
+
+def test_without_the_polish_standing_is_admms_even_where_the_compiled_step_could_take_it(solo):
+    """``polish=False`` asks for ADMM's answer: solo12 standing, from last step's impulses
+    off by 10 %, the stepper runs ADMM (iterations > 0), neither the compiled step of kept
+    modes nor numpy's polish; with the polish, the kept modes answer at once (0 iterations,
+    the negative control)."""
+    points = tuple(ContactPoint(foot, foot, (0.0, 0.0, 0.0), 1e-4) for foot in FEET)
+    ground, q = Ground(friction=0.8), solo.neutral_configuration()
+    q[2] -= contact_kinematics(solo, q, ground, points)[0].min()  # the feet on the ground
+    v, tau = np.zeros(solo.nv), np.zeros(solo.nv)
+    stepper, guess = ContactStepper(solo, ground, points), None
+    for _ in range(20):  # landed, standing
+        step = stepper.step(q, v, tau, 1e-3, ContactSettings(), guess)
+        q, v, guess = step.q, step.v, step.impulses
+    assert stepper.step(q, v, tau, 1e-3, ContactSettings(polish=False), 1.1 * guess).iterations > 0
+    assert stepper.step(q, v, tau, 1e-3, ContactSettings(), 1.1 * guess).iterations == 0
+
+
+def test_a_torque_too_large_to_integrate_is_a_diverged_run_not_a_singular_mass_matrix(box):
+    """1e200 N on the box: the free velocity overflows, the mass matrix is fine — the run
+    says it diverged (a smaller step), never that ``M`` is singular."""
+    from robodyn.exceptions import SimulationError
+    from robodyn.sim.contact_run import simulate_contact
+
+    q = box.neutral_configuration()
+    q[2] = 0.05
+    with np.errstate(all="ignore"), pytest.raises(SimulationError, match="diverged at t = 0 s"):
+        simulate_contact(box, ground=Ground(friction=0.5), duration=0.01, q0=q, controller=lambda t, q, v: np.full(6, 1e200))

@@ -97,3 +97,21 @@ def test_hybrid_options_with_another_controller_are_refused():
     with pytest.raises(InputError) as caught:
         run_named(robodyn.load("rp_arm"), controller="passive", surface=WALL, duration=0.02)
     assert caught.value.argument == "surface"
+
+
+def test_a_given_start_on_the_surface_is_the_runs_first_state_and_its_step_is_the_given_one():
+    """The default start projected onto the wall, given back as ``q0``: the run starts there
+    (not at the default configuration) and steps by the given ``dt``; the same start 1 cm off
+    the wall is refused naming ``q0`` with its gap."""
+    robot = robodyn.load("rp_arm")
+    first, _ = run_hybrid(robot, force=1.0, surface=WALL, duration=0.02, dt=0.01)
+    on_wall = first.q[0]
+    assert np.abs(on_wall - robot.default_configuration()).max() > 1e-3  # the projection moved it
+    trajectory, _ = run_hybrid(robot, force=1.0, surface=WALL, q0=on_wall, duration=0.04, dt=0.02)
+    assert np.abs(trajectory.q[0] - on_wall).max() < 1e-12 and np.allclose(np.diff(trajectory.t), 0.02)
+    off = on_wall.copy()
+    off[1] += 0.01  # the prismatic joint: the tip leaves the wall
+    gap = float(-(robot.frame_position(off, "end_effector")[0] - 1.0))
+    with pytest.raises(InputError) as caught:
+        run_hybrid(robot, force=1.0, surface=WALL, q0=off, duration=0.02, dt=0.01)
+    assert caught.value.argument == "q0" and caught.value.received == f"{gap:.3g} m off it" and abs(gap) > 1e-4

@@ -7,13 +7,16 @@ An actuator without a limit (MJCF's motor without ctrlrange, a URDF's effort 0) 
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 import robodyn
 from robodyn.exceptions import ControllerFailedError, InputError
 from robodyn.sim.experiment import run_simulation
-from robodyn.sim.ground import Ground
+from robodyn.sim.ground import Ground, contact_points
+from robodyn.sim.stand_run import RecordedStand, stand_law
 
 # A floating table on four sphere feet with a nodding head (a sphere 0.3 m above the ground).
 TABLE = """<mujoco model="table_with_head">
@@ -66,3 +69,88 @@ def test_a_qp_without_solution_stops_the_run_saying_when(tmp_path):
     slope = Ground.tilted(0.5, friction=0.1)  # μ = 0.1 < tan 0.5: no force in the cones holds it
     with pytest.raises(ControllerFailedError, match=r"stopped at t = 0 s \(step 0\): the controller failed \(the whole-body QP"):
         run_simulation(table, controller="stand", ground=slope, q0=q0, duration=0.01)
+
+
+class _Law:
+    """A stand law's stand-in: two feet, forces of its own, failing on a negative time."""
+
+    contacts = ("front", "back")
+    model = SimpleNamespace(dofs=[SimpleNamespace(joint=name) for name in ("base_x", "hip", "knee")])
+    compensate_damping = False
+
+    def __init__(self) -> None:
+        self.seen: list[float] = []
+        self.last_forces = np.zeros(6)
+
+    def __call__(self, t, q, v):
+        if t < 0:
+            raise InputError("q", "a state from which the contacts can carry the robot", "a QP PrimalInfeasible")
+        self.seen.append(t)
+        self.last_forces = np.arange(6.0) + t
+        return -v
+
+
+def test_the_recorded_stand_files_each_calls_forces_under_its_feet_and_holds_the_last_one_in_force():
+    """Feet 0 and 2 of three contact points: each call's QP forces land on them (the middle
+    point carries none); ``held`` gives the forces of the last call at or before each time
+    (before the first call: the first; between calls: the earlier; after: the last)."""
+    law = _Law()
+    recorded = RecordedStand(law, feet=[0, 2], count=3)
+    for t in (0.0, 0.01, 0.02):
+        assert np.array_equal(recorded(t, np.zeros(3), np.array([0.1, -0.2, 0.0])), [-0.1, 0.2, 0.0])
+    assert law.seen == [0.0, 0.01, 0.02] and recorded.times == [0.0, 0.01, 0.02]
+    assert np.array_equal(recorded.forces[1].reshape(3, 3), [[0.01, 1.01, 2.01], [0, 0, 0], [3.01, 4.01, 5.01]])
+    held = recorded.held(np.array([-0.005, 0.0, 0.005, 0.01, 0.015, 0.02, 0.5]))
+    assert held.shape == (7, 3, 3)
+    assert np.array_equal(held[:, 0, 0], [0.0, 0.0, 0.0, 0.01, 0.01, 0.02, 0.02])
+    every = RecordedStand(_Law())  # every contact a foot
+    every(0.0, np.zeros(3), np.zeros(3))
+    assert every.feet == [0, 1] and every.count == 2 and np.array_equal(every.forces[0], np.arange(6.0))
+
+
+def test_a_qp_failing_mid_run_names_the_time_the_step_and_the_fastest_joint():
+    recorded = RecordedStand(_Law())
+    recorded(0.0, np.zeros(3), np.zeros(3))
+    with pytest.raises(ControllerFailedError) as caught:
+        recorded(-1.0, np.zeros(3), np.array([0.1, -0.7, 0.3]))
+    error = caught.value
+    assert (error.time, error.step, error.joint, error.speed) == (-1.0, 1, "hip", -0.7)
+    assert error.reason == "the whole-body QP: a QP PrimalInfeasible, a state from which the contacts can carry the robot"
+
+
+def test_each_stand_it_cannot_do_is_refused_in_one_sentence_naming_the_parameter(tmp_path):
+    path = tmp_path / "table.xml"
+    path.write_text(TABLE)
+    table, arm = robodyn.load(str(path)), robodyn.load("rp_arm")
+    start = table.neutral_configuration()
+    cases = [
+        ((arm, arm, arm.neutral_configuration(), None, Ground(), "collision"), "controller",
+         "controller must be another controller than 'stand' for a fixed-base robot (stand holds a floating one on its feet), got 'rp_arm'."),
+        ((table, table, start, None, None, "collision"), "ground",
+         "ground must be given for the stand controller (the robot stands on it), got no ground."),
+        ((table, table, start, None, Ground(friction=0.0), "collision"), "friction",
+         "friction must be a coefficient > 0 for the stand controller (its feet stick), got 0.0."),
+        ((table, table, start, [0.0, 0.01], Ground(), "collision"), "target",
+         "target must be DX,DY,DZ in [m] (the centre of mass's shift) for the stand controller, got 2 values."),
+        ((table, table, start, [0.0, 0.0, float("nan")], Ground(), "collision"), "target",
+         "target must be DX,DY,DZ in [m] (the centre of mass's shift) for the stand controller, got 3 values."),
+    ]  # fmt: skip
+    for arguments, parameter, sentence in cases:
+        with pytest.raises(InputError) as caught:
+            stand_law(*arguments)
+        assert caught.value.argument == parameter and str(caught.value) == sentence
+    law, placed, line = stand_law(table, table, start, [0.01, 0.0, 0.0], Ground(), "collision")  # the negative control
+    assert len(law.law.contacts) == 4 and law.count == 5 and law.feet == [0, 1, 2, 3]
+    assert np.abs(law.law.com - table.center_of_mass(placed) - [0.01, 0.0, 0.0]).max() < 1e-15
+    assert line.startswith("start: the base moved ")
+    assert line.endswith("; feet: the 4 of 5 contact points within 0.001 m of the ground at the start")
+    points = contact_points(table, "collision").points
+    for foot, point in zip(law.law.contacts, points[:4], strict=True):  # each sphere's lowest point, its name
+        assert foot.name == point.name and abs(foot.point[2] - (point.position[2] - point.radius)) < 1e-15
+    with pytest.raises(InputError) as caught:
+        stand_law(table, table, start, [1.0, 0.0, 0.0], Ground(), "collision")
+    assert (
+        caught.value.argument == "target"
+        and caught.value.received == f"{table.center_of_mass(placed)[0] + 1.0 - 0.2:.3g} m outside it"
+    )
+    assert caught.value.expected == "a centre of mass shift that stays over the support polygon of the feet"

@@ -7,6 +7,7 @@ reached; the negative control drops the cone from the QP and its forces leave th
 from __future__ import annotations
 
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +19,7 @@ from robodyn.sim.constrained import simulate_constrained
 from robodyn.sim.whole_body import Stand, friction_cone_margin, support_margin, support_polygon
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+DATA = Path(__file__).parents[1] / "data" / "contact"
 LEGS = np.array([0.0, 0.8, -1.6, 0.0, 0.8, -1.6, 0.0, -0.8, 1.6, 0.0, -0.8, 1.6])
 GRAVITY = 9.81
 
@@ -234,3 +236,188 @@ def test_on_real_ground_a_pushed_robot_recovers_without_a_foot_slipping_and_with
     assert np.abs(robot.center_of_mass(run.trajectory.q[-1]) - robot.center_of_mass(q)).max() < 1e-4
     _, _, loose, slid = push_on_the_ground(None)
     assert np.where(loose.active, loose.slip, 0.0).max() > 0.1 and slid > 5e-3
+
+
+def _independent_margin(points: np.ndarray, up: np.ndarray, point: np.ndarray) -> float:
+    """The signed distance of ``point`` inside the hull of ``points`` seen along ``up``, by
+    SciPy's hull in a basis of the plane normal to ``up`` of this test's own choosing."""
+    from scipy.spatial import ConvexHull
+
+    first = np.cross(up, [0.3, 0.5, 0.7])
+    first /= np.linalg.norm(first)
+    basis = np.stack([first, np.cross(up, first)])
+    flat, target = points @ basis.T, basis @ point
+    corners = flat[ConvexHull(flat).vertices]  # counter-clockwise
+    edges = np.roll(corners, -1, axis=0) - corners
+    cross = edges[:, 0] * (target - corners)[:, 1] - edges[:, 1] * (target - corners)[:, 0]
+    return float(np.min(cross / np.linalg.norm(edges, axis=1)))
+
+
+@pytest.mark.parametrize("turned", [False, True])
+@pytest.mark.parametrize("gravity", [(0.0, 0.0, -9.81), (-9.81, 0.0, 0.0), (0.0, 9.81, 0.0), (-3.0, 1.0, -9.0)])
+def test_the_support_polygon_and_margin_are_scipys_hull_seen_along_any_gravity(gravity, turned):
+    """Six feet on a floating box (one inside the others' hull, one on an edge): the
+    polygon is their hull seen along gravity (four corners: neither the inner foot nor the
+    one on an edge), counter-clockwise, in world x, y for gravity along −z; the margin of
+    points in and out is SciPy's hull's signed distance in a basis of this test's own; three
+    feet make a polygon too (a triangle). Gravity along ±x and ±y takes the axes' other seed.
+    Off the world's axes the foot on an edge is so only to round-off (kept or not): the margins alone."""
+    box = robodyn.load(DATA / "box.urdf", floating_base=True, gravity=gravity)
+    q = box.neutral_configuration()
+    if turned:  # the feet's world points are no local ones
+        q[3:7] = [0.1, -0.2, 0.3, np.sqrt(1 - 0.14)]
+    up = -np.asarray(gravity) / np.linalg.norm(gravity)
+    seed = np.cross(up, [0.6, 0.0, 0.8])
+    axes = np.stack([seed / np.linalg.norm(seed), np.cross(up, seed / np.linalg.norm(seed))])  # in the feet's plane
+    if gravity == (0.0, 0.0, -9.81):
+        axes = np.eye(3)[:2]  # world x, y
+    flat = [(0.2, 0.1), (-0.2, 0.1), (-0.2, -0.1), (0.25, -0.15), (0.0, 0.0), (0.0, 0.1)]  # the last two inside, on an edge
+    world = np.array([np.array(xy) @ axes - 0.05 * up for xy in flat])
+    local = (world - box.frame_position(q, "box")) @ _rotation_of(q)  # Rᵀ (p − o), a row each
+    feet = tuple(PointContact("box", tuple(point)) for point in local)
+    polygon = support_polygon(box, q, feet)
+    assert turned or gravity != (0.0, 0.0, -9.81) or len(polygon) == 4  # (exactly on an edge only there)
+    area = 0.5 * np.sum(polygon[:, 0] * np.roll(polygon[:, 1], -1) - np.roll(polygon[:, 0], -1) * polygon[:, 1])
+    assert area > 0  # counter-clockwise
+    if gravity == (0.0, 0.0, -9.81):
+        assert all(np.abs(polygon - xy).sum(axis=1).min() < 1e-12 for xy in world[:4, :2])
+    for point in ([0.01, 0.02, 0.3], [0.5, -0.1, 0.0], [-0.1, 0.3, -0.2]):
+        margin = support_margin(box, q, feet, np.array(point))
+        assert abs(margin - _independent_margin(world, up, np.array(point))) < 1e-12
+        three = support_margin(box, q, feet[:3], np.array(point))
+        assert abs(three - _independent_margin(world[:3], up, np.array(point))) < 1e-12
+
+
+def _rotation_of(q: np.ndarray) -> np.ndarray:
+    import pinocchio as pin
+
+    return pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+
+
+def test_the_contact_tangents_are_unit_orthogonal_and_right_handed_about_any_normal():
+    """The cones' tangent rows (``_tangents``): for a floor, walls along x and y, and an
+    oblique plane, two unit vectors normal to ``n`` and to each other with ``t₁ × t₂ = n``."""
+    from robodyn.sim.whole_body import _tangents
+
+    for normal in (
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+        np.array([0.3, -0.2, 0.9]) / np.linalg.norm([0.3, -0.2, 0.9]),
+    ):
+        tangents = _tangents(np.asarray(normal, float))
+        assert np.abs(tangents @ tangents.T - np.eye(2)).max() < 1e-15 and np.abs(tangents @ normal).max() < 1e-15
+        assert np.abs(np.cross(*tangents) - normal).max() < 1e-15
+
+
+def test_an_orientation_that_is_no_rotation_is_refused_in_one_sentence_and_a_rotation_is_kept():
+    robot, q, feet = standing()
+    centre, start = robot.center_of_mass(q), "orientation must be a rotation matrix (3, 3), got "
+    ragged = [[1.0] * 40, [2.0]]
+    for value, received in (
+        ("eye", "'eye'"),
+        (ragged, repr(ragged)[:80]),
+        (1.001 * np.eye(3), "an array of shape (3, 3), not a rotation"),
+        (np.diag([1.0, 1.0, -1.0]), "an array of shape (3, 3), not a rotation"),  # a reflection
+        (np.eye(3) + np.diag([5e-9, 0.0], 1), "an array of shape (3, 3), not a rotation"),  # R Rᵀ off by 5e-9
+        (np.eye(2), "an array of shape (2, 2), not a rotation"),
+    ):
+        with pytest.raises(InputError) as caught:
+            Stand(robot, feet, centre, value, q)
+        assert str(caught.value) == start + received + "." and caught.value.argument == "orientation"
+    turned = _rotation_of(np.r_[np.zeros(3), 0.1, -0.2, 0.3, np.sqrt(1 - 0.14)])
+    assert np.abs(Stand(robot, feet, centre, turned.tolist(), q).orientation - turned).max() == 0.0
+
+
+def test_a_call_keeps_the_qps_contact_forces_which_carry_the_weight_and_prints_nothing(capfd):
+    robot, q, feet = standing()
+    control = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    tau = control(0.0, q, np.zeros(robot.nv))
+    forces = control.last_forces.reshape(-1, 3)
+    assert abs(forces[:, 2].sum() / (robot.total_mass * 9.81) - 1) < 1e-6 and np.abs(tau[:6]).max() == 0.0
+    assert capfd.readouterr() == ("", "")  # the solver's log stays off
+
+
+def test_the_qps_acceleration_makes_the_centre_of_mass_and_attitude_follow_their_pd_laws():
+    """solo12 moving (its base turned 0.1 rad, every joint and the base with a velocity), the
+    posture's weight 0: the QP's ``v̇`` gives ``c̈ = Kp (c_d − c) − Kd ċ`` and
+    ``ω̇ = Kp log(R_d Rᵀ) − Kd ω`` (world axes), both read by central differences of the
+    motion ``q ⊕ (v t + v̇ t²/2)`` (the centre of mass and the base's rotation, not the QP's
+    rows); the feet, moving, do not accelerate. Negative control: the laws with ``+Kd`` are
+    off by ``2 Kd ċ``, ``2 Kd ω``."""
+    import pinocchio as pin
+
+    robot, q, feet = standing()
+    start = robot.floating_configuration(list(q[:3]), [0.05, -0.08, 0.04], list(q[7:]))
+    v = np.r_[0.03, -0.02, 0.01, 0.2, -0.1, 0.15, np.linspace(-0.3, 0.3, robot.nv - 6)]
+    target = robot.center_of_mass(q) + np.array([0.01, -0.005, 0.004])
+    stand = Stand(robot, feet, target, np.eye(3), q, kp=100.0, kd=20.0, weights=(1.0, 1.0, 0.0))
+    acceleration = stand.solve(start, v)[0]
+    h = 1e-4
+
+    def at(t: float) -> np.ndarray:
+        return pin.integrate(robot.model, start, v * t + 0.5 * acceleration * t**2)
+
+    centres = [robot.center_of_mass(at(t)) for t in (-h, 0.0, h)]
+    velocity, com_acceleration = (centres[2] - centres[0]) / (2 * h), (centres[2] - 2 * centres[1] + centres[0]) / h**2
+    rotations = [_rotation_of(at(t)) for t in (-h, 0.0, h)]
+    ahead, behind = pin.log3(rotations[2] @ rotations[1].T), pin.log3(rotations[1] @ rotations[0].T)
+    omega, omega_dot = (ahead + behind) / (2 * h), (ahead - behind) / h**2
+    com_law = 100.0 * (target - centres[1]) - 20.0 * velocity
+    attitude_law = 100.0 * pin.log3(rotations[1].T) - 20.0 * omega
+    assert np.abs(com_acceleration - com_law).max() < 1e-5 * np.abs(com_law).max()
+    assert np.abs(omega_dot - attitude_law).max() < 1e-5 * np.abs(attitude_law).max()
+    assert np.abs(com_acceleration - (com_law + 40.0 * velocity)).max() > 0.1 * np.abs(com_law).max()  # the negative control
+    for foot in FEET:  # the feet do not accelerate (Jc v̇ + J̇c v = 0), though they move
+        points = [robot.frame_position(at(t), foot) for t in (-h, 0.0, h)]
+        assert np.abs(points[2] - 2 * points[1] + points[0]).max() / h**2 < 1e-5 < np.abs(points[2] - points[0]).max() / (2 * h)
+    assert np.abs(omega_dot - (attitude_law + 40.0 * omega)).max() > 0.1 * np.abs(attitude_law).max()
+
+
+def test_torque_limits_that_bind_hold_exactly_on_both_sides_and_slack_ones_leave_the_stand_at_rest():
+    """solo12 at rest with every joint limited to half the largest torque the unlimited QP
+    asks: the torques reach the limit on both sides and never pass it (the tasks then give
+    way: the base accelerates); limited to twice that torque (slack), the QP holds the robot
+    at rest as without limits."""
+    robot, q, feet = standing()
+    centre, rest = robot.center_of_mass(q), np.zeros(robot.nv)
+    largest = np.abs(Stand(robot, feet, centre, np.eye(3), q).solve(q, rest)[1]).max()
+    acceleration, torques, _ = Stand(robot, feet, centre, np.eye(3), q, torque_limit=0.5 * largest).solve(q, rest)
+    ratio = torques / (0.5 * largest)
+    assert ratio.max() <= 1 + 1e-9 and ratio.min() >= -1 - 1e-9  # never past it
+    assert ratio.max() > 1 - 1e-6 and ratio.min() < -1 + 1e-6  # reached on both sides
+    assert np.abs(acceleration).max() > 1.0  # the tasks gave way
+    slack = Stand(robot, feet, centre, np.eye(3), q, torque_limit=2.0 * largest).solve(q, rest)
+    assert np.abs(slack[0]).max() < 1e-6 and np.abs(slack[1]).max() < 2.0 * largest
+
+
+def test_a_qp_without_solution_is_refused_in_one_sentence_naming_the_state():
+    """Feet of friction 0.01 and torques of at most 1 mN m: no force in the cones carries
+    solo12 (the negative control: the same feet with the model's torques can)."""
+    robot, q, feet = standing(0.01)
+    rest = np.zeros(robot.nv)
+    with pytest.raises(InputError) as caught:
+        Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q, torque_limit=1e-3).solve(q, rest)
+    assert str(caught.value) == (
+        "q must be a state from which the contacts can carry the robot within their cones and torque limits, "
+        "got a QP PrimalInfeasible (a leg stretched, a push beyond friction)."
+    )
+    assert np.abs(Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q).solve(q, rest)[0]).max() < 1e-6
+
+
+def test_without_clarabel_the_stand_names_the_extra_to_install(monkeypatch):
+    import sys
+
+    from robodyn.exceptions import MissingExtraError
+
+    robot, q, feet = standing()
+    stand = Stand(robot, feet, robot.center_of_mass(q), np.eye(3), q)
+    for module in ("clarabel", "scipy.sparse"):
+        with monkeypatch.context() as patch:
+            patch.setitem(sys.modules, module, None)  # its import fails
+            with pytest.raises(MissingExtraError) as caught:
+                stand.solve(q, np.zeros(robot.nv))
+        assert str(caught.value) == (
+            f"the whole-body controller's QP need {module!r}, which is not installed: the 'robodyn[ident]' extra "
+            "(pip install '.[ident]' in a clone of robodyn)."
+        )
