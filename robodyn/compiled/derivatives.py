@@ -105,7 +105,14 @@ def derivative_module(robot: Robot, *, kernels: Callable[[], str]) -> ModuleType
 def paired_trig(kernels: str) -> str:
     """The kernels' C with each function's ``rd_sin(x)`` and ``rd_cos(x)`` of one ``x`` as one
     ``rd_sincos`` where the first of the two stood (each of the two computes both: the
-    compiler does not always merge them); the same results, bit for bit."""
+    compiler does not always merge them); the same results, bit for bit.
+
+    Args:
+        kernels: The C source of the robot's kernels, one statement a line.
+
+    Returns:
+        The same source with each function's pairs merged.
+    """
     pattern = re.compile(r"^    const double (\w+) = rd_(sin|cos)\((\w+)\);$")
     lines = kernels.splitlines()
     first: dict[tuple[str, str], int] = {}

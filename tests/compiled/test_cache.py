@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import os
 import subprocess
 import sys
 import textwrap
@@ -127,9 +128,13 @@ def test_lookup_finds_a_compiled_robot_without_sympy(rp_arm):
 
 def test_lookup_in_an_empty_cache_or_without_a_compiler_is_none(rp_arm, tmp_path, monkeypatch):
     robot, _ = rp_arm
+    compiled_in = os.environ.get("ROBODYN_CACHE")  # where the fixture compiled it (None: the default)
     monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))
     assert build.lookup(robot) is None
-    monkeypatch.delenv("ROBODYN_CACHE")
+    if compiled_in is None:
+        monkeypatch.delenv("ROBODYN_CACHE")
+    else:
+        monkeypatch.setenv("ROBODYN_CACHE", compiled_in)
     assert build.lookup(robot) is not None  # negative control: the fixture compiled it
     monkeypatch.setenv("CC", "no-such-compiler-robodyn")
     assert build.lookup(robot) is None
