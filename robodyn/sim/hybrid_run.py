@@ -116,10 +116,15 @@ def _gains(kp: Any, kd: Any) -> dict[str, float]:
     """The motion's gains given, each one finite value >= 0 (naming ``kp`` or ``kd``)."""
     gains = {}
     for name, value in (("kp", kp), ("kd", kd)):
-        if value is not None and np.size(value) != 1:
-            raise InputError(name, "one finite gain >= 0 for the hybrid controller", f"{np.size(value)} values")
-        if value is not None:
-            gains[name] = scalar(np.squeeze(np.asarray(value, dtype=float)), name, "one finite gain >= 0")
+        if value is None:
+            continue
+        try:
+            values = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):  # text, or ragged nested lists
+            raise InputError(name, "one finite gain >= 0 for the hybrid controller", repr(value)[:80]) from None
+        if values.size != 1:
+            raise InputError(name, "one finite gain >= 0 for the hybrid controller", f"{values.size} values")
+        gains[name] = scalar(float(values.reshape(())), name, "one finite gain >= 0")
     return gains
 
 

@@ -13,6 +13,7 @@ from robodyn.exceptions import InputError
 from robodyn.sim import hybrid_run
 from robodyn.sim.hybrid_run import SlidingReference, run_hybrid, run_named
 from robodyn.sim.surface_run import ForceOutcome, SurfaceRun
+from robodyn.urdf.models.pendulum import pendulum_urdf
 from robodyn.urdf.models.rp_arm import rp_arm_urdf
 
 WALL = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0))
@@ -115,3 +116,89 @@ def test_a_given_start_on_the_surface_is_the_runs_first_state_and_its_step_is_th
     with pytest.raises(InputError) as caught:
         run_hybrid(robot, force=1.0, surface=WALL, q0=off, duration=0.02, dt=0.01)
     assert caught.value.argument == "q0" and caught.value.received == f"{gap:.3g} m off it" and abs(gap) > 1e-4
+
+
+def _three_link_start():
+    """A planar 3R chain (links of 0.5 m) with its tip on the wall ``x = 0.6``: one joint
+    more than the wall's two directions, so a one-dimensional null space ``n``."""
+    robot = robodyn.load(pendulum_urdf(3, length=0.5))
+    wall = ((0.6, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    first, _ = run_hybrid(robot, force=2.0, surface=wall, duration=0.01, dt=0.01)
+    start = first.q[0]
+    null = np.linalg.svd(robot.frame_jacobian(start, "tip")[:3])[2][-1]
+    return robot, wall, start, null
+
+
+def test_the_posture_pulls_the_arm_along_its_null_space_without_moving_the_task():
+    """A posture 0.3 along the null space: after 0.8 s the arm is within a tenth of that of it
+    (the law's gains 25 and 10: ``(1 + 5t) e^{-5t}`` ≈ 0.09), the tip held on its point and the
+    force the command throughout. Negative control: without a posture it stays at its start."""
+    robot, wall, start, null = _three_link_start()
+    posture = start + 0.3 * null
+    pulled, summary = run_hybrid(robot, force=2.0, surface=wall, q0=start, posture=posture, duration=0.8, dt=0.02)
+    assert np.abs(pulled.q[-1] - posture).max() <= 0.1 * np.abs(posture - start).max()
+    assert summary.forces.motion_peak <= 1e-6 and summary.forces.peak_error <= 1e-6 * 2.0  # RK4's steps: 1e-7, 3e-8
+    assert np.abs(robot.frame_position(pulled.q, "tip") - robot.frame_position(start, "tip")).max() <= 1e-6
+    held, _ = run_hybrid(robot, force=2.0, surface=wall, q0=start, duration=0.8, dt=0.02)
+    assert np.abs(held.q - start).max() <= 1e-9
+
+
+def test_the_summary_says_how_far_the_start_moved_onto_the_surface():
+    """``start_moved`` is ``max |q₀ − default|`` of the written first state (the projection's
+    move); a given start already on the surface moved by nothing."""
+    robot, wall, start, _ = _three_link_start()
+    _, summary = run_hybrid(robot, force=2.0, surface=wall, duration=0.01, dt=0.01)
+    assert summary.forces.start_moved == np.abs(start - robot.default_configuration()).max() > 1.0
+    assert "start: moved by 1.66 (max |dq|, rad / m)" in "\n".join(summary.forces.lines())  # |joint3| = 1.6596
+    _, given = run_hybrid(robot, force=2.0, surface=wall, q0=start, duration=0.01, dt=0.01)
+    assert given.forces.start_moved <= 1e-12
+
+
+def test_the_summarys_motion_error_is_the_tips_distance_from_its_reference_in_the_surface():
+    """The final and peak motion errors, recomputed from the written trajectory: the tip's
+    distance (y, z: the wall's directions) from ``c + a sin(2π f t)`` with ``f`` the
+    documented default 0.5 Hz, ``c`` the tip's start. Gains 4 and 1: an error to see."""
+    robot = robodyn.load("rp_arm")
+    trajectory, summary = run_hybrid(robot, force=1.0, surface=WALL, along=(0, 0, 0.1), kp=4.0, kd=1.0, duration=0.3, dt=0.03)
+    tip = robot.frame_position(trajectory.q, "end_effector")
+    wanted = tip[0] + np.outer(np.sin(np.pi * trajectory.t), [0.0, 0.0, 0.1])
+    errors = np.linalg.norm((wanted - tip)[:, 1:], axis=1)
+    assert errors[-1] > 1e-3  # not degenerate
+    np.testing.assert_allclose([summary.forces.motion_error, summary.forces.motion_peak], [errors[-1], errors.max()], rtol=1e-9)
+
+
+def test_the_surface_drawn_is_a_square_in_it_a_tenth_of_a_metre_beyond_the_motion():
+    """The patch is a square in the wall about the motion's middle, its edges 0.1 m beyond
+    the farthest point of the motion (sampled over a period): a line of amplitude 0.1 along
+    z, then a circle of radius 0.05."""
+    robot = robodyn.load("rp_arm")
+    middle, times = np.array([1.0, 0.0, 0.02]), np.linspace(0.0, 2.0, 81)
+    for along in ((0, 0, 0.1), ((0, 0.05, 0), (0, 0, 0.05))):
+        _, summary = run_hybrid(robot, force=1.0, surface=WALL, along=along, target=middle, duration=0.01, dt=0.01)
+        (patch,) = summary.drawings
+        corners = patch.vertices
+        assert corners.shape == (4, 3) and np.abs(corners[:, 0] - 1.0).max() <= 1e-12  # in the wall
+        np.testing.assert_allclose(corners.mean(axis=0), middle, atol=1e-12)
+        edges = np.roll(corners, -1, axis=0) - corners
+        sides = np.linalg.norm(edges, axis=1)
+        assert np.ptp(sides) <= 1e-12 and abs(edges[0] @ edges[1]) <= 1e-12  # a square
+        amplitudes = np.reshape(along, (-1, 3))
+        path = np.outer(np.sin(np.pi * times), amplitudes[0])
+        if len(amplitudes) == 2:
+            path += np.outer(np.cos(np.pi * times), amplitudes[1])
+        reach = np.abs(path @ (edges[:2] / sides[:2, None]).T).max()
+        assert abs(sides[0] / 2 - reach - 0.1) <= 1e-12
+
+
+def test_the_run_defaults_are_the_documented_three_seconds_in_steps_of_a_millisecond(monkeypatch):
+    """``duration`` 3 s and ``dt`` 1 ms unless given (the simulation's call caught, not run)."""
+    asked = {}
+
+    def caught(robot, start, **options):
+        asked.update(options)
+        raise InterruptedError
+
+    monkeypatch.setattr(hybrid_run, "simulate_constrained", caught)
+    with pytest.raises(InterruptedError):
+        run_hybrid(robodyn.load("rp_arm"), force=1.0, surface=WALL)
+    assert asked["duration"] == 3.0 and asked["dt"] == 1e-3
