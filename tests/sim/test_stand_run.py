@@ -154,3 +154,64 @@ def test_each_stand_it_cannot_do_is_refused_in_one_sentence_naming_the_parameter
         and caught.value.received == f"{table.center_of_mass(placed)[0] + 1.0 - 0.2:.3g} m outside it"
     )
     assert caught.value.expected == "a centre of mass shift that stays over the support polygon of the feet"
+
+
+def _rotation(axis: int, angle: float) -> np.ndarray:
+    """The rotation by ``angle`` [rad] about world axis ``axis`` (0, 1, 2), written out."""
+    c, s = np.cos(angle), np.sin(angle)
+    i, j = [k for k in range(3) if k != axis]
+    rotation = np.eye(3)
+    rotation[i, i], rotation[i, j], rotation[j, i], rotation[j, j] = c, -s, s, c
+    return rotation if axis != 1 else rotation.T  # about y: z → x is the positive turn
+
+
+def test_a_turned_start_on_a_slope_is_the_attitude_the_stand_holds(tmp_path):
+    """The table pitched 0.5 rad onto a slope of 0.5 rad and turned 0.8 rad about its own
+    normal (every part of its quaternion non-zero, its four feet on the slope): the attitude
+    the law holds is that rotation, ``R_y(0.5) R_z(0.8)``, written out here."""
+    path = tmp_path / "table.xml"
+    path.write_text(TABLE)
+    table = robodyn.load(str(path))
+    rotation = _rotation(1, 0.5) @ _rotation(2, 0.8)
+    w = np.sqrt(1 + np.trace(rotation)) / 2
+    xyz = np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0], rotation[1, 0] - rotation[0, 1]]) / (4 * w)
+    assert np.abs(xyz).min() > 0.05  # no part zero: a swap of parts shows
+    start = np.concatenate([[0.0, 0.0, 0.5], xyz, [w], [0.0]])  # Pinocchio's (x, y, z, w)
+    law, _, _ = stand_law(table, table, start, None, Ground.tilted(0.5), "collision")
+    assert law.feet == [0, 1, 2, 3]
+    np.testing.assert_allclose(law.law.orientation, rotation, atol=1e-12)
+
+
+# The table without its head, and with a sphere on its back listed before the feet.
+HEADLESS = TABLE[: TABLE.index('      <body name="neck"')] + "    </body>\n  </worldbody>\n</mujoco>\n"
+BACK_FIRST = TABLE.replace(
+    '<geom type="sphere" pos="0.2 0.1 -0.2"',
+    '<geom type="sphere" pos="0 0 0.1" size="0.03" mass="0.1"/>\n      <geom type="sphere" pos="0.2 0.1 -0.2"',
+    1,
+)
+
+
+def test_when_every_contact_point_is_a_foot_the_start_line_says_no_feet(tmp_path):
+    path = tmp_path / "table.xml"
+    path.write_text(HEADLESS)
+    table = robodyn.load(str(path))
+    law, _, line = stand_law(table, table, table.neutral_configuration(), None, Ground(), "collision")
+    assert law.feet == [0, 1, 2, 3] and law.count == 4
+    lift = 0.2 + 0.02  # neutral: the base at the origin, the feet's centres 0.2 m below it, their radius 0.02 m
+    assert line == (
+        f"start: the base moved {lift:.6g} m along the ground's normal (its lowest contact point on it: stand's feet do not move)"
+    )  # no "; feet: the 4 of 4 ..."
+
+
+def test_a_point_above_the_ground_listed_before_the_feet_carries_no_force(tmp_path):
+    """The back's sphere is contact point 0: the QP's forces of the four feet are filed under
+    points 1 to 4 (they carry m g together), point 0 under none."""
+    path = tmp_path / "table.xml"
+    path.write_text(BACK_FIRST)
+    table = robodyn.load(str(path))
+    law, placed, line = stand_law(table, table, table.neutral_configuration(), None, Ground(), "collision")
+    assert law.feet == [1, 2, 3, 4] and law.count == 6 and "the 4 of 6 contact points" in line
+    law(0.0, placed, np.zeros(table.nv))
+    forces = law.forces[0].reshape(6, 3)
+    assert np.abs(forces[[0, 5]]).max() == 0.0
+    assert abs(forces[1:5, 2].sum() - table.total_mass * 9.81) <= 1e-6 * table.total_mass * 9.81
