@@ -215,3 +215,24 @@ def test_a_point_above_the_ground_listed_before_the_feet_carries_no_force(tmp_pa
     forces = law.forces[0].reshape(6, 3)
     assert np.abs(forces[[0, 5]]).max() == 0.0
     assert abs(forces[1:5, 2].sum() - table.total_mass * 9.81) <= 1e-6 * table.total_mass * 9.81
+
+
+def test_feet_that_cannot_stand_are_refused_in_one_sentence_with_how_far_or_how_many(tmp_path):
+    """Every foot ahead of the centre of mass: the sentence says by how far, recomputed here
+    from the masses (the box 5 kg at x = 0, spheres 0.1 kg at 0.2 and 0.25, the head 1 kg at
+    0.25); two feet only: no polygon, the sentence counts them."""
+    ahead, two = tmp_path / "ahead.xml", tmp_path / "two.xml"
+    ahead.write_text(TABLE.replace('pos="-0.2 ', 'pos="0.25 '))
+    two.write_text(TABLE.replace('<geom type="sphere" pos="-0.2 0.1 -0.2" size="0.02" mass="0.1"/>', "", 1).replace(
+        '<geom type="sphere" pos="-0.2 -0.1 -0.2" size="0.02" mass="0.1"/>', "", 1))  # fmt: skip
+    com_x = (0.1 * (0.2 + 0.2 + 0.25 + 0.25) + 1.0 * 0.25) / (5 + 0.4 + 1)
+    cases = [
+        (ahead, f"contacts must be feet whose support polygon holds the centre of mass at the start (name them), "
+         f"got {0.2 - com_x:.3g} m outside the polygon of 4 points on 'body'."),
+        (two, "contacts must be feet spanning a support polygon (three points or more off one line), got 2 points."),
+    ]  # fmt: skip
+    for path, sentence in cases:
+        table = robodyn.load(str(path))
+        with pytest.raises(InputError) as caught:
+            stand_law(table, table, table.neutral_configuration(), None, Ground(), "collision")
+        assert str(caught.value) == sentence
