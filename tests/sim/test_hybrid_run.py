@@ -167,27 +167,64 @@ def test_the_summarys_motion_error_is_the_tips_distance_from_its_reference_in_th
     np.testing.assert_allclose([summary.forces.motion_error, summary.forces.motion_peak], [errors[-1], errors.max()], rtol=1e-9)
 
 
-def test_the_surface_drawn_is_a_square_in_it_a_tenth_of_a_metre_beyond_the_motion():
-    """The patch is a square in the wall about the motion's middle, its edges 0.1 m beyond
+def test_the_surface_drawn_is_a_grey_square_in_it_a_tenth_of_a_metre_beyond_the_motion():
+    """The patch is a square in the surface about the motion's middle, its edges 0.1 m beyond
     the farthest point of the motion (sampled over a period): a line of amplitude 0.1 along
-    z, then a circle of radius 0.05."""
+    z, a diagonal line (0.06, 0.08), a circle of radius 0.05, and a point held on an oblique
+    plane (no part of its normal zero). It is the grey node ``surface`` of the recording."""
     robot = robodyn.load("rp_arm")
     middle, times = np.array([1.0, 0.0, 0.02]), np.linspace(0.0, 2.0, 81)
-    for along in ((0, 0, 0.1), ((0, 0.05, 0), (0, 0, 0.05))):
-        _, summary = run_hybrid(robot, force=1.0, surface=WALL, along=along, target=middle, duration=0.01, dt=0.01)
+    oblique = ((0.9, 0.0, 0.0), (-0.8, 0.36, 0.48))  # through the tip's start, |n| = 1
+    cases = [
+        (WALL, (0, 0, 0.1), middle),
+        (WALL, (0, 0.06, 0.08), middle),
+        (WALL, ((0, 0.05, 0), (0, 0, 0.05)), middle),
+        (oblique, None, np.array([0.9, 0.0, 0.0])),
+    ]
+    for surface, along, centre in cases:
+        target = None if along is None else centre
+        _, summary = run_hybrid(robot, force=1.0, surface=surface, along=along, target=target, duration=0.01, dt=0.01)
         (patch,) = summary.drawings
-        corners = patch.vertices
-        assert corners.shape == (4, 3) and np.abs(corners[:, 0] - 1.0).max() <= 1e-12  # in the wall
-        np.testing.assert_allclose(corners.mean(axis=0), middle, atol=1e-12)
+        corners, normal = patch.vertices, np.array(surface[1])
+        assert patch.name == "surface" and len({(patch.colour >> shift) & 0xFF for shift in (0, 8, 16)}) == 1  # grey
+        assert corners.shape == (4, 3) and np.abs((corners - surface[0]) @ normal).max() <= 1e-12  # in the surface
+        np.testing.assert_allclose(corners.mean(axis=0), centre, atol=1e-12)
         edges = np.roll(corners, -1, axis=0) - corners
         sides = np.linalg.norm(edges, axis=1)
         assert np.ptp(sides) <= 1e-12 and abs(edges[0] @ edges[1]) <= 1e-12  # a square
-        amplitudes = np.reshape(along, (-1, 3))
-        path = np.outer(np.sin(np.pi * times), amplitudes[0])
-        if len(amplitudes) == 2:
-            path += np.outer(np.cos(np.pi * times), amplitudes[1])
+        amplitudes = np.zeros((2, 3)) if along is None else np.vstack([np.reshape(along, (-1, 3)), np.zeros((1, 3))])[:2]
+        path = np.outer(np.sin(np.pi * times), amplitudes[0]) + np.outer(np.cos(np.pi * times), amplitudes[1])
         reach = np.abs(path @ (edges[:2] / sides[:2, None]).T).max()
         assert abs(sides[0] / 2 - reach - 0.1) <= 1e-12
+
+
+def test_another_frame_presses_and_holds_by_the_law_and_the_summary_names_it():
+    """The 3R chain pressing with ``link3``'s origin (not its end effector): the force is the
+    command and ``link3`` stays where it started (forward kinematics of the written ``q``);
+    the summary's surface line names it, its step is the given one, its panel the forces."""
+    robot = robodyn.load(pendulum_urdf(3, length=0.5))
+    wall = ((0.6, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    trajectory, summary = run_hybrid(robot, force=2.0, surface=wall, frame="link3", duration=0.2, dt=0.02)
+    held = robot.frame_position(trajectory.q, "link3")
+    assert abs(held[0, 0] - 0.6) <= 1e-9 and np.abs(held - held[0]).max() <= 1e-6
+    assert np.abs(summary.contact.measured - 2.0).max() <= 1e-6 * 2.0 and summary.forces.peak_error <= 1e-6 * 2.0
+    assert summary.forces.surface == "surface: the origin of link3 slides on it without friction, normal [-1, 0, 0]"
+    assert summary.dt == 0.02 and summary.forces.notes == ()  # no Coulomb friction in the file: nothing to say
+    ((label, t, commanded, _), (measured_label, _, measured, _)) = summary.panels[0].curves
+    assert (label, measured_label) == ("commanded force", "measured force") and np.array_equal(t, trajectory.t)
+    assert np.all(commanded == 2.0) and np.array_equal(measured, summary.contact.measured)
+
+
+def test_without_joint_friction_the_damped_arm_moves_as_the_undamped_one():
+    """``joint_friction=False``: neither the plant's damping nor its note (the damped arm's
+    motion is the plain arm's); with it the note is the one line said."""
+    robot = _damped_arm()
+    free, summary = run_hybrid(robot, force=10.0, surface=WALL, along=(0, 0, 0.1), joint_friction=False, duration=0.2, dt=0.02)
+    plain, _ = run_hybrid(robodyn.load(rp_arm_urdf()), force=10.0, surface=WALL, along=(0, 0, 0.1), duration=0.2, dt=0.02)
+    np.testing.assert_allclose(free.q, plain.q, atol=1e-12)
+    assert summary.forces.notes == ()
+    _, damped = run_hybrid(robot, force=10.0, surface=WALL, duration=0.02, dt=0.01)
+    assert damped.forces.notes == ("joint Coulomb friction of the file is not applied in hybrid runs (the constrained plant)",)
 
 
 def test_the_run_defaults_are_the_documented_three_seconds_in_steps_of_a_millisecond(monkeypatch):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from robodyn.exceptions import InputError
+from robodyn.exceptions import InputError, StaticFrameError
 from robodyn.sim.hybrid_run import run_hybrid, run_named
 from robodyn.urdf.models.rp_arm import rp_arm_urdf
 
@@ -59,6 +59,17 @@ AMPLITUDES = "along must be 3 amplitudes in [m] (or 2 x 3: the sine's and the co
         ({"along": "x"}, f"{AMPLITUDES} 'x'."),
         ({"along": [(0, 0, 0.1), (0, 0, np.inf)]}, f"{AMPLITUDES} [(0, 0, 0.1), (0, 0, inf)]."),
         ({"frequency": -1.0}, "frequency must be a finite frequency >= 0 in [Hz], got -1.0."),
+        ({"surface": ((1.0, 0.0), (-1.0, 0.0, 0.0))}, "surface must be 3 finite numbers in [m], got shape (2,)."),
+        ({"target": (1.0, 0.0)}, "target must be 3 finite numbers in [m], got shape (2,)."),
+        (  # 1.5e-9 m out of 0.1 m: beyond 1e-9 m (the tolerance is relative only above 1 m)
+            {"along": (1.5e-9, 0.0, 0.1)},
+            "along must be amplitudes DX,DY,DZ[:EX,EY,EZ] in [m] along the surface (normal part 0), got normal part 1.5e-09 m.",
+        ),
+        # a long value is said by its first 80 characters
+        ({"surface": "s" * 100}, "surface must be a point X,Y,Z in [m] and an outward normal NX,NY,NZ, got '" + "s" * 79 + "."),
+        ({"q0": "q" * 100}, f"q0 {CONFIGURATION} '" + "q" * 79 + "."),
+        ({"kp": "k" * 100}, "kp must be one finite gain >= 0 for the hybrid controller, got '" + "k" * 79 + "."),
+        ({"along": "a" * 100}, f"{AMPLITUDES} '" + "a" * 79 + "."),
     ],
 )
 def test_a_refusal_is_one_sentence_naming_the_parameter_and_its_value(change, sentence):
@@ -84,11 +95,13 @@ def test_a_floating_robot_is_refused_naming_it():
     )
 
 
-@pytest.mark.parametrize(("name", "value"), [("force", 1.0), ("surface", WALL), ("along", (0, 0, 1)), ("frequency", 2.0)])
+@pytest.mark.parametrize(
+    ("name", "value"), [("force", 1.0), ("surface", WALL), ("along", (0, 0, 1)), ("frequency", 2.0), ("force", "f" * 100)]
+)
 def test_a_hybrid_option_with_another_controller_is_one_sentence_with_its_value(name, value):
     with pytest.raises(InputError) as caught:
         run_named(robodyn.load("rp_arm"), controller="passive", duration=0.02, **{name: value})
-    assert str(caught.value) == f"{name} must be given only with the hybrid controller, got {value!r}."
+    assert str(caught.value) == f"{name} must be given only with the hybrid controller, got {repr(value)[:80]}."
 
 
 def test_unset_hybrid_options_reach_the_other_controller():  # negative control: None is not refused
@@ -96,3 +109,21 @@ def test_unset_hybrid_options_reach_the_other_controller():  # negative control:
         robodyn.load("rp_arm"), controller="passive", duration=0.02, dt=0.01, force=None, surface=None, along=None
     )
     assert summary.controller == "passive" and len(trajectory) == 3
+
+
+def test_amplitudes_within_the_tolerance_are_taken():  # the negative controls of the normal part's tolerance
+    robot = robodyn.load("rp_arm")
+    run_hybrid(robot, **RUN, along=(5e-9, 0.0, 10.0), limits="ignore")  # 5e-10 of 10 m: within 1e-9 relative
+    run_hybrid(robot, **RUN, along=(0.5e-9, 0.0, 0.1))  # within 1e-9 m
+    _, summary = run_hybrid(robot, **RUN, along=("0", "0", "0.1"))  # numbers as text, as numpy reads them
+    _, floats = run_hybrid(robot, **RUN, along=(0.0, 0.0, 0.1))
+    assert summary.forces.motion_error == floats.forces.motion_error
+
+
+def test_a_frame_no_joint_moves_is_refused_saying_what_it_was_for():
+    with pytest.raises(StaticFrameError) as caught:
+        run_hybrid(robodyn.load("rp_arm"), **RUN, frame="base_link")
+    assert str(caught.value) == (
+        "robot 'rp_arm': frame 'base_link' is fixed to the world (no joint moves it), so hybrid force/motion control"
+        " on it would have no effect (moving frames: 'link1', 'link2', 'end_effector')."
+    )
