@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 SCALAR_CALL = re.compile(r"(?<!\w)(?:rd_)?(?:cos|sin|sincos|pow)\(")
 #: The writer's ``double s, c; rd_sincos(x, &s, &c);`` (a vector form replaces its start).
 SINCOS = re.compile(r"^    double (\w+), (\w+); rd_sincos\(")
+#: A lone ``rd_sin``/``rd_cos`` statement, for its vector form.
+TRIG = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
 
 
 def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tuple[str, int, str]]) -> list[str]:
@@ -35,9 +37,8 @@ def pair_function(writer: TangentWriter, used: set[sp.Basic], results: list[tupl
         results: ``(array, index, C value)`` of every output entry: ``array`` ``"dq"`` or
             ``"dv"`` (∂tau/∂q, ∂tau/∂v), ``index`` ``j * nv + k`` (row j, column k, row-major).
     """
-    pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
     body = [
-        pattern.sub(r"= rdd_\1_2(\2);", SINCOS.sub(r"    rdd_v2 \1, \2; rdd_sincos_2(", line)).replace(
+        TRIG.sub(r"= rdd_\1_2(\2);", SINCOS.sub(r"    rdd_v2 \1, \2; rdd_sincos_2(", line)).replace(
             "const double ", "const rdd_v2 "
         )
         for line in writer.lines
@@ -90,13 +91,12 @@ def block_functions(writer: TangentWriter, used: set[sp.Basic], results: list[tu
         results: ``(array, index, C value)`` of every output entry: ``array`` ``"dq"`` or
             ``"dv"`` (∂tau/∂q, ∂tau/∂v), ``index`` ``j * nv + k`` (row j, column k, row-major).
     """
-    pattern = re.compile(r"= rd_(cos|sin)\((\w+)\);$")
     out: list[str] = []
     names: list[str] = []
     for name, lanes, target in writer.variants:
         vector, attribute = f"rdd{lanes}", f'__attribute__((target("{target}")))'
         body = [
-            pattern.sub(rf"= {vector}_\1(\2);", SINCOS.sub(rf"    {vector} \1, \2; {vector}_sincos(", line)).replace(
+            TRIG.sub(rf"= {vector}_\1(\2);", SINCOS.sub(rf"    {vector} \1, \2; {vector}_sincos(", line)).replace(
                 "const double ", f"const {vector} "
             )
             for line in writer.lines

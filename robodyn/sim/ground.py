@@ -298,10 +298,11 @@ def asked_ground(robot: Robot, *, height: float | None = None, friction: float |
     if height is None and stated is not None:
         found = Ground(*stated, "the file's plane")
         return found if friction is None else Ground(found.height, found.normal, friction, "the file's plane, μ given")
-    if height is not None and stated is not None and friction is None:  # the file's μ is still the file's
+    if height is None:
+        return Ground(0.0, friction=1.0 if friction is None else friction, origin="flat at height 0: the file states no plane")
+    if friction is None and stated is not None:  # a plane at the height given keeps the file's μ
         return Ground(height, friction=stated[2], origin="flat at the height given, the file's plane's μ")
-    origin = "flat at height 0: the file states no plane" if height is None else ""
-    return Ground(0.0 if height is None else height, friction=1.0 if friction is None else friction, origin=origin)
+    return Ground(height, friction=1.0 if friction is None else friction, origin="")
 
 
 def contact_points(robot: Robot, contacts: str | Sequence[str | ContactPoint]) -> Contacts:
